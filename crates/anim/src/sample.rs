@@ -1,0 +1,352 @@
+//! Sampling a scene clip at a fixed frame rate into point caches and skeletal animation.
+
+use glam::{Mat4, Vec3};
+use rayon::prelude::*;
+
+use crate::{
+    clip::frame_count, skin_positions, AnimError, Bone, Camera, MeshAnimation, Result, Scene,
+    SkeletalAnimation, Skeleton, Skin, Transform, DEFAULT_FPS,
+};
+
+/// What to sample.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SampleOptions {
+    /// Frames per second (default [`DEFAULT_FPS`]).
+    pub fps: f32,
+    /// Clip index; `None` samples the first clip, or the rest pose when there is none.
+    pub clip: Option<usize>,
+    /// Keep only the mesh objects whose name is listed (all when empty).
+    pub meshes: Vec<String>,
+}
+
+impl Default for SampleOptions {
+    fn default() -> Self {
+        SampleOptions {
+            fps: DEFAULT_FPS,
+            clip: None,
+            meshes: Vec::new(),
+        }
+    }
+}
+
+/// One mesh-drawing node of a sampled scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshObject {
+    /// Node index in the scene.
+    pub node: usize,
+    /// Display name.
+    pub name: String,
+    /// World-space positions per frame.
+    pub animation: MeshAnimation,
+    /// Binding to [`SampledScene::skeleton`] when the node is skinned.
+    pub skin: Option<Skin>,
+    /// Nearest ancestor joint of an unskinned object (a rigid prop carried by a bone).
+    pub parent_joint: Option<usize>,
+}
+
+/// A clip sampled at a fixed rate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SampledScene {
+    /// Frames per second.
+    pub fps: f32,
+    /// Time of frame 0 (the clip's first key).
+    pub start_time: f32,
+    /// Number of frames.
+    pub frame_count: usize,
+    /// Mesh objects in parent-first node order.
+    pub objects: Vec<MeshObject>,
+    /// Joints of all skins (empty when nothing is skinned).
+    pub skeleton: Skeleton,
+    /// Node of every skeleton joint.
+    pub joint_nodes: Vec<usize>,
+    /// Joint world matrices per frame (`None` when there is no joint).
+    pub skeletal: Option<SkeletalAnimation>,
+    /// Bones per frame, frame-major (`frames × joints`).
+    pub bones: Vec<Bone>,
+    /// Cameras.
+    pub cameras: Vec<Camera>,
+    /// World matrix of every node per frame, frame-major (`frames × nodes`).
+    pub node_world: Vec<Mat4>,
+}
+
+impl SampledScene {
+    /// A scene holding one point cache as its only object (no skeleton, no camera).
+    pub fn from_animation(animation: MeshAnimation) -> SampledScene {
+        let name = animation.mesh.name.clone();
+        SampledScene {
+            fps: animation.fps,
+            start_time: animation.start_time,
+            frame_count: animation.frame_count(),
+            objects: vec![MeshObject {
+                node: 0,
+                name,
+                animation,
+                skin: None,
+                parent_joint: None,
+            }],
+            skeleton: Skeleton::default(),
+            joint_nodes: Vec::new(),
+            skeletal: None,
+            bones: Vec::new(),
+            cameras: Vec::new(),
+            node_world: Vec::new(),
+        }
+    }
+
+    /// All objects merged into one cache (vertex order = object order).
+    pub fn merged(&self, name: &str) -> Result<MeshAnimation> {
+        if self.objects.len() == 1 {
+            let mut a = self.objects[0].animation.clone();
+            a.mesh.name = name.to_string();
+            return Ok(a);
+        }
+        let parts: Vec<MeshAnimation> = self.objects.iter().map(|o| o.animation.clone()).collect();
+        MeshAnimation::concat(name, &parts)
+    }
+
+    /// Total vertices over all objects.
+    pub fn vertex_count(&self) -> usize {
+        self.objects
+            .iter()
+            .map(|o| o.animation.vertex_count())
+            .sum()
+    }
+
+    /// Bones of frame `f`.
+    pub fn bones_at(&self, f: usize) -> &[Bone] {
+        let n = self.skeleton.len();
+        &self.bones[f * n..(f + 1) * n]
+    }
+}
+
+/// Samples a clip of `scene` at `options.fps` from its first to its last key (inclusive),
+/// evaluating node animation, morph weights and linear blend skinning. Parallel over frames.
+///
+/// # Errors
+/// When the scene is invalid, the clip index is out of range, or a mesh filter matches
+/// nothing.
+pub fn sample(scene: &Scene, options: &SampleOptions) -> Result<SampledScene> {
+    scene.validate()?;
+    if !(options.fps.is_finite() && options.fps > 0.0) {
+        return Err(AnimError::Invalid(format!(
+            "frame rate must be positive, got {}",
+            options.fps
+        )));
+    }
+    let clip = match options.clip {
+        Some(i) => Some(scene.clips.get(i).ok_or_else(|| {
+            AnimError::NotFound {
+                kind: "clip",
+                name: i.to_string(),
+                available: scene
+                    .clips
+                    .iter()
+                    .map(|c| c.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            }
+        })?),
+        None => scene.clips.first(),
+    };
+    let (start, frames) = match clip {
+        Some(c) => (c.start(), frame_count(c.duration(), options.fps)),
+        None => (0.0, 1),
+    };
+    let fps = options.fps;
+    let order = scene.topological_order();
+    let nn = scene.nodes.len();
+
+    // Pose every frame: node world matrices and morph weights (cheap, done once).
+    let poses: Vec<(Vec<Mat4>, Vec<Vec<f32>>)> = (0..frames)
+        .into_par_iter()
+        .map_init(Vec::new, |locals: &mut Vec<Transform>, f| {
+            let t = start + f as f32 / fps;
+            let mut weights: Vec<Vec<f32>> = Vec::new();
+            let mut world = Vec::new();
+            scene.pose_at(clip, t, locals, &mut weights);
+            scene.world_matrices(&order, locals, &mut world);
+            (world, weights)
+        })
+        .collect();
+    let mut node_world = Vec::with_capacity(frames * nn);
+    for (w, _) in &poses {
+        node_world.extend_from_slice(w);
+    }
+
+    let (skeleton, joint_nodes) = scene.skeleton();
+    let mut joint_of_node = vec![None; nn];
+    for (k, &n) in joint_nodes.iter().enumerate() {
+        joint_of_node[n] = Some(k);
+    }
+    let skeletal = if skeleton.is_empty() {
+        None
+    } else {
+        let mut w = Vec::with_capacity(frames * joint_nodes.len());
+        for (world, _) in &poses {
+            w.extend(joint_nodes.iter().map(|&n| world[n]));
+        }
+        let mut s = SkeletalAnimation::new(fps, joint_nodes.len(), w)?;
+        s.start_time = start;
+        Some(s)
+    };
+    let bones = skeletal
+        .as_ref()
+        .map(|s| s.bones(&skeleton))
+        .unwrap_or_default();
+
+    let mut objects = Vec::new();
+    for node in scene.mesh_nodes() {
+        let name = scene.object_name(node);
+        if !options.meshes.is_empty() && !options.meshes.contains(&name) {
+            continue;
+        }
+        objects.push(sample_object(
+            scene,
+            node,
+            name,
+            &poses,
+            &joint_of_node,
+            fps,
+            start,
+        )?);
+    }
+    if !options.meshes.is_empty() && objects.is_empty() {
+        return Err(AnimError::NotFound {
+            kind: "mesh",
+            name: options.meshes.join(","),
+            available: scene
+                .mesh_nodes()
+                .iter()
+                .map(|&n| scene.object_name(n))
+                .collect::<Vec<_>>()
+                .join(", "),
+        });
+    }
+
+    let cameras = (0..nn)
+        .filter_map(|n| scene.nodes[n].camera.map(|c| (n, c)))
+        .map(|(n, c)| Camera {
+            name: if scene.nodes[n].name.is_empty() {
+                scene.cameras[c].name.clone()
+            } else {
+                scene.nodes[n].name.clone()
+            },
+            projection: scene.cameras[c].projection,
+            world: poses.iter().map(|(w, _)| w[n]).collect(),
+        })
+        .collect();
+
+    Ok(SampledScene {
+        fps,
+        start_time: start,
+        frame_count: frames,
+        objects,
+        skeleton,
+        joint_nodes,
+        skeletal,
+        bones,
+        cameras,
+        node_world,
+    })
+}
+
+type Pose = (Vec<Mat4>, Vec<Vec<f32>>);
+
+fn sample_object(
+    scene: &Scene,
+    node: usize,
+    name: String,
+    poses: &[Pose],
+    joint_of_node: &[Option<usize>],
+    fps: f32,
+    start: f32,
+) -> Result<MeshObject> {
+    let n = &scene.nodes[node];
+    let sm = &scene.meshes[n.mesh.expect("mesh node")];
+    let rest = &sm.mesh.positions;
+    let nv = rest.len();
+    let skin = match (n.skin, &sm.joint_weights) {
+        (Some(s), Some(w)) => {
+            let def = &scene.skins[s];
+            Some(Skin {
+                joints: def
+                    .joints
+                    .iter()
+                    .map(|&j| joint_of_node[j].expect("skin joints are skeleton joints"))
+                    .collect(),
+                inverse_bind: def.inverse_bind.clone(),
+                weights: w.clone(),
+            })
+        }
+        _ => None,
+    };
+    let skin_nodes: Vec<usize> = n
+        .skin
+        .map(|s| scene.skins[s].joints.clone())
+        .unwrap_or_default();
+    let mut parent_joint = None;
+    let mut p = n.parent;
+    while let Some(q) = p {
+        if let Some(j) = joint_of_node[q] {
+            parent_joint = Some(j);
+            break;
+        }
+        p = scene.nodes[q].parent;
+    }
+
+    let mut positions = vec![Vec3::ZERO; poses.len() * nv];
+    positions
+        .par_chunks_mut(nv.max(1))
+        .zip(poses.par_iter())
+        .for_each_init(
+            || (Vec::new(), Vec::new()),
+            |(morphed, mats): &mut (Vec<Vec3>, Vec<Mat4>), (out, (world, weights))| {
+                morphed.clear();
+                morphed.extend_from_slice(rest);
+                for (t, &w) in sm.morph_targets.iter().zip(&weights[node]) {
+                    if w != 0.0 {
+                        for (m, d) in morphed.iter_mut().zip(&t.positions) {
+                            *m += w * *d;
+                        }
+                    }
+                }
+                match (&skin, &sm.joint_weights) {
+                    (Some(s), Some(w)) => {
+                        mats.clear();
+                        mats.extend(
+                            skin_nodes
+                                .iter()
+                                .zip(&s.inverse_bind)
+                                .map(|(&j, ib)| world[j] * *ib),
+                        );
+                        skin_positions(w, mats, morphed, out);
+                    }
+                    _ => {
+                        let m = world[node];
+                        for (o, p) in out.iter_mut().zip(morphed.iter()) {
+                            *o = m.transform_point3(*p);
+                        }
+                    }
+                }
+            },
+        );
+    let mut mesh = sm.mesh.clone();
+    mesh.name = name.clone();
+    mesh.normals = None; // normals of the bind pose are wrong once deformed
+    let mut animation = MeshAnimation::new(mesh, fps, positions)?;
+    animation.start_time = start;
+    let first = animation.frame(0).to_vec();
+    animation.mesh.positions = first;
+    Ok(MeshObject {
+        node,
+        name,
+        animation,
+        skin,
+        parent_joint,
+    })
+}
+
+/// Local transform of a node at the scene's rest pose, for writers.
+pub fn rest_transform(scene: &Scene, node: usize) -> Transform {
+    scene.nodes[node].transform
+}

@@ -1,0 +1,80 @@
+//! `toonkit convert IN OUT [--clip NAME] [--fps F] [--mesh NAME] [--as flipbook|morph|sequence]`.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anim::Scene;
+use anyhow::Result;
+use clap::Args;
+use serde_json::json;
+use tkio::{Format, Loaded};
+
+use super::Context;
+use crate::input::{self, InputArgs};
+use crate::output::{self, Layout};
+
+/// Arguments of `toonkit convert`.
+#[derive(Debug, Args)]
+pub struct ConvertArgs {
+    /// Input animation (glTF/GLB, OBJ or OBJ sequence, PC2/MDD + rest OBJ, BVH).
+    pub input: PathBuf,
+    /// Output file; the extension picks the format (.glb, .pc2, .mdd, .obj, .stl, .npy).
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub input_args: InputArgs,
+    /// Layout of the animation in the output.
+    #[arg(long = "as", value_enum, default_value_t = Layout::Flipbook)]
+    pub layout: Layout,
+}
+
+/// Runs `toonkit convert`.
+pub fn run(ctx: &Context, args: ConvertArgs) -> Result<()> {
+    let start = Instant::now();
+    let loaded = input::load(&args.input, &args.input_args)?;
+    let spinner = crate::progress::spinner("converting", ctx.json);
+    // A skeleton without mesh (BVH) to glTF: keep the joint hierarchy and its clip.
+    if let Loaded::Scene(scene) = &loaded {
+        if scene.meshes.is_empty() && Format::from_extension(&args.output) == Some(Format::Glb) {
+            let mut out = Scene::clone(scene);
+            if let Some(name) = &args.input_args.clip {
+                let k = scene.find_clip(name)?;
+                out.clips = vec![scene.clips[k].clone()];
+            }
+            let bytes = tkio::gltf::write_glb(&out).map_err(|e| e.at(&args.output))?;
+            tkio::write_atomic(&args.output, &bytes)?;
+            spinner.finish_and_clear();
+            let summary = json!({"input": args.input, "outputs": [args.output], "joints": scene.skeleton().0.len(),
+                                 "seconds": start.elapsed().as_secs_f64()});
+            ctx.report(&summary, || {
+                format!("wrote {} (skeleton)", args.output.display())
+            });
+            return Ok(());
+        }
+    }
+    let sampled = input::sample(&args.input, &loaded, &args.input_args)?;
+    let merged = input::merged(&args.input, &sampled)?;
+    let written = output::write_animation(&args.output, &merged, args.layout, None)?;
+    spinner.finish_and_clear();
+    let summary = json!({
+        "input": args.input,
+        "outputs": written,
+        "frames": merged.frame_count(),
+        "vertices": merged.vertex_count(),
+        "fps": merged.fps,
+        "seconds": start.elapsed().as_secs_f64(),
+    });
+    ctx.report(&summary, || {
+        format!(
+            "wrote {} ({} frames × {} vertices at {} fps)",
+            written
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
+            merged.frame_count(),
+            merged.vertex_count(),
+            merged.fps
+        )
+    });
+    Ok(())
+}

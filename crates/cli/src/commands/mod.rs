@@ -1,0 +1,27 @@
+//! One module per subcommand.
+
+pub mod convert;
+pub mod demo;
+pub mod info;
+pub mod loa;
+
+/// Options every command sees.
+#[derive(Debug, Clone, Copy)]
+pub struct Context {
+    /// Print JSON on stdout instead of human text.
+    pub json: bool,
+}
+
+impl Context {
+    /// Prints a summary: the JSON value with `--json`, otherwise the human text.
+    pub fn report(&self, value: &serde_json::Value, text: impl FnOnce() -> String) {
+        if self.json {
+            println!(
+                "{}",
+                serde_json::to_string_pretty(value).unwrap_or_default()
+            );
+        } else {
+            println!("{}", text());
+        }
+    }
+}

@@ -1,0 +1,90 @@
+//! Opening inputs: detect the format, pick a clip, sample at a frame rate.
+
+use std::path::{Path, PathBuf};
+
+use anim::{MeshAnimation, SampleOptions, SampledScene, DEFAULT_FPS};
+use anyhow::{Context as _, Result};
+use clap::Args;
+use tkio::{LoadOptions, Loaded};
+
+/// Options shared by every command that reads an animation.
+#[derive(Debug, Clone, Args)]
+pub struct InputArgs {
+    /// Clip to sample, by name or index (default: the first clip).
+    #[arg(long)]
+    pub clip: Option<String>,
+    /// Frames per second to sample at.
+    #[arg(long, default_value_t = DEFAULT_FPS)]
+    pub fps: f32,
+    /// Only this mesh object (by name; repeat or comma-separate for several).
+    #[arg(long, value_delimiter = ',')]
+    pub mesh: Vec<String>,
+    /// Rest mesh (.obj) for a PC2/MDD point cache (default: same name .obj, or rest.obj).
+    #[arg(long)]
+    pub rest: Option<PathBuf>,
+}
+
+impl Default for InputArgs {
+    fn default() -> Self {
+        InputArgs {
+            clip: None,
+            fps: DEFAULT_FPS,
+            mesh: Vec::new(),
+            rest: None,
+        }
+    }
+}
+
+/// Reads a file of any supported format.
+pub fn load(path: &Path, args: &InputArgs) -> Result<Loaded> {
+    if !(args.fps.is_finite() && args.fps > 0.0) {
+        anyhow::bail!("--fps must be a positive number, got {}", args.fps);
+    }
+    let options = LoadOptions {
+        fps: args.fps,
+        rest: args.rest.clone(),
+    };
+    Ok(tkio::load(path, &options)?)
+}
+
+/// Samples what was loaded into per-object point caches (and skeleton, cameras).
+pub fn sample(path: &Path, loaded: &Loaded, args: &InputArgs) -> Result<SampledScene> {
+    let with_path = |e: anim::AnimError| anyhow::anyhow!("{}: {e}", path.display());
+    match loaded {
+        Loaded::Scene(scene) => {
+            let clip = match &args.clip {
+                Some(name) => Some(scene.find_clip(name).map_err(with_path)?),
+                None => None,
+            };
+            let options = SampleOptions {
+                fps: args.fps,
+                clip,
+                meshes: args.mesh.clone(),
+            };
+            anim::sample(scene, &options).map_err(with_path)
+        }
+        Loaded::Cache(cache) => Ok(SampledScene::from_animation(cache.clone())),
+        Loaded::Mesh(mesh) => Ok(SampledScene::from_animation(MeshAnimation::still(
+            mesh.clone(),
+        ))),
+    }
+}
+
+/// Loads and samples in one call.
+#[allow(dead_code)] // the tool commands (smear, stopmo) call it
+pub fn open(path: &Path, args: &InputArgs) -> Result<SampledScene> {
+    let loaded = load(path, args)?;
+    sample(path, &loaded, args)
+}
+
+/// All mesh objects merged into one point cache (the vertex order every per-vertex output
+/// uses, and that `toonkit convert IN rest.obj` writes).
+pub fn merged(path: &Path, sampled: &SampledScene) -> Result<MeshAnimation> {
+    if sampled.objects.is_empty() {
+        anyhow::bail!("{}: the file has no mesh", path.display());
+    }
+    let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh");
+    sampled
+        .merged(name)
+        .with_context(|| path.display().to_string())
+}

@@ -1,0 +1,54 @@
+//! `toonkit`: smear frames, stop-motion replacement libraries and dynamic lines of action for
+//! 3D animation. The CLI is thin: it parses options, calls the library crates, and reports.
+
+mod commands;
+mod input;
+mod output;
+mod progress;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Stylization tools for 3D animation: smear frames, 3D-printed stop-motion, lines of action.
+#[derive(Debug, Parser)]
+#[command(name = "toonkit", version, about, propagate_version = true)]
+pub struct Cli {
+    /// Print a machine-readable JSON summary (timings included) on stdout instead of text.
+    #[arg(long, global = true)]
+    json: bool,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Describe a file: meshes, vertices, triangles, joints, morph targets, clips, bounds.
+    Info(commands::info::InfoArgs),
+    /// Convert any readable animation into any writable one.
+    Convert(commands::convert::ConvertArgs),
+    /// Run the tools on the bundled sample and write the results.
+    Demo(commands::demo::DemoArgs),
+    /// Dynamic lines of action: sketched keystrokes → animated line (Guay et al. 2015).
+    Loa(commands::loa::LoaArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let ctx = commands::Context { json: cli.json };
+    let result = match cli.command {
+        Command::Info(a) => commands::info::run(&ctx, a),
+        Command::Convert(a) => commands::convert::run(&ctx, a),
+        Command::Demo(a) => commands::demo::run(&ctx, a),
+        Command::Loa(a) => commands::loa::run(&ctx, a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            // One line: the cause chain joined, the file named by the innermost error.
+            let msg = format!("{e:#}").replace('\n', " ");
+            eprintln!("toonkit: error: {msg}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,91 @@
+//! Helpers shared by the CLI integration tests.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Path of a shared test asset; panics (fails loudly) if it is missing.
+pub fn data(rel: &str) -> PathBuf {
+    let p = PathBuf::from(format!(
+        "{}/../../../shared/data/{rel}",
+        env!("CARGO_MANIFEST_DIR")
+    ));
+    assert!(p.exists(), "missing test asset {}", p.display());
+    p
+}
+
+/// Runs `toonkit` with arguments.
+pub fn toonkit(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_toonkit"))
+        .args(args)
+        .output()
+        .expect("run toonkit")
+}
+
+/// Runs `toonkit`, asserting success; returns stdout.
+pub fn ok(args: &[&str]) -> String {
+    let out = toonkit(args);
+    assert!(
+        out.status.success(),
+        "toonkit {args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("utf-8 stdout")
+}
+
+/// Runs `toonkit --json ...` and parses stdout.
+pub fn json(args: &[&str]) -> serde_json::Value {
+    let mut a = vec!["--json"];
+    a.extend_from_slice(args);
+    serde_json::from_str(&ok(&a)).expect("json stdout")
+}
+
+/// Keeps a copy of every glTF in `dir` for CI's Khronos validation run
+/// (`TOONKIT_VALIDATE_DIR`), under a name prefixed by `tag`.
+pub fn keep_for_validation(dir: &Path, tag: &str) {
+    let Ok(dest) = std::env::var("TOONKIT_VALIDATE_DIR") else {
+        return;
+    };
+    let dest = PathBuf::from(dest);
+    std::fs::create_dir_all(&dest).unwrap();
+    for e in walk(dir) {
+        if e.extension().is_some_and(|x| x == "glb" || x == "gltf") {
+            let name = format!("{tag}_{}", e.file_name().unwrap().to_string_lossy());
+            std::fs::copy(&e, dest.join(name)).unwrap();
+        }
+    }
+}
+
+fn walk(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            out.extend(walk(&p));
+        } else {
+            out.push(p);
+        }
+    }
+    out
+}
+
+/// Asserts a failed run: exit code 2, one line on stderr mentioning `needle`, no panic.
+pub fn assert_bad_input(args: &[&str], needle: &str) {
+    let out = toonkit(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "toonkit {args:?}: expected exit 2, stderr: {err}"
+    );
+    assert!(!err.contains("panicked"), "panic on {args:?}: {err}");
+    assert_eq!(
+        err.trim_end().lines().count(),
+        1,
+        "expected one line, got: {err}"
+    );
+    assert!(
+        err.contains(needle),
+        "stderr {err:?} does not mention {needle:?}"
+    );
+}

@@ -1,0 +1,113 @@
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use anim::AnimError;
+use thiserror::Error;
+
+/// A file path for messages; empty until the caller that knows the path attaches it.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct FilePath(pub PathBuf);
+
+impl fmt::Display for FilePath {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.0.as_os_str().is_empty() {
+            f.write_str("<input>")
+        } else {
+            write!(f, "{}", self.0.display())
+        }
+    }
+}
+
+/// The one error type of toonkit-io. Every message is one line naming the file.
+#[derive(Debug, Error)]
+pub enum IoError {
+    /// The file could not be read or written. Check the path and permissions.
+    #[error("{path}: {source}")]
+    Io {
+        /// File.
+        path: FilePath,
+        /// Operating-system error.
+        source: std::io::Error,
+    },
+    /// The bytes are not a valid file of the format. Re-export the file from its source
+    /// application; the message says what is wrong.
+    #[error("{path}: invalid {format}: {message}")]
+    Malformed {
+        /// File.
+        path: FilePath,
+        /// Format name (glTF, OBJ, PC2, …).
+        format: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+    /// The file is valid but uses something toonkit cannot handle (yet), or the format cannot
+    /// hold the data asked for. The message says which.
+    #[error("{path}: {message}")]
+    Unsupported {
+        /// File.
+        path: FilePath,
+        /// What is not supported.
+        message: String,
+    },
+    /// The file parsed but its content is inconsistent (e.g. NaN positions, bad indices).
+    #[error("{path}: {source}")]
+    Anim {
+        /// File.
+        path: FilePath,
+        /// The data-model error.
+        source: AnimError,
+    },
+}
+
+impl IoError {
+    /// A format error without a path yet.
+    pub fn malformed(format: &'static str, message: impl Into<String>) -> IoError {
+        IoError::Malformed {
+            path: FilePath::default(),
+            format,
+            message: message.into(),
+        }
+    }
+
+    /// An unsupported-feature error without a path yet.
+    pub fn unsupported(message: impl Into<String>) -> IoError {
+        IoError::Unsupported {
+            path: FilePath::default(),
+            message: message.into(),
+        }
+    }
+
+    /// An OS error on `path`.
+    pub fn io(path: &Path, source: std::io::Error) -> IoError {
+        IoError::Io {
+            path: FilePath(path.to_path_buf()),
+            source,
+        }
+    }
+
+    /// Attaches `path` when none is set.
+    pub fn at(mut self, p: &Path) -> IoError {
+        let slot = match &mut self {
+            IoError::Io { path, .. }
+            | IoError::Malformed { path, .. }
+            | IoError::Unsupported { path, .. }
+            | IoError::Anim { path, .. } => path,
+        };
+        if slot.0.as_os_str().is_empty() {
+            slot.0 = p.to_path_buf();
+        }
+        self
+    }
+}
+
+impl From<AnimError> for IoError {
+    fn from(source: AnimError) -> IoError {
+        IoError::Anim {
+            path: FilePath::default(),
+            source,
+        }
+    }
+}
+
+/// Result alias for this crate.
+pub type Result<T, E = IoError> = std::result::Result<T, E>;

@@ -1,0 +1,201 @@
+//! A [`MeshAnimation`] as glTF: a *flipbook* (one node per frame, visibility keyed with STEP
+//! scale) or *morph targets* (one target per frame, STEP weights). Both open in Blender and
+//! three.js; the flipbook also carries per-frame vertex colours (with alpha).
+
+use anim::glam::Vec3;
+use anim::{Channel, Clip, Interpolation, MeshAnimation, Property};
+use gltf_json as json;
+
+use crate::gltf_write::{frame_mesh, write_clip, Builder, SharedTopology};
+use crate::{IoError, Result};
+
+/// How a point cache is laid out in glTF.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AnimationLayout {
+    /// One node (and mesh) per frame; only the current frame's node has scale 1.
+    #[default]
+    Flipbook,
+    /// One mesh whose morph target `f` moves frame 0 onto frame `f`; weights are one-hot.
+    Morph,
+}
+
+/// Writes a point cache as `.glb` bytes.
+///
+/// # Arguments
+/// * `colors` — optional per-frame RGBA vertex colours, frame-major (`frames × vertices`).
+///   Alpha below 1 selects an alpha-blended material. Morph layout uses frame 0's colours.
+///
+/// # Errors
+/// When `colors` has the wrong length, or the mesh is empty.
+pub fn write_animation(
+    anim: &MeshAnimation,
+    layout: AnimationLayout,
+    colors: Option<&[[f32; 4]]>,
+) -> Result<Vec<u8>> {
+    let (n, frames) = (anim.vertex_count(), anim.frame_count());
+    if let Some(c) = colors {
+        if c.len() != n * frames {
+            return Err(IoError::unsupported(format!(
+                "vertex colours: expected {} values (frames × vertices), got {}",
+                n * frames,
+                c.len()
+            )));
+        }
+    }
+    let colors_of = |f: usize| colors.map(|c| &c[f * n..(f + 1) * n]);
+    let times: Vec<f32> = (0..frames).map(|f| f as f32 / anim.fps).collect();
+    match layout {
+        AnimationLayout::Flipbook => flipbook(anim, &times, colors_of),
+        AnimationLayout::Morph => morph(anim, &times, colors_of(0)),
+    }
+}
+
+fn flipbook<'a>(
+    anim: &MeshAnimation,
+    times: &[f32],
+    colors_of: impl Fn(usize) -> Option<&'a [[f32; 4]]>,
+) -> Result<Vec<u8>> {
+    let frames = anim.frame_count();
+    let mut b = Builder::new();
+    let mut shared = SharedTopology::default();
+    let name = if anim.mesh.name.is_empty() {
+        "mesh"
+    } else {
+        anim.mesh.name.as_str()
+    };
+    let mut children = Vec::with_capacity(frames);
+    let mut channels = Vec::new();
+    let root_index = frames; // nodes 0..frames are frames, then the root
+    for f in 0..frames {
+        let sm = frame_mesh(&anim.mesh, anim.frame(f), colors_of(f));
+        let mesh = b.mesh(&sm, &mut shared)?;
+        let visible = if f == 0 { 1.0 } else { 0.0 };
+        let node = b.root.push(json::Node {
+            mesh: Some(mesh),
+            name: Some(format!("{name}_f{:04}", f + 1)),
+            scale: (f != 0).then_some([visible; 3]),
+            ..empty_node()
+        });
+        children.push(node);
+        if frames > 1 {
+            let (mut t, mut v) = (Vec::new(), Vec::new());
+            if f > 0 {
+                t.push(times[0]);
+                v.extend([0.0; 3]);
+            }
+            t.push(times[f]);
+            v.extend([1.0; 3]);
+            if f + 1 < frames {
+                t.push(times[f + 1]);
+                v.extend([0.0; 3]);
+            }
+            channels.push(Channel {
+                node: f,
+                property: Property::Scale,
+                interpolation: Interpolation::Step,
+                times: t,
+                values: v,
+            });
+        }
+    }
+    let root = b.root.push(json::Node {
+        name: Some(name.to_string()),
+        children: Some(children),
+        ..empty_node()
+    });
+    debug_assert_eq!(root.value(), root_index);
+    let scene = b.root.push(json::Scene {
+        extensions: None,
+        extras: Default::default(),
+        name: None,
+        nodes: vec![root],
+    });
+    b.root.scene = Some(scene);
+    if !channels.is_empty() {
+        write_clip(
+            &mut b,
+            &Clip {
+                name: format!("{name}_flipbook"),
+                channels,
+            },
+        );
+    }
+    b.finish()
+}
+
+fn morph(anim: &MeshAnimation, times: &[f32], colors: Option<&[[f32; 4]]>) -> Result<Vec<u8>> {
+    let frames = anim.frame_count();
+    let base = anim.frame(0);
+    let mut sm = frame_mesh(&anim.mesh, base, colors);
+    if frames > 1 {
+        sm.morph_targets = (0..frames)
+            .map(|f| anim::MorphTarget {
+                name: format!("frame_{:04}", f + 1),
+                positions: anim
+                    .frame(f)
+                    .iter()
+                    .zip(base)
+                    .map(|(p, q)| *p - *q)
+                    .collect::<Vec<Vec3>>(),
+            })
+            .collect();
+        sm.default_weights = vec![0.0; frames];
+    }
+    let mut b = Builder::new();
+    let mesh = b.mesh(&sm, &mut SharedTopology::default())?;
+    let name = if anim.mesh.name.is_empty() {
+        "mesh"
+    } else {
+        anim.mesh.name.as_str()
+    };
+    let node = b.root.push(json::Node {
+        mesh: Some(mesh),
+        name: Some(name.to_string()),
+        ..empty_node()
+    });
+    let scene = b.root.push(json::Scene {
+        extensions: None,
+        extras: Default::default(),
+        name: None,
+        nodes: vec![node],
+    });
+    b.root.scene = Some(scene);
+    if frames > 1 {
+        let mut values = vec![0.0f32; frames * frames];
+        for f in 0..frames {
+            values[f * frames + f] = 1.0;
+        }
+        let ch = Channel {
+            node: 0,
+            property: Property::Weights(frames),
+            interpolation: Interpolation::Step,
+            times: times.to_vec(),
+            values,
+        };
+        write_clip(
+            &mut b,
+            &Clip {
+                name: format!("{name}_morph"),
+                channels: vec![ch],
+            },
+        );
+    }
+    b.finish()
+}
+
+fn empty_node() -> json::Node {
+    json::Node {
+        camera: None,
+        children: None,
+        extensions: None,
+        extras: Default::default(),
+        matrix: None,
+        mesh: None,
+        name: None,
+        rotation: None,
+        scale: None,
+        translation: None,
+        skin: None,
+        weights: None,
+    }
+}

@@ -1,0 +1,37 @@
+//! # toonkit-io
+//!
+//! Reading and writing animation files: glTF 2.0 (`.gltf`/`.glb`), OBJ and OBJ sequences, PC2
+//! and MDD point caches, binary STL, BVH motion capture, and NPY arrays. Formats are detected
+//! by content. Every reader returns [`IoError`] on bad bytes, never panics; every writer
+//! produces bytes, and [`write_atomic`] puts them on disk.
+//!
+//! This crate does no algorithm work beyond format conversion.
+
+mod atomic;
+mod error;
+
+pub mod bvh;
+pub mod mdd;
+pub mod npy;
+#[cfg(feature = "obj")]
+pub mod obj;
+pub mod pc2;
+#[cfg(feature = "stl")]
+pub mod stl;
+
+pub use atomic::{read_file, write_atomic};
+pub use error::{FilePath, IoError, Result};
+
+mod detect;
+mod gltf_flipbook;
+mod gltf_read;
+mod gltf_write;
+
+/// glTF 2.0: read `.gltf`/`.glb` into a scene, write scenes and point caches as `.glb`.
+pub mod gltf {
+    pub use crate::gltf_flipbook::{write_animation, AnimationLayout};
+    pub use crate::gltf_read::{read, read_bytes};
+    pub use crate::gltf_write::write_glb;
+}
+
+pub use detect::{detect, load, Format, LoadOptions, Loaded};

@@ -1,0 +1,478 @@
+//! Wavefront OBJ meshes and OBJ sequences (one file per frame).
+//!
+//! # Vertex order
+//! [`read`] keeps the `v` lines exactly in file order, including vertices no face uses, so
+//! that a point cache (PC2/MDD) or a `.npy` field exported for the same file lines up vertex
+//! by vertex. This is why the reader is our own: `tobj` 4 (even with `single_index: false`)
+//! renumbers positions in order of first use by a face, drops unused ones and splits the file
+//! per `o`/`g` group.
+//!
+//! # What is kept
+//! * `v x y z [w]` positions (`w` is ignored), `v x y z r g b` colours (kept only when every
+//!   vertex has one).
+//! * `f` faces with absolute or negative (relative) indices in all four corner forms. Faces are
+//!   fan-triangulated into [`Mesh::triangles`]; when any face has more than three corners, all
+//!   faces are also kept as [`Mesh::polygons`]. Faces with fewer than three corners, `l` lines
+//!   and `p` points are skipped.
+//! * `vt`/`vn` only when they are *per position*: every face corner of a position uses the same
+//!   texture coordinate (normal) value. Files with UV seams or split normals (several values
+//!   per position) get `uvs: None` (`normals: None`); toonkit never needs them and splitting
+//!   vertices would break the vertex order.
+//! * The first `o` name (else the first `g` name) as [`Mesh::name`]; empty when there is none.
+//!
+//! Materials, smoothing groups, curves and free-form surfaces are ignored.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anim::{triangulate_polygon, Mesh, MeshAnimation};
+use glam::Vec3;
+
+use crate::{IoError, Result};
+
+const FORMAT: &str = "OBJ";
+
+/// Parses an OBJ file.
+///
+/// # Errors
+/// [`IoError::Malformed`] naming the line of a non-number, a missing coordinate, a NaN or
+/// infinite value, an index of 0 or out of range, or more than `u32::MAX` vertices.
+pub fn read(bytes: &[u8]) -> Result<Mesh> {
+    let text = String::from_utf8_lossy(bytes);
+    let mut positions: Vec<Vec3> = Vec::new();
+    let mut colors: Vec<[f32; 4]> = Vec::new();
+    let mut uvs: Vec<[f32; 2]> = Vec::new();
+    let mut normals: Vec<Vec3> = Vec::new();
+    // Face corners, flat: (position, uv, normal); uv/normal u32::MAX = absent.
+    let mut corners: Vec<[u32; 3]> = Vec::new();
+    let mut faces: Vec<(usize, usize)> = Vec::new(); // (first corner, line)
+    let mut object_name: Option<String> = None;
+    let mut group_name: Option<String> = None;
+
+    for (ln, raw) in text.split('\n').enumerate() {
+        let line_no = ln + 1;
+        let line = raw.split('#').next().unwrap_or("").trim();
+        let mut words = line.split_ascii_whitespace();
+        let Some(key) = words.next() else { continue };
+        let bad = |msg: String| IoError::malformed(FORMAT, format!("line {line_no}: {msg}"));
+        let nums = |words: std::str::SplitAsciiWhitespace<'_>, what: &str| -> Result<Vec<f32>> {
+            words
+                .map(|w| match w.parse::<f32>() {
+                    Ok(v) if v.is_finite() => Ok(v),
+                    Ok(_) => Err(bad(format!("{what} value '{w}' is NaN or infinite"))),
+                    Err(_) => Err(bad(format!("{what} value '{w}' is not a number"))),
+                })
+                .collect()
+        };
+        match key {
+            "v" => {
+                let v = nums(words, "vertex")?;
+                if v.len() < 3 {
+                    return Err(bad(format!(
+                        "vertex has {} coordinates, expected 3",
+                        v.len()
+                    )));
+                }
+                positions.push(Vec3::new(v[0], v[1], v[2]));
+                if v.len() >= 6 {
+                    colors.push([v[3], v[4], v[5], 1.0]);
+                }
+            }
+            "vt" => {
+                let v = nums(words, "texture coordinate")?;
+                if v.is_empty() {
+                    return Err(bad("texture coordinate has no value".into()));
+                }
+                uvs.push([v[0], v.get(1).copied().unwrap_or(0.0)]);
+            }
+            "vn" => {
+                let v = nums(words, "normal")?;
+                if v.len() < 3 {
+                    return Err(bad(format!(
+                        "normal has {} coordinates, expected 3",
+                        v.len()
+                    )));
+                }
+                normals.push(Vec3::new(v[0], v[1], v[2]));
+            }
+            "f" => {
+                let start = corners.len();
+                for w in words {
+                    let mut c = [u32::MAX; 3];
+                    let counts = [positions.len(), uvs.len(), normals.len()];
+                    for (k, part) in w.split('/').enumerate() {
+                        if k > 2 {
+                            return Err(bad(format!("face corner '{w}' has more than 3 indices")));
+                        }
+                        if part.is_empty() {
+                            if k == 0 {
+                                return Err(bad(format!("face corner '{w}' has no vertex index")));
+                            }
+                            continue;
+                        }
+                        c[k] = resolve_index(part, counts[k]).ok_or_else(|| {
+                            bad(format!("bad index '{part}' in face corner '{w}'"))
+                        })?;
+                    }
+                    corners.push(c);
+                }
+                if corners.len() - start < 3 {
+                    corners.truncate(start);
+                } else {
+                    faces.push((start, line_no));
+                }
+            }
+            "o" if object_name.is_none() => object_name = Some(rest_of(line)),
+            "g" if group_name.is_none() => group_name = Some(rest_of(line)),
+            _ => {}
+        }
+    }
+    if positions.len() > u32::MAX as usize {
+        return Err(IoError::unsupported("OBJ has more than 2^32 vertices"));
+    }
+
+    // Validate indices (absolute indices may refer forward) and build faces.
+    let counts = [positions.len(), uvs.len(), normals.len()];
+    let names = ["vertex", "texture coordinate", "normal"];
+    let mut triangles = Vec::new();
+    let mut polygons = Vec::with_capacity(faces.len());
+    for (f, &(start, line_no)) in faces.iter().enumerate() {
+        let end = faces.get(f + 1).map_or(corners.len(), |n| n.0);
+        for c in &corners[start..end] {
+            for k in 0..3 {
+                if c[k] != u32::MAX && c[k] as usize >= counts[k] {
+                    return Err(IoError::malformed(
+                        FORMAT,
+                        format!(
+                            "line {line_no}: face refers to {} {} but the file has {}",
+                            names[k],
+                            c[k] as u64 + 1,
+                            counts[k]
+                        ),
+                    ));
+                }
+            }
+        }
+        let poly: Vec<u32> = corners[start..end].iter().map(|c| c[0]).collect();
+        triangulate_polygon(&poly, &mut triangles);
+        polygons.push(poly);
+    }
+    let has_ngons = polygons.iter().any(|p| p.len() > 3);
+
+    let n = positions.len();
+    let per_position_uvs = per_position(&corners, 1, n, &uvs, [0.0; 2]);
+    let per_position_normals = per_position(&corners, 2, n, &normals, Vec3::Y);
+    let mesh = Mesh {
+        name: object_name.or(group_name).unwrap_or_default(),
+        positions,
+        triangles,
+        polygons: has_ngons.then_some(polygons),
+        normals: per_position_normals,
+        uvs: per_position_uvs,
+        colors: (colors.len() == n && n > 0).then_some(colors),
+    };
+    mesh.validate()?;
+    Ok(mesh)
+}
+
+fn rest_of(line: &str) -> String {
+    line.split_once(char::is_whitespace)
+        .map(|(_, r)| r.trim().to_string())
+        .unwrap_or_default()
+}
+
+/// 0-based index of an OBJ index (1-based, or negative = relative to `count`).
+fn resolve_index(text: &str, count: usize) -> Option<u32> {
+    let i: i64 = text.parse().ok()?;
+    let i = match i {
+        0 => return None,
+        i if i > 0 => i - 1,
+        i => i64::try_from(count)
+            .ok()?
+            .checked_add(i)
+            .filter(|&r| r >= 0)?,
+    };
+    u32::try_from(i).ok().filter(|&i| i != u32::MAX)
+}
+
+/// Per-position attribute values when every corner of every position agrees on one value;
+/// positions on no face get `default`.
+fn per_position<T: Copy + PartialEq>(
+    corners: &[[u32; 3]],
+    slot: usize,
+    n: usize,
+    values: &[T],
+    default: T,
+) -> Option<Vec<T>> {
+    if values.is_empty() || corners.is_empty() {
+        return None;
+    }
+    let mut out: Vec<Option<T>> = vec![None; n];
+    for c in corners {
+        let idx = c[slot];
+        if idx == u32::MAX {
+            return None;
+        }
+        let v = values[idx as usize];
+        match &mut out[c[0] as usize] {
+            Some(old) if *old != v => return None,
+            slot @ None => *slot = Some(v),
+            _ => {}
+        }
+    }
+    Some(out.into_iter().map(|v| v.unwrap_or(default)).collect())
+}
+
+/// Writes a mesh as OBJ text.
+///
+/// Writes `o` (when the mesh has a name), one `v` per vertex in order (with `r g b` when the
+/// mesh has colours), `vt`/`vn` per vertex when present (sharing the vertex's index), and one
+/// `f` per polygon when [`Mesh::polygons`] is set, else per triangle. Numbers are written in
+/// the shortest form that reads back to the same `f32`, so `read(write(m))` is exact.
+pub fn write(mesh: &Mesh) -> String {
+    let mut out = String::with_capacity(mesh.positions.len() * 40 + mesh.triangles.len() * 24);
+    out.push_str("# written by toonkit\n");
+    if !mesh.name.is_empty() {
+        let _ = writeln!(out, "o {}", mesh.name.replace(['\n', '\r'], " "));
+    }
+    let colors = mesh
+        .colors
+        .as_ref()
+        .filter(|c| c.len() == mesh.positions.len());
+    for (i, p) in mesh.positions.iter().enumerate() {
+        let _ = write!(out, "v {} {} {}", p.x, p.y, p.z);
+        if let Some(c) = colors {
+            let _ = write!(out, " {} {} {}", c[i][0], c[i][1], c[i][2]);
+        }
+        out.push('\n');
+    }
+    let uvs = mesh
+        .uvs
+        .as_ref()
+        .filter(|u| u.len() == mesh.positions.len());
+    let normals = mesh
+        .normals
+        .as_ref()
+        .filter(|n| n.len() == mesh.positions.len());
+    for uv in uvs.into_iter().flatten() {
+        let _ = writeln!(out, "vt {} {}", uv[0], uv[1]);
+    }
+    for n in normals.into_iter().flatten() {
+        let _ = writeln!(out, "vn {} {} {}", n.x, n.y, n.z);
+    }
+    let mut face = |poly: &[u32]| {
+        out.push('f');
+        for &i in poly {
+            let k = i as u64 + 1;
+            let _ = match (uvs.is_some(), normals.is_some()) {
+                (false, false) => write!(out, " {k}"),
+                (true, false) => write!(out, " {k}/{k}"),
+                (false, true) => write!(out, " {k}//{k}"),
+                (true, true) => write!(out, " {k}/{k}/{k}"),
+            };
+        }
+        out.push('\n');
+    };
+    match &mesh.polygons {
+        Some(polys) => polys.iter().for_each(|p| face(p)),
+        None => mesh.triangles.iter().for_each(|t| face(t)),
+    }
+    out
+}
+
+/// The files of an OBJ sequence, starting at `first`.
+///
+/// The frame number is the trailing run of digits of `first`'s file stem (`walk_0001.obj` →
+/// `0001`); the following files are found by incrementing it with the same zero-padded width
+/// (`walk_0002.obj`, …) until one is missing.
+///
+/// # Errors
+/// [`IoError::Io`] when `first` does not exist; [`IoError::Unsupported`] when its name has
+/// no trailing frame number.
+pub fn sequence_paths(first: &Path) -> Result<Vec<PathBuf>> {
+    std::fs::metadata(first).map_err(|e| IoError::io(first, e))?;
+    let stem = first.file_stem().and_then(|s| s.to_str()).unwrap_or("");
+    let digits = stem.bytes().rev().take_while(u8::is_ascii_digit).count();
+    let prefix = &stem[..stem.len() - digits];
+    let number: Option<u64> = stem[prefix.len()..].parse().ok();
+    let Some(number) = number else {
+        return Err(IoError::unsupported(
+            "the file name has no trailing frame number (expected e.g. name_0001.obj)",
+        )
+        .at(first));
+    };
+    let ext = first
+        .extension()
+        .map(|e| format!(".{}", e.to_string_lossy()))
+        .unwrap_or_default();
+    let mut paths = vec![first.to_path_buf()];
+    for k in number.saturating_add(1).. {
+        let p = first.with_file_name(format!("{prefix}{k:0digits$}{ext}"));
+        if !p.is_file() {
+            break;
+        }
+        paths.push(p);
+    }
+    Ok(paths)
+}
+
+/// Reads an OBJ sequence into a point cache.
+///
+/// # Arguments
+/// * `paths` – one file per frame, in order (see [`sequence_paths`]).
+/// * `fps` – frames per second of the sequence.
+///
+/// # Returns
+/// A cache whose mesh (topology, attributes, rest positions) is the first file's.
+///
+/// # Errors
+/// Any read or parse error (with the path attached), an empty list, or a file whose vertex
+/// count or triangles differ from the first file's.
+pub fn read_sequence(paths: &[PathBuf], fps: f32) -> Result<MeshAnimation> {
+    let Some(first_path) = paths.first() else {
+        return Err(IoError::unsupported("no OBJ file given for the sequence"));
+    };
+    let load = |p: &Path| {
+        crate::read_file(p)
+            .and_then(|b| read(&b))
+            .map_err(|e| e.at(p))
+    };
+    let first = load(first_path)?;
+    let mut positions = Vec::with_capacity(first.positions.len() * paths.len());
+    positions.extend_from_slice(&first.positions);
+    for p in &paths[1..] {
+        let m = load(p)?;
+        if m.vertex_count() != first.vertex_count() {
+            return Err(IoError::malformed(
+                FORMAT,
+                format!(
+                    "frame has {} vertices but the first frame ({}) has {}",
+                    m.vertex_count(),
+                    first_path.display(),
+                    first.vertex_count()
+                ),
+            )
+            .at(p));
+        }
+        if m.triangles != first.triangles {
+            return Err(IoError::malformed(
+                FORMAT,
+                format!(
+                    "faces differ from the first frame ({})",
+                    first_path.display()
+                ),
+            )
+            .at(p));
+        }
+        positions.extend_from_slice(&m.positions);
+    }
+    Ok(MeshAnimation::new(first, fps, positions)?)
+}
+
+/// Renders every frame of a cache as OBJ text, named `<base>_0001.obj`, `<base>_0002.obj`, …
+/// (1-based, at least 4 digits; a `.obj` extension on `base` is dropped).
+///
+/// Normals are written only for a one-frame cache: the rest normals are wrong once the mesh
+/// deforms. The caller writes each file with [`crate::write_atomic`].
+pub fn write_sequence(anim: &MeshAnimation, base: &Path) -> Vec<(PathBuf, String)> {
+    let base = match base.extension() {
+        Some(e) if e.eq_ignore_ascii_case("obj") => base.with_extension(""),
+        _ => base.to_path_buf(),
+    };
+    let stem = base
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let stem = if stem.is_empty() {
+        "frame".to_string()
+    } else {
+        stem
+    };
+    let frames = anim.frame_count();
+    (0..frames)
+        .map(|f| {
+            let mut m = anim.mesh_at(f);
+            if frames > 1 {
+                m.normals = None;
+            }
+            (
+                base.with_file_name(format!("{stem}_{:04}.obj", f + 1)),
+                write(&m),
+            )
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const QUAD_AND_TRI: &str = "# test\no thing\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+        v 2 2 2\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\nf -4/-3 -2/-1 -1/-1\n";
+
+    #[test]
+    fn keeps_file_order_polygons_and_unused_vertices() {
+        let m = read(QUAD_AND_TRI.as_bytes()).unwrap();
+        assert_eq!(m.name, "thing");
+        assert_eq!(m.vertex_count(), 5);
+        assert_eq!(m.positions[4], Vec3::splat(2.0));
+        assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3], [1, 3, 4]]);
+        assert_eq!(m.polygons.as_ref().unwrap()[0], vec![0, 1, 2, 3]);
+        // Relative corners reuse each vertex's own vt, so UVs are per position.
+        assert_eq!(m.uvs.as_ref().unwrap()[3], [0.0, 1.0]);
+        assert_eq!(m.uvs.as_ref().unwrap()[4], [0.0, 1.0]);
+        let again = read(write(&m).as_bytes()).unwrap();
+        assert_eq!(again, m);
+    }
+
+    #[test]
+    fn uv_seams_drop_uvs() {
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvt 0.5 0.5\n\
+            f 1/1 2/2 3/3\nf 1/4 3/3 2/2\n";
+        let m = read(text.as_bytes()).unwrap();
+        assert!(m.uvs.is_none());
+        assert_eq!(m.triangles.len(), 2);
+    }
+
+    #[test]
+    fn bad_inputs_name_the_line() {
+        let cases = [
+            ("v 0 0\n", "line 1"),
+            ("v 0 0 0\nv 0 nan 0\n", "line 2"),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", "line 4"),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n", "line 4"),
+            ("v 0 0 0\nf -2 1 1\n", "line 2"),
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/9 2 3\n",
+                "texture coordinate 9",
+            ),
+            ("v x 0 0\n", "not a number"),
+        ];
+        for (text, needle) in cases {
+            let e = read(text.as_bytes()).unwrap_err().to_string();
+            assert!(e.contains(needle), "{text:?}: {e}");
+        }
+    }
+
+    #[test]
+    fn sequence_round_trip_on_disk() {
+        let dir = tempfile::tempdir().unwrap();
+        let tri = read(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        let pos: Vec<Vec3> = (0..3)
+            .flat_map(|f| tri.positions.iter().map(move |p| *p * (1.0 + f as f32)))
+            .collect();
+        let a = MeshAnimation::new(tri, 12.0, pos).unwrap();
+        let files = write_sequence(&a, &dir.path().join("walk.obj"));
+        assert_eq!(files[2].0.file_name().unwrap(), "walk_0003.obj");
+        for (p, text) in &files {
+            crate::write_atomic(p, text.as_bytes()).unwrap();
+        }
+        let paths = sequence_paths(&files[0].0).unwrap();
+        assert_eq!(paths.len(), 3);
+        let b = read_sequence(&paths, 12.0).unwrap();
+        assert_eq!(b.positions(), a.positions());
+        assert!(sequence_paths(&dir.path().join("walk_0009.obj")).is_err());
+        crate::write_atomic(&dir.path().join("nonum.obj"), b"v 0 0 0\n").unwrap();
+        assert!(sequence_paths(&dir.path().join("nonum.obj")).is_err());
+    }
+}
