@@ -270,8 +270,16 @@ pub fn frame_count(duration: f32, fps: f32) -> usize {
     if !(duration.is_finite() && fps.is_finite() && duration > 0.0 && fps > 0.0) {
         return 1;
     }
-    ((duration as f64 * fps as f64) + 1e-3).floor() as usize + 1
+    let n = (duration as f64 * fps as f64 + 1e-3).floor();
+    if n >= MAX_FRAMES as f64 {
+        return MAX_FRAMES + 1; // callers reject this; it never allocates
+    }
+    n as usize + 1
 }
+
+/// The most frames a clip may be sampled into; longer requests are an error (lower the fps
+/// or pick a shorter clip) rather than an allocation that cannot succeed.
+pub const MAX_FRAMES: usize = 10_000_000;
 
 #[cfg(test)]
 mod tests {

@@ -30,7 +30,7 @@ mod skin;
 mod transform;
 
 pub use camera::{Camera, Projection};
-pub use clip::{frame_count, Channel, Clip, Interpolation, Property};
+pub use clip::{frame_count, Channel, Clip, Interpolation, Property, MAX_FRAMES};
 pub use error::{AnimError, Result};
 pub use mesh::{triangulate_polygon, Aabb, Mesh};
 pub use mesh_animation::{MeshAnimation, DEFAULT_FPS};

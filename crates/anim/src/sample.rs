@@ -8,6 +8,9 @@ use crate::{
     SkeletalAnimation, Skeleton, Skin, Transform, DEFAULT_FPS,
 };
 
+/// Upper bound on sampled positions (frames × vertices), about 12 GB of `Vec3`.
+pub const MAX_SAMPLED_VALUES: usize = 1_000_000_000;
+
 /// What to sample.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SampleOptions {
@@ -153,6 +156,20 @@ pub fn sample(scene: &Scene, options: &SampleOptions) -> Result<SampledScene> {
         None => (0.0, 1),
     };
     let fps = options.fps;
+    let cache_values = frames.saturating_mul(
+        scene
+            .meshes
+            .iter()
+            .map(|m| m.mesh.vertex_count())
+            .sum::<usize>()
+            .max(1),
+    );
+    if frames > crate::MAX_FRAMES || cache_values > MAX_SAMPLED_VALUES {
+        return Err(AnimError::Invalid(format!(
+            "sampling {:.1} s at {fps} fps needs {frames} frames: too many (lower --fps or pick a shorter clip)",
+            clip.map(|c| c.duration()).unwrap_or(0.0)
+        )));
+    }
     let order = scene.topological_order();
     let nn = scene.nodes.len();
 

@@ -13,13 +13,14 @@
 //!   (`Zrotation Xrotation Yrotation` = `Rz · Rx · Ry`), in degrees. Position channels are
 //!   *added to* the `OFFSET` (the Biovision convention; for the usual root with
 //!   `OFFSET 0 0 0` this equals the "absolute position" reading of other tools);
-//! * one [`SkinDef`] listing every node with inverse bind matrices = inverse rest world
+//! * one [`SkinDef`] listing every `ROOT`/`JOINT` node (End Sites are tips, not joints: the
+//!   joint count is the file's) with inverse bind matrices = inverse rest world
 //!   matrices, so that [`Scene::skeleton`] and [`anim::sample`] find the joints. No mesh.
 //!
 //! Units are the file's. A file with `Frames: 0` gives a scene without clip.
 //!
 //! # Writing
-//! [`write`] and [`write_local`] produce BVH text with `ZXY` rotation channels (see the
+//! [`write()`] and [`write_local`] produce BVH text with `ZXY` rotation channels (see the
 //! `write` submodule).
 
 use anim::{Channel, Clip, Interpolation, Node, Property, Scene, SkinDef, Transform};
@@ -53,6 +54,8 @@ struct Joint {
     offset: Option<DVec3>,
     channels: Vec<Chan>,
     end_sites: usize,
+    /// An `End Site`: a node for the chain's tip, not a joint.
+    end_site: bool,
 }
 
 struct Tokens<'a> {
@@ -191,6 +194,7 @@ pub fn read(bytes: &[u8]) -> Result<Scene> {
                     offset: None,
                     channels: Vec::new(),
                     end_sites: 0,
+                    end_site: false,
                 });
                 stack.push(joints.len() - 1);
             }
@@ -215,6 +219,7 @@ pub fn read(bytes: &[u8]) -> Result<Scene> {
                     offset: Some(offset),
                     channels: Vec::new(),
                     end_sites: 0,
+                    end_site: true,
                 });
             }
             "OFFSET" => {
@@ -357,10 +362,10 @@ fn build_scene(joints: &[Joint], frames: usize, dt: f64, values: &[f64]) -> Resu
     }
     let skin = SkinDef {
         name: "bvh".into(),
-        joints: (0..n).collect(),
-        inverse_bind: rest_world
-            .iter()
-            .map(|&w| Mat4::from_translation(-w))
+        joints: (0..n).filter(|&k| !joints[k].end_site).collect(),
+        inverse_bind: (0..n)
+            .filter(|&k| !joints[k].end_site)
+            .map(|k| Mat4::from_translation(-rest_world[k]))
             .collect(),
     };
     let mut clips = Vec::new();

@@ -35,7 +35,12 @@ pub fn read_bytes(bytes: &[u8]) -> Result<Scene> {
 }
 
 fn read_with_base(bytes: &[u8], base: Option<&Path>) -> Result<Scene> {
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| bad(e.to_string()))?;
+    precheck(bytes)?;
+    // gltf-json's validation indexes some arrays unchecked; `precheck` covers the known
+    // cases and this guard turns any other panic into an error.
+    let parsed = std::panic::catch_unwind(|| gltf::Gltf::from_slice(bytes))
+        .map_err(|_| bad("the document is inconsistent (rejected during validation)"))?;
+    let gltf = parsed.map_err(|e| bad(e.to_string()))?;
     let blob = gltf.blob.clone();
     let doc = gltf.document;
     let base = base.map(|b| {
@@ -50,6 +55,40 @@ fn read_with_base(bytes: &[u8], base: Option<&Path>) -> Result<Scene> {
     let scene = convert(&doc, &data)?;
     scene.validate()?;
     Ok(scene)
+}
+
+/// Checks what gltf-json 1.4 validation assumes without checking: that every mesh
+/// attribute refers to an existing accessor.
+fn precheck(bytes: &[u8]) -> Result<()> {
+    let json: std::borrow::Cow<[u8]> = if bytes.starts_with(b"glTF") {
+        gltf::binary::Glb::from_slice(bytes)
+            .map_err(|e| bad(e.to_string()))?
+            .json
+    } else {
+        std::borrow::Cow::Borrowed(bytes)
+    };
+    let Ok(root) = serde_json::from_slice::<gltf_json::Root>(&json) else {
+        return Ok(()); // syntax errors are reported by the full parse
+    };
+    let n = root.accessors.len();
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for p in &mesh.primitives {
+            let refs = p.attributes.values().chain(p.indices.iter());
+            let targets = p.targets.iter().flatten().flat_map(|t| {
+                t.positions
+                    .iter()
+                    .chain(t.normals.iter())
+                    .chain(t.tangents.iter())
+            });
+            if let Some(bad_ref) = refs.chain(targets).find(|i| i.value() >= n) {
+                return Err(bad(format!(
+                    "mesh {m} refers to accessor {} but there are {n}",
+                    bad_ref.value()
+                )));
+            }
+        }
+    }
+    Ok(())
 }
 
 fn convert(doc: &gltf::Document, buffers: &[&[u8]]) -> Result<Scene> {

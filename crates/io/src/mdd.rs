@@ -12,7 +12,7 @@
 //! Blender's exporter writes the times `k / fps` starting at 0 and its importer ignores
 //! them. [`read`] takes the frame rate and start time from the times when they are evenly
 //! spaced and increasing (within 0.1 %), and otherwise falls back to the `fps` argument and
-//! a start time of 0. [`write`] writes `start_time + k / fps`.
+//! a start time of 0. [`write()`] writes `start_time + k / fps`.
 
 use anim::{Mesh, MeshAnimation};
 use glam::Vec3;

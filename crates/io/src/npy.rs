@@ -235,7 +235,7 @@ mod tests {
             let data: Vec<f32> = (0..n).map(|i| i as f32 * 0.5 - 1.0).collect();
             let bytes = write_f32(&shape, &data).unwrap();
             let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
-            assert_eq!((10 + header_len) % 64, 0);
+            assert!((10 + header_len).is_multiple_of(64));
             assert_eq!(bytes[10 + header_len - 1], b'\n');
             assert_eq!(read_f32(&bytes).unwrap(), (shape, data));
         }

@@ -233,7 +233,8 @@ pub fn write(mesh: &Mesh) -> String {
     let mut out = String::with_capacity(mesh.positions.len() * 40 + mesh.triangles.len() * 24);
     out.push_str("# written by toonkit\n");
     if !mesh.name.is_empty() {
-        let _ = writeln!(out, "o {}", mesh.name.replace(['\n', '\r'], " "));
+        // A line break or '#' would end the name early when read back.
+        let _ = writeln!(out, "o {}", mesh.name.replace(['\n', '#'], "_"));
     }
     let colors = mesh
         .colors

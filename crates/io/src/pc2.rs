@@ -15,7 +15,7 @@
 //! The file stores *frame numbers*, not seconds, so the scene frame rate `fps` is an argument
 //! of [`read`]: sample `k` is at frame `start + k × rate`, i.e. at time
 //! `(start + k × rate) / fps` seconds. The resulting [`MeshAnimation`] therefore has
-//! `fps / rate` samples per second and `start_time = start / fps`. [`write`] writes
+//! `fps / rate` samples per second and `start_time = start / fps`. [`write()`] writes
 //! `rate = 1` and `start = start_time × fps` (what Blender writes), so
 //! `read(&write(a), mesh, a.fps)` reproduces `a`.
 

@@ -62,7 +62,7 @@ pub fn write(skeleton: &Skeleton, motion: &SkeletalAnimation) -> Result<String> 
 /// * `fps` – frames per second (`Frame Time = 1 / fps`).
 ///
 /// # Errors
-/// As [`write`], plus buffer lengths that do not match the skeleton, or non-finite values.
+/// As [`write()`], plus buffer lengths that do not match the skeleton, or non-finite values.
 pub fn write_local(
     skeleton: &Skeleton,
     root_translations: &[Vec3],
