@@ -31,6 +31,10 @@ enum Command {
     Demo(commands::demo::DemoArgs),
     /// Dynamic lines of action: sketched keystrokes → animated line (Guay et al. 2015).
     Loa(commands::loa::LoaArgs),
+    /// Preview an animation as PNG (one frame, onion skins) or GIF, coloured by motion offsets.
+    Render(commands::render::RenderArgs),
+    /// Smear frames: motion offsets (Basset et al. 2024).
+    Smear(commands::smear::SmearArgs),
 }
 
 fn main() -> ExitCode {
@@ -41,6 +45,8 @@ fn main() -> ExitCode {
         Command::Convert(a) => commands::convert::run(&ctx, a),
         Command::Demo(a) => commands::demo::run(&ctx, a),
         Command::Loa(a) => commands::loa::run(&ctx, a),
+        Command::Render(a) => commands::render::run(&ctx, a),
+        Command::Smear(a) => commands::smear::run(&ctx, a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,18 +1,21 @@
-//! `toonkit demo`: every tool on the bundled sample (RobotExpressive, CC0).
+//! `toonkit demo`: every tool on bundled samples — RobotExpressive (CC0) for the 3D tools,
+//! the jump keystrokes of `examples/loa/` for the line of action.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anim::SampleOptions;
-use anyhow::Result;
+use anyhow::{Context as _, Result};
 use clap::Args;
 use serde_json::json;
 
 use super::Context;
 use crate::output::{self, Layout};
 
-/// The bundled sample: RobotExpressive (CC0, see assets/LICENSES.md).
+/// The bundled 3D sample: RobotExpressive (CC0, see assets/LICENSES.md).
 pub const SAMPLE_GLB: &[u8] = include_bytes!("../../../../assets/RobotExpressive.glb");
+/// The bundled keystrokes: a jump-like arc.
+pub const SAMPLE_KEYS: &str = include_str!("../../../../examples/loa/jump.json");
 
 /// Arguments of `toonkit demo`.
 #[derive(Debug, Args)]
@@ -31,6 +34,7 @@ pub struct DemoArgs {
 /// Runs `toonkit demo`.
 pub fn run(ctx: &Context, args: DemoArgs) -> Result<()> {
     let start = Instant::now();
+    let spinner = crate::progress::spinner("demo", ctx.json);
     let scene = tkio::gltf::read_bytes(SAMPLE_GLB)?;
     let clip = scene.find_clip(&args.clip)?;
     let sampled = anim::sample(
@@ -43,35 +47,105 @@ pub fn run(ctx: &Context, args: DemoArgs) -> Result<()> {
     )?;
     let robot = sampled.merged("robot")?;
     let mut written = Vec::new();
+    let out = |name: &str| args.out.join(name);
+
+    // Foundation: the clip as a glTF flipbook and a Blender point cache.
     written.extend(output::write_animation(
-        &args.out.join("robot.glb"),
+        &out("robot.glb"),
         &robot,
         Layout::Flipbook,
         None,
     )?);
     written.extend(output::write_animation(
-        &args.out.join("robot.pc2"),
+        &out("robot.pc2"),
         &robot,
         Layout::Flipbook,
         None,
     )?);
+
+    // smear: motion offsets as colours (red leading, blue trailing) and a preview.
+    let parts = smear::scene_offsets(&sampled, &smear::OffsetOptions::default())?;
+    let offsets = smear::MotionOffsets::concat(&parts)?;
+    let colors: Vec<[f32; 4]> = offsets
+        .values()
+        .iter()
+        .map(|&d| super::smear::color(d))
+        .collect();
+    written.extend(output::write_animation(
+        &out("robot_offsets.glb"),
+        &robot,
+        Layout::Flipbook,
+        Some(&colors),
+    )?);
+    let preview = |format, frame, onion| {
+        render::preview_scene(
+            &sampled,
+            &render::PreviewOptions {
+                frame,
+                onion,
+                format,
+                scalar: Some((offsets.values(), render::ColorMap::Diverging)),
+                ..render::PreviewOptions::default()
+            },
+        )
+    };
+    let mid = sampled.frame_count / 2;
+    put(
+        &out("robot_offsets.png"),
+        &preview(render::OutputFormat::Png, mid, 2)?,
+        &mut written,
+    )?;
+    put(
+        &out("robot_offsets.gif"),
+        &preview(render::OutputFormat::Gif, 0, 0)?,
+        &mut written,
+    )?;
+
+    // loa: the jump keystrokes as a dynamic line of action.
+    let keys = loa::Keystrokes::from_json_str(SAMPLE_KEYS).context("bundled keystrokes")?;
+    let line = loa::line_of_action(&keys, &loa::LineOptions::default())?;
+    put(
+        &out("jump_line.json"),
+        line.animation.to_json_string().as_bytes(),
+        &mut written,
+    )?;
+    put(
+        &out("jump_line.svg"),
+        loa::to_svg_string(&line.animation, Some(&keys)).as_bytes(),
+        &mut written,
+    )?;
+    put(
+        &out("jump_line.gif"),
+        &super::loa_render::render_line(&line.animation, &keys, true)?,
+        &mut written,
+    )?;
+    spinner.finish_and_clear();
+
     let summary = json!({
         "outputs": written,
         "frames": robot.frame_count(),
         "vertices": robot.vertex_count(),
+        "line_frames": line.animation.frames.len(),
         "seconds": start.elapsed().as_secs_f64(),
     });
     ctx.report(&summary, || {
         let mut s = format!(
-            "RobotExpressive '{}': {} frames × {} vertices\n",
+            "RobotExpressive '{}': {} frames × {} vertices; jump line: {} frames\n",
             args.clip,
             robot.frame_count(),
-            robot.vertex_count()
+            robot.vertex_count(),
+            line.animation.frames.len()
         );
         for w in &written {
             s += &format!("  wrote {}\n", w.display());
         }
         s.trim_end().to_string()
     });
+    Ok(())
+}
+
+fn put(path: &Path, bytes: &[u8], written: &mut Vec<PathBuf>) -> Result<()> {
+    tkio::write_atomic(path, bytes)?;
+    written.push(path.to_path_buf());
     Ok(())
 }

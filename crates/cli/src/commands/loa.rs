@@ -71,6 +71,8 @@ pub fn run(ctx: &Context, args: LoaArgs) -> Result<()> {
 enum OutputKind {
     Json,
     Svg,
+    Png,
+    Gif,
 }
 
 fn output_kind(path: &Path) -> Result<OutputKind> {
@@ -82,11 +84,12 @@ fn output_kind(path: &Path) -> Result<OutputKind> {
     match ext.as_str() {
         "json" => Ok(OutputKind::Json),
         "svg" => Ok(OutputKind::Svg),
-        "gif" | "png" => bail!(
-            "{}: .{ext} output is not yet supported (it needs the render crate); write .json or .svg",
+        "png" => Ok(OutputKind::Png),
+        "gif" => Ok(OutputKind::Gif),
+        _ => bail!(
+            "{}: unknown output extension (use .json, .svg, .png or .gif)",
             path.display()
         ),
-        _ => bail!("{}: unknown output extension (use .json or .svg)", path.display()),
     }
 }
 
@@ -132,10 +135,15 @@ fn line(ctx: &Context, args: LineArgs) -> Result<()> {
     let line = loa::line_of_action(&keys, &options)
         .with_context(|| format!("{}", args.input.display()))?;
     let bytes = match kind {
-        OutputKind::Json => line.animation.to_json_string(),
-        OutputKind::Svg => loa::to_svg_string(&line.animation, Some(&keys)),
+        OutputKind::Json => line.animation.to_json_string().into_bytes(),
+        OutputKind::Svg => loa::to_svg_string(&line.animation, Some(&keys)).into_bytes(),
+        OutputKind::Png | OutputKind::Gif => {
+            let gif = matches!(kind, OutputKind::Gif);
+            super::loa_render::render_line(&line.animation, &keys, gif)
+                .with_context(|| args.output.display().to_string())?
+        }
     };
-    tkio::write_atomic(&args.output, bytes.as_bytes())?;
+    tkio::write_atomic(&args.output, &bytes)?;
     let seconds = start.elapsed().as_secs_f64();
     let summary = json!({
         "output": args.output.display().to_string(),

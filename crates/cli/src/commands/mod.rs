@@ -4,6 +4,9 @@ pub mod convert;
 pub mod demo;
 pub mod info;
 pub mod loa;
+mod loa_render;
+pub mod render;
+pub mod smear;
 
 /// Options every command sees.
 #[derive(Debug, Clone, Copy)]

@@ -1,0 +1,76 @@
+//! Errors of the smear crate. Every variant's documentation says how to fix the input.
+
+use thiserror::Error;
+
+/// Any error of the `smear` crate.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum SmearError {
+    /// A bone named in [`OffsetOptions::prune`](crate::OffsetOptions::prune) is not a joint of
+    /// the skeleton. Use one of the listed joint names (they are case-sensitive).
+    #[error("no joint named '{name}' to prune; joints are: {available}")]
+    UnknownJoint {
+        /// The name that was asked for.
+        name: String,
+        /// Comma-separated joint names.
+        available: String,
+    },
+    /// A pruned joint has skinned vertices but no kept ancestor to take them over (it is a
+    /// root, or all its ancestors are pruned too). Keep the root, or prune only descendants.
+    #[error(
+        "joint '{name}' is pruned but has no kept ancestor to drive its vertices; \
+         keep it or one of its ancestors"
+    )]
+    PruneWithoutAncestor {
+        /// Name of the pruned joint.
+        name: String,
+    },
+    /// The camera asked for is not in the scene. Use one of the listed camera names or an
+    /// index below the number of cameras.
+    #[error("no camera '{name}'; cameras are: {available}")]
+    UnknownCamera {
+        /// The name or index that was asked for.
+        name: String,
+        /// Comma-separated camera names (empty when the input has none).
+        available: String,
+    },
+    /// An object index is out of range. Use an index below the number of objects.
+    #[error("object {index} does not exist; there are {count} objects")]
+    UnknownObject {
+        /// The index asked for.
+        index: usize,
+        /// Number of objects.
+        count: usize,
+    },
+    /// A surface point refers to a missing triangle or has non-finite or all-zero barycentric
+    /// coordinates. Sample points on existing triangles with finite, non-negative weights.
+    #[error("surface point {index}: {reason}")]
+    InvalidSurfacePoint {
+        /// Index of the point in the input list.
+        index: usize,
+        /// What is wrong.
+        reason: String,
+    },
+    /// Two offset fields to combine have different frame counts. Combine offsets of one clip.
+    #[error("offsets have {found} frames, expected {expected}")]
+    FrameMismatch {
+        /// Frames of the first field.
+        expected: usize,
+        /// Frames of the offending field.
+        found: usize,
+    },
+    /// A value buffer's length is not `frames × vertices`. Pass a buffer of that length.
+    #[error("offset buffer has {found} values, expected {expected}")]
+    LengthMismatch {
+        /// `frames × vertices`.
+        expected: usize,
+        /// Actual length.
+        found: usize,
+    },
+    /// The sampled scene is inconsistent (skin slots, bone buffer). Re-sample it with
+    /// `anim::sample`, which always produces consistent scenes.
+    #[error("inconsistent scene: {0}")]
+    InvalidScene(String),
+}
+
+/// Result alias of the smear crate.
+pub type Result<T, E = SmearError> = std::result::Result<T, E>;

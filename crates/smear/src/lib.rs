@@ -1,0 +1,58 @@
+//! Smear frames from motion offsets — Basset, Bénard, Barla, "Smear: Stylized Motion Effects
+//! for 3D Animation", SIGGRAPH 2024, Section 3.
+//!
+//! Motion offsets δ_i(f) ∈ [−1, 1] say which parts of a moving object lead (δ > 0) and which
+//! trail (δ < 0); elongated in-betweens, multiple in-betweens and motion lines are driven by
+//! them (Section 4).
+//!
+//! * Simple objects (Eq. 1): signed distance to the plane through the area-weighted surface
+//!   centroid ([`surface_centroid`]) with the direction of motion as normal, normalized by the
+//!   largest |δ̃|.
+//! * Temporal smoothing (Eq. 2): [`smoothing_weights`], [`smooth_in_time`].
+//! * Articulated figures (Eqs. 3–9): per-bone ribbons orthogonal to the bone and as aligned as
+//!   possible with the slerped joint motion, collinear weights, skin-weighted sum, and the
+//!   joint-continuous normalization of Eq. 9 (orientation fixed in SPEC.md); optional
+//!   skeleton pruning and whole-body mode.
+//! * Camera space, several objects per scene, offsets at surface points ([`OffsetSolver`]).
+//! * Velocities by central differences ([`vertex_velocities`]), used for speed.
+//!
+//! The crate is pure computation: it never touches files.
+//!
+//! ```
+//! use anim::{Mesh, MeshAnimation};
+//! use glam::Vec3;
+//! use smear::{mesh_offsets, OffsetOptions};
+//!
+//! // A unit tetrahedron translating along +X, one unit per frame.
+//! let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+//! let mesh = Mesh::new("tet", p.clone(), vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]);
+//! let frames: Vec<Vec3> = (0..4).flat_map(|f| p.iter().map(move |q| *q + Vec3::X * f as f32)).collect();
+//! let anim = MeshAnimation::new(mesh, 24.0, frames)?;
+//! let delta = mesh_offsets(&anim, &OffsetOptions::default())?;
+//! assert!((delta.get(2, 1).unwrap() - 1.0).abs() < 1e-6); // the vertex at +X leads
+//! assert!(delta.get(2, 0).unwrap() < 0.0); // the others trail
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod error;
+mod field;
+mod offsets;
+mod options;
+mod plane;
+mod ribbon;
+mod rig;
+mod smooth;
+mod solver;
+mod velocity;
+
+pub use error::{Result, SmearError};
+pub use offsets::MotionOffsets;
+pub use options::{
+    CameraSelect, OffsetOptions, DEFAULT_LERP_ANGLE, DEFAULT_SMOOTH, DEFAULT_STILL_TOLERANCE,
+    DEFAULT_ZERO_LENGTH, STILL_ROUNDING_FACTOR,
+};
+pub use plane::surface_centroid;
+pub use ribbon::smoothstep;
+pub use smooth::{smooth_in_time, smoothing_weights};
+pub use solver::{mesh_offsets, scene_offsets, OffsetMode, OffsetSolver, SurfacePoint};
+pub use velocity::{camera_vertex_velocities, speeds, vertex_velocities};

@@ -1,0 +1,62 @@
+//! Options of the motion-offset computation and the crate's named tolerances.
+
+use serde::{Deserialize, Serialize};
+
+/// Default temporal smoothing half-window `N` of Eq. 2 (the paper's "N = 2 in practice").
+pub const DEFAULT_SMOOTH: usize = 2;
+
+/// A velocity shorter than this fraction of the bounding-box diagonal counts as "still"
+/// (SPEC.md): a still object gets offsets 0, a still joint takes its bone's other joint's
+/// direction.
+pub const DEFAULT_STILL_TOLERANCE: f32 = 1e-9;
+
+/// Velocities below this multiple of the largest absolute coordinate (f32 rounding of the
+/// positions) are still too, whatever [`DEFAULT_STILL_TOLERANCE`] says: an object followed by
+/// the camera moves by rounding noise only, which must not pick a random separation plane.
+pub const STILL_ROUNDING_FACTOR: f32 = 16.0 * f32::EPSILON;
+
+/// Below this angle (radians) between root and tip directions, Eq. 4's slerp falls back to a
+/// renormalized linear interpolation (paper Section 3.2).
+pub const DEFAULT_LERP_ANGLE: f32 = 0.1;
+
+/// Bones shorter than this fraction of the bounding-box diagonal are zero-length and skipped.
+pub const DEFAULT_ZERO_LENGTH: f32 = 1e-6;
+
+/// Which scene camera to compute offsets relative to.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub enum CameraSelect {
+    /// Index into `SampledScene::cameras`.
+    Index(usize),
+    /// Camera (node) name.
+    Name(String),
+}
+
+/// How to compute motion offsets (missing fields take their defaults when deserialized).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct OffsetOptions {
+    /// Temporal smoothing half-window `N` of Eq. 2; 0 turns smoothing off.
+    pub smooth: usize,
+    /// Treat every skinned character (its skinned meshes and the rigid props parented to its
+    /// joints) as one simple object with a single separation plane (paper Fig. 14).
+    pub whole_body: bool,
+    /// Joints toggled off (paper Fig. 8d): their vertices follow the nearest kept ancestor.
+    pub prune: Vec<String>,
+    /// Compute offsets relative to this (possibly moving) camera instead of the world.
+    pub camera: Option<CameraSelect>,
+    /// Apply the collinear weight w_coll of Eqs. 6/8 (paper Fig. 7); turning it off shows the
+    /// shearing it prevents.
+    pub collinear_weight: bool,
+}
+
+impl Default for OffsetOptions {
+    fn default() -> Self {
+        OffsetOptions {
+            smooth: DEFAULT_SMOOTH,
+            whole_body: false,
+            prune: Vec::new(),
+            camera: None,
+            collinear_weight: true,
+        }
+    }
+}

@@ -1,0 +1,93 @@
+//! Temporal smoothing of motion offsets (paper Eq. 2).
+
+use rayon::prelude::*;
+
+/// The normalized weights w_n, n = −N..=N, of Eq. 2: w_n = (1 − (n/(N+1))²)² / Σ w.
+///
+/// # Arguments
+/// * `n` — half-window N; 0 gives `[1.0]` (no smoothing).
+///
+/// # Returns
+/// `2N + 1` weights summing to 1, index `n + N` holding w_n.
+pub fn smoothing_weights(n: usize) -> Vec<f32> {
+    let denom = (n + 1) as f64;
+    let raw: Vec<f64> = (-(n as i64)..=n as i64)
+        .map(|k| {
+            let x = k as f64 / denom;
+            (1.0 - x * x).powi(2)
+        })
+        .collect();
+    let sum: f64 = raw.iter().sum();
+    raw.iter().map(|w| (w / sum) as f32).collect()
+}
+
+/// Smooths a frame-major `frames × vertices` buffer in time with Eq. 2; frames outside the
+/// animation are clamped to the first/last frame (SPEC.md).
+///
+/// # Performance
+/// Parallel over frames; `(2N + 1) × frames × vertices` multiply-adds.
+pub fn smooth_in_time(values: &[f32], frames: usize, vertices: usize, n: usize) -> Vec<f32> {
+    if n == 0 || frames <= 1 || vertices == 0 {
+        return values.to_vec();
+    }
+    let w = smoothing_weights(n);
+    let mut out = vec![0.0f32; values.len()];
+    out.par_chunks_mut(vertices)
+        .enumerate()
+        .for_each(|(f, dst)| {
+            for (k, &wk) in w.iter().enumerate() {
+                let g = (f as i64 + k as i64 - n as i64).clamp(0, frames as i64 - 1) as usize;
+                let src = &values[g * vertices..(g + 1) * vertices];
+                for (d, s) in dst.iter_mut().zip(src) {
+                    *d += wk * s;
+                }
+            }
+        });
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn smoothing_weights_sum_to_one() {
+        for n in 0..6 {
+            let w = smoothing_weights(n);
+            assert_eq!(w.len(), 2 * n + 1);
+            let s: f32 = w.iter().sum();
+            assert!((s - 1.0).abs() < 1e-6, "N = {n}: sum {s}");
+            // Symmetric and peaked at the centre.
+            for k in 0..n {
+                assert_eq!(w[k], w[2 * n - k]);
+                assert!(w[k] < w[k + 1]);
+            }
+        }
+        // N = 2: raw weights (1 − (n/3)²)² = 25/81, 64/81, 1, 64/81, 25/81.
+        let w = smoothing_weights(2);
+        let total = (2.0 * 25.0 + 2.0 * 64.0 + 81.0) / 81.0;
+        assert!((w[2] - 1.0 / total).abs() < 1e-6);
+        assert!((w[0] - 25.0 / 81.0 / total).abs() < 1e-6);
+    }
+
+    #[test]
+    fn smoothing_is_identity_for_n0_and_constant_signals() {
+        let v: Vec<f32> = (0..12).map(|i| (i as f32).sin()).collect();
+        assert_eq!(smooth_in_time(&v, 4, 3, 0), v);
+        let c = vec![0.7f32; 15];
+        for x in smooth_in_time(&c, 5, 3, 2) {
+            assert!((x - 0.7).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn smoothing_clamps_at_the_ends() {
+        // A step at the last frame: frame 0 sees only clamped copies of frames 0..=2.
+        let v = [0.0, 0.0, 0.0, 1.0];
+        let s = smooth_in_time(&v, 4, 1, 2);
+        let w = smoothing_weights(2);
+        assert_eq!(s[0], 0.0);
+        assert!((s[3] - (w[2] + w[3] + w[4])).abs() < 1e-6);
+        assert!((s[1] - w[4]).abs() < 1e-6);
+    }
+}

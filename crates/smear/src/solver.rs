@@ -1,0 +1,473 @@
+//! Motion offsets of whole scenes: grouping objects, camera space, pruning, surface points.
+
+use std::borrow::Cow;
+
+use anim::{Aabb, Camera, MeshAnimation, SampledScene, Skin};
+use glam::Vec3;
+use rayon::prelude::*;
+
+use crate::field::{Field, Tolerances};
+use crate::rig::{Pruned, Rig};
+use crate::velocity::CameraSpace;
+use crate::{
+    CameraSelect, MotionOffsets, OffsetOptions, Result, SmearError, DEFAULT_STILL_TOLERANCE,
+    DEFAULT_ZERO_LENGTH, STILL_ROUNDING_FACTOR,
+};
+
+/// How an object's offsets are computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OffsetMode {
+    /// A simple object on its own: separation plane of Eq. 1.
+    Simple,
+    /// Part of a skinned character treated as one simple object (whole-body mode, Fig. 14).
+    WholeBody,
+    /// A skinned mesh: ribbons of Eqs. 3–9.
+    Articulated,
+}
+
+/// A point on an object's surface: a triangle and barycentric coordinates (normalized to sum
+/// 1 on use). Motion lines start at such points (paper Section 4.3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfacePoint {
+    /// Triangle index in the object's mesh.
+    pub triangle: u32,
+    /// Barycentric weights of the triangle's three vertices.
+    pub barycentric: [f32; 3],
+}
+
+#[derive(Debug)]
+struct Slot<'a> {
+    anim: &'a MeshAnimation,
+    group: usize,
+    base: usize,
+}
+
+#[derive(Debug)]
+struct Group<'a> {
+    positions: Cow<'a, [Vec3]>,
+    vertices: usize,
+    mode: OffsetMode,
+    field: Field,
+    /// Unsmoothed vertex offsets, frame-major.
+    raw: Vec<f32>,
+}
+
+/// Motion offsets of every object of a sampled scene (or of one bare point cache), computed
+/// once and evaluated at vertices or arbitrary surface points.
+///
+/// Objects are grouped so that a character stays continuous across its meshes: all meshes
+/// skinned to one skeleton tree form one articulated group (Eqs. 3–9, neighbourhood maxima of
+/// Eq. 9 taken over all of them); in whole-body mode they form one simple object together
+/// with the rigid props parented to its joints. Other objects, including props parented to a
+/// joint outside whole-body mode, are simple objects moving with whatever carries them.
+#[derive(Debug)]
+pub struct OffsetSolver<'a> {
+    frames: usize,
+    smooth: usize,
+    slots: Vec<Slot<'a>>,
+    groups: Vec<Group<'a>>,
+}
+
+fn resolve_camera<'c>(
+    cameras: &'c [Camera],
+    select: &Option<CameraSelect>,
+) -> Result<Option<&'c Camera>> {
+    let Some(select) = select else {
+        return Ok(None);
+    };
+    let found = match select {
+        CameraSelect::Index(i) => cameras.get(*i),
+        CameraSelect::Name(n) => cameras.iter().find(|c| c.name == *n),
+    };
+    found.map(Some).ok_or_else(|| SmearError::UnknownCamera {
+        name: match select {
+            CameraSelect::Index(i) => i.to_string(),
+            CameraSelect::Name(n) => n.clone(),
+        },
+        available: cameras
+            .iter()
+            .map(|c| c.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", "),
+    })
+}
+
+/// Absolute tolerances from the bounding box of the first, middle and last frames.
+///
+/// The still tolerance is SPEC.md's `DEFAULT_STILL_TOLERANCE × diagonal`, raised to the f32
+/// rounding of the coordinates involved ([`STILL_ROUNDING_FACTOR`] × the largest absolute
+/// coordinate, camera translation included): below that a "velocity" is rounding noise
+/// (e.g. an object followed by the camera) and would give a random separation plane.
+fn tolerances(
+    positions: &[Vec3],
+    frames: usize,
+    vertices: usize,
+    space: Option<&CameraSpace>,
+) -> Tolerances {
+    let mut b = Aabb::EMPTY;
+    if vertices > 0 {
+        for f in [0, frames / 2, frames.saturating_sub(1)] {
+            b = b.union(Aabb::from_points(
+                &positions[f * vertices..(f + 1) * vertices],
+            ));
+        }
+    }
+    let diag = b.diagonal();
+    let mut scale = if b.is_empty() {
+        0.0
+    } else {
+        b.min.abs().max(b.max.abs()).max_element()
+    };
+    if let Some(c) = space {
+        scale = scale.max(c.max_translation());
+    }
+    Tolerances {
+        still: (DEFAULT_STILL_TOLERANCE * diag).max(STILL_ROUNDING_FACTOR * scale),
+        zero_length: DEFAULT_ZERO_LENGTH * diag,
+    }
+}
+
+/// Frame-major positions of several caches side by side (borrowed when there is one).
+fn merged_positions<'a>(parts: &[&'a MeshAnimation], frames: usize) -> Cow<'a, [Vec3]> {
+    if let [one] = parts {
+        return Cow::Borrowed(one.positions());
+    }
+    let n: usize = parts.iter().map(|a| a.vertex_count()).sum();
+    let mut out = Vec::with_capacity(n * frames);
+    for f in 0..frames {
+        for a in parts {
+            out.extend_from_slice(a.frame(f));
+        }
+    }
+    Cow::Owned(out)
+}
+
+fn merged_triangles(parts: &[&MeshAnimation]) -> Vec<[u32; 3]> {
+    let mut base = 0u32;
+    let mut out = Vec::new();
+    for a in parts {
+        out.extend(a.mesh.triangles.iter().map(|t| t.map(|i| i + base)));
+        base += a.vertex_count() as u32;
+    }
+    out
+}
+
+impl<'a> OffsetSolver<'a> {
+    /// Prepares the offsets of every object of `scene`.
+    ///
+    /// # Errors
+    /// Unknown pruned joint or camera, a pruned root with skinned vertices, or an inconsistent
+    /// scene (see [`SmearError`]).
+    ///
+    /// # Performance
+    /// Computes the per-frame planes, ribbons, Eq. 9 maxima and unsmoothed vertex offsets
+    /// (parallel over frames); [`OffsetSolver::all`] then only smooths (Eq. 2) and splits.
+    pub fn new(scene: &'a SampledScene, options: &OffsetOptions) -> Result<OffsetSolver<'a>> {
+        let frames = scene.frame_count;
+        let joints = scene.skeleton.len();
+        if joints > 0 && scene.bones.len() != frames * joints {
+            return Err(SmearError::InvalidScene(format!(
+                "{} bones for {frames} frames × {joints} joints",
+                scene.bones.len()
+            )));
+        }
+        for o in &scene.objects {
+            if o.animation.frame_count() != frames {
+                return Err(SmearError::InvalidScene(format!(
+                    "object '{}' has {} frames, the scene {frames}",
+                    o.name,
+                    o.animation.frame_count()
+                )));
+            }
+            if let Some(s) = &o.skin {
+                s.validate(o.animation.vertex_count(), joints)
+                    .map_err(|e| SmearError::InvalidScene(format!("object '{}': {e}", o.name)))?;
+            }
+        }
+        let pruned = Pruned::new(&scene.skeleton, &options.prune)?;
+        let camera = resolve_camera(&scene.cameras, &options.camera)?;
+        let space = camera.map(|c| CameraSpace::new(c, frames));
+
+        let root_of = |mut j: usize| {
+            while let Some(p) = scene.skeleton.joints[j].parent {
+                j = p;
+            }
+            j
+        };
+        // Group key: Some(root joint) for characters, None for a standalone simple object.
+        let mut keys: Vec<(Option<usize>, Vec<usize>)> = Vec::new();
+        for (i, o) in scene.objects.iter().enumerate() {
+            let skin_root = o
+                .skin
+                .as_ref()
+                .and_then(|s| s.joints.first())
+                .map(|&j| root_of(j));
+            let key = match (skin_root, o.parent_joint) {
+                (Some(r), _) => Some(r),
+                (None, Some(j)) if options.whole_body && j < joints => Some(root_of(j)),
+                _ => None,
+            };
+            match keys.iter_mut().find(|(k, _)| key.is_some() && *k == key) {
+                Some((_, members)) => members.push(i),
+                None => keys.push((key, vec![i])),
+            }
+        }
+
+        let mut slots: Vec<Option<Slot<'a>>> = (0..scene.objects.len()).map(|_| None).collect();
+        let mut groups = Vec::with_capacity(keys.len());
+        for (key, members) in keys {
+            let parts: Vec<&MeshAnimation> = members
+                .iter()
+                .map(|&i| &scene.objects[i].animation)
+                .collect();
+            let positions = merged_positions(&parts, frames);
+            let vertices: usize = parts.iter().map(|a| a.vertex_count()).sum();
+            let tol = tolerances(&positions, frames, vertices, space.as_ref());
+            let mode = match key {
+                None => OffsetMode::Simple,
+                Some(_) if options.whole_body => OffsetMode::WholeBody,
+                Some(_) => OffsetMode::Articulated,
+            };
+            let (field, raw) = if mode == OffsetMode::Articulated {
+                let skins: Vec<&Skin> = members
+                    .iter()
+                    .filter_map(|&i| scene.objects[i].skin.as_ref())
+                    .collect();
+                let rig = Rig::new(&scene.skeleton, &pruned, &skins)?;
+                Field::ribbons(
+                    rig,
+                    &positions,
+                    frames,
+                    &scene.bones,
+                    tol,
+                    space.as_ref(),
+                    options.collinear_weight,
+                )
+            } else {
+                let tris = merged_triangles(&parts);
+                Field::plane(&positions, frames, vertices, &tris, tol, space.as_ref())
+            };
+            let mut base = 0;
+            for (&i, a) in members.iter().zip(&parts) {
+                slots[i] = Some(Slot {
+                    anim: a,
+                    group: groups.len(),
+                    base,
+                });
+                base += a.vertex_count();
+            }
+            groups.push(Group {
+                positions,
+                vertices,
+                mode,
+                field,
+                raw,
+            });
+        }
+        Ok(OffsetSolver {
+            frames,
+            smooth: options.smooth,
+            slots: slots
+                .into_iter()
+                .map(|s| s.expect("every object is grouped"))
+                .collect(),
+            groups,
+        })
+    }
+
+    /// Prepares the offsets of a bare point cache, a simple object (Eq. 1).
+    ///
+    /// # Arguments
+    /// * `cameras` — cameras that `options.camera` may select from (may be empty).
+    ///
+    /// # Errors
+    /// [`SmearError::UnknownCamera`] when the selected camera is not in `cameras`;
+    /// [`SmearError::UnknownJoint`] when `options.prune` names a joint (there is no skeleton).
+    pub fn from_animation(
+        anim: &'a MeshAnimation,
+        options: &OffsetOptions,
+        cameras: &[Camera],
+    ) -> Result<OffsetSolver<'a>> {
+        if let Some(name) = options.prune.first() {
+            return Err(SmearError::UnknownJoint {
+                name: name.clone(),
+                available: String::new(),
+            });
+        }
+        let camera = resolve_camera(cameras, &options.camera)?;
+        let frames = anim.frame_count();
+        let space = camera.map(|c| CameraSpace::new(c, frames));
+        let positions = Cow::Borrowed(anim.positions());
+        let tol = tolerances(&positions, frames, anim.vertex_count(), space.as_ref());
+        let (field, raw) = Field::plane(
+            &positions,
+            frames,
+            anim.vertex_count(),
+            &anim.mesh.triangles,
+            tol,
+            space.as_ref(),
+        );
+        Ok(OffsetSolver {
+            frames,
+            smooth: options.smooth,
+            slots: vec![Slot {
+                anim,
+                group: 0,
+                base: 0,
+            }],
+            groups: vec![Group {
+                positions,
+                vertices: anim.vertex_count(),
+                mode: OffsetMode::Simple,
+                field,
+                raw,
+            }],
+        })
+    }
+
+    /// Number of frames.
+    pub fn frame_count(&self) -> usize {
+        self.frames
+    }
+
+    /// Number of objects (scene order).
+    pub fn object_count(&self) -> usize {
+        self.slots.len()
+    }
+
+    /// How object `i`'s offsets are computed (`None` when out of range).
+    pub fn mode(&self, i: usize) -> Option<OffsetMode> {
+        self.slots.get(i).map(|s| self.groups[s.group].mode)
+    }
+
+    fn slot(&self, i: usize) -> Result<&Slot<'a>> {
+        self.slots.get(i).ok_or(SmearError::UnknownObject {
+            index: i,
+            count: self.slots.len(),
+        })
+    }
+
+    fn group_offsets(&self, g: usize) -> Vec<f32> {
+        let grp = &self.groups[g];
+        crate::smooth_in_time(&grp.raw, self.frames, grp.vertices, self.smooth)
+    }
+
+    fn split(&self, g: usize, values: &[f32], slot: &Slot<'_>) -> MotionOffsets {
+        let (n, nv) = (self.groups[g].vertices, slot.anim.vertex_count());
+        let mut out = Vec::with_capacity(self.frames * nv);
+        for f in 0..self.frames {
+            out.extend_from_slice(&values[f * n + slot.base..f * n + slot.base + nv]);
+        }
+        MotionOffsets::new(self.frames, nv, out).expect("frames × vertices")
+    }
+
+    /// Smoothed (Eq. 2) offsets of every vertex of object `i`.
+    ///
+    /// # Errors
+    /// [`SmearError::UnknownObject`] when `i` is out of range.
+    ///
+    /// # Performance
+    /// Smooths the object's whole group (a character's meshes); use [`OffsetSolver::all`] for
+    /// every object.
+    pub fn vertex_offsets(&self, i: usize) -> Result<MotionOffsets> {
+        let slot = self.slot(i)?;
+        let values = self.group_offsets(slot.group);
+        Ok(self.split(slot.group, &values, slot))
+    }
+
+    /// Smoothed offsets of every object, in object order.
+    pub fn all(&self) -> Vec<MotionOffsets> {
+        let per_group: Vec<Vec<f32>> = (0..self.groups.len())
+            .map(|g| self.group_offsets(g))
+            .collect();
+        self.slots
+            .iter()
+            .map(|s| self.split(s.group, &per_group[s.group], s))
+            .collect()
+    }
+
+    /// Smoothed offsets at surface points of object `i` (Section 4.3: Eq. 8 evaluated at the
+    /// points' own positions, skin weights interpolated barycentrically, the neighbourhood
+    /// maxima of the mesh).
+    ///
+    /// # Returns
+    /// `frames × points` offsets.
+    ///
+    /// # Errors
+    /// [`SmearError::UnknownObject`], or [`SmearError::InvalidSurfacePoint`] for a triangle out
+    /// of range or unusable barycentric coordinates.
+    pub fn surface_offsets(&self, i: usize, points: &[SurfacePoint]) -> Result<MotionOffsets> {
+        let slot = self.slot(i)?;
+        let grp = &self.groups[slot.group];
+        let tris = &slot.anim.mesh.triangles;
+        // Per point: three group vertices and weights, then merged influences (CSR).
+        let mut corners = Vec::with_capacity(points.len());
+        let (mut start, mut joints, mut weights) = (vec![0u32], Vec::new(), Vec::new());
+        let mut row: Vec<(u32, f32)> = Vec::new();
+        for (k, pt) in points.iter().enumerate() {
+            let bad = |reason: String| SmearError::InvalidSurfacePoint { index: k, reason };
+            let tri = tris.get(pt.triangle as usize).ok_or_else(|| {
+                bad(format!(
+                    "triangle {} does not exist ({} triangles)",
+                    pt.triangle,
+                    tris.len()
+                ))
+            })?;
+            let b = pt.barycentric;
+            let sum = b[0] + b[1] + b[2];
+            if !(b.iter().all(|x| x.is_finite() && *x >= 0.0) && sum > 0.0) {
+                return Err(bad(format!(
+                    "barycentric coordinates {b:?} must be finite, ≥ 0, not all 0"
+                )));
+            }
+            let c = [0, 1, 2].map(|j| (slot.base + tri[j] as usize, b[j] / sum));
+            row.clear();
+            if let Field::Ribbons(rf) = &grp.field {
+                for &(v, bw) in &c {
+                    let (js, ws) = rf.rig.influences(v);
+                    for (&j, &w) in js.iter().zip(ws) {
+                        match row.iter_mut().find(|e| e.0 == j) {
+                            Some(e) => e.1 += bw * w,
+                            None => row.push((j, bw * w)),
+                        }
+                    }
+                }
+            }
+            joints.extend(row.iter().map(|e| e.0));
+            weights.extend(row.iter().map(|e| e.1));
+            start.push(joints.len() as u32);
+            corners.push(c);
+        }
+        let np = points.len();
+        let mut raw = vec![0.0f32; self.frames * np];
+        if np > 0 {
+            raw.par_chunks_mut(np).enumerate().for_each(|(f, dst)| {
+                let pos = &grp.positions[f * grp.vertices..(f + 1) * grp.vertices];
+                for (k, d) in dst.iter_mut().enumerate() {
+                    let p: Vec3 = corners[k].iter().map(|&(v, w)| w * pos[v]).sum();
+                    let (a, b) = (start[k] as usize, start[k + 1] as usize);
+                    *d = grp.field.eval(f, p, &joints[a..b], &weights[a..b]);
+                }
+            });
+        }
+        let values = crate::smooth_in_time(&raw, self.frames, np, self.smooth);
+        MotionOffsets::new(self.frames, np, values)
+    }
+}
+
+/// Motion offsets of every object of a sampled scene (see [`OffsetSolver`]).
+///
+/// # Errors
+/// As [`OffsetSolver::new`].
+pub fn scene_offsets(scene: &SampledScene, options: &OffsetOptions) -> Result<Vec<MotionOffsets>> {
+    Ok(OffsetSolver::new(scene, options)?.all())
+}
+
+/// Motion offsets of a bare point cache treated as a simple object (Eqs. 1–2).
+///
+/// # Errors
+/// As [`OffsetSolver::from_animation`] with no camera.
+pub fn mesh_offsets(anim: &MeshAnimation, options: &OffsetOptions) -> Result<MotionOffsets> {
+    let s = OffsetSolver::from_animation(anim, options, &[])?;
+    Ok(s.all().remove(0))
+}
