@@ -35,6 +35,8 @@ enum Command {
     Render(commands::render::RenderArgs),
     /// Smear frames: motion offsets (Basset et al. 2024).
     Smear(commands::smear::SmearArgs),
+    /// Replacement libraries for 3D-printed stop-motion (StopShop).
+    Stopmo(commands::stopmo::StopmoArgs),
 }
 
 fn main() -> ExitCode {
@@ -47,6 +49,7 @@ fn main() -> ExitCode {
         Command::Loa(a) => commands::loa::run(&ctx, a),
         Command::Render(a) => commands::render::run(&ctx, a),
         Command::Smear(a) => commands::smear::run(&ctx, a),
+        Command::Stopmo(a) => commands::stopmo::run(&ctx, a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

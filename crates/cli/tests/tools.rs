@@ -132,3 +132,77 @@ fn loa_line_writes_every_output_kind() {
         .iter()
         .any(|p| p[0] > 180 && p[1] < 90 && p[2] < 90));
 }
+
+#[test]
+fn stopmo_segment_face_writes_parts_report_and_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("face_parts.glb");
+    let report = dir.path().join("seg.json");
+    let png = dir.path().join("seg.png");
+    let face = data("face/ict-face-talk.glb");
+    // 2 fps keeps the test quick (120 frames of the 60 s talk).
+    ok(&[
+        "stopmo",
+        "segment",
+        face.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--fps",
+        "2",
+        "--part",
+        "upper=point:0,10,13",
+        "--part",
+        "lower=point:0,-14,10",
+        "--report",
+        report.to_str().unwrap(),
+        "--render",
+        png.to_str().unwrap(),
+    ]);
+    let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    assert_eq!(r["parts"], serde_json::json!(["upper", "lower"]));
+    assert_eq!(r["gamma"], 100.0);
+    assert!(r["cut_length"].as_f64().unwrap() > 10.0);
+    assert!(r["seam_vertices"].as_array().unwrap().len() > 50);
+    let tp = r["triangle_part"].as_array().unwrap();
+    assert!(tp.len() >= 18460, "every (cut) triangle has a part");
+    // One mesh node per part, each morphing through the same frames.
+    let scene = tkio::gltf::read(&out).unwrap();
+    let names: Vec<&str> = scene.nodes.iter().map(|n| n.name.as_str()).collect();
+    assert_eq!(names, ["upper", "lower"]);
+    assert!(scene.meshes.iter().all(|m| m.morph_targets.len() == 120));
+    let s = anim::sample(
+        &scene,
+        &anim::SampleOptions {
+            fps: 2.0,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(s.frame_count, 120);
+    // Seam vertices are shared by both parts and identical across frames: the parts' boundary
+    // positions coincide in every frame (mixing frames leaves no gap).
+    let upper = &s.objects[0].animation;
+    let lower = &s.objects[1].animation;
+    let shared: Vec<(usize, usize)> = (0..upper.vertex_count())
+        .filter_map(|i| {
+            let p = upper.frame(0)[i];
+            (0..lower.vertex_count())
+                .find(|&j| (lower.frame(0)[j] - p).length() < 1e-6)
+                .map(|j| (i, j))
+        })
+        .collect();
+    assert!(
+        shared.len() > 50,
+        "parts share their seam: {}",
+        shared.len()
+    );
+    for &(i, j) in &shared {
+        assert!(
+            (upper.frame(7)[i] - lower.frame(90)[j]).length() < 1e-4,
+            "gap at seam vertex {i}"
+        );
+    }
+    let img = render::decode_png(&std::fs::read(&png).unwrap()).unwrap();
+    assert!(img.width() > img.height(), "two panels side by side");
+    keep_for_validation(dir.path(), "stopmo_segment");
+}

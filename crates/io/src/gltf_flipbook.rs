@@ -32,48 +32,109 @@ pub fn write_animation(
     layout: AnimationLayout,
     colors: Option<&[[f32; 4]]>,
 ) -> Result<Vec<u8>> {
-    let (n, frames) = (anim.vertex_count(), anim.frame_count());
-    if let Some(c) = colors {
-        if c.len() != n * frames {
+    write_animations(&[(anim, colors)], layout)
+}
+
+/// Writes several point caches with the same frames into one `.glb`: one top-level node per
+/// cache, named after its mesh (a flipbook root with a child per frame, or one morphing
+/// mesh), all driven by one clip.
+///
+/// # Errors
+/// When the frame counts differ, colours have the wrong length, or a mesh is empty.
+pub fn write_animations(
+    parts: &[(&MeshAnimation, Option<&[[f32; 4]]>)],
+    layout: AnimationLayout,
+) -> Result<Vec<u8>> {
+    let Some((first, _)) = parts.first() else {
+        return Err(IoError::unsupported("nothing to write"));
+    };
+    let frames = first.frame_count();
+    for (anim, colors) in parts {
+        if anim.frame_count() != frames {
             return Err(IoError::unsupported(format!(
-                "vertex colours: expected {} values (frames × vertices), got {}",
-                n * frames,
-                c.len()
+                "mesh '{}' has {} frames, expected {frames}",
+                anim.mesh.name,
+                anim.frame_count()
             )));
         }
+        let n = anim.vertex_count();
+        if let Some(c) = colors {
+            if c.len() != n * frames {
+                return Err(IoError::unsupported(format!(
+                    "vertex colours: expected {} values (frames × vertices), got {}",
+                    n * frames,
+                    c.len()
+                )));
+            }
+        }
     }
-    let colors_of = |f: usize| colors.map(|c| &c[f * n..(f + 1) * n]);
-    let times: Vec<f32> = (0..frames).map(|f| f as f32 / anim.fps).collect();
-    match layout {
-        AnimationLayout::Flipbook => flipbook(anim, &times, colors_of),
-        AnimationLayout::Morph => morph(anim, &times, colors_of(0)),
+    let times: Vec<f32> = (0..frames).map(|f| f as f32 / first.fps).collect();
+    let mut b = Builder::new();
+    let mut roots = Vec::new();
+    let mut channels = Vec::new();
+    for (anim, colors) in parts {
+        let n = anim.vertex_count();
+        let colors_of = |f: usize| colors.map(|c| &c[f * n..(f + 1) * n]);
+        let root = match layout {
+            AnimationLayout::Flipbook => flipbook(&mut b, anim, &times, colors_of, &mut channels)?,
+            AnimationLayout::Morph => morph(&mut b, anim, &times, colors_of(0), &mut channels)?,
+        };
+        roots.push(root);
+    }
+    let scene = b.root.push(json::Scene {
+        extensions: None,
+        extras: Default::default(),
+        name: None,
+        nodes: roots,
+    });
+    b.root.scene = Some(scene);
+    if !channels.is_empty() {
+        let name = if parts.len() == 1 {
+            mesh_name(first).to_string()
+        } else {
+            "parts".into()
+        };
+        let suffix = match layout {
+            AnimationLayout::Flipbook => "flipbook",
+            AnimationLayout::Morph => "morph",
+        };
+        write_clip(
+            &mut b,
+            &Clip {
+                name: format!("{name}_{suffix}"),
+                channels,
+            },
+        );
+    }
+    b.finish()
+}
+
+fn mesh_name(anim: &MeshAnimation) -> &str {
+    if anim.mesh.name.is_empty() {
+        "mesh"
+    } else {
+        anim.mesh.name.as_str()
     }
 }
 
 fn flipbook<'a>(
+    b: &mut Builder,
     anim: &MeshAnimation,
     times: &[f32],
     colors_of: impl Fn(usize) -> Option<&'a [[f32; 4]]>,
-) -> Result<Vec<u8>> {
+    channels: &mut Vec<Channel>,
+) -> Result<json::Index<json::Node>> {
     let frames = anim.frame_count();
-    let mut b = Builder::new();
     let mut shared = SharedTopology::default();
-    let name = if anim.mesh.name.is_empty() {
-        "mesh"
-    } else {
-        anim.mesh.name.as_str()
-    };
+    let name = mesh_name(anim);
     let mut children = Vec::with_capacity(frames);
-    let mut channels = Vec::new();
-    let root_index = frames; // nodes 0..frames are frames, then the root
     for f in 0..frames {
         let sm = frame_mesh(&anim.mesh, anim.frame(f), colors_of(f));
         let mesh = b.mesh(&sm, &mut shared)?;
-        let visible = if f == 0 { 1.0 } else { 0.0 };
         let node = b.root.push(json::Node {
             mesh: Some(mesh),
             name: Some(format!("{name}_f{:04}", f + 1)),
-            scale: (f != 0).then_some([visible; 3]),
+            scale: (f != 0).then_some([0.0; 3]),
             ..empty_node()
         });
         children.push(node);
@@ -90,7 +151,7 @@ fn flipbook<'a>(
                 v.extend([0.0; 3]);
             }
             channels.push(Channel {
-                node: f,
+                node: node.value(),
                 property: Property::Scale,
                 interpolation: Interpolation::Step,
                 times: t,
@@ -98,32 +159,20 @@ fn flipbook<'a>(
             });
         }
     }
-    let root = b.root.push(json::Node {
+    Ok(b.root.push(json::Node {
         name: Some(name.to_string()),
         children: Some(children),
         ..empty_node()
-    });
-    debug_assert_eq!(root.value(), root_index);
-    let scene = b.root.push(json::Scene {
-        extensions: None,
-        extras: Default::default(),
-        name: None,
-        nodes: vec![root],
-    });
-    b.root.scene = Some(scene);
-    if !channels.is_empty() {
-        write_clip(
-            &mut b,
-            &Clip {
-                name: format!("{name}_flipbook"),
-                channels,
-            },
-        );
-    }
-    b.finish()
+    }))
 }
 
-fn morph(anim: &MeshAnimation, times: &[f32], colors: Option<&[[f32; 4]]>) -> Result<Vec<u8>> {
+fn morph(
+    b: &mut Builder,
+    anim: &MeshAnimation,
+    times: &[f32],
+    colors: Option<&[[f32; 4]]>,
+    channels: &mut Vec<Channel>,
+) -> Result<json::Index<json::Node>> {
     let frames = anim.frame_count();
     let base = anim.frame(0);
     let mut sm = frame_mesh(&anim.mesh, base, colors);
@@ -141,46 +190,26 @@ fn morph(anim: &MeshAnimation, times: &[f32], colors: Option<&[[f32; 4]]>) -> Re
             .collect();
         sm.default_weights = vec![0.0; frames];
     }
-    let mut b = Builder::new();
     let mesh = b.mesh(&sm, &mut SharedTopology::default())?;
-    let name = if anim.mesh.name.is_empty() {
-        "mesh"
-    } else {
-        anim.mesh.name.as_str()
-    };
     let node = b.root.push(json::Node {
         mesh: Some(mesh),
-        name: Some(name.to_string()),
+        name: Some(mesh_name(anim).to_string()),
         ..empty_node()
     });
-    let scene = b.root.push(json::Scene {
-        extensions: None,
-        extras: Default::default(),
-        name: None,
-        nodes: vec![node],
-    });
-    b.root.scene = Some(scene);
     if frames > 1 {
         let mut values = vec![0.0f32; frames * frames];
         for f in 0..frames {
             values[f * frames + f] = 1.0;
         }
-        let ch = Channel {
-            node: 0,
+        channels.push(Channel {
+            node: node.value(),
             property: Property::Weights(frames),
             interpolation: Interpolation::Step,
             times: times.to_vec(),
             values,
-        };
-        write_clip(
-            &mut b,
-            &Clip {
-                name: format!("{name}_morph"),
-                channels: vec![ch],
-            },
-        );
+        });
     }
-    b.finish()
+    Ok(node)
 }
 
 fn empty_node() -> json::Node {

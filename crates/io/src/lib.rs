@@ -29,7 +29,7 @@ mod gltf_write;
 
 /// glTF 2.0: read `.gltf`/`.glb` into a scene, write scenes and point caches as `.glb`.
 pub mod gltf {
-    pub use crate::gltf_flipbook::{write_animation, AnimationLayout};
+    pub use crate::gltf_flipbook::{write_animation, write_animations, AnimationLayout};
     pub use crate::gltf_read::{read, read_bytes};
     pub use crate::gltf_write::write_glb;
 }

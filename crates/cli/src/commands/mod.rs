@@ -7,6 +7,7 @@ pub mod loa;
 mod loa_render;
 pub mod render;
 pub mod smear;
+pub mod stopmo;
 
 /// Options every command sees.
 #[derive(Debug, Clone, Copy)]

@@ -1,0 +1,250 @@
+//! `toonkit stopmo …`: replacement libraries for 3D-printed stop-motion (StopShop).
+//!
+//! `segment` cuts a face animation into parts and homogenizes the seams (Sections 3.1–3.2).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anim::glam::Vec3;
+use anim::MeshAnimation;
+use anyhow::{bail, Context as _, Result};
+use clap::{Args, Subcommand, ValueEnum};
+use serde_json::json;
+use stopmo::segment::{PartSpec, Seed, SegmentOptions, Segmentation};
+
+use super::Context;
+use crate::input::{self, InputArgs};
+
+/// Arguments of `toonkit stopmo`.
+#[derive(Debug, Args)]
+pub struct StopmoArgs {
+    #[command(subcommand)]
+    pub command: StopmoCommand,
+}
+
+/// Subcommands of `toonkit stopmo`.
+#[derive(Debug, Subcommand)]
+pub enum StopmoCommand {
+    /// Cut the animation into parts along low-motion seams and make the seams identical in
+    /// every frame (StopShop Sections 3.1–3.2).
+    Segment(SegmentArgs),
+}
+
+/// glTF layout of the segmented parts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum PartsLayout {
+    /// One mesh node per part with a morph target per frame.
+    #[default]
+    Morph,
+    /// One flipbook per part.
+    Flipbook,
+}
+
+/// Arguments of `toonkit stopmo segment`.
+#[derive(Debug, Args)]
+pub struct SegmentArgs {
+    /// Input mesh animation (fixed topology), any readable format.
+    pub input: PathBuf,
+    /// Output `.glb`: one mesh node per part, named after the part, all with the same frames.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// A part and its seed: `NAME=tri:ID` (triangle id) or `NAME=point:X,Y,Z` (snapped to the
+    /// nearest triangle). Repeat for each part; repeat a name for several seeds.
+    #[arg(long = "part", value_name = "NAME=SEED")]
+    pub parts: Vec<String>,
+    /// Choose N parts automatically (farthest seeds on per-triangle motion statistics).
+    #[arg(long, conflicts_with = "parts")]
+    pub auto_parts: Option<usize>,
+    /// Weight γ of the seam term (Eq. 1), after scaling the model to a unit box.
+    #[arg(long, default_value_t = stopmo::segment::DEFAULT_GAMMA)]
+    pub gamma: f64,
+    /// Laplacian smoothing iterations of the part boundaries (0: cut along mesh edges).
+    #[arg(long = "smooth-iters")]
+    pub smooth_iters: Option<usize>,
+    /// Keep the seams as they move (skip Section 3.2).
+    #[arg(long)]
+    pub no_homogenize: bool,
+    /// Write the JSON report (parts, triangle_part, seam_vertices, gamma, cut_length).
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// Write a PNG: parts on the average mesh and the average displacement (paper Fig. 5).
+    #[arg(long)]
+    pub render: Option<PathBuf>,
+    /// glTF layout of the parts.
+    #[arg(long = "as", value_enum, default_value_t = PartsLayout::Morph)]
+    pub layout: PartsLayout,
+    #[command(flatten)]
+    pub input_args: InputArgs,
+}
+
+/// Runs `toonkit stopmo …`.
+pub fn run(ctx: &Context, args: StopmoArgs) -> Result<()> {
+    match args.command {
+        StopmoCommand::Segment(a) => segment(ctx, a),
+    }
+}
+
+/// Parses `NAME=tri:ID` or `NAME=point:X,Y,Z` and groups seeds by part name (in order).
+fn parse_parts(specs: &[String]) -> Result<Vec<PartSpec>> {
+    let mut parts: Vec<PartSpec> = Vec::new();
+    for s in specs {
+        let (name, seed) = s
+            .split_once('=')
+            .with_context(|| format!("--part {s}: expected NAME=tri:ID or NAME=point:X,Y,Z"))?;
+        let seed = if let Some(id) = seed.strip_prefix("tri:") {
+            Seed::Triangle(
+                id.trim()
+                    .parse()
+                    .with_context(|| format!("--part {s}: bad triangle id"))?,
+            )
+        } else if let Some(p) = seed.strip_prefix("point:") {
+            let v: Vec<f32> = p
+                .split(',')
+                .map(|x| x.trim().parse::<f32>())
+                .collect::<Result<_, _>>()
+                .with_context(|| format!("--part {s}: bad point"))?;
+            if v.len() != 3 || !v.iter().all(|x| x.is_finite()) {
+                bail!("--part {s}: a point needs three finite coordinates");
+            }
+            Seed::Point(Vec3::new(v[0], v[1], v[2]))
+        } else {
+            bail!("--part {s}: the seed must start with tri: or point:");
+        };
+        match parts.iter_mut().find(|p| p.name == name) {
+            Some(p) => p.seeds.push(seed),
+            None => parts.push(PartSpec::new(name, vec![seed])),
+        }
+    }
+    Ok(parts)
+}
+
+fn segment(ctx: &Context, args: SegmentArgs) -> Result<()> {
+    let start = Instant::now();
+    if tkio::Format::from_extension(&args.output) != Some(tkio::Format::Glb) {
+        bail!(
+            "{}: the segmented animation is written as .glb",
+            args.output.display()
+        );
+    }
+    let sampled = input::open(&args.input, &args.input_args)?;
+    let anim = input::merged(&args.input, &sampled)?;
+    let parts = match args.auto_parts {
+        Some(n) => stopmo::segment::auto_parts(&anim, n)
+            .with_context(|| args.input.display().to_string())?,
+        None => parse_parts(&args.parts)?,
+    };
+    if parts.len() < 2 {
+        bail!("give at least two parts (--part NAME=SEED twice, or --auto-parts N)");
+    }
+    let mut options = SegmentOptions {
+        gamma: args.gamma,
+        homogenize: !args.no_homogenize,
+        ..SegmentOptions::default()
+    };
+    if let Some(k) = args.smooth_iters {
+        options.smooth_iterations = k;
+    }
+    let spinner = crate::progress::spinner("segmenting", ctx.json);
+    let seg = stopmo::segment::segment(&anim, &parts, &options)
+        .with_context(|| args.input.display().to_string())?;
+    let pieces = seg.parts()?;
+    let layout = match args.layout {
+        PartsLayout::Morph => tkio::gltf::AnimationLayout::Morph,
+        PartsLayout::Flipbook => tkio::gltf::AnimationLayout::Flipbook,
+    };
+    let refs: Vec<(&MeshAnimation, Option<&[[f32; 4]]>)> =
+        pieces.iter().map(|p| (&p.animation, None)).collect();
+    let bytes = tkio::gltf::write_animations(&refs, layout).map_err(|e| e.at(&args.output))?;
+    tkio::write_atomic(&args.output, &bytes)?;
+    let report = serde_json::to_value(seg.report())?;
+    if let Some(path) = &args.report {
+        tkio::write_atomic(path, serde_json::to_string_pretty(&report)?.as_bytes())?;
+    }
+    if let Some(path) = &args.render {
+        tkio::write_atomic(path, &render_parts(&seg)?)?;
+    }
+    spinner.finish_and_clear();
+    let summary = json!({
+        "input": args.input,
+        "output": args.output,
+        "parts": pieces.iter().map(|p| json!({"name": p.name, "vertices": p.animation.vertex_count(),
+            "triangles": p.animation.mesh.triangle_count()})).collect::<Vec<_>>(),
+        "frames": anim.frame_count(),
+        "gamma": seg.gamma,
+        "cut_length": seg.cut_length,
+        "seam_vertices": seg.seam_vertices.len(),
+        "homogenization": report["homogenization"],
+        "seconds": start.elapsed().as_secs_f64(),
+    });
+    ctx.report(&summary, || {
+        let names: Vec<String> = pieces
+            .iter()
+            .map(|p| {
+                format!(
+                    "{} ({} triangles)",
+                    p.name,
+                    p.animation.mesh.triangle_count()
+                )
+            })
+            .collect();
+        format!(
+            "wrote {}: {} over {} frames, cut length {:.3}, {} seam vertices, {:.2} s",
+            args.output.display(),
+            names.join(", "),
+            anim.frame_count(),
+            seg.cut_length,
+            seg.seam_vertices.len(),
+            start.elapsed().as_secs_f64()
+        )
+    });
+    Ok(())
+}
+
+/// Paper Fig. 5: the parts on the average mesh, beside the mean displacement from the
+/// average mesh (of the output: homogenized seams show as still).
+fn render_parts(seg: &Segmentation) -> Result<Vec<u8>> {
+    let out = &seg.animation;
+    let avg = out.average_positions();
+    let mesh = &out.mesh;
+    let part_colors: Vec<render::Color> = seg
+        .triangle_part
+        .iter()
+        .map(|&p| render::categorical(p as usize))
+        .collect();
+    let frames = out.frame_count() as f32;
+    let mut disp = vec![0f32; out.vertex_count()];
+    for f in out.frames() {
+        for (v, (p, a)) in f.iter().zip(&avg).enumerate() {
+            disp[v] += (*p - *a).length() / frames;
+        }
+    }
+    let max = disp.iter().copied().fold(0.0f32, f32::max).max(1e-12);
+    let disp_colors: Vec<render::Color> = disp
+        .iter()
+        .map(|d| render::ColorMap::Sequential.map(d / max))
+        .collect();
+    let renderer = render::Renderer::new(480, 480)?;
+    let view = render::View::fit(
+        anim::Aabb::from_points(&avg),
+        render::ViewDirection::Front,
+        renderer.aspect(),
+    );
+    let item = |colors| render::MeshItem::new(&avg, &mesh.triangles).colors(colors);
+    let left = renderer.render(
+        &render::DrawList::new().mesh(item(render::MeshColors::PerTriangle(&part_colors))),
+        &view,
+    )?;
+    let right = renderer.render(
+        &render::DrawList::new().mesh(item(render::MeshColors::PerVertex(&disp_colors))),
+        &view,
+    )?;
+    let sheet = render::contact_sheet(
+        &[left, right],
+        None,
+        &render::SheetOptions {
+            columns: 2,
+            ..Default::default()
+        },
+    )?;
+    Ok(render::encode_png(&sheet)?)
+}

@@ -1,0 +1,247 @@
+//! One part's optimization problem: validated inputs and reduced coordinates.
+
+use std::ops::Range;
+
+use anim::MeshAnimation;
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::error::{LibraryError, Result};
+use super::subspace::{reduce, Subspace, SubspaceOptions};
+
+/// Per-part inputs beyond the animation (all optional).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PartSetup {
+    /// Per-vertex saliency weights `w` (Section 3.3); `None` = all 1.
+    pub saliency: Option<Vec<f32>>,
+    /// Pre-defined pieces (a fully or partially fixed library), model units, one position per
+    /// vertex. They take labels `0..fixed.len()`; free pieces follow.
+    pub fixed: Vec<Vec<Vec3>>,
+    /// Frames that start a new, unrelated clip (the cut vector `c` of Eq. 12); 0 is implied.
+    pub cuts: Vec<usize>,
+}
+
+/// One part, ready to be solved for any library size.
+///
+/// Building it validates the inputs and reduces the frames once (see
+/// [`SubspaceOptions`]); [`PartProblem::solve`] can then be called for many sizes cheaply.
+#[derive(Debug, Clone)]
+pub struct PartProblem<'a> {
+    pub(crate) name: String,
+    pub(crate) anim: &'a MeshAnimation,
+    /// Saliency per vertex (`None` = uniform).
+    pub(crate) weights: Option<Vec<f64>>,
+    /// Fixed pieces, row-major `fixed × 3m` (model units).
+    pub(crate) fixed_rows: Vec<f64>,
+    pub(crate) fixed: usize,
+    pub(crate) chains: Vec<Range<usize>>,
+    /// Reduced coordinates: frames first, then the fixed pieces.
+    pub(crate) sub: Subspace,
+    /// ‖y_f‖² per frame.
+    pub(crate) xx: Vec<f64>,
+    /// ‖y_f − y_{f−1}‖² per frame (0 at chain starts).
+    pub(crate) dxx: Vec<f64>,
+}
+
+/// Splits `0..n` at the cuts.
+pub(crate) fn chains(n: usize, cuts: &[usize]) -> Result<Vec<Range<usize>>> {
+    let mut c: Vec<usize> = cuts.to_vec();
+    if let Some(&bad) = c.iter().find(|&&c| c >= n) {
+        return Err(LibraryError::BadCut {
+            cut: bad,
+            frames: n,
+        });
+    }
+    c.push(0);
+    c.push(n);
+    c.sort_unstable();
+    c.dedup();
+    Ok(c.windows(2).map(|w| w[0]..w[1]).collect())
+}
+
+impl<'a> PartProblem<'a> {
+    /// Validates one part and reduces its frames.
+    ///
+    /// # Arguments
+    /// * `anim` — the part's animation (frames × vertices);
+    /// * `setup` — saliency, fixed pieces, cuts;
+    /// * `subspace` — reduction options;
+    /// * `seed` — seed of the random sketch.
+    ///
+    /// # Errors
+    /// [`LibraryError::EmptyPart`], [`LibraryError::BadSaliency`],
+    /// [`LibraryError::BadFixedPiece`], [`LibraryError::BadCut`].
+    ///
+    /// # Performance
+    /// One centred f32 copy of the frames plus the reduction (see [`SubspaceOptions`]).
+    pub fn new(
+        anim: &'a MeshAnimation,
+        setup: &PartSetup,
+        subspace: &SubspaceOptions,
+        seed: u64,
+    ) -> Result<PartProblem<'a>> {
+        let name = anim.mesh.name.clone();
+        let m = anim.vertex_count();
+        if m == 0 {
+            return Err(LibraryError::EmptyPart { part: name });
+        }
+        let n = anim.frame_count();
+        let weights = match &setup.saliency {
+            None => None,
+            Some(w) => {
+                let reason = if w.len() != m {
+                    Some(format!("{} weights for {m} vertices", w.len()))
+                } else if w.iter().any(|v| !v.is_finite() || *v < 0.0) {
+                    Some("a weight is negative or not finite".to_string())
+                } else if w.iter().all(|&v| v == 0.0) {
+                    Some("all weights are zero".to_string())
+                } else {
+                    None
+                };
+                if let Some(reason) = reason {
+                    return Err(LibraryError::BadSaliency { part: name, reason });
+                }
+                Some(w.iter().map(|&v| f64::from(v)).collect::<Vec<f64>>())
+            }
+        };
+        let mut fixed_rows = Vec::with_capacity(setup.fixed.len() * 3 * m);
+        for (i, piece) in setup.fixed.iter().enumerate() {
+            let reason = if piece.len() != m {
+                Some(format!("{} positions for {m} vertices", piece.len()))
+            } else if !piece.iter().all(|p| p.is_finite()) {
+                Some("a position is not finite".to_string())
+            } else {
+                None
+            };
+            if let Some(reason) = reason {
+                return Err(LibraryError::BadFixedPiece {
+                    part: name,
+                    piece: i,
+                    reason,
+                });
+            }
+            fixed_rows.extend(piece.iter().flat_map(|p| p.to_array().map(f64::from)));
+        }
+        let chains = chains(n, &setup.cuts)?;
+
+        // Centred, saliency-scaled rows Z = [X; R_fixed] (x̄ = mean frame).
+        let mut mean = vec![0.0f64; 3 * m];
+        for f in anim.frames() {
+            for (acc, p) in mean.chunks_exact_mut(3).zip(f) {
+                acc[0] += f64::from(p.x);
+                acc[1] += f64::from(p.y);
+                acc[2] += f64::from(p.z);
+            }
+        }
+        mean.iter_mut().for_each(|v| *v /= n as f64);
+        let scale: Vec<f64> = (0..3 * m)
+            .map(|c| weights.as_ref().map_or(1.0, |w| w[c / 3].sqrt()))
+            .collect();
+        let rows = n + setup.fixed.len();
+        let mut z = vec![0.0f32; rows * 3 * m];
+        z.par_chunks_mut(3 * m).enumerate().for_each(|(r, row)| {
+            for (c, out) in row.iter_mut().enumerate() {
+                let v = if r < n {
+                    f64::from(anim.frame(r)[c / 3][c % 3])
+                } else {
+                    fixed_rows[(r - n) * 3 * m + c]
+                };
+                *out = ((v - mean[c]) * scale[c]) as f32;
+            }
+        });
+        let sub = reduce(&z, rows, 3 * m, subspace, seed)?;
+        drop(z);
+        let q = sub.dim;
+        let row = |f: usize| &sub.coords[f * q..(f + 1) * q];
+        let xx = (0..n).map(|f| row(f).iter().map(|v| v * v).sum()).collect();
+        let mut dxx = vec![0.0; n];
+        for ch in &chains {
+            for f in ch.start + 1..ch.end {
+                dxx[f] = row(f)
+                    .iter()
+                    .zip(row(f - 1))
+                    .map(|(a, b)| (a - b) * (a - b))
+                    .sum();
+            }
+        }
+        Ok(PartProblem {
+            name,
+            anim,
+            weights,
+            fixed_rows,
+            fixed: setup.fixed.len(),
+            chains,
+            sub,
+            xx,
+            dxx,
+        })
+    }
+
+    /// Name of the part (its mesh name).
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Number of frames.
+    pub fn frames(&self) -> usize {
+        self.anim.frame_count()
+    }
+
+    /// Number of vertices.
+    pub fn vertices(&self) -> usize {
+        self.anim.vertex_count()
+    }
+
+    /// Number of fixed (pre-defined) pieces.
+    pub fn fixed_pieces(&self) -> usize {
+        self.fixed
+    }
+
+    /// The part's animation.
+    pub fn animation(&self) -> &'a MeshAnimation {
+        self.anim
+    }
+
+    /// Clips of the frame chain (split at the cuts).
+    pub fn chains(&self) -> &[Range<usize>] {
+        &self.chains
+    }
+
+    /// Fraction of the centred, weighted frame energy kept by the reduction (1 = exact).
+    pub fn captured(&self) -> f64 {
+        self.sub.captured
+    }
+
+    /// Dimension of the reduced coordinates.
+    pub fn reduced_dimension(&self) -> usize {
+        self.sub.dim
+    }
+
+    /// Row-major `frames × dim` reduced coordinates of the frames.
+    pub(crate) fn frame_coords(&self) -> &[f64] {
+        &self.sub.coords[..self.frames() * self.sub.dim]
+    }
+
+    /// Row-major `fixed × dim` reduced coordinates of the fixed pieces.
+    pub(crate) fn fixed_coords(&self) -> &[f64] {
+        &self.sub.coords[self.frames() * self.sub.dim..]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cuts_split_the_chain() {
+        assert_eq!(chains(10, &[]).unwrap(), vec![0..10]);
+        assert_eq!(chains(10, &[0, 3, 7, 3]).unwrap(), vec![0..3, 3..7, 7..10]);
+        assert_eq!(
+            chains(10, &[10]),
+            Err(LibraryError::BadCut {
+                cut: 10,
+                frames: 10
+            })
+        );
+    }
+}

@@ -1,0 +1,514 @@
+//! The segmentation pipeline: seeds → graph cut (Eqs. 1–3) → smooth boundaries → cut mesh →
+//! seam homogenization (Eqs. 4–9) → per-part animations.
+
+use anim::{Mesh, MeshAnimation};
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+
+use super::cut::{cut_mesh, CutMesh, VertexSource, DEFAULT_SNAP};
+use super::error::{Result, SegmentError};
+use super::homogenize::{HomogenizeStats, Homogenizer};
+use super::problem::{SegmentationProblem, DEFAULT_GAMMA};
+use super::seeds::{auto_seeds, resolve_seeds, PartSpec, Seed};
+use super::smooth::{smooth_votes, vertex_votes, DEFAULT_SMOOTH_ITERATIONS, DEFAULT_SMOOTH_STEP};
+use super::topology::Topology;
+use super::weld::{Weld, DEFAULT_WELD_EPSILON};
+
+/// Parameters of [`segment`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SegmentOptions {
+    /// Weight γ of the binary term of Eq. 1 (unit-box units).
+    pub gamma: f64,
+    /// Laplacian smoothing iterations of the part votes (0 keeps the jagged per-triangle
+    /// boundary, cut exactly along edges).
+    pub smooth_iterations: usize,
+    /// Step of one smoothing iteration, in (0, 1].
+    pub smooth_step: f64,
+    /// Snap threshold of level-set crossings (fraction of an edge), in [0, 0.49].
+    pub snap: f64,
+    /// Homogenize the seams (Section 3.2).
+    pub homogenize: bool,
+    /// Welding tolerance relative to the bounding-box diagonal.
+    pub weld_epsilon: f32,
+}
+
+impl Default for SegmentOptions {
+    fn default() -> SegmentOptions {
+        SegmentOptions {
+            gamma: DEFAULT_GAMMA,
+            smooth_iterations: DEFAULT_SMOOTH_ITERATIONS,
+            smooth_step: DEFAULT_SMOOTH_STEP,
+            snap: DEFAULT_SNAP,
+            homogenize: true,
+            weld_epsilon: DEFAULT_WELD_EPSILON,
+        }
+    }
+}
+
+/// The result of [`segment`].
+#[derive(Debug, Clone)]
+pub struct Segmentation {
+    /// Part names, in part order.
+    pub part_names: Vec<String>,
+    /// γ used.
+    pub gamma: f64,
+    /// Seed triangles of every part (input triangle ids).
+    pub seeds: Vec<Vec<u32>>,
+    /// Graph-cut label of every input triangle (before boundary smoothing).
+    pub input_triangle_part: Vec<u32>,
+    /// The cut (and, if requested, homogenized) animation: input vertices first, in input
+    /// order, then the new boundary vertices; same frames as the input.
+    pub animation: MeshAnimation,
+    /// How every vertex of `animation` derives from the input vertices.
+    pub cut: CutMesh,
+    /// Part of every triangle of `animation`.
+    pub triangle_part: Vec<u32>,
+    /// Vertices of `animation` on a part boundary, sorted.
+    pub seam_vertices: Vec<u32>,
+    /// Length of the part boundaries on the average mesh, in model units.
+    pub cut_length: f64,
+    /// Homogenization measurements (`None` when not requested).
+    pub homogenization: Option<HomogenizeStats>,
+}
+
+/// One part as its own animation.
+#[derive(Debug, Clone)]
+pub struct Part {
+    /// Part name.
+    pub name: String,
+    /// The part's triangles and vertices, all frames.
+    pub animation: MeshAnimation,
+    /// For every vertex of the part, its vertex in [`Segmentation::animation`].
+    pub vertices: Vec<u32>,
+}
+
+/// The JSON report of `toonkit stopmo segment --report` (SPEC "Output layouts").
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct SegmentReport {
+    /// Part names.
+    pub parts: Vec<String>,
+    /// Part of every triangle of the output mesh.
+    pub triangle_part: Vec<u32>,
+    /// Output vertices on part boundaries.
+    pub seam_vertices: Vec<u32>,
+    /// γ used.
+    pub gamma: f64,
+    /// Boundary length on the average mesh (model units).
+    pub cut_length: f64,
+    /// Homogenization measurements, when run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub homogenization: Option<HomogenizeStats>,
+}
+
+impl Segmentation {
+    /// Number of parts.
+    pub fn part_count(&self) -> usize {
+        self.part_names.len()
+    }
+
+    /// Every part as its own animation (vertices in increasing order of their id in
+    /// [`Segmentation::animation`]; seam vertices are copied into every part they bound).
+    pub fn parts(&self) -> Result<Vec<Part>> {
+        (0..self.part_count()).map(|j| self.part(j)).collect()
+    }
+
+    /// Part `j` as its own animation.
+    ///
+    /// # Errors
+    /// [`SegmentError::Parameter`] when `j` is not a part.
+    pub fn part(&self, j: usize) -> Result<Part> {
+        if j >= self.part_count() {
+            return Err(SegmentError::Parameter(format!("no part {j}")));
+        }
+        let mesh = &self.animation.mesh;
+        let mut local = vec![u32::MAX; mesh.vertex_count()];
+        let tris: Vec<[u32; 3]> = mesh
+            .triangles
+            .iter()
+            .zip(&self.triangle_part)
+            .filter(|(_, p)| **p as usize == j)
+            .map(|(t, _)| *t)
+            .collect();
+        for t in &tris {
+            for &i in t {
+                local[i as usize] = 0;
+            }
+        }
+        let mut vertices = Vec::new();
+        for (i, l) in local.iter_mut().enumerate() {
+            if *l == 0 {
+                *l = vertices.len() as u32;
+                vertices.push(i as u32);
+            }
+        }
+        let pick =
+            |src: &[Vec3]| -> Vec<Vec3> { vertices.iter().map(|&i| src[i as usize]).collect() };
+        let mut part_mesh = Mesh::new(
+            self.part_names[j].clone(),
+            pick(&mesh.positions),
+            tris.iter().map(|t| t.map(|i| local[i as usize])).collect(),
+        );
+        part_mesh.normals = mesh.normals.as_ref().map(|n| pick(n));
+        part_mesh.uvs = mesh
+            .uvs
+            .as_ref()
+            .map(|u| vertices.iter().map(|&i| u[i as usize]).collect());
+        part_mesh.colors = mesh
+            .colors
+            .as_ref()
+            .map(|c| vertices.iter().map(|&i| c[i as usize]).collect());
+        let positions: Vec<Vec3> = self
+            .animation
+            .frames()
+            .flat_map(|f| vertices.iter().map(move |&i| f[i as usize]))
+            .collect();
+        let mut animation = MeshAnimation::new(part_mesh, self.animation.fps, positions)
+            .map_err(|e| SegmentError::Invalid(e.to_string()))?;
+        animation.start_time = self.animation.start_time;
+        Ok(Part {
+            name: self.part_names[j].clone(),
+            animation,
+            vertices,
+        })
+    }
+
+    /// The report of SPEC "Output layouts".
+    pub fn report(&self) -> SegmentReport {
+        SegmentReport {
+            parts: self.part_names.clone(),
+            triangle_part: self.triangle_part.clone(),
+            seam_vertices: self.seam_vertices.clone(),
+            gamma: self.gamma,
+            cut_length: self.cut_length,
+            homogenization: self.homogenization,
+        }
+    }
+}
+
+/// Automatic parts: `n` parts named `part1`…`partN`, one seed triangle each, chosen by
+/// [`auto_seeds`].
+pub fn auto_parts(anim: &MeshAnimation, n: usize) -> Result<Vec<PartSpec>> {
+    let problem = SegmentationProblem::with_defaults(anim)?;
+    let seeds = auto_seeds(anim, &problem, n)?;
+    Ok(seeds
+        .into_iter()
+        .enumerate()
+        .map(|(j, s)| {
+            PartSpec::new(
+                format!("part{}", j + 1),
+                s.into_iter().map(Seed::Triangle).collect(),
+            )
+        })
+        .collect())
+}
+
+/// Segments an animation into parts and homogenizes the seams (Sections 3.1–3.2).
+///
+/// # Arguments
+/// * `anim` — the input mesh animation X.
+/// * `parts` — at least two named parts with seeds.
+/// * `options` — γ, smoothing, snapping, homogenization ([`SegmentOptions::default`]).
+///
+/// # Errors
+/// Bad seeds or parts ([`SegmentError`]), or a failed factorization.
+///
+/// # Performance
+/// One parallel pass over the frames for Eq. 3, one min-cut (or a few α-expansion cycles),
+/// one sparse Cholesky factorization and one parallel back-substitution pass.
+pub fn segment(
+    anim: &MeshAnimation,
+    parts: &[PartSpec],
+    options: &SegmentOptions,
+) -> Result<Segmentation> {
+    check_options(options)?;
+    let problem = SegmentationProblem::new(anim, options.weld_epsilon)?;
+    let seeds = resolve_seeds(anim, &problem, parts)?;
+    segment_with(
+        anim,
+        &problem,
+        parts.iter().map(|p| p.name.clone()).collect(),
+        seeds,
+        options,
+    )
+}
+
+fn check_options(o: &SegmentOptions) -> Result<()> {
+    if !(o.gamma.is_finite() && o.gamma >= 0.0) {
+        return Err(SegmentError::Parameter(format!(
+            "gamma must be ≥ 0, got {}",
+            o.gamma
+        )));
+    }
+    if !(o.smooth_step > 0.0 && o.smooth_step <= 1.0) {
+        return Err(SegmentError::Parameter(format!(
+            "smooth step must be in (0, 1], got {}",
+            o.smooth_step
+        )));
+    }
+    if !(0.0..=0.49).contains(&o.snap) {
+        return Err(SegmentError::Parameter(format!(
+            "snap must be in [0, 0.49], got {}",
+            o.snap
+        )));
+    }
+    Ok(())
+}
+
+/// [`segment`] on a prepared problem with resolved seeds (reuse the problem to try several
+/// seeds or γ values without recomputing Eq. 3).
+pub fn segment_with(
+    anim: &MeshAnimation,
+    problem: &SegmentationProblem,
+    part_names: Vec<String>,
+    seeds: Vec<Vec<u32>>,
+    options: &SegmentOptions,
+) -> Result<Segmentation> {
+    check_options(options)?;
+    let s = seeds.len();
+    if s < 2 {
+        return Err(SegmentError::TooFewParts(s));
+    }
+    if part_names.len() != s {
+        return Err(SegmentError::Parameter(format!(
+            "{} names for {s} parts",
+            part_names.len()
+        )));
+    }
+    let labels = problem.label(&seeds, options.gamma);
+    let mut votes = vertex_votes(
+        s,
+        &problem.topology.vertex_triangles,
+        &labels,
+        &problem.areas,
+    );
+    smooth_votes(
+        &mut votes,
+        s,
+        &problem.topology.neighbors,
+        options.smooth_iterations,
+        options.smooth_step,
+    );
+    // Seeds stay hard constraints through smoothing: their corners vote for their part only.
+    for (j, part) in seeds.iter().enumerate() {
+        for &t in part {
+            for v in anim.mesh.triangles[t as usize] {
+                let w = problem.weld.class[v as usize] as usize;
+                for (l, x) in votes[w * s..(w + 1) * s].iter_mut().enumerate() {
+                    *x = if l == j { 1.0 } else { 0.0 };
+                }
+            }
+        }
+    }
+    let cut = cut_mesh(
+        &anim.mesh.triangles,
+        &problem.weld.class,
+        problem.weld.len(),
+        &votes,
+        s,
+        options.snap,
+    );
+    let mut animation = build_cut_animation(anim, &cut)?;
+
+    // Seam and cut length on the welded cut mesh.
+    let weld_y = Weld {
+        class: cut.weld_class.clone(),
+        representative: representatives(&cut.weld_class, cut.welded_count),
+    };
+    let welded_tris = weld_y.triangles(&cut.triangles);
+    let topo = Topology::new(weld_y.len(), &welded_tris);
+    let avg_input = problem.average_positions();
+    let average: Vec<DVec3> = weld_y
+        .representative
+        .iter()
+        .map(|&r| cut.sources[r as usize].eval(avg_input).as_dvec3())
+        .collect();
+    let mut seam = vec![false; weld_y.len()];
+    let mut first_part = vec![u32::MAX; weld_y.len()];
+    for (t, tri) in welded_tris.iter().enumerate() {
+        for &v in tri {
+            let f = &mut first_part[v as usize];
+            if *f == u32::MAX {
+                *f = cut.triangle_part[t];
+            } else if *f != cut.triangle_part[t] {
+                seam[v as usize] = true;
+            }
+        }
+    }
+    let cut_length = topo
+        .dual
+        .iter()
+        .filter(|e| cut.triangle_part[e.a as usize] != cut.triangle_part[e.b as usize])
+        .map(|e| average[e.v[0] as usize].distance(average[e.v[1] as usize]))
+        .sum();
+    let seam_vertices: Vec<u32> = (0..cut.weld_class.len() as u32)
+        .filter(|&i| seam[cut.weld_class[i as usize] as usize])
+        .collect();
+
+    let homogenization = if options.homogenize {
+        let h = Homogenizer::new(
+            &average,
+            &welded_tris,
+            &seam,
+            weld_y.class.clone(),
+            weld_y.representative.clone(),
+        )?;
+        Some(h.apply(&mut animation))
+    } else {
+        None
+    };
+    Ok(Segmentation {
+        part_names,
+        gamma: options.gamma,
+        seeds,
+        input_triangle_part: labels,
+        animation,
+        triangle_part: cut.triangle_part.clone(),
+        cut,
+        seam_vertices,
+        cut_length,
+        homogenization,
+    })
+}
+
+fn representatives(class: &[u32], count: usize) -> Vec<u32> {
+    let mut rep = vec![u32::MAX; count];
+    for (i, &c) in class.iter().enumerate() {
+        if rep[c as usize] == u32::MAX {
+            rep[c as usize] = i as u32;
+        }
+    }
+    rep
+}
+
+/// Evaluates the cut mesh's vertices in every frame and interpolates the attributes.
+fn build_cut_animation(anim: &MeshAnimation, cut: &CutMesh) -> Result<MeshAnimation> {
+    let src = &anim.mesh;
+    let mut mesh = Mesh::new(
+        src.name.clone(),
+        cut.sources.iter().map(|s| s.eval(&src.positions)).collect(),
+        cut.triangles.clone(),
+    );
+    let lerp = |s: &VertexSource, f: &dyn Fn(u32) -> Vec<f32>| -> Vec<f32> {
+        match *s {
+            VertexSource::Original(i) => f(i),
+            VertexSource::Edge { a, b, t } => f(a)
+                .iter()
+                .zip(f(b))
+                .map(|(x, y)| x + (y - x) * t as f32)
+                .collect(),
+            VertexSource::Interior { v, w } => {
+                let vals: Vec<Vec<f32>> = v.iter().map(|&i| f(i)).collect();
+                (0..vals[0].len())
+                    .map(|c| (0..3).map(|k| vals[k][c] * w[k] as f32).sum())
+                    .collect()
+            }
+        }
+    };
+    mesh.normals = src.normals.as_ref().map(|n| {
+        cut.sources
+            .iter()
+            .map(|s| {
+                let v = lerp(s, &|i| n[i as usize].to_array().to_vec());
+                Vec3::new(v[0], v[1], v[2])
+                    .try_normalize()
+                    .unwrap_or(Vec3::Y)
+            })
+            .collect()
+    });
+    mesh.uvs = src.uvs.as_ref().map(|u| {
+        cut.sources
+            .iter()
+            .map(|s| {
+                let v = lerp(s, &|i| u[i as usize].to_vec());
+                [v[0], v[1]]
+            })
+            .collect()
+    });
+    mesh.colors = src.colors.as_ref().map(|c| {
+        cut.sources
+            .iter()
+            .map(|s| {
+                let v = lerp(s, &|i| c[i as usize].to_vec());
+                [v[0], v[1], v[2], v[3]]
+            })
+            .collect()
+    });
+    let n = cut.sources.len();
+    let mut positions = vec![Vec3::ZERO; n * anim.frame_count()];
+    positions
+        .par_chunks_mut(n.max(1))
+        .zip(anim.positions().par_chunks(anim.vertex_count().max(1)))
+        .for_each(|(out, x)| {
+            for (o, s) in out.iter_mut().zip(&cut.sources) {
+                *o = s.eval(x);
+            }
+        });
+    let mut out = MeshAnimation::new(mesh, anim.fps, positions)
+        .map_err(|e| SegmentError::Invalid(e.to_string()))?;
+    out.start_time = anim.start_time;
+    Ok(out)
+}
+
+/// Homogenizes the seams of an animation whose triangles already carry part labels
+/// (Section 3.2, Eqs. 4–9), without cutting.
+///
+/// # Arguments
+/// * `anim` — the animation (vertices coincident in the average mesh are welded).
+/// * `triangle_part` — part of every triangle.
+/// * `weld_epsilon` — welding tolerance relative to the bounding-box diagonal.
+///
+/// # Returns
+/// The deformed animation and measurements.
+///
+/// # Errors
+/// Wrong label count, or a failed factorization.
+pub fn homogenize(
+    anim: &MeshAnimation,
+    triangle_part: &[u32],
+    weld_epsilon: f32,
+) -> Result<(MeshAnimation, HomogenizeStats)> {
+    let k = anim.mesh.triangle_count();
+    if triangle_part.len() != k {
+        return Err(SegmentError::LabelCount {
+            expected: k,
+            found: triangle_part.len(),
+        });
+    }
+    anim.mesh
+        .validate()
+        .map_err(|e| SegmentError::Invalid(e.to_string()))?;
+    let avg = anim.average_positions();
+    let bbox = anim::Aabb::from_points(&avg);
+    let weld = Weld::new(
+        &avg,
+        if weld_epsilon > 0.0 {
+            weld_epsilon * bbox.diagonal()
+        } else {
+            0.0
+        },
+    );
+    let tris = weld.triangles(&anim.mesh.triangles);
+    let mut first = vec![u32::MAX; weld.len()];
+    let mut seam = vec![false; weld.len()];
+    for (t, tri) in tris.iter().enumerate() {
+        for &v in tri {
+            let f = &mut first[v as usize];
+            if *f == u32::MAX {
+                *f = triangle_part[t];
+            } else if *f != triangle_part[t] {
+                seam[v as usize] = true;
+            }
+        }
+    }
+    let average: Vec<DVec3> = weld.gather(&avg).iter().map(|p| p.as_dvec3()).collect();
+    let h = Homogenizer::new(
+        &average,
+        &tris,
+        &seam,
+        weld.class.clone(),
+        weld.representative.clone(),
+    )?;
+    let mut out = anim.clone();
+    let stats = h.apply(&mut out);
+    Ok((out, stats))
+}
