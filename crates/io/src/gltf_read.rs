@@ -52,7 +52,9 @@ fn read_with_base(bytes: &[u8], base: Option<&Path>) -> Result<Scene> {
     });
     let buffers = gltf::import_buffers(&doc, base, blob).map_err(|e| bad(e.to_string()))?;
     let data: Vec<&[u8]> = buffers.iter().map(|b| b.0.as_slice()).collect();
-    let scene = convert(&doc, &data)?;
+    // The gltf crate unwraps some fields it validated loosely; a panic there is bad input.
+    let scene = std::panic::catch_unwind(|| convert(&doc, &data))
+        .map_err(|_| bad("the document is inconsistent (rejected while reading)"))??;
     scene.validate()?;
     Ok(scene)
 }
@@ -70,8 +72,29 @@ fn precheck(bytes: &[u8]) -> Result<()> {
     let Ok(root) = serde_json::from_slice::<gltf_json::Root>(&json) else {
         return Ok(()); // syntax errors are reported by the full parse
     };
+    use gltf_json::validation::Checked;
+    for (k, a) in root.animations.iter().enumerate() {
+        for c in &a.channels {
+            if matches!(c.target.path, Checked::Invalid) {
+                return Err(bad(format!("animation {k} targets an unknown property")));
+            }
+        }
+        if a.samplers
+            .iter()
+            .any(|s| matches!(s.interpolation, Checked::Invalid))
+        {
+            return Err(bad(format!("animation {k} has an unknown interpolation")));
+        }
+    }
     let n = root.accessors.len();
     for (m, mesh) in root.meshes.iter().enumerate() {
+        if mesh
+            .primitives
+            .iter()
+            .any(|p| matches!(p.mode, Checked::Invalid))
+        {
+            return Err(bad(format!("mesh {m} has an unknown primitive mode")));
+        }
         for p in &mesh.primitives {
             let refs = p.attributes.values().chain(p.indices.iter());
             let targets = p.targets.iter().flatten().flat_map(|t| {
