@@ -206,3 +206,125 @@ fn stopmo_segment_face_writes_parts_report_and_render() {
     assert!(img.width() > img.height(), "two panels side by side");
     keep_for_validation(dir.path(), "stopmo_segment");
 }
+
+#[test]
+fn stopmo_library_face_writes_spec_layout() {
+    let dir = tempfile::tempdir().unwrap();
+    let parts = dir.path().join("face_parts.glb");
+    let out = dir.path().join("lib");
+    let face = data("face/ict-face-talk.glb");
+    // 2 fps: 120 frames of the 60 s talk.
+    ok(&[
+        "stopmo",
+        "segment",
+        face.to_str().unwrap(),
+        "-o",
+        parts.to_str().unwrap(),
+        "--fps",
+        "2",
+        "--part",
+        "upper=point:0,10,13",
+        "--part",
+        "lower=point:0,-14,10",
+    ]);
+    let summary = json(&[
+        "stopmo",
+        "library",
+        parts.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--pieces",
+        "upper=4,lower=6",
+        "--restarts",
+        "2",
+        "--seed",
+        "1",
+        "--fps",
+        "2",
+    ]);
+    assert_eq!(summary["pieces"], 10);
+    for f in [
+        "assembly.csv",
+        "assembly.md",
+        "shooting_order.csv",
+        "report.json",
+        "reconstruction.glb",
+        "reconstruction.pc2",
+        "rest.obj",
+    ] {
+        assert!(out.join(f).is_file(), "missing {f}");
+    }
+    assert!(!out.join("error_curve.csv").exists(), "no size search ran");
+    let mut ids = Vec::new();
+    for (part, n) in [("upper", 4), ("lower", 6)] {
+        for k in 0..n {
+            let id = format!("{part}_{k:02}");
+            assert!(out.join(format!("pieces/{id}.obj")).is_file(), "{id}.obj");
+            let stl = std::fs::read(out.join(format!("pieces/{id}.stl"))).unwrap();
+            let solid = tkio::stl::read(&stl).unwrap();
+            // Closed: every undirected edge is shared by exactly two triangles.
+            let mut edges = std::collections::HashMap::new();
+            for t in &solid.triangles {
+                for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                    *edges.entry((a.min(b), a.max(b))).or_insert(0usize) += 1;
+                }
+            }
+            assert!(solid.triangle_count() > 100, "{id}: tiny solid");
+            assert!(edges.values().all(|&c| c == 2), "{id} is not closed");
+            ids.push(id);
+        }
+    }
+    let csv = std::fs::read_to_string(out.join("assembly.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("frame,upper,lower"));
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), 120);
+    for (f, row) in rows.iter().enumerate() {
+        let cells: Vec<&str> = row.split(',').collect();
+        assert_eq!(cells.len(), 3, "row {row}");
+        assert_eq!(cells[0], f.to_string());
+        assert!(cells[1].starts_with("upper_") && ids.iter().any(|i| i == cells[1]));
+        assert!(cells[2].starts_with("lower_") && ids.iter().any(|i| i == cells[2]));
+    }
+    let r: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    for key in [
+        "energy",
+        "lambda",
+        "pieces",
+        "errors_mm",
+        "parts",
+        "seconds",
+        "iterations",
+        "restarts",
+    ] {
+        assert!(!r[key].is_null(), "report.json lacks {key}");
+    }
+    assert_eq!(r["lambda"], 2.0);
+    assert_eq!(r["restarts"], 2);
+    let e = &r["errors_mm"];
+    let mean = e["position_mean"].as_f64().unwrap();
+    assert!(mean > 0.0 && mean < e["position_max"].as_f64().unwrap());
+    assert!(e["velocity_mean"].as_f64().unwrap() > 0.0);
+    let names: Vec<&str> = r["parts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["upper", "lower"]);
+    // The reconstruction has both parts and the talk's 120 frames.
+    let scene = tkio::gltf::read(&out.join("reconstruction.glb")).unwrap();
+    let s = anim::sample(
+        &scene,
+        &anim::SampleOptions {
+            fps: 2.0,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert_eq!((s.objects.len(), s.frame_count), (2, 120));
+    let shots = std::fs::read_to_string(out.join("shooting_order.csv")).unwrap();
+    assert!(shots.starts_with("shot,upper,lower,frames\n"));
+    keep_for_validation(&out, "stopmo_library");
+}

@@ -78,6 +78,11 @@ fn precheck(bytes: &[u8]) -> Result<()> {
             if matches!(c.target.path, Checked::Invalid) {
                 return Err(bad(format!("animation {k} targets an unknown property")));
             }
+            if c.target.node.value() >= root.nodes.len() || c.sampler.value() >= a.samplers.len() {
+                return Err(bad(format!(
+                    "animation {k} refers to a missing node or sampler"
+                )));
+            }
         }
         if a.samplers
             .iter()

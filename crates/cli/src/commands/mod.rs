@@ -8,6 +8,7 @@ mod loa_render;
 pub mod render;
 pub mod smear;
 pub mod stopmo;
+mod stopmo_library;
 
 /// Options every command sees.
 #[derive(Debug, Clone, Copy)]

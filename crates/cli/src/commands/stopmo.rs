@@ -28,6 +28,9 @@ pub enum StopmoCommand {
     /// Cut the animation into parts along low-motion seams and make the seams identical in
     /// every frame (StopShop Sections 3.1–3.2).
     Segment(SegmentArgs),
+    /// Build a replacement library of printable pieces per part, the assembly sheet and a
+    /// shooting order (StopShop Sections 3.3–3.4, 5).
+    Library(super::stopmo_library::LibraryArgs),
 }
 
 /// glTF layout of the segmented parts.
@@ -81,6 +84,7 @@ pub struct SegmentArgs {
 pub fn run(ctx: &Context, args: StopmoArgs) -> Result<()> {
     match args.command {
         StopmoCommand::Segment(a) => segment(ctx, a),
+        StopmoCommand::Library(a) => super::stopmo_library::library(ctx, a),
     }
 }
 
