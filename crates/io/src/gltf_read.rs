@@ -91,6 +91,24 @@ fn precheck(bytes: &[u8]) -> Result<()> {
             return Err(bad(format!("animation {k} has an unknown interpolation")));
         }
     }
+    // A byte stride shorter than the element would make accessor reads overlap.
+    for (k, a) in root.accessors.iter().enumerate() {
+        let (Checked::Valid(ty), Checked::Valid(ct)) = (&a.type_, &a.component_type) else {
+            continue;
+        };
+        let stride = a
+            .buffer_view
+            .and_then(|v| root.buffer_views.get(v.value()))
+            .and_then(|v| v.byte_stride);
+        if let Some(st) = stride {
+            if st.0 < ty.multiplicity() * ct.0.size() {
+                return Err(bad(format!(
+                    "accessor {k}: byteStride {} is shorter than its elements",
+                    st.0
+                )));
+            }
+        }
+    }
     let n = root.accessors.len();
     for (m, mesh) in root.meshes.iter().enumerate() {
         if mesh
