@@ -32,7 +32,7 @@ mod transform;
 pub use camera::{Camera, Projection};
 pub use clip::{frame_count, Channel, Clip, Interpolation, Property, MAX_FRAMES};
 pub use error::{AnimError, Result};
-pub use mesh::{triangulate_polygon, Aabb, Mesh};
+pub use mesh::{triangulate_polygon, vertex_normals, Aabb, Mesh};
 pub use mesh_animation::{MeshAnimation, DEFAULT_FPS};
 pub use sample::{rest_transform, sample, MeshObject, SampleOptions, SampledScene};
 pub use scene::{MorphTarget, Node, Scene, SceneCamera, SceneMesh, SkinDef};

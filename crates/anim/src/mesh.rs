@@ -150,17 +150,7 @@ impl Mesh {
     ///
     /// Vertices on no triangle, or on degenerate ones only, get +Y.
     pub fn vertex_normals(&self, positions: &[Vec3]) -> Vec<Vec3> {
-        let mut acc = vec![Vec3::ZERO; positions.len()];
-        for t in &self.triangles {
-            let [a, b, c] = t.map(|i| i as usize);
-            let n = (positions[b] - positions[a]).cross(positions[c] - positions[a]);
-            acc[a] += n;
-            acc[b] += n;
-            acc[c] += n;
-        }
-        acc.into_iter()
-            .map(|n| n.try_normalize().unwrap_or(Vec3::Y))
-            .collect()
+        vertex_normals(positions, &self.triangles)
     }
 
     /// Appends another mesh (vertex indices shifted); attributes present on only one side are
@@ -201,6 +191,24 @@ impl Mesh {
 fn tri_polys(tris: &[[u32; 3]], base: u32) -> Vec<Vec<u32>> {
     tris.iter()
         .map(|t| t.iter().map(|i| i + base).collect())
+        .collect()
+}
+
+/// Area-weighted vertex normals of `positions` over `triangles` (indices must be valid).
+/// Vertices on no triangle, or only on degenerate or non-finite ones, get +Y.
+pub fn vertex_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+    let mut acc = vec![Vec3::ZERO; positions.len()];
+    for t in triangles {
+        let [a, b, c] = t.map(|i| i as usize);
+        let n = (positions[b] - positions[a]).cross(positions[c] - positions[a]);
+        if n.is_finite() {
+            acc[a] += n;
+            acc[b] += n;
+            acc[c] += n;
+        }
+    }
+    acc.into_iter()
+        .map(|n| n.try_normalize().unwrap_or(Vec3::Y))
         .collect()
 }
 

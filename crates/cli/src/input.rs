@@ -71,7 +71,6 @@ pub fn sample(path: &Path, loaded: &Loaded, args: &InputArgs) -> Result<SampledS
 }
 
 /// Loads and samples in one call.
-#[allow(dead_code)] // the tool commands (smear, stopmo) call it
 pub fn open(path: &Path, args: &InputArgs) -> Result<SampledScene> {
     let loaded = load(path, args)?;
     sample(path, &loaded, args)

@@ -90,6 +90,14 @@ pub fn write_animation(
     Ok(written)
 }
 
+/// The lower-case extension of `path` ("" when it has none).
+pub fn extension(path: &Path) -> String {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default()
+}
+
 /// `out/walk.obj` or `out/walk_0001.obj` → `out/walk` (frames are numbered from there).
 fn sequence_base(path: &Path) -> PathBuf {
     let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("frame");
@@ -103,7 +111,6 @@ fn sequence_base(path: &Path) -> PathBuf {
 }
 
 /// Writes a scalar field per frame and vertex as `.npy` (float32, frames × vertices).
-#[allow(dead_code)] // used by `smear offsets`
 pub fn write_npy_field(path: &Path, frames: usize, vertices: usize, values: &[f32]) -> Result<()> {
     let bytes = tkio::npy::write_f32(&[frames, vertices], values).map_err(|e| e.at(path))?;
     write_atomic(path, &bytes)?;

@@ -133,15 +133,11 @@ fn loa_line_writes_every_output_kind() {
         .any(|p| p[0] > 180 && p[1] < 90 && p[2] < 90));
 }
 
-#[test]
-fn stopmo_segment_face_writes_parts_report_and_render() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("face_parts.glb");
-    let report = dir.path().join("seg.json");
-    let png = dir.path().join("seg.png");
+/// `toonkit stopmo segment` on the face at 2 fps (120 frames of the 60 s talk, quick), seeds
+/// on the forehead and the chin, writing `out` plus any `extra` options.
+fn segment_face(out: &std::path::Path, extra: &[&str]) {
     let face = data("face/ict-face-talk.glb");
-    // 2 fps keeps the test quick (120 frames of the 60 s talk).
-    ok(&[
+    let mut args = vec![
         "stopmo",
         "segment",
         face.to_str().unwrap(),
@@ -153,11 +149,26 @@ fn stopmo_segment_face_writes_parts_report_and_render() {
         "upper=point:0,10,13",
         "--part",
         "lower=point:0,-14,10",
-        "--report",
-        report.to_str().unwrap(),
-        "--render",
-        png.to_str().unwrap(),
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    ok(&args);
+}
+
+#[test]
+fn stopmo_segment_face_writes_parts_report_and_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("face_parts.glb");
+    let report = dir.path().join("seg.json");
+    let png = dir.path().join("seg.png");
+    segment_face(
+        &out,
+        &[
+            "--report",
+            report.to_str().unwrap(),
+            "--render",
+            png.to_str().unwrap(),
+        ],
+    );
     let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
     assert_eq!(r["parts"], serde_json::json!(["upper", "lower"]));
     assert_eq!(r["gamma"], 100.0);
@@ -212,21 +223,7 @@ fn stopmo_library_face_writes_spec_layout() {
     let dir = tempfile::tempdir().unwrap();
     let parts = dir.path().join("face_parts.glb");
     let out = dir.path().join("lib");
-    let face = data("face/ict-face-talk.glb");
-    // 2 fps: 120 frames of the 60 s talk.
-    ok(&[
-        "stopmo",
-        "segment",
-        face.to_str().unwrap(),
-        "-o",
-        parts.to_str().unwrap(),
-        "--fps",
-        "2",
-        "--part",
-        "upper=point:0,10,13",
-        "--part",
-        "lower=point:0,-14,10",
-    ]);
+    segment_face(&parts, &[]);
     let summary = json(&[
         "stopmo",
         "library",

@@ -77,23 +77,6 @@ struct Corner {
     color: Vec4,
 }
 
-/// Area-weighted vertex normals (+Y for isolated vertices). Indices must be valid.
-pub(crate) fn vertex_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
-    let mut acc = vec![Vec3::ZERO; positions.len()];
-    for t in triangles {
-        let [a, b, c] = t.map(|i| i as usize);
-        let n = (positions[b] - positions[a]).cross(positions[c] - positions[a]);
-        if n.is_finite() {
-            acc[a] += n;
-            acc[b] += n;
-            acc[c] += n;
-        }
-    }
-    acc.into_iter()
-        .map(|n| n.try_normalize().unwrap_or(Vec3::Y))
-        .collect()
-}
-
 /// Checks indices and attribute lengths of a mesh item.
 pub(crate) fn validate(item: &MeshItem) -> Result<()> {
     let n = item.positions.len();
@@ -152,7 +135,7 @@ pub(crate) fn setup_mesh(
             let nm = Mat3::from_mat4(view.view).inverse().transpose();
             let world = match item.normals {
                 Some(n) => n.to_vec(),
-                None => vertex_normals(item.positions, item.triangles),
+                None => anim::vertex_normals(item.positions, item.triangles),
             };
             Some(
                 world

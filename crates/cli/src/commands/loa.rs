@@ -76,11 +76,7 @@ enum OutputKind {
 }
 
 fn output_kind(path: &Path) -> Result<OutputKind> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .unwrap_or_default();
+    let ext = crate::output::extension(path);
     match ext.as_str() {
         "json" => Ok(OutputKind::Json),
         "svg" => Ok(OutputKind::Svg),

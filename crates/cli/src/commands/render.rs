@@ -82,11 +82,7 @@ fn parse_size(s: &str) -> Result<(u32, u32)> {
 }
 
 fn output_format(path: &Path) -> Result<OutputFormat> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .unwrap_or_default();
+    let ext = crate::output::extension(path);
     match ext.as_str() {
         "png" => Ok(OutputFormat::Png),
         "gif" => Ok(OutputFormat::Gif),
