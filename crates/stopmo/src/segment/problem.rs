@@ -190,8 +190,11 @@ impl SegmentationProblem {
     /// * Eq. 3's sum over frames is divided by the frame count (a mean over frames). Summed
     ///   literally, the binary term grows with the clip length, so one default γ could not
     ///   serve the paper's clips of 260 to 5,177 frames: with hundreds of frames the cheapest
-    ///   cut simply encircles a seed triangle. With the mean, γ = 100 in a unit box makes the
-    ///   binary term dominate (Fig. 4) while the unary term still decides where it is flat.
+    ///   cut simply encircles a seed triangle. With the mean, the default γ = 100 (SPEC.md)
+    ///   already moves the face cut below the eyes, where motion is low, but the cut still
+    ///   follows the seeds; around γ = 1,000 it no longer depends on them (Fig. 4); far beyond
+    ///   (γ ≈ 10,000 on the face) the shrinking bias of graph cuts wins and the cut encircles
+    ///   a seed (measured in `tests/segment_face.rs`).
     /// * Seed triangles are hard constraints (a seed always belongs to its part).
     /// * The double sum of Eq. 1 runs over ordered pairs, so every adjacent pair contributes
     ///   `2 γ b(α, β)` (as printed).
