@@ -32,6 +32,7 @@
 //! # Ok::<(), loa::LoaError>(())
 //! ```
 
+pub mod animate;
 mod animation;
 mod chain;
 mod dynamics;

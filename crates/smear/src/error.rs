@@ -66,6 +66,15 @@ pub enum SmearError {
         /// Actual length.
         found: usize,
     },
+    /// An effect parameter is out of its range (a count, spacing, step or per-vertex buffer).
+    /// Pass a value in the range the message names.
+    #[error("invalid {name}: {reason}")]
+    InvalidParameter {
+        /// The parameter's name.
+        name: &'static str,
+        /// What is wrong and what is allowed.
+        reason: String,
+    },
     /// The sampled scene is inconsistent (skin slots, bone buffer). Re-sample it with
     /// `anim::sample`, which always produces consistent scenes.
     #[error("inconsistent scene: {0}")]

@@ -5,8 +5,8 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use crate::plane::{plane_frames, PlaneFrame};
-use crate::ribbon::{Interp, Ribbon, RibbonSample};
-use crate::rig::{HoodEntry, Rig, IN_ROOT, IN_TIP};
+use crate::ribbon::{Ribbon, RibbonSample};
+use crate::rig::{Hood, Rig};
 use crate::velocity::{track_velocity, CameraSpace};
 
 /// The offset field of one group of vertices (one simple object or one skinned character).
@@ -15,7 +15,7 @@ pub(crate) enum Field {
     /// Eq. 1, one plane per frame.
     Plane(Vec<PlaneFrame>),
     /// Eqs. 3–9, one ribbon per bone and frame.
-    Ribbons(RibbonField),
+    Ribbons(Box<RibbonField>),
 }
 
 /// Ribbons and neighbourhood maxima of Eq. 9 for every bone and frame.
@@ -41,7 +41,7 @@ impl Field {
     /// The Eq. 1 field of a frame-major buffer, and the (unsmoothed) offsets of its vertices.
     ///
     /// # Performance
-    /// Parallel over frames, allocation-free per vertex.
+    /// Parallel over frames, allocation-free per vertex (see [`plane_frames`]).
     pub(crate) fn plane(
         positions: &[Vec3],
         frames: usize,
@@ -50,21 +50,10 @@ impl Field {
         tol: Tolerances,
         space: Option<&CameraSpace>,
     ) -> (Field, Vec<f32>) {
-        let planes = plane_frames(positions, frames, vertices, triangles, tol.still, space);
         let mut raw = vec![0.0f32; frames * vertices];
-        if vertices > 0 {
-            raw.par_chunks_mut(vertices)
-                .enumerate()
-                .for_each(|(f, dst)| {
-                    let pl = planes[f];
-                    for (d, p) in dst
-                        .iter_mut()
-                        .zip(&positions[f * vertices..(f + 1) * vertices])
-                    {
-                        *d = pl.eval(*p);
-                    }
-                });
-        }
+        let planes = plane_frames(
+            positions, frames, vertices, triangles, tol.still, space, &mut raw,
+        );
         (Field::Plane(planes), raw)
     }
 
@@ -78,9 +67,14 @@ impl Field {
     ///
     /// # Performance
     /// Ribbons once per bone and frame. Then, parallel over frames and bone-major, every
-    /// neighbourhood V_k,r ∪ V_k,t is evaluated once: the maxima of Eq. 9 come out of that
-    /// pass, and the skinned entries are kept in a per-thread scratch and accumulated into
-    /// Eq. 7's sum once the bone's maxima are known. No allocation per frame or vertex.
+    /// neighbourhood V_k,r ∪ V_k,t (precomputed once per rig, struct-of-arrays) is read
+    /// run by run from the frame's position columns (or gathered into per-worker columns
+    /// when fragmented, see [`Hood::runs`]) and evaluated once by the vectorized
+    /// [`Ribbon::eval_batch`]:
+    /// the maxima of Eq. 9 come out of that pass, then only the bone's skinned entries are
+    /// normalized and accumulated into Eq. 7's sum in a per-worker buffer, and each output
+    /// frame is written once (no read of fresh zeroed pages). No allocation per frame or
+    /// vertex.
     pub(crate) fn ribbons(
         rig: Rig,
         positions: &[Vec3],
@@ -97,13 +91,13 @@ impl Field {
         let mut maxima = vec![[0.0f32; 2]; frames * joints];
         if joints == 0 || vertices == 0 {
             return (
-                Field::Ribbons(RibbonField {
+                Field::Ribbons(Box::new(RibbonField {
                     rig,
                     joints,
                     collinear,
                     ribbons,
                     maxima,
-                }),
+                })),
                 raw,
             );
         }
@@ -122,48 +116,31 @@ impl Field {
             .zip(maxima.par_chunks_mut(joints))
             .enumerate()
             .for_each_init(
-                || {
-                    (
-                        Vec::<(u32, f32, RibbonSample)>::new(),
-                        vec![0.0f32; vertices],
-                    )
-                },
-                |(skinned, wsum), (f, (dst, mx))| {
+                || Scratch::new(rig.max_hood_len(), vertices, rig.has_runs()),
+                |sc, (f, (dst, mx))| {
                     let pos = &positions[f * vertices..(f + 1) * vertices];
-                    wsum.fill(0.0);
+                    sc.acc.fill(0.0);
+                    sc.wsum.fill(0.0);
+                    sc.transpose(pos);
                     for (k, m) in mx.iter_mut().enumerate() {
-                        let Some(rib) = &ribbons[f * joints + k] else {
-                            continue;
-                        };
-                        skinned.clear();
-                        let hood = rig.hood(k);
-                        let (mr, mt) = match rib.interp() {
-                            Interp::Slerp => hood_pass(hood, pos, skinned, |x| rib.eval_slerp(x)),
-                            Interp::Lerp => hood_pass(hood, pos, skinned, |x| rib.eval_lerp(x)),
-                            Interp::Still => hood_pass(hood, pos, skinned, |x| rib.eval_still(x)),
-                        };
-                        *m = [mr, mt];
-                        for &(v, w, s) in skinned.iter() {
-                            dst[v as usize] += w * normalized(s, mr, mt, collinear);
-                            wsum[v as usize] += w;
+                        if let Some(rib) = &ribbons[f * joints + k] {
+                            *m = sc.bone(rib, rig.hood(k), pos, collinear);
                         }
                     }
                     // Zero-length bones were skipped: renormalize over the remaining weights.
-                    for (d, &w) in dst.iter_mut().zip(wsum.iter()) {
-                        if w > 0.0 {
-                            *d /= w;
-                        }
+                    for ((d, &a), &w) in dst.iter_mut().zip(&sc.acc).zip(&sc.wsum) {
+                        *d = if w > 0.0 { a / w } else { 0.0 };
                     }
                 },
             );
         (
-            Field::Ribbons(RibbonField {
+            Field::Ribbons(Box::new(RibbonField {
                 rig,
                 joints,
                 collinear,
                 ribbons,
                 maxima,
-            }),
+            })),
             raw,
         )
     }
@@ -178,30 +155,141 @@ impl Field {
     }
 }
 
-/// Evaluates one bone's ribbon over its neighbourhood: returns the maxima of |δ̃| over
-/// V_k,r and V_k,t, and keeps the samples of the vertices skinned to the bone.
-#[inline(always)]
-fn hood_pass(
-    hood: &[HoodEntry],
-    pos: &[Vec3],
-    skinned: &mut Vec<(u32, f32, RibbonSample)>,
-    eval: impl Fn(Vec3) -> RibbonSample,
-) -> (f32, f32) {
-    let (mut mr, mut mt) = (0.0f32, 0.0f32);
-    for e in hood {
-        let s = eval(pos[e.vertex as usize]);
-        let a = s.raw.abs();
-        if e.flags & IN_ROOT != 0 {
-            mr = mr.max(a);
-        }
-        if e.flags & IN_TIP != 0 {
-            mt = mt.max(a);
-        }
-        if e.weight > 0.0 {
-            skinned.push((e.vertex, e.weight, s));
+/// Per-worker columns of the articulated pass, allocated once per rayon job.
+struct Scratch {
+    xs: Vec<f32>,
+    ys: Vec<f32>,
+    zs: Vec<f32>,
+    raw: Vec<f32>,
+    u: Vec<f32>,
+    coll: Vec<f32>,
+    /// Σ_k w_k·δ_k of Eq. 7 per vertex.
+    acc: Vec<f32>,
+    /// Σ_k w_k over the non-skipped bones per vertex.
+    wsum: Vec<f32>,
+    /// The frame's positions as columns, for neighbourhoods evaluated by runs.
+    px: Vec<f32>,
+    py: Vec<f32>,
+    pz: Vec<f32>,
+}
+
+impl Scratch {
+    fn new(hood: usize, vertices: usize, runs: bool) -> Scratch {
+        let col = || vec![0.0f32; hood];
+        let pcol = || vec![0.0f32; if runs { vertices } else { 0 }];
+        Scratch {
+            xs: col(),
+            ys: col(),
+            zs: col(),
+            raw: col(),
+            u: col(),
+            coll: col(),
+            acc: vec![0.0; vertices],
+            wsum: vec![0.0; vertices],
+            px: pcol(),
+            py: pcol(),
+            pz: pcol(),
         }
     }
-    (mr, mt)
+
+    /// Fills the position columns with a frame (when some neighbourhood is run-based).
+    fn transpose(&mut self, pos: &[Vec3]) {
+        if self.px.len() != pos.len() {
+            return;
+        }
+        for (((x, y), z), p) in self
+            .px
+            .iter_mut()
+            .zip(&mut self.py)
+            .zip(&mut self.pz)
+            .zip(pos)
+        {
+            (*x, *y, *z) = (p.x, p.y, p.z);
+        }
+    }
+
+    /// Evaluates one bone's ribbon over its neighbourhood (batched, Eqs. 3–6), accumulates
+    /// the normalized offsets of its skinned vertices (Eqs. 7–9) into `acc`/`wsum`.
+    ///
+    /// # Returns
+    /// The maxima of |δ̃| over V_k,r and V_k,t.
+    fn bone(&mut self, rib: &Ribbon, hood: Hood<'_>, pos: &[Vec3], collinear: bool) -> [f32; 2] {
+        let n = hood.vertex.len();
+        let (raw, u, coll) = (&mut self.raw[..n], &mut self.u[..n], &mut self.coll[..n]);
+        if hood.runs.is_empty() {
+            let (xs, ys, zs) = (&mut self.xs[..n], &mut self.ys[..n], &mut self.zs[..n]);
+            for (i, &v) in hood.vertex.iter().enumerate() {
+                let p = pos[v as usize];
+                (xs[i], ys[i], zs[i]) = (p.x, p.y, p.z);
+            }
+            rib.eval_batch(xs, ys, zs, raw, u, coll);
+        } else {
+            // Straight from the frame's columns (filled by `transpose`), run by run.
+            let mut o = 0;
+            for &(v, len) in hood.runs {
+                let (v, len) = (v as usize, len as usize);
+                let (a, b) = (v, v + len);
+                rib.eval_batch(
+                    &self.px[a..b],
+                    &self.py[a..b],
+                    &self.pz[a..b],
+                    &mut raw[o..o + len],
+                    &mut u[o..o + len],
+                    &mut coll[o..o + len],
+                );
+                o += len;
+            }
+        }
+        let (raw, u, coll) = (&self.raw[..n], &self.u[..n], &self.coll[..n]);
+        let [mr, mt] = masked_maxima(raw, hood.in_root, hood.in_tip);
+        for (&i, &w) in hood.skinned_at.iter().zip(hood.skinned_weight) {
+            let i = i as usize;
+            let v = hood.vertex[i] as usize;
+            let s = RibbonSample {
+                u: u[i],
+                raw: raw[i],
+                coll: coll[i],
+            };
+            self.acc[v] += w * normalized(s, mr, mt, collinear);
+            self.wsum[v] += w;
+        }
+        [mr, mt]
+    }
+}
+
+/// [max |raw| over V_k,r, max over V_k,t] given the 0/1 masks of [`Hood::in_root`] and
+/// [`Hood::in_tip`]: NaN (and ±inf outside the set, masked to NaN) are ignored, 0 when none.
+/// Same value as folding `f32::max` over the flagged entries, in lanes the compiler vectorizes.
+fn masked_maxima(raw: &[f32], in_root: &[f32], in_tip: &[f32]) -> [f32; 2] {
+    const L: usize = 8;
+    #[inline(always)]
+    fn lane(m: &mut f32, x: f32) {
+        // NaN compares false: ignored, like `f32::max`.
+        if x > *m {
+            *m = x;
+        }
+    }
+    let (mut mr, mut mt) = ([0.0f32; L], [0.0f32; L]);
+    let (rc, ac, bc) = (
+        raw.chunks_exact(L),
+        in_root.chunks_exact(L),
+        in_tip.chunks_exact(L),
+    );
+    let (rr, ar, br) = (rc.remainder(), ac.remainder(), bc.remainder());
+    for ((r, a), b) in rc.zip(ac).zip(bc) {
+        for l in 0..L {
+            let x = r[l].abs();
+            lane(&mut mr[l], x * a[l]);
+            lane(&mut mt[l], x * b[l]);
+        }
+    }
+    for (l, ((r, a), b)) in rr.iter().zip(ar).zip(br).enumerate() {
+        let x = r.abs();
+        lane(&mut mr[l], x * a);
+        lane(&mut mt[l], x * b);
+    }
+    let fold = |m: [f32; L]| m.iter().fold(0.0f32, |a, &b| a.max(b));
+    [fold(mr), fold(mt)]
 }
 
 /// Eq. 8 with Eq. 9's normalizer M = (1 − u)·max_{V_k,r} + u·max_{V_k,t} (SPEC.md's

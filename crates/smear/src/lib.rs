@@ -34,6 +34,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod effects;
 mod error;
 mod field;
 mod offsets;
@@ -43,8 +44,16 @@ mod ribbon;
 mod rig;
 mod smooth;
 mod solver;
+mod stylize;
 mod velocity;
 
+pub use effects::{
+    elongate, elongate_frame, eq12_opacity, held_frame, motion_lines, motion_lines_frame,
+    multiple_opacity, multiples, multiples_frame, overlap_spacing, sample_surface, EffectInputs,
+    ElongateOptions, LineFrame, LineOptions, LineStyle, MultipleCopy, MultiplesOptions, Spacing,
+    StyleInput, Stylize, Trajectories, DEFAULT_FRAME_STEP, DEFAULT_LINE_SAMPLES,
+    DEFAULT_LINE_SIDES, DEFAULT_SEED, DEFAULT_SPACING,
+};
 pub use error::{Result, SmearError};
 pub use offsets::MotionOffsets;
 pub use options::{
@@ -55,4 +64,10 @@ pub use plane::surface_centroid;
 pub use ribbon::smoothstep;
 pub use smooth::{smooth_in_time, smoothing_weights};
 pub use solver::{mesh_offsets, scene_offsets, OffsetMode, OffsetSolver, SurfacePoint};
+pub use stylize::{
+    apply_stages, hise_curve, voronoi_f1, warp_offset, CompiledEffects, CompiledLines,
+    ElongateStyle, Expression, FunctionSpec, LinesStyle, MultiplesStyle, ObjectEffects,
+    ObjectStyle, Param, Stage, Style, StyleError, StyleFunction, StyleOps, DEFAULT_LINE_COUNT,
+    DEFAULT_LINE_THICKNESS, EXPRESSION_INPUTS, MAX_EXPRESSION_VARIABLES,
+};
 pub use velocity::{camera_vertex_velocities, speeds, vertex_velocities};

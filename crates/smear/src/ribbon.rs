@@ -4,6 +4,17 @@ use glam::Vec3;
 
 use crate::options::DEFAULT_LERP_ANGLE;
 
+/// Points per block of [`Ribbon::eval_batch`] (two SSE registers; 4 costs more overhead).
+const BATCH_LANES: usize = 8;
+
+/// The block of [`BATCH_LANES`] entries of `c` starting at `s`.
+#[inline(always)]
+fn lanes_mut(c: &mut [f32], s: usize) -> &mut [f32; BATCH_LANES] {
+    (&mut c[s..s + BATCH_LANES])
+        .try_into()
+        .expect("BATCH_LANES entries")
+}
+
 /// Smoothstep S(x) = 3x² − 2x³ on x clamped to [0, 1] (Eq. 3).
 #[inline]
 pub fn smoothstep(x: f32) -> f32 {
@@ -175,7 +186,7 @@ impl Ribbon {
     ///
     /// # Performance
     /// About 40 flops, a polynomial `sin_cos` for slerped bones, one square root and two
-    /// divisions. Hot loops call the per-mode variants ([`Ribbon::interp`]) to hoist the match.
+    /// divisions. Hot loops call [`Ribbon::eval_batch`] instead.
     #[inline]
     pub(crate) fn eval(&self, x: Vec3) -> RibbonSample {
         match self.interp {
@@ -183,12 +194,6 @@ impl Ribbon {
             Interp::Lerp => self.eval_lerp(x),
             Interp::Still => self.eval_still(x),
         }
-    }
-
-    /// How the direction of motion is interpolated along the bone.
-    #[inline]
-    pub(crate) fn interp(&self) -> Interp {
-        self.interp
     }
 
     /// Eq. 3: offset from the root, its projection on the axis, and the unclamped ratio.
@@ -251,6 +256,137 @@ impl Ribbon {
             u: smoothstep(self.project(x).2),
             raw: 0.0,
             coll: 0.0,
+        }
+    }
+
+    /// [`Ribbon::eval`] at many points, bit for bit: point i is `(xs[i], ys[i], zs[i])`, its
+    /// sample goes to `raw[i]`, `u[i]`, `coll[i]` (only the first `xs.len()` entries of the
+    /// outputs are written).
+    ///
+    /// # Panics
+    /// If an input or output column is shorter than `xs`.
+    ///
+    /// # Performance
+    /// Branch-free columns the compiler vectorizes (4 points per instruction with SSE2); the
+    /// beyond-the-ends cases are selected, not branched to.
+    pub(crate) fn eval_batch(
+        &self,
+        xs: &[f32],
+        ys: &[f32],
+        zs: &[f32],
+        raw: &mut [f32],
+        u: &mut [f32],
+        coll: &mut [f32],
+    ) {
+        let n = xs.len();
+        let (ys, zs) = (&ys[..n], &zs[..n]);
+        let (raw, u, coll) = (&mut raw[..n], &mut u[..n], &mut coll[..n]);
+        match self.interp {
+            Interp::Slerp => self.batch(xs, ys, zs, raw, u, coll, |u| {
+                let (s, c) = sin_cos_0_pi(u * self.omega);
+                (c, s, 1.0)
+            }),
+            Interp::Lerp => self.batch(xs, ys, zs, raw, u, coll, |u| {
+                let (a, b) = (1.0 - u, u);
+                (
+                    a,
+                    b,
+                    a * a * self.pp + 2.0 * a * b * self.pq + b * b * self.qq,
+                )
+            }),
+            Interp::Still => {
+                for i in 0..n {
+                    let x = Vec3::new(xs[i], ys[i], zs[i]);
+                    u[i] = smoothstep(self.project(x).2);
+                }
+                raw.fill(0.0);
+                coll.fill(0.0);
+            }
+        }
+    }
+
+    /// The loop of [`Ribbon::eval_batch`] for v(u) = a·P + b·Q, `dir(u) = (a, b, |v|²)`, by
+    /// blocks of [`BATCH_LANES`] points: a block entirely beyond the bone's ends (most of the
+    /// neighbours of a bone, spatially coherent in vertex order) only needs Eq. 6's dot
+    /// product with the end normals; other blocks run [`Ribbon::beyond_ends`] and
+    /// [`Ribbon::finish`] written as selects. Both give the same bits.
+    #[inline(always)]
+    fn batch(
+        &self,
+        xs: &[f32],
+        ys: &[f32],
+        zs: &[f32],
+        raw: &mut [f32],
+        us: &mut [f32],
+        colls: &mut [f32],
+        dir: impl Fn(f32) -> (f32, f32, f32),
+    ) {
+        let n = xs.len();
+        let (ys, zs) = (&ys[..n], &zs[..n]);
+        let (raw, us, colls) = (&mut raw[..n], &mut us[..n], &mut colls[..n]);
+        const L: usize = BATCH_LANES;
+        let blocks = n / L * L;
+        for s in (0..blocks).step_by(L) {
+            let col = |c: &[f32]| -> [f32; L] { c[s..s + L].try_into().expect("L points") };
+            let (x, y, z) = (col(xs), col(ys), col(zs));
+            let (r, u, c) = (lanes_mut(raw, s), lanes_mut(us, s), lanes_mut(colls, s));
+            let at = |l: usize| self.project(Vec3::new(x[l], y[l], z[l]));
+            let mut inside = 0u32;
+            for l in 0..L {
+                let t = at(l).2;
+                inside |= u32::from(!(t <= 0.0 || t >= 1.0));
+            }
+            if inside == 0 {
+                for l in 0..L {
+                    let (d, _, t) = at(l);
+                    (r[l], u[l], c[l]) = self.lane_ends(d, t);
+                }
+            } else {
+                for l in 0..L {
+                    let (d, db, t) = at(l);
+                    (r[l], u[l], c[l]) = self.lane(d, db, t, &dir);
+                }
+            }
+        }
+        for i in blocks..n {
+            let (d, db, t) = self.project(Vec3::new(xs[i], ys[i], zs[i]));
+            (raw[i], us[i], colls[i]) = self.lane(d, db, t, &dir);
+        }
+    }
+
+    /// `(raw, u, coll)` of [`Ribbon::eval`] from [`Ribbon::project`]'s `(d, db, t)`, with
+    /// selects instead of branches.
+    #[inline(always)]
+    fn lane(
+        &self,
+        d: Vec3,
+        db: f32,
+        t: f32,
+        dir: &impl Fn(f32) -> (f32, f32, f32),
+    ) -> (f32, f32, f32) {
+        let u = smoothstep(t);
+        let (a, b, vv) = dir(u);
+        let vb = a * self.pb + b * self.qb;
+        let nn = vv - vb * vb;
+        let ok = nn > 1e-12 * vv;
+        let dn = a * d.dot(self.p) + b * d.dot(self.q) - vb * db;
+        let mid_raw = if ok { dn / nn.sqrt() } else { 0.0 };
+        let mid_coll = if ok { nn / vv } else { 0.0 };
+        if t <= 0.0 || t >= 1.0 {
+            self.lane_ends(d, t)
+        } else {
+            (mid_raw, u, mid_coll)
+        }
+    }
+
+    /// [`Ribbon::lane`] for a point beyond an end of the bone (`t <= 0` or `t >= 1`).
+    #[inline(always)]
+    fn lane_ends(&self, d: Vec3, t: f32) -> (f32, f32, f32) {
+        let (r0, r1) = (d.dot(self.n0), d.dot(self.n1));
+        if t <= 0.0 {
+            (r0, 0.0, self.coll0)
+        } else {
+            (r1, 1.0, self.coll1)
         }
     }
 
@@ -331,6 +467,55 @@ mod tests {
             worst = worst.max((s - x.sin()).abs()).max((c - x.cos()).abs());
         }
         assert!(worst < 2e-7, "max error {worst}");
+    }
+
+    /// The vectorized batch (blocks beyond the ends, mixed blocks, scalar tail) gives the
+    /// bits of the scalar evaluation for slerped, lerped, still and axis-parallel motions.
+    #[test]
+    fn batch_equals_scalar_bit_for_bit() {
+        let (root, tip) = (Vec3::new(0.1, -0.2, 0.3), Vec3::new(0.3, 1.5, 0.2));
+        let motions = [
+            (Vec3::new(0.0, 0.0, 1.0), Vec3::new(1.0, 0.0, 0.0)),
+            (Vec3::new(1.0, 0.2, 0.0), Vec3::new(1.0, 0.21, 0.01)),
+            (Vec3::ZERO, Vec3::ZERO),
+            (Vec3::Y, Vec3::Y),
+            (Vec3::X, -Vec3::X),
+        ];
+        // 61 points: 7 blocks of 8 plus a tail; a run below the root, one through the bone,
+        // one beyond the tip, one interleaved, plus a NaN.
+        let mut pts: Vec<Vec3> = (0..60)
+            .map(|i| {
+                let y = match i / 16 {
+                    0 => -1.0 - 0.01 * i as f32,
+                    1 => 0.1 * (i - 16) as f32,
+                    2 => 2.0 + 0.01 * i as f32,
+                    _ => [-0.5, 0.7, 1.8][i % 3],
+                };
+                Vec3::new(0.3 * (i as f32).sin(), y, 0.2 * (i as f32).cos())
+            })
+            .collect();
+        pts.push(Vec3::NAN);
+        let col = |f: fn(Vec3) -> f32| pts.iter().map(|p| f(*p)).collect::<Vec<f32>>();
+        let (xs, ys, zs) = (col(|p| p.x), col(|p| p.y), col(|p| p.z));
+        for (vr, vt) in motions {
+            let rib = Ribbon::new(root, tip, vr, vt, 1e-9, 1e-9).unwrap();
+            let n = pts.len();
+            let (mut raw, mut u, mut coll) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+            rib.eval_batch(&xs, &ys, &zs, &mut raw, &mut u, &mut coll);
+            for (i, p) in pts.iter().enumerate() {
+                let s = rib.eval(*p);
+                let same =
+                    |a: f32, b: f32| a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
+                assert!(
+                    same(s.raw, raw[i]) && same(s.u, u[i]) && same(s.coll, coll[i]),
+                    "{:?} point {i}: scalar {s:?}, batch ({}, {}, {})",
+                    rib.interp,
+                    raw[i],
+                    u[i],
+                    coll[i]
+                );
+            }
+        }
     }
 
     #[test]

@@ -16,19 +16,49 @@ pub(crate) struct Rig {
     row_start: Vec<u32>,
     row_joint: Vec<u32>,
     row_weight: Vec<f32>,
+    /// Per bone: start of its neighbourhood in `hood_vertex` / `hood_flags`.
     hood_start: Vec<u32>,
-    hood: Vec<HoodEntry>,
+    hood_vertex: Vec<u32>,
+    hood_flags: Vec<u8>,
+    /// 1.0 where the entry is in V_k,r (resp. V_k,t), else 0.0: masks for vectorized maxima.
+    hood_in_root: Vec<f32>,
+    hood_in_tip: Vec<f32>,
+    /// Per bone: start of its skinned entries in `skinned_at` / `skinned_weight`.
+    skinned_start: Vec<u32>,
+    skinned_at: Vec<u32>,
+    skinned_weight: Vec<f32>,
+    /// Per bone: start of its runs in `runs`.
+    run_start: Vec<u32>,
+    /// `(first vertex, length)` of the runs of consecutive vertices of each neighbourhood
+    /// whose runs are long enough (see [`MIN_MEAN_RUN`]); none for fragmented ones.
+    runs: Vec<(u32, u32)>,
+    max_hood: usize,
 }
 
-/// One vertex of a bone's neighbourhood V_k,r ∪ V_k,t.
+/// A neighbourhood whose runs of consecutive vertex indices are at least this long on
+/// average is evaluated run by run straight from struct-of-arrays positions, without a
+/// gather (vertices of one bone are often stored together).
+pub(crate) const MIN_MEAN_RUN: usize = 32;
+
+/// Bone k's neighbourhood V_k,r ∪ V_k,t in struct-of-arrays form (vertices ascending), as the
+/// batched ribbon evaluation reads it.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct HoodEntry {
-    /// Vertex index.
-    pub(crate) vertex: u32,
-    /// The vertex's (normalized) skin weight on the bone; 0 when it is only a neighbour.
-    pub(crate) weight: f32,
-    /// [`IN_ROOT`] | [`IN_TIP`] membership.
-    pub(crate) flags: u8,
+pub(crate) struct Hood<'a> {
+    /// Vertex indices.
+    pub(crate) vertex: &'a [u32],
+    /// [`IN_ROOT`] | [`IN_TIP`] membership of each vertex.
+    pub(crate) flags: &'a [u8],
+    /// `flags` as multiplicative masks: 1.0 for entries in V_k,r, else 0.0.
+    pub(crate) in_root: &'a [f32],
+    /// 1.0 for entries in V_k,t, else 0.0.
+    pub(crate) in_tip: &'a [f32],
+    /// Positions in `vertex` of the vertices skinned to the bone (non-zero weight).
+    pub(crate) skinned_at: &'a [u32],
+    /// Their (normalized) skin weights on the bone.
+    pub(crate) skinned_weight: &'a [f32],
+    /// `(first vertex, length)` of the runs of consecutive vertices covering `vertex` in
+    /// order, or empty when the neighbourhood is too fragmented (then gather `vertex`).
+    pub(crate) runs: &'a [(u32, u32)],
 }
 
 /// Joint hierarchy after pruning (paper Fig. 8d).
@@ -131,16 +161,14 @@ impl Rig {
 
         // Neighbourhoods (SPEC.md): V_k,t ∋ vertices on k or its children; V_k,r ∋ vertices on
         // k, its parent or the parent's other children (for a root: on any root bone).
-        let mut hoods: Vec<Vec<HoodEntry>> = vec![Vec::new(); n];
-        let mut local: Vec<(usize, u8)> = Vec::with_capacity(32);
-        for v in 0..rig.vertex_count() {
-            local.clear();
-            let mut mark = |k: usize, flag: u8| match local.iter_mut().find(|e| e.0 == k) {
-                Some(e) => e.1 |= flag,
-                None => local.push((k, flag)),
-            };
-            for &m in rig.influences(v).0 {
-                let m = m as usize;
+        // Per joint m, the neighbourhoods a vertex on m belongs to (merged flags), once.
+        let marks: Vec<Vec<(usize, u8)>> = (0..n)
+            .map(|m| {
+                let mut l: Vec<(usize, u8)> = Vec::new();
+                let mut mark = |k: usize, flag: u8| match l.iter_mut().find(|e| e.0 == k) {
+                    Some(e) => e.1 |= flag,
+                    None => l.push((k, flag)),
+                };
                 mark(m, IN_ROOT | IN_TIP);
                 if let Some(p) = pruned.parent[m] {
                     mark(p, IN_TIP);
@@ -155,26 +183,66 @@ impl Rig {
                 for &c in &pruned.children[m] {
                     mark(c, IN_ROOT);
                 }
-            }
+                l
+            })
+            .collect();
+        let mut hoods: Vec<Vec<(u32, f32, u8)>> = vec![Vec::new(); n];
+        let mut local: Vec<(usize, u8)> = Vec::with_capacity(32);
+        for v in 0..rig.vertex_count() {
             let (js, ws) = rig.influences(v);
-            for &(k, flags) in &local {
+            let local: &[(usize, u8)] = if let [m] = js {
+                &marks[*m as usize]
+            } else {
+                local.clear();
+                for &m in js {
+                    for &(k, flag) in &marks[m as usize] {
+                        match local.iter_mut().find(|e| e.0 == k) {
+                            Some(e) => e.1 |= flag,
+                            None => local.push((k, flag)),
+                        }
+                    }
+                }
+                &local
+            };
+            for &(k, flags) in local {
                 let weight = js
                     .iter()
                     .zip(ws)
                     .find(|(j, _)| **j as usize == k)
                     .map_or(0.0, |(_, w)| *w);
-                hoods[k].push(HoodEntry {
-                    vertex: v as u32,
-                    weight,
-                    flags,
-                });
+                hoods[k].push((v as u32, weight, flags));
             }
         }
         rig.hood_start.push(0);
-
+        rig.skinned_start.push(0);
+        rig.run_start.push(0);
+        let mut runs: Vec<(u32, u32)> = Vec::new();
         for h in hoods {
-            rig.hood.extend_from_slice(&h);
-            rig.hood_start.push(rig.hood.len() as u32);
+            runs.clear();
+            for &(v, _, _) in &h {
+                match runs.last_mut() {
+                    Some((first, len)) if *first + *len == v => *len += 1,
+                    _ => runs.push((v, 1)),
+                }
+            }
+            if h.len() >= MIN_MEAN_RUN * runs.len() {
+                rig.runs.extend_from_slice(&runs);
+            }
+            rig.run_start.push(rig.runs.len() as u32);
+            rig.max_hood = rig.max_hood.max(h.len());
+            for (i, &(v, w, flags)) in h.iter().enumerate() {
+                if w > 0.0 {
+                    rig.skinned_at.push(i as u32);
+                    rig.skinned_weight.push(w);
+                }
+                rig.hood_vertex.push(v);
+                rig.hood_flags.push(flags);
+                let mask = |f: u8| if flags & f != 0 { 1.0 } else { 0.0 };
+                rig.hood_in_root.push(mask(IN_ROOT));
+                rig.hood_in_tip.push(mask(IN_TIP));
+            }
+            rig.hood_start.push(rig.hood_vertex.len() as u32);
+            rig.skinned_start.push(rig.skinned_at.len() as u32);
         }
         Ok(rig)
     }
@@ -196,10 +264,34 @@ impl Rig {
         (&self.row_joint[a..b], &self.row_weight[a..b])
     }
 
-    /// Vertices of V_k,r ∪ V_k,t, ascending, with their weights and membership flags.
+    /// Vertices of V_k,r ∪ V_k,t, ascending, with their membership flags and skin weights.
     #[inline]
-    pub(crate) fn hood(&self, k: usize) -> &[HoodEntry] {
-        &self.hood[self.hood_start[k] as usize..self.hood_start[k + 1] as usize]
+    pub(crate) fn hood(&self, k: usize) -> Hood<'_> {
+        let (a, b) = (self.hood_start[k] as usize, self.hood_start[k + 1] as usize);
+        let (c, d) = (
+            self.skinned_start[k] as usize,
+            self.skinned_start[k + 1] as usize,
+        );
+        let (e, f) = (self.run_start[k] as usize, self.run_start[k + 1] as usize);
+        Hood {
+            runs: &self.runs[e..f],
+            vertex: &self.hood_vertex[a..b],
+            flags: &self.hood_flags[a..b],
+            in_root: &self.hood_in_root[a..b],
+            in_tip: &self.hood_in_tip[a..b],
+            skinned_at: &self.skinned_at[c..d],
+            skinned_weight: &self.skinned_weight[c..d],
+        }
+    }
+
+    /// Whether some neighbourhood is evaluated by runs (see [`Hood::runs`]).
+    pub(crate) fn has_runs(&self) -> bool {
+        !self.runs.is_empty()
+    }
+
+    /// Size of the largest neighbourhood (scratch size of the batched evaluation).
+    pub(crate) fn max_hood_len(&self) -> usize {
+        self.max_hood
     }
 }
 
@@ -243,16 +335,18 @@ mod tests {
         assert_eq!(rig.influences(2).0, &[1]);
         // V_forearm,t = vertices on the forearm (and no kept child); V_forearm,r adds the arm's.
         let hood = rig.hood(1);
-        assert_eq!(hood.iter().map(|e| e.vertex).collect::<Vec<_>>(), [0, 1, 2]);
+        assert_eq!(hood.vertex, [0, 1, 2]);
+        assert_eq!(hood.flags, [IN_ROOT, IN_ROOT | IN_TIP, IN_ROOT | IN_TIP]);
         assert_eq!(
-            hood.iter().map(|e| e.flags).collect::<Vec<_>>(),
-            [IN_ROOT, IN_ROOT | IN_TIP, IN_ROOT | IN_TIP]
+            (hood.in_root, hood.in_tip),
+            (&[1.0; 3][..], &[0.0, 1.0, 1.0][..])
         );
-        assert_eq!(
-            hood.iter().map(|e| e.weight).collect::<Vec<_>>(),
-            [0.0, 1.0, 1.0]
-        );
-        assert!(rig.hood(2).is_empty());
+        assert_eq!(hood.skinned_at, [1, 2]);
+        assert_eq!(hood.skinned_weight, [1.0, 1.0]);
+        assert!(rig.hood(2).vertex.is_empty());
+        assert_eq!(rig.max_hood_len(), 3);
+        // Three consecutive vertices: one run, but too short to be worth it.
+        assert!(hood.runs.is_empty() && !rig.has_runs());
         assert!(matches!(
             Pruned::new(&s, &["wrist".into()]),
             Err(SmearError::UnknownJoint { .. })

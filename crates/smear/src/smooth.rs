@@ -27,22 +27,51 @@ pub fn smoothing_weights(n: usize) -> Vec<f32> {
 /// # Performance
 /// Parallel over frames; `(2N + 1) × frames × vertices` multiply-adds.
 pub fn smooth_in_time(values: &[f32], frames: usize, vertices: usize, n: usize) -> Vec<f32> {
-    if n == 0 || frames <= 1 || vertices == 0 {
-        return values.to_vec();
+    smooth_columns(values, frames, vertices, 0..vertices, n)
+}
+
+/// Eq. 2 on the columns `cols` of a frame-major `frames × stride` buffer (one object's
+/// vertices inside a group), into a new frame-major `frames × cols.len()` buffer.
+///
+/// # Panics
+/// If `values` is shorter than `frames × stride` or `cols` is not inside `0..stride`.
+///
+/// # Performance
+/// Parallel over frames. Each output frame is written before it is read, so the fresh
+/// (zeroed, not yet mapped) output pages fault once, not twice.
+pub(crate) fn smooth_columns(
+    values: &[f32],
+    frames: usize,
+    stride: usize,
+    cols: std::ops::Range<usize>,
+    n: usize,
+) -> Vec<f32> {
+    let width = cols.len();
+    let column = |g: usize| &values[g * stride + cols.start..g * stride + cols.end];
+    if n == 0 || frames <= 1 || width == 0 {
+        let mut out = Vec::with_capacity(frames * width);
+        for f in 0..frames {
+            out.extend_from_slice(column(f));
+        }
+        return out;
     }
     let w = smoothing_weights(n);
-    let mut out = vec![0.0f32; values.len()];
-    out.par_chunks_mut(vertices)
-        .enumerate()
-        .for_each(|(f, dst)| {
-            for (k, &wk) in w.iter().enumerate() {
-                let g = (f as i64 + k as i64 - n as i64).clamp(0, frames as i64 - 1) as usize;
-                let src = &values[g * vertices..(g + 1) * vertices];
+    let mut out = vec![0.0f32; frames * width];
+    out.par_chunks_mut(width).enumerate().for_each(|(f, dst)| {
+        for (k, &wk) in w.iter().enumerate() {
+            let g = (f as i64 + k as i64 - n as i64).clamp(0, frames as i64 - 1) as usize;
+            let src = column(g);
+            if k == 0 {
+                for (d, s) in dst.iter_mut().zip(src) {
+                    *d = wk * s;
+                }
+            } else {
                 for (d, s) in dst.iter_mut().zip(src) {
                     *d += wk * s;
                 }
             }
-        });
+        }
+    });
     out
 }
 

@@ -347,18 +347,18 @@ impl<'a> OffsetSolver<'a> {
         })
     }
 
-    fn group_offsets(&self, g: usize) -> Vec<f32> {
-        let grp = &self.groups[g];
-        crate::smooth_in_time(&grp.raw, self.frames, grp.vertices, self.smooth)
-    }
-
-    fn split(&self, g: usize, values: &[f32], slot: &Slot<'_>) -> MotionOffsets {
-        let (n, nv) = (self.groups[g].vertices, slot.anim.vertex_count());
-        let mut out = Vec::with_capacity(self.frames * nv);
-        for f in 0..self.frames {
-            out.extend_from_slice(&values[f * n + slot.base..f * n + slot.base + nv]);
-        }
-        MotionOffsets::new(self.frames, nv, out).expect("frames × vertices")
+    /// Smoothed (Eq. 2) offsets of one object, straight from its group's raw offsets.
+    fn slot_offsets(&self, slot: &Slot<'_>) -> MotionOffsets {
+        let grp = &self.groups[slot.group];
+        let nv = slot.anim.vertex_count();
+        let values = crate::smooth::smooth_columns(
+            &grp.raw,
+            self.frames,
+            grp.vertices,
+            slot.base..slot.base + nv,
+            self.smooth,
+        );
+        MotionOffsets::new(self.frames, nv, values).expect("frames × vertices")
     }
 
     /// Smoothed (Eq. 2) offsets of every vertex of object `i`.
@@ -367,23 +367,15 @@ impl<'a> OffsetSolver<'a> {
     /// [`SmearError::UnknownObject`] when `i` is out of range.
     ///
     /// # Performance
-    /// Smooths the object's whole group (a character's meshes); use [`OffsetSolver::all`] for
-    /// every object.
+    /// Smooths only the object's own vertices (its group's neighbourhood maxima were taken
+    /// when the solver was built).
     pub fn vertex_offsets(&self, i: usize) -> Result<MotionOffsets> {
-        let slot = self.slot(i)?;
-        let values = self.group_offsets(slot.group);
-        Ok(self.split(slot.group, &values, slot))
+        Ok(self.slot_offsets(self.slot(i)?))
     }
 
     /// Smoothed offsets of every object, in object order.
     pub fn all(&self) -> Vec<MotionOffsets> {
-        let per_group: Vec<Vec<f32>> = (0..self.groups.len())
-            .map(|g| self.group_offsets(g))
-            .collect();
-        self.slots
-            .iter()
-            .map(|s| self.split(s.group, &per_group[s.group], s))
-            .collect()
+        self.slots.iter().map(|s| self.slot_offsets(s)).collect()
     }
 
     /// Smoothed offsets at surface points of object `i` (Section 4.3: Eq. 8 evaluated at the

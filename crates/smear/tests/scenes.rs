@@ -466,3 +466,79 @@ mod properties {
         }
     }
 }
+
+/// `scene` with its single object's vertices reordered: new vertex i is old vertex
+/// `(i · 7919) mod n` (scatters every bone's vertices over the index range).
+fn shuffled(mut scene: SampledScene) -> (SampledScene, Vec<usize>) {
+    let obj = &mut scene.objects[0];
+    let (n, frames) = (obj.animation.vertex_count(), obj.animation.frame_count());
+    let old_of: Vec<usize> = (0..n).map(|i| i * 7919 % n).collect();
+    let mut new_of = vec![0u32; n];
+    for (i, &o) in old_of.iter().enumerate() {
+        new_of[o] = i as u32;
+    }
+    let mesh = &obj.animation.mesh;
+    let positions = old_of.iter().map(|&o| mesh.positions[o]).collect();
+    let triangles = mesh
+        .triangles
+        .iter()
+        .map(|t| t.map(|v| new_of[v as usize]))
+        .collect();
+    let mesh = anim::Mesh::new(&mesh.name, positions, triangles);
+    let frames_pos = (0..frames)
+        .flat_map(|f| old_of.iter().map(move |&o| (f, o)))
+        .map(|(f, o)| obj.animation.frame(f)[o])
+        .collect();
+    let skin = obj.skin.as_mut().unwrap();
+    let weights = VertexWeights::from_influences(old_of.iter().map(|&o| {
+        let (s, w) = skin.weights.influences(o);
+        s.iter().zip(w).map(|(&s, &w)| (s, w)).collect::<Vec<_>>()
+    }));
+    skin.weights = weights;
+    obj.animation = MeshAnimation::new(mesh, 24.0, frames_pos).unwrap();
+    (scene, old_of)
+}
+
+/// The optimized vertex pass (batched ribbons over neighbourhoods read by runs of
+/// consecutive vertices, or gathered when the vertex order is scattered) equals the
+/// straightforward pointwise evaluation of Eqs. 3–9 (surface points at the vertices) at
+/// every vertex and frame, and both vertex orders give the same offsets.
+#[test]
+fn vertex_pass_matches_pointwise_evaluation() {
+    let no_smooth = opts(0);
+    let frames = 7;
+    let scene = arm_scene(frames, |m| chain_weights(m, 3, 1.0, 0.2));
+    let (mixed, old_of) = shuffled(arm_scene(frames, |m| chain_weights(m, 3, 1.0, 0.2)));
+    let mut per_order = Vec::new();
+    for s in [&scene, &mixed] {
+        let solver = OffsetSolver::new(s, &no_smooth).unwrap();
+        let verts = solver.vertex_offsets(0).unwrap();
+        let tris = &s.objects[0].animation.mesh.triangles;
+        let n = verts.vertex_count();
+        // One surface point exactly at every vertex.
+        let mut points = vec![None; n];
+        for (t, tri) in tris.iter().enumerate() {
+            for (c, &v) in tri.iter().enumerate() {
+                let mut barycentric = [0.0; 3];
+                barycentric[c] = 1.0;
+                points[v as usize].get_or_insert(SurfacePoint {
+                    triangle: t as u32,
+                    barycentric,
+                });
+            }
+        }
+        let points: Vec<SurfacePoint> = points.into_iter().map(Option::unwrap).collect();
+        let at = solver.surface_offsets(0, &points).unwrap();
+        let worst = max_diff(&verts, &at);
+        assert!(worst <= 1e-5, "vertex pass vs pointwise: {worst}");
+        assert!(verts.max_abs() > 0.5, "range {:?}", verts.range());
+        per_order.push(verts);
+    }
+    let mut worst = 0.0f32;
+    for f in 0..frames {
+        for (i, &o) in old_of.iter().enumerate() {
+            worst = worst.max((per_order[1].frame(f)[i] - per_order[0].frame(f)[o]).abs());
+        }
+    }
+    assert!(worst <= 1e-6, "vertex orders differ by {worst}");
+}

@@ -14,6 +14,8 @@ use crate::output::{self, Layout};
 
 /// The bundled 3D sample: RobotExpressive (CC0, see assets/LICENSES.md).
 pub const SAMPLE_GLB: &[u8] = include_bytes!("../../../../assets/RobotExpressive.glb");
+/// The bundled smear style: all three effects (paper Fig. 16).
+pub const SAMPLE_STYLE: &str = include_str!("../../../../examples/smear/fig16_combined.toml");
 /// The bundled keystrokes: a jump-like arc.
 pub const SAMPLE_KEYS: &str = include_str!("../../../../examples/loa/jump.json");
 
@@ -98,6 +100,15 @@ pub fn run(ctx: &Context, args: DemoArgs) -> Result<()> {
     put(
         &out("robot_offsets.gif"),
         &preview(render::OutputFormat::Gif, 0, 0)?,
+        &mut written,
+    )?;
+
+    // smear: the bundled style (elongation, multiples, motion lines) as a GIF.
+    let style = smear::Style::from_toml_str(SAMPLE_STYLE).context("bundled smear style")?;
+    let styled = super::smear_style::apply(&sampled, &style)?;
+    put(
+        &out("robot_smear.gif"),
+        &styled.render_gif(320, 320)?,
         &mut written,
     )?;
 

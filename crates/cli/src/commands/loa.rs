@@ -22,6 +22,8 @@ pub struct LoaArgs {
 pub enum LoaCommand {
     /// Interpolate sketched keystrokes into a dynamic line of action (Guay et al. 2015, §3).
     Line(LineArgs),
+    /// Synthesize 3D character motion that follows the dynamic line (Guay et al. 2015, §4).
+    Animate(super::loa_animate::AnimateArgs),
 }
 
 /// Interpolation mode.
@@ -64,6 +66,7 @@ pub struct LineArgs {
 pub fn run(ctx: &Context, args: LoaArgs) -> Result<()> {
     match args.command {
         LoaCommand::Line(a) => line(ctx, a),
+        LoaCommand::Animate(a) => super::loa_animate::run(ctx, a),
     }
 }
 
@@ -89,7 +92,7 @@ fn output_kind(path: &Path) -> Result<OutputKind> {
     }
 }
 
-fn read_keystrokes(path: &Path) -> Result<loa::Keystrokes> {
+pub(super) fn read_keystrokes(path: &Path) -> Result<loa::Keystrokes> {
     let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
     let is_svg = path
         .extension()

@@ -4,11 +4,16 @@ pub mod convert;
 pub mod demo;
 pub mod info;
 pub mod loa;
+mod loa_animate;
 mod loa_render;
 pub mod render;
 pub mod smear;
+pub mod smear_effects;
+pub mod smear_style;
 pub mod stopmo;
+mod stopmo_curve;
 mod stopmo_library;
+mod stopmo_run;
 
 /// Options every command sees.
 #[derive(Debug, Clone, Copy)]

@@ -19,11 +19,14 @@ use super::Context;
 use crate::input::{self, InputArgs};
 use crate::output::{self, Layout};
 
-/// Arguments of `toonkit smear`.
+/// Arguments of `toonkit smear`: a subcommand, or `IN --style STYLE.toml -o OUT.glb`.
 #[derive(Debug, Args)]
+#[command(args_conflicts_with_subcommands = true)]
 pub struct SmearArgs {
     #[command(subcommand)]
-    pub command: SmearCommand,
+    pub command: Option<SmearCommand>,
+    #[command(flatten)]
+    pub style: super::smear_style::StyleArgs,
 }
 
 /// Subcommands of `toonkit smear`.
@@ -31,6 +34,12 @@ pub struct SmearArgs {
 pub enum SmearCommand {
     /// Motion offsets per frame and vertex: leading parts > 0, trailing parts < 0 (§3).
     Offsets(OffsetsArgs),
+    /// Elongated in-betweens: vertices slid along their trajectories by β = S_E(δ) (§4.1).
+    Elongate(super::smear_effects::ElongateArgs),
+    /// Multiple in-betweens: displaced copies with per-vertex opacity (§4.2).
+    Multiples(super::smear_effects::MultiplesArgs),
+    /// Motion lines: tubes along seed trajectories, length τ = S_L(δ) (§4.3).
+    Lines(super::smear_effects::LinesArgs),
 }
 
 /// Arguments of `toonkit smear offsets`.
@@ -63,7 +72,11 @@ pub struct OffsetsArgs {
 /// Runs `toonkit smear`.
 pub fn run(ctx: &Context, args: SmearArgs) -> Result<()> {
     match args.command {
-        SmearCommand::Offsets(a) => offsets(ctx, a),
+        None => super::smear_style::run(ctx, args.style),
+        Some(SmearCommand::Offsets(a)) => offsets(ctx, a),
+        Some(SmearCommand::Elongate(a)) => super::smear_effects::elongate(ctx, a),
+        Some(SmearCommand::Multiples(a)) => super::smear_effects::multiples(ctx, a),
+        Some(SmearCommand::Lines(a)) => super::smear_effects::lines(ctx, a),
     }
 }
 

@@ -1,8 +1,10 @@
 //! `toonkit stopmo …`: replacement libraries for 3D-printed stop-motion (StopShop).
 //!
-//! `segment` cuts a face animation into parts and homogenizes the seams (Sections 3.1–3.2).
+//! `segment` cuts a face animation into parts and homogenizes the seams (Sections 3.1–3.2);
+//! `library` ([`super::stopmo_library`]) builds the replacement library; `run`
+//! ([`super::stopmo_run`]) chains both.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anim::glam::Vec3;
@@ -31,6 +33,9 @@ pub enum StopmoCommand {
     /// Build a replacement library of printable pieces per part, the assembly sheet and a
     /// shooting order (StopShop Sections 3.3–3.4, 5).
     Library(super::stopmo_library::LibraryArgs),
+    /// Segment, then build the library of every part: `segment` and `library` in one go,
+    /// writing DIR/segmentation.glb, DIR/segmentation.json and the library layout in DIR.
+    Run(super::stopmo_run::RunArgs),
 }
 
 /// glTF layout of the segmented parts.
@@ -51,6 +56,24 @@ pub struct SegmentArgs {
     /// Output `.glb`: one mesh node per part, named after the part, all with the same frames.
     #[arg(short, long)]
     pub output: PathBuf,
+    #[command(flatten)]
+    pub segment: SegmentOptionsArgs,
+    /// Write the JSON report (parts, triangle_part, seam_vertices, gamma, cut_length).
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// Write a PNG: parts on the average mesh and the average displacement (paper Fig. 5).
+    #[arg(long)]
+    pub render: Option<PathBuf>,
+    /// glTF layout of the parts.
+    #[arg(long = "as", value_enum, default_value_t = PartsLayout::Morph)]
+    pub layout: PartsLayout,
+    #[command(flatten)]
+    pub input_args: InputArgs,
+}
+
+/// Segmentation options shared by `stopmo segment` and `stopmo run`.
+#[derive(Debug, Args)]
+pub struct SegmentOptionsArgs {
     /// A part and its seed: `NAME=tri:ID` (triangle id) or `NAME=point:X,Y,Z` (snapped to the
     /// nearest triangle). Repeat for each part; repeat a name for several seeds.
     #[arg(long = "part", value_name = "NAME=SEED")]
@@ -68,17 +91,6 @@ pub struct SegmentArgs {
     /// Keep the seams as they move (skip Section 3.2).
     #[arg(long)]
     pub no_homogenize: bool,
-    /// Write the JSON report (parts, triangle_part, seam_vertices, gamma, cut_length).
-    #[arg(long)]
-    pub report: Option<PathBuf>,
-    /// Write a PNG: parts on the average mesh and the average displacement (paper Fig. 5).
-    #[arg(long)]
-    pub render: Option<PathBuf>,
-    /// glTF layout of the parts.
-    #[arg(long = "as", value_enum, default_value_t = PartsLayout::Morph)]
-    pub layout: PartsLayout,
-    #[command(flatten)]
-    pub input_args: InputArgs,
 }
 
 /// Runs `toonkit stopmo …`.
@@ -86,6 +98,7 @@ pub fn run(ctx: &Context, args: StopmoArgs) -> Result<()> {
     match args.command {
         StopmoCommand::Segment(a) => segment(ctx, a),
         StopmoCommand::Library(a) => super::stopmo_library::library(ctx, a),
+        StopmoCommand::Run(a) => super::stopmo_run::run(ctx, a),
     }
 }
 
@@ -125,53 +138,105 @@ fn parse_parts(specs: &[String]) -> Result<Vec<PartSpec>> {
 
 fn segment(ctx: &Context, args: SegmentArgs) -> Result<()> {
     let start = Instant::now();
-    if tkio::Format::from_extension(&args.output) != Some(tkio::Format::Glb) {
-        bail!(
-            "{}: the segmented animation is written as .glb",
-            args.output.display()
-        );
-    }
     let sampled = input::open(&args.input, &args.input_args)?;
     let anim = input::merged(&args.input, &sampled)?;
-    let parts = match args.auto_parts {
-        Some(n) => stopmo::segment::auto_parts(&anim, n)
-            .with_context(|| args.input.display().to_string())?,
-        None => parse_parts(&args.parts)?,
+    let out = segment_and_write(
+        ctx,
+        &args.input,
+        &anim,
+        &args.segment,
+        &SegmentOutputs {
+            glb: &args.output,
+            layout: args.layout,
+            report: args.report.as_deref(),
+            render: args.render.as_deref(),
+        },
+    )?;
+    let mut summary = out.summary;
+    summary["seconds"] = json!(start.elapsed().as_secs_f64());
+    ctx.report(&summary, || {
+        format!("{}, {:.2} s", out.text, start.elapsed().as_secs_f64())
+    });
+    Ok(())
+}
+
+/// Where [`segment_and_write`] writes.
+pub(super) struct SegmentOutputs<'a> {
+    /// The parts (`.glb`).
+    pub glb: &'a Path,
+    /// Their glTF layout.
+    pub layout: PartsLayout,
+    /// The JSON report, if wanted.
+    pub report: Option<&'a Path>,
+    /// The Fig. 5 PNG, if wanted.
+    pub render: Option<&'a Path>,
+}
+
+/// What [`segment_and_write`] produced.
+pub(super) struct Segmented {
+    /// The parts, named after the segmentation's part names.
+    pub parts: Vec<stopmo::segment::Part>,
+    /// JSON summary (no timing).
+    pub summary: serde_json::Value,
+    /// One-line human summary (no timing).
+    pub text: String,
+}
+
+/// Segments `anim` (read from `input`) and writes the parts, the report and the render:
+/// the body of `stopmo segment`, shared with `stopmo run`.
+pub(super) fn segment_and_write(
+    ctx: &Context,
+    input: &Path,
+    anim: &MeshAnimation,
+    opts: &SegmentOptionsArgs,
+    out: &SegmentOutputs<'_>,
+) -> Result<Segmented> {
+    if tkio::Format::from_extension(out.glb) != Some(tkio::Format::Glb) {
+        bail!(
+            "{}: the segmented animation is written as .glb",
+            out.glb.display()
+        );
+    }
+    let parts = match opts.auto_parts {
+        Some(n) => {
+            stopmo::segment::auto_parts(anim, n).with_context(|| input.display().to_string())?
+        }
+        None => parse_parts(&opts.parts)?,
     };
     if parts.len() < 2 {
         bail!("give at least two parts (--part NAME=SEED twice, or --auto-parts N)");
     }
     let mut options = SegmentOptions {
-        gamma: args.gamma,
-        homogenize: !args.no_homogenize,
+        gamma: opts.gamma,
+        homogenize: !opts.no_homogenize,
         ..SegmentOptions::default()
     };
-    if let Some(k) = args.smooth_iters {
+    if let Some(k) = opts.smooth_iters {
         options.smooth_iterations = k;
     }
     let spinner = crate::progress::spinner("segmenting", ctx.json);
-    let seg = stopmo::segment::segment(&anim, &parts, &options)
-        .with_context(|| args.input.display().to_string())?;
+    let seg = stopmo::segment::segment(anim, &parts, &options)
+        .with_context(|| input.display().to_string())?;
     let pieces = seg.parts()?;
-    let layout = match args.layout {
+    let layout = match out.layout {
         PartsLayout::Morph => tkio::gltf::AnimationLayout::Morph,
         PartsLayout::Flipbook => tkio::gltf::AnimationLayout::Flipbook,
     };
     let refs: Vec<(&MeshAnimation, Option<&[[f32; 4]]>)> =
         pieces.iter().map(|p| (&p.animation, None)).collect();
-    let bytes = tkio::gltf::write_animations(&refs, layout).map_err(|e| e.at(&args.output))?;
-    tkio::write_atomic(&args.output, &bytes)?;
+    let bytes = tkio::gltf::write_animations(&refs, layout).map_err(|e| e.at(out.glb))?;
+    tkio::write_atomic(out.glb, &bytes)?;
     let report = serde_json::to_value(seg.report())?;
-    if let Some(path) = &args.report {
+    if let Some(path) = out.report {
         tkio::write_atomic(path, serde_json::to_string_pretty(&report)?.as_bytes())?;
     }
-    if let Some(path) = &args.render {
+    if let Some(path) = out.render {
         tkio::write_atomic(path, &render_parts(&seg)?)?;
     }
     spinner.finish_and_clear();
     let summary = json!({
-        "input": args.input,
-        "output": args.output,
+        "input": input,
+        "output": out.glb,
         "parts": pieces.iter().map(|p| json!({"name": p.name, "vertices": p.animation.vertex_count(),
             "triangles": p.animation.mesh.triangle_count()})).collect::<Vec<_>>(),
         "frames": anim.frame_count(),
@@ -179,30 +244,30 @@ fn segment(ctx: &Context, args: SegmentArgs) -> Result<()> {
         "cut_length": seg.cut_length,
         "seam_vertices": seg.seam_vertices.len(),
         "homogenization": report["homogenization"],
-        "seconds": start.elapsed().as_secs_f64(),
     });
-    ctx.report(&summary, || {
-        let names: Vec<String> = pieces
-            .iter()
-            .map(|p| {
-                format!(
-                    "{} ({} triangles)",
-                    p.name,
-                    p.animation.mesh.triangle_count()
-                )
-            })
-            .collect();
-        format!(
-            "wrote {}: {} over {} frames, cut length {:.3}, {} seam vertices, {:.2} s",
-            args.output.display(),
-            names.join(", "),
-            anim.frame_count(),
-            seg.cut_length,
-            seg.seam_vertices.len(),
-            start.elapsed().as_secs_f64()
-        )
-    });
-    Ok(())
+    let names: Vec<String> = pieces
+        .iter()
+        .map(|p| {
+            format!(
+                "{} ({} triangles)",
+                p.name,
+                p.animation.mesh.triangle_count()
+            )
+        })
+        .collect();
+    let text = format!(
+        "wrote {}: {} over {} frames, cut length {:.3}, {} seam vertices",
+        out.glb.display(),
+        names.join(", "),
+        anim.frame_count(),
+        seg.cut_length,
+        seg.seam_vertices.len(),
+    );
+    Ok(Segmented {
+        parts: pieces,
+        summary,
+        text,
+    })
 }
 
 /// Paper Fig. 5: the parts on the average mesh, beside the mean displacement from the

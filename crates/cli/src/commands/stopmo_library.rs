@@ -4,7 +4,8 @@
 //! Output layout (SPEC.md "Output layouts"): `DIR/pieces/<part>_<NN>.stl` (printable solids,
 //! mm), `DIR/pieces/<part>_<NN>.obj` (piece surfaces, model units), `DIR/assembly.csv`,
 //! `DIR/assembly.md`, `DIR/shooting_order.csv`, `DIR/report.json`, `DIR/reconstruction.glb`,
-//! `DIR/reconstruction.pc2` + `DIR/rest.obj`, and `DIR/error_curve.csv` after a size search.
+//! `DIR/reconstruction.pc2` + `DIR/rest.obj`, and `DIR/error_curve.csv` / `.png` (drawn by
+//! [`super::stopmo_curve`]) after a size search.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -17,9 +18,9 @@ use clap::{Args, ValueEnum};
 use rayon::prelude::*;
 use serde_json::json;
 use stopmo::library::{
-    build_library, print_scale, shooting_order, Library, LibraryOptions, LibrarySize, Method,
-    PartInput, PartSetup, SolveOptions, DEFAULT_LAMBDA, DEFAULT_PRINT_HEIGHT_MM, DEFAULT_RESTARTS,
-    DEFAULT_SEED, DEFAULT_THICKNESS_MM,
+    add_plugs, build_library, plan_plugs, print_scale, scaled, shooting_order, Library,
+    LibraryOptions, LibrarySize, Method, PartInput, PartSetup, Plug, PlugOptions, SolveOptions,
+    DEFAULT_LAMBDA, DEFAULT_PRINT_HEIGHT_MM, DEFAULT_RESTARTS, DEFAULT_SEED, DEFAULT_THICKNESS_MM,
 };
 
 use super::Context;
@@ -59,6 +60,15 @@ pub struct LibraryArgs {
     /// Output directory.
     #[arg(short, long)]
     pub output: PathBuf,
+    #[command(flatten)]
+    pub library: LibraryOptionsArgs,
+    #[command(flatten)]
+    pub input_args: InputArgs,
+}
+
+/// Library options shared by `stopmo library` and `stopmo run`.
+#[derive(Debug, Args)]
+pub struct LibraryOptionsArgs {
     /// Pieces per part: `20` for every part, or `upper=20,lower=30`.
     #[arg(long, value_name = "N|PART=N,...", conflicts_with_all = ["max_error", "budget"])]
     pub pieces: Option<String>,
@@ -98,15 +108,19 @@ pub struct LibraryArgs {
     /// Wall thickness of the printed pieces in millimetres.
     #[arg(long, value_name = "MM", default_value_t = DEFAULT_THICKNESS_MM)]
     pub thickness: f64,
+    /// Add male/female plugs (paper Fig. 13) across every seam shared by two parts: a pin
+    /// under the first part, a socket tube under the second, fused into the pieces' STL files
+    /// as extra shells (slicers union them). Placed on the rest geometry; listed in
+    /// report.json under "plugs".
+    #[arg(long)]
+    pub plugs: bool,
     /// Also write the JSON report here (it is always written to DIR/report.json).
     #[arg(long)]
     pub report: Option<PathBuf>,
-    #[command(flatten)]
-    pub input_args: InputArgs,
 }
 
 /// Replaces characters that do not belong in a file name.
-fn file_safe(name: &str) -> String {
+pub(super) fn file_safe(name: &str) -> String {
     let s: String = name
         .chars()
         .map(|c| {
@@ -125,7 +139,7 @@ fn file_safe(name: &str) -> String {
 }
 
 /// The parts of the input: one per mesh object, named after it.
-fn parts(path: &Path, args: &InputArgs) -> Result<Vec<MeshAnimation>> {
+pub(super) fn parts(path: &Path, args: &InputArgs) -> Result<Vec<MeshAnimation>> {
     let sampled = input::open(path, args)?;
     if sampled.objects.is_empty() {
         bail!("{}: the file has no mesh", path.display());
@@ -246,8 +260,33 @@ fn read_fixed(dir: &Path, part: &MeshAnimation) -> Result<Vec<Vec<Vec3>>> {
 
 /// Runs `toonkit stopmo library`.
 pub fn library(ctx: &Context, args: LibraryArgs) -> Result<()> {
-    let start = Instant::now();
     let anims = parts(&args.input, &args.input_args)?;
+    let out = build_and_write(ctx, &args.input, &anims, &args.library, &args.output)?;
+    if let Some(p) = &args.library.report {
+        tkio::write_atomic(p, serde_json::to_string_pretty(&out.report)?.as_bytes())?;
+    }
+    ctx.report(&out.report, || out.text.clone());
+    Ok(())
+}
+
+/// What [`build_and_write`] produced.
+pub(super) struct LibraryOutcome {
+    /// The report written to `DIR/report.json`.
+    pub report: serde_json::Value,
+    /// One-line human summary.
+    pub text: String,
+}
+
+/// Builds the library of `anims` (one animation per part, read from `input`) and writes the
+/// SPEC layout into `dir`: the body of `stopmo library`, shared with `stopmo run`.
+pub(super) fn build_and_write(
+    ctx: &Context,
+    input: &Path,
+    anims: &[MeshAnimation],
+    args: &LibraryOptionsArgs,
+    dir: &Path,
+) -> Result<LibraryOutcome> {
+    let start = Instant::now();
     let names: Vec<&str> = anims.iter().map(|a| a.mesh.name.as_str()).collect();
     let refs: Vec<&MeshAnimation> = anims.iter().collect();
     let size = match (&args.pieces, args.max_error, args.budget) {
@@ -265,7 +304,7 @@ pub fn library(ctx: &Context, args: LibraryArgs) -> Result<()> {
         bail!("--thickness must be a positive number of millimetres");
     }
     let saliency = match &args.saliency {
-        Some(p) => Some(read_saliency(p, &anims)?),
+        Some(p) => Some(read_saliency(p, anims)?),
         None => None,
     };
     let mut setups = Vec::with_capacity(anims.len());
@@ -301,10 +340,14 @@ pub fn library(ctx: &Context, args: LibraryArgs) -> Result<()> {
         ..LibraryOptions::default()
     };
     let spinner = crate::progress::spinner("optimizing the library", ctx.json);
-    let lib = build_library(&inputs, &opts).with_context(|| args.input.display().to_string())?;
+    let lib = build_library(&inputs, &opts).with_context(|| input.display().to_string())?;
     spinner.finish_and_clear();
-    let dir = &args.output;
-    write_pieces(dir, &lib, &anims, args.thickness)?;
+    let plugs = if args.plugs {
+        plan_part_plugs(&lib, anims, args.thickness)?
+    } else {
+        Vec::new()
+    };
+    write_pieces(dir, &lib, anims, args.thickness, &plugs)?;
     let assembly = lib.assembly();
     let frames = assembly.frames.len();
     let ids: Vec<Vec<String>> = (0..frames).map(|f| assembly.frame_ids(f)).collect();
@@ -327,7 +370,7 @@ pub fn library(ctx: &Context, args: LibraryArgs) -> Result<()> {
         let _ = writeln!(csv, "{s},{},{}", pieces.join(","), frames.join(" "));
     }
     tkio::write_atomic(&dir.join("shooting_order.csv"), csv.as_bytes())?;
-    write_reconstruction(dir, &lib, &anims)?;
+    write_reconstruction(dir, &lib, anims)?;
     if lib.parts.iter().any(|p| !p.curve.is_empty()) {
         let mut csv = String::from("part,pieces,energy,worst_frame_error_mm,mean_error_mm\n");
         for p in &lib.parts {
@@ -344,9 +387,11 @@ pub fn library(ctx: &Context, args: LibraryArgs) -> Result<()> {
             }
         }
         tkio::write_atomic(&dir.join("error_curve.csv"), csv.as_bytes())?;
+        let png = super::stopmo_curve::plot(&lib)?;
+        tkio::write_atomic(&dir.join("error_curve.png"), &png)?;
     }
     let report = json!({
-        "input": args.input,
+        "input": input,
         "method": lib.method,
         "energy": lib.energy,
         "lambda": lib.lambda,
@@ -356,6 +401,19 @@ pub fn library(ctx: &Context, args: LibraryArgs) -> Result<()> {
         "mm_per_unit": lib.mm_per_unit,
         "print_height_mm": args.print_height,
         "thickness_mm": args.thickness,
+        "plugs": plugs.iter().map(|p| json!({
+            "male": names[p.male],
+            "female": names[p.female],
+            "anchor_mm": p.anchor,
+            "normal": p.normal,
+            "axis": p.axis,
+            "center_mm": p.center,
+            "radius_mm": p.radius_mm,
+            "socket_radius_mm": p.socket_radius_mm,
+            "outer_radius_mm": p.outer_radius_mm,
+            "length_mm": p.length_mm,
+            "seam_vertices": p.seam_vertices,
+        })).collect::<Vec<_>>(),
         "errors_mm": lib.errors_mm,
         "parts": lib.parts.iter().map(|p| json!({
             "name": p.name,
@@ -373,12 +431,9 @@ pub fn library(ctx: &Context, args: LibraryArgs) -> Result<()> {
         "seconds": lib.seconds,
         "total_seconds": start.elapsed().as_secs_f64(),
     });
-    let text = serde_json::to_string_pretty(&report)?;
-    tkio::write_atomic(&dir.join("report.json"), text.as_bytes())?;
-    if let Some(p) = &args.report {
-        tkio::write_atomic(p, text.as_bytes())?;
-    }
-    ctx.report(&report, || {
+    let json = serde_json::to_string_pretty(&report)?;
+    tkio::write_atomic(&dir.join("report.json"), json.as_bytes())?;
+    let text = {
         let e = lib.errors_mm;
         format!(
             "wrote {}: {} pieces over {} parts and {} frames; error mean {:.3} mm (max {:.3}), \
@@ -396,12 +451,37 @@ pub fn library(ctx: &Context, args: LibraryArgs) -> Result<()> {
             order.sequential_swaps,
             start.elapsed().as_secs_f64()
         )
-    });
-    Ok(())
+    };
+    Ok(LibraryOutcome { report, text })
 }
 
-/// `DIR/pieces/<id>.obj` (surface, model units) and `<id>.stl` (printable solid, mm).
-fn write_pieces(dir: &Path, lib: &Library, anims: &[MeshAnimation], thickness: f64) -> Result<()> {
+/// One plug per seam between two parts, placed on the average geometry in millimetres (the
+/// STL coordinates).
+fn plan_part_plugs(lib: &Library, anims: &[MeshAnimation], thickness: f64) -> Result<Vec<Plug>> {
+    let surfaces: Vec<anim::Mesh> = anims
+        .iter()
+        .map(|a| {
+            let mut m = a.mesh.clone();
+            m.positions = a.average_positions();
+            scaled(&m, lib.mm_per_unit as f32)
+        })
+        .collect();
+    let opts = PlugOptions {
+        thickness_mm: thickness,
+        ..PlugOptions::default()
+    };
+    Ok(plan_plugs(&surfaces, &opts)?)
+}
+
+/// `DIR/pieces/<id>.obj` (surface, model units) and `<id>.stl` (printable solid, mm, with the
+/// part's plug shells).
+fn write_pieces(
+    dir: &Path,
+    lib: &Library,
+    anims: &[MeshAnimation],
+    thickness: f64,
+    plugs: &[Plug],
+) -> Result<()> {
     let jobs: Vec<(usize, usize)> = lib
         .parts
         .iter()
@@ -421,6 +501,7 @@ fn write_pieces(dir: &Path, lib: &Library, anims: &[MeshAnimation], thickness: f
         let solid = lib
             .printable_piece(p, k, topology, thickness)
             .with_context(|| format!("piece {}", surface.name))?;
+        let solid = add_plugs(&solid, p, plugs, stopmo::library::DEFAULT_PLUG_SEGMENTS);
         tkio::write_atomic(
             &base.with_extension("stl"),
             &tkio::stl::write_binary(&solid),

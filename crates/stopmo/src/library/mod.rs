@@ -47,6 +47,7 @@ mod build;
 mod error;
 mod fabricate;
 mod metrics;
+mod plugs;
 mod problem;
 mod rng;
 mod size;
@@ -68,6 +69,10 @@ pub use fabricate::{
     DEFAULT_PRINT_HEIGHT_MM, DEFAULT_THICKNESS_MM, PLA_DENSITY_G_PER_MM3,
 };
 pub use metrics::{ErrorSummary, FrameErrors};
+pub use plugs::{
+    add_plugs, components, plan_plugs, Plug, PlugOptions, DEFAULT_PLUG_CLEARANCE_MM,
+    DEFAULT_PLUG_LENGTH_MM, DEFAULT_PLUG_RADIUS_MM, DEFAULT_PLUG_SEGMENTS, DEFAULT_PLUG_WALL_MM,
+};
 pub use problem::{PartProblem, PartSetup};
 pub use size::{allocate_budget, CurvePoint};
 pub use solver::{

@@ -1,0 +1,70 @@
+//! End-to-end character motion synthesis (Section 4): 5 keystrokes, RobotExpressive's 43
+//! joints, 120 frames, changing bone sets — the interactive target is ≤ 100 ms on 2 cores.
+//!
+//! `cargo bench -p toonkit-loa --bench animate`
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use loa::animate::{animate, AnimateOptions, BoneSetKey, Character};
+use loa::{line_of_action, Keystrokes, LineOptions};
+
+fn stroke(bow: f64, lean: f64) -> String {
+    let pts: Vec<String> = (0..=20)
+        .map(|i| {
+            let s = i as f64 / 20.0;
+            let x = bow * 100.0 * (std::f64::consts::PI * s).sin() + lean * 100.0 * s;
+            format!("[{x:.3}, {:.3}]", -100.0 * s)
+        })
+        .collect();
+    format!("[{}]", pts.join(", "))
+}
+
+fn bench(c: &mut Criterion) {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/data/characters/RobotExpressive.glb"
+    );
+    let scene =
+        tkio::gltf::read(std::path::Path::new(path)).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let skeleton = scene.skeleton().0;
+    assert_eq!(skeleton.len(), 43);
+    let keys: Vec<String> = [
+        (0, 0.2, 0.1),
+        (30, 0.0, 0.0),
+        (60, -0.2, -0.1),
+        (90, 0.1, 0.2),
+        (119, 0.0, 0.0),
+    ]
+    .iter()
+    .map(|(f, b, l)| format!(r#"{{"frame": {f}, "points": {}}}"#, stroke(*b, *l)))
+    .collect();
+    let json = format!(r#"{{"keystrokes": [{}]}}"#, keys.join(", "));
+    let keys = Keystrokes::from_json_str(&json).unwrap();
+    let sets: Vec<BoneSetKey> = [
+        "right-leg-spine-head@0",
+        "left-leg-spine-head@60",
+        "right-leg-spine-head@119",
+    ]
+    .iter()
+    .map(|s| s.parse().unwrap())
+    .collect();
+    c.bench_function("animate_robot_5keys_120frames", |b| {
+        b.iter(|| {
+            let character = Character::rest(&skeleton).unwrap();
+            let line = line_of_action(&keys, &LineOptions::default()).unwrap();
+            let motion = animate(
+                &character,
+                &line.animation,
+                &sets,
+                &[],
+                &[],
+                &AnimateOptions::default(),
+            )
+            .unwrap();
+            assert_eq!(motion.frames(), 120);
+            motion
+        })
+    });
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,418 @@
+//! The whole pipeline of [`super::animate`]: setup, planar stage, 3D stage, measurements.
+
+use std::collections::BTreeMap;
+
+use glam::{DQuat, DVec2, DVec3};
+
+use super::bones::{self, BoneSet, ChainPoint, Preset};
+use super::camera::{ActionCamera, ActionPlane, ScreenMap};
+use super::error::AnimateError;
+use super::keys::{BoneSetKey, ContactKey, TwistKey};
+use super::reduction::Reduction;
+use super::rig::{Rig, WorldPose};
+use super::solver::{Poses, Stage};
+use super::targets::{
+    image_lines, line_targets, twist_target, ContactTarget, FrameTargets, ImageLine, KeyChain,
+    OrientTarget,
+};
+use super::terms::{log, point_position, Columns};
+use super::{AnimateOptions, AnimateReport, Character, Motion, DEFAULT_MAX_ITERATIONS};
+use crate::Animation;
+
+fn joint_index(rig: &Rig, name: &str) -> Result<usize, AnimateError> {
+    rig.names
+        .iter()
+        .position(|n| n == name)
+        .ok_or_else(|| AnimateError::UnknownJoint {
+            name: name.to_string(),
+            joints: rig.names.join(", "),
+        })
+}
+
+/// The bone set of every keystroke.
+fn key_sets(line: &Animation, sets: &[BoneSetKey]) -> Result<Vec<BoneSet>, AnimateError> {
+    let frames = &line.keystroke_frames;
+    for s in sets {
+        if !frames.contains(&s.frame) {
+            return Err(AnimateError::BadFrame {
+                what: "bone set",
+                frame: s.frame,
+                expected: format!("bone sets go on keystroke frames {frames:?}"),
+            });
+        }
+    }
+    let mut current = sets
+        .iter()
+        .min_by_key(|s| s.frame)
+        .map_or(BoneSet::Preset(Preset::RightLegSpineHead), |s| {
+            s.set.clone()
+        });
+    Ok(frames
+        .iter()
+        .map(|f| {
+            if let Some(s) = sets.iter().rev().find(|s| s.frame == *f) {
+                current = s.set.clone();
+            }
+            current.clone()
+        })
+        .collect())
+}
+
+/// Default screen map: the first keystroke's line length equals the first chain's length and
+/// their arc-length midpoints coincide.
+fn fit_screen(line: &Animation, key0: usize, chain: &KeyChain, image: &[DVec2]) -> ScreenMap {
+    let screen = ImageLine::new(line.frames[key0].chain.joints());
+    let scale = if screen.length() > 0.0 && chain.length > 0.0 {
+        chain.length / screen.length()
+    } else {
+        1.0
+    };
+    // The chain's midpoint by 3D arc length.
+    let k = chain
+        .u
+        .partition_point(|&u| u <= 0.5)
+        .clamp(1, image.len().max(2) - 1);
+    let (u0, u1) = (chain.u[k - 1], chain.u[k]);
+    let t = if u1 > u0 { (0.5 - u0) / (u1 - u0) } else { 0.0 };
+    let origin = image
+        .get(k - 1)
+        .copied()
+        .unwrap_or_default()
+        .lerp(image.get(k).copied().unwrap_or_default(), t);
+    ScreenMap {
+        anchor: screen.at(0.5),
+        origin,
+        scale,
+    }
+}
+
+/// Marks the joints whose rotation moves chain point `p`.
+fn mark_ancestors(rig: &Rig, p: ChainPoint, dof: &mut [bool]) {
+    let mut a = match p {
+        ChainPoint::Joint(j) => rig.parent[j],
+        ChainPoint::Tip(j) => Some(j),
+    };
+    while let Some(k) = a {
+        dof[k] = true;
+        a = rig.parent[k];
+    }
+}
+
+pub(crate) fn run(
+    character: &Character,
+    line: &Animation,
+    bone_sets: &[BoneSetKey],
+    contacts: &[ContactKey],
+    twists: &[TwistKey],
+    options: &AnimateOptions,
+) -> Result<Motion, AnimateError> {
+    let rig = &character.rig;
+    let frames = line.frames.len();
+    if frames == 0 || line.keystroke_frames.is_empty() {
+        return Err(AnimateError::EmptyLine);
+    }
+    let first = line.frames[0].frame;
+    let last = first + frames as i64 - 1;
+    let key_offsets: Vec<usize> = line
+        .keystroke_frames
+        .iter()
+        .map(|&k| (k - first).clamp(0, frames as i64 - 1) as usize)
+        .collect();
+    let max_iterations = if options.max_iterations == 0 {
+        DEFAULT_MAX_ITERATIONS
+    } else {
+        options.max_iterations
+    };
+    let weights = &options.weights;
+
+    // Setup: initial pose, camera, plane, chains, screen map.
+    let initial = rig.world(&rig.rotation, DVec3::ZERO);
+    let (bmin, bmax) = character.bounds();
+    let camera = options
+        .camera
+        .unwrap_or_else(|| ActionCamera::front_fitted(bmin, bmax));
+    let plane = ActionPlane::new(options.plane_normal.unwrap_or(camera.forward))?;
+    let height = character.height();
+    let sets = key_sets(line, bone_sets)?;
+    let chains: Vec<_> = sets
+        .iter()
+        .map(|s| bones::resolve(rig, s))
+        .collect::<Result<_, _>>()?;
+    let keys: Vec<KeyChain> = chains
+        .iter()
+        .map(|c| KeyChain::new(rig, &initial, c))
+        .collect();
+    let ref_length = keys
+        .iter()
+        .map(|k| k.length)
+        .fold(0.0, f64::max)
+        .max(height * 1e-6);
+    let screen = options.screen.unwrap_or_else(|| {
+        let image: Vec<DVec2> = keys[0]
+            .points
+            .iter()
+            .map(|&p| camera.project(point_position(rig, &initial, p)))
+            .collect();
+        fit_screen(line, key_offsets[0], &keys[0], &image)
+    });
+    let lines = image_lines(line, &screen);
+    let mut targets: Vec<FrameTargets> = vec![FrameTargets::default(); frames];
+    for (f, t) in targets.iter_mut().enumerate() {
+        line_targets(&keys, &key_offsets, f, &lines[f], t);
+    }
+    let reduction = Reduction::new(&line.keystroke_frames);
+
+    // Planar stage (Section 4).
+    let mut dof = vec![false; rig.len()];
+    for k in &keys {
+        for &p in &k.points {
+            mark_ancestors(rig, p, &mut dof);
+        }
+    }
+    // The turn joint of a chain (pelvis, chest) carries a sideways branch connector: turning
+    // it, or any of its ancestors, swaps the connector's side — a discrete flip the solver
+    // would otherwise take mid-clip, the children counter-rotating. The turn joint and its
+    // ancestors therefore keep their initial orientation; the limbs and the spine hanging
+    // from it turn, and the root translates.
+    for k in &keys {
+        for (i, c) in k.connector.iter().enumerate() {
+            if let (true, Some(&ChainPoint::Joint(turn))) = (*c, k.points.get(i + 1)) {
+                let mut a = Some(turn);
+                while let Some(x) = a {
+                    dof[x] = false;
+                    a = rig.parent[x];
+                }
+            }
+        }
+    }
+    let mut poses = Poses {
+        joints: rig.len(),
+        rotations: (0..frames)
+            .flat_map(|_| rig.rotation.iter().copied())
+            .collect(),
+        offsets: vec![DVec3::ZERO; frames],
+    };
+    let stage = Stage {
+        rig,
+        camera: &camera,
+        cols: Columns::new(rig, &dof, &[plane.normal], &[plane.u, plane.v]),
+        targets: &targets,
+        reduction: &reduction,
+        weights,
+        ref_length,
+        height,
+    };
+    let planar = stage.solve(&mut poses, max_iterations);
+
+    // 3D stage (Section 4.1).
+    let mut spatial = None;
+    let mut contact_targets: Vec<Vec<ContactTarget>> = vec![Vec::new(); frames];
+    if !contacts.is_empty() || !twists.is_empty() {
+        let worlds = poses.worlds(rig);
+        let frame_index = |what: &'static str, f: i64| -> Result<usize, AnimateError> {
+            if f < first || f > last {
+                return Err(AnimateError::BadFrame {
+                    what,
+                    frame: f,
+                    expected: format!("the line covers frames {first}..={last}"),
+                });
+            }
+            Ok((f - first) as usize)
+        };
+        let mut by_joint: BTreeMap<usize, Vec<(usize, Option<DVec3>)>> = BTreeMap::new();
+        for c in contacts {
+            let j = joint_index(rig, &c.joint)?;
+            by_joint
+                .entry(j)
+                .or_default()
+                .push((frame_index("contact", c.frame)?, c.position));
+        }
+        for (j, mut ks) in by_joint {
+            ks.sort_by_key(|k| k.0);
+            let rotation = worlds[ks[0].0].rotation[j];
+            let mut resolved: Vec<(usize, DVec3)> = Vec::with_capacity(ks.len());
+            for (f, p) in ks {
+                let p = p.unwrap_or_else(|| {
+                    resolved
+                        .last()
+                        .map_or(worlds[f].position[j], |&(_, prev)| prev)
+                });
+                resolved.push((f, p));
+            }
+            for w in 0..resolved.len() {
+                let (f0, p0) = resolved[w];
+                let (f1, p1) = resolved.get(w + 1).copied().unwrap_or((f0, p0));
+                for f in f0..=f1 {
+                    let t = if f1 > f0 {
+                        (f - f0) as f64 / (f1 - f0) as f64
+                    } else {
+                        0.0
+                    };
+                    let t_ = &mut contact_targets[f];
+                    t_.retain(|c| c.joint != j);
+                    t_.push(ContactTarget {
+                        joint: j,
+                        position: p0.lerp(p1, t),
+                        rotation,
+                    });
+                }
+            }
+        }
+        let mut twist_by_joint: BTreeMap<usize, Vec<(usize, f64)>> = BTreeMap::new();
+        for t in twists {
+            let j = joint_index(rig, &t.joint)?;
+            twist_by_joint
+                .entry(j)
+                .or_default()
+                .push((frame_index("twist", t.frame)?, t.angle));
+        }
+        let mut targets3 = targets.clone();
+        for (f, t) in targets3.iter_mut().enumerate() {
+            t.contacts = contact_targets[f].clone();
+            for (&j, ks) in &twist_by_joint {
+                let angle = piecewise_linear(ks, f);
+                t.twists.push(OrientTarget {
+                    joint: j,
+                    rotation: twist_target(rig, &worlds[f], j, angle),
+                });
+            }
+        }
+        for t in &targets3 {
+            for c in &t.contacts {
+                mark_ancestors(rig, ChainPoint::Tip(c.joint), &mut dof);
+            }
+            for o in &t.twists {
+                mark_ancestors(rig, ChainPoint::Tip(o.joint), &mut dof);
+            }
+        }
+        let stage = Stage {
+            rig,
+            camera: &camera,
+            cols: Columns::new(
+                rig,
+                &dof,
+                &[DVec3::X, DVec3::Y, DVec3::Z],
+                &[DVec3::X, DVec3::Y, DVec3::Z],
+            ),
+            targets: &targets3,
+            reduction: &reduction,
+            weights,
+            ref_length,
+            height,
+        };
+        spatial = Some(stage.solve(&mut poses, max_iterations));
+    }
+
+    // Output and measurements.
+    let worlds = poses.worlds(rig);
+    let report = measure(rig, &camera, &targets, &contact_targets, &worlds, height);
+    let n = rig.len();
+    let mut positions = Vec::with_capacity(frames * n);
+    let mut rotations = Vec::with_capacity(frames * n);
+    let mut scales = Vec::with_capacity(frames * n);
+    for w in &worlds {
+        positions.extend_from_slice(&w.position);
+        rotations.extend_from_slice(&w.rotation);
+        scales.extend_from_slice(&w.scale);
+    }
+    let constrained = targets
+        .iter()
+        .map(|t| {
+            t.points
+                .iter()
+                .map(|p| match p.point {
+                    ChainPoint::Joint(j) | ChainPoint::Tip(j) => j,
+                })
+                .collect()
+        })
+        .collect();
+    Ok(Motion {
+        fps: line.fps,
+        first_frame: first,
+        joints: n,
+        positions,
+        rotations,
+        scales,
+        camera,
+        plane,
+        screen,
+        line: lines.into_iter().map(|l| l.points).collect(),
+        constrained,
+        report: AnimateReport {
+            planar,
+            spatial,
+            ..report
+        },
+    })
+}
+
+/// Linear interpolation of `(frame, value)` keys at `f`, held outside.
+fn piecewise_linear(keys: &[(usize, f64)], f: usize) -> f64 {
+    let mut ks = keys.to_vec();
+    ks.sort_by_key(|k| k.0);
+    match ks.iter().position(|k| k.0 >= f) {
+        None => ks.last().map_or(0.0, |k| k.1),
+        Some(0) => ks[0].1,
+        Some(i) => {
+            let ((f0, a), (f1, b)) = (ks[i - 1], ks[i]);
+            a + (b - a) * (f - f0) as f64 / (f1 - f0).max(1) as f64
+        }
+    }
+}
+
+fn measure(
+    rig: &Rig,
+    camera: &ActionCamera,
+    targets: &[FrameTargets],
+    contacts: &[Vec<ContactTarget>],
+    worlds: &[WorldPose],
+    height: f64,
+) -> AnimateReport {
+    let mut sum = 0.0;
+    let mut counted = 0usize;
+    let mut max: f64 = 0.0;
+    for (t, w) in targets.iter().zip(worlds) {
+        if t.points.is_empty() || t.line_length <= 0.0 {
+            continue;
+        }
+        let d: f64 = t
+            .points
+            .iter()
+            .map(|p| (camera.project(point_position(rig, w, p.point)) - p.target).length())
+            .sum::<f64>()
+            / t.points.len() as f64
+            / t.line_length;
+        sum += d;
+        counted += 1;
+        max = max.max(d);
+    }
+    let mut step: f64 = 0.0;
+    for pair in worlds.windows(2) {
+        for j in 0..rig.len() {
+            let local = |w: &WorldPose| -> DQuat {
+                let p = rig.skeleton_parent[j].map_or(DQuat::IDENTITY, |p| w.rotation[p]);
+                p.inverse() * w.rotation[j]
+            };
+            let r = log(local(&pair[1]).inverse() * local(&pair[0])).length();
+            step = step.max(r);
+        }
+    }
+    let mut contact: f64 = 0.0;
+    for (cs, w) in contacts.iter().zip(worlds) {
+        for c in cs {
+            contact = contact.max((w.position[c.joint] - c.position).length() / height);
+        }
+    }
+    AnimateReport {
+        line_distance_mean: if counted > 0 {
+            sum / counted as f64
+        } else {
+            0.0
+        },
+        line_distance_max: max,
+        max_rotation_step: step,
+        contact_error_max: contact,
+        height,
+        ..AnimateReport::default()
+    }
+}

@@ -1,0 +1,277 @@
+//! Per-frame targets of the matching: which chain points and bones are constrained at each
+//! frame (Ω(t) = Ω(t_k) ∩ Ω(t_k+1) between keys), where on the moving line they go (by arc
+//! length), and the 3D twist and contact targets.
+
+use glam::{DQuat, DVec2, DVec3};
+
+use super::bones::{Chain3, ChainPoint};
+use super::camera::ScreenMap;
+use super::rig::{Rig, WorldPose};
+use super::terms::{exp, point_position};
+use crate::Animation;
+
+/// A chain point pulled toward the line (E_x).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PointTarget {
+    pub point: ChainPoint,
+    pub target: DVec2,
+}
+
+/// A rigid segment whose projected direction follows the line's tangent (E_∂).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SegmentTarget {
+    pub a: ChainPoint,
+    pub b: ChainPoint,
+    /// Unit tangent of the line between the two points' arc lengths.
+    pub tangent: DVec2,
+    /// 1 / the segment's 3D length.
+    pub inv_length: f64,
+}
+
+/// A world orientation target of a joint (twist cans, contact orientations).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct OrientTarget {
+    pub joint: usize,
+    pub rotation: DQuat,
+}
+
+/// A contact: position and orientation of a joint.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ContactTarget {
+    pub joint: usize,
+    pub position: DVec3,
+    pub rotation: DQuat,
+}
+
+/// Everything constraining one frame.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct FrameTargets {
+    pub points: Vec<PointTarget>,
+    pub segments: Vec<SegmentTarget>,
+    /// Bones in Ω(t) (the joint rotating each constrained segment), for Eq. 3.
+    pub bones: Vec<usize>,
+    pub twists: Vec<OrientTarget>,
+    pub contacts: Vec<ContactTarget>,
+    /// Line length in image units (for reporting distances relative to it).
+    pub line_length: f64,
+}
+
+/// The line at one frame in image coordinates, with cumulative arc lengths.
+#[derive(Debug, Clone)]
+pub(crate) struct ImageLine {
+    pub points: Vec<DVec2>,
+    cumulative: Vec<f64>,
+}
+
+impl ImageLine {
+    pub fn new(points: Vec<DVec2>) -> ImageLine {
+        let mut cumulative = Vec::with_capacity(points.len());
+        let mut s = 0.0;
+        for (i, p) in points.iter().enumerate() {
+            if i > 0 {
+                s += (*p - points[i - 1]).length();
+            }
+            cumulative.push(s);
+        }
+        ImageLine { points, cumulative }
+    }
+
+    pub fn length(&self) -> f64 {
+        self.cumulative.last().copied().unwrap_or(0.0)
+    }
+
+    /// The point at normalized arc length `u ∈ [0, 1]`.
+    pub fn at(&self, u: f64) -> DVec2 {
+        let total = self.length();
+        if self.points.is_empty() {
+            return DVec2::ZERO;
+        }
+        if total <= 0.0 {
+            return self.points[0];
+        }
+        let s = u.clamp(0.0, 1.0) * total;
+        let k = self
+            .cumulative
+            .partition_point(|&c| c <= s)
+            .clamp(1, self.points.len() - 1);
+        let (s0, s1) = (self.cumulative[k - 1], self.cumulative[k]);
+        let t = if s1 > s0 { (s - s0) / (s1 - s0) } else { 0.0 };
+        self.points[k - 1].lerp(self.points[k], t)
+    }
+}
+
+/// The line of every frame mapped onto the image plane.
+pub(crate) fn image_lines(line: &Animation, map: &ScreenMap) -> Vec<ImageLine> {
+    line.frames
+        .iter()
+        .map(|f| ImageLine::new(f.chain.joints().into_iter().map(|p| map.map(p)).collect()))
+        .collect()
+}
+
+/// A resolved chain with its points' normalized arc lengths (from 3D segment lengths).
+#[derive(Debug, Clone)]
+pub(crate) struct KeyChain {
+    pub points: Vec<ChainPoint>,
+    pub u: Vec<f64>,
+    /// Points with a position term (all but the lower end of a branch connector).
+    pub matched: Vec<bool>,
+    /// Segments that are branch connectors (see [`KeyChain::new`]).
+    pub connector: Vec<bool>,
+    pub seg_length: Vec<f64>,
+    /// The joint rotating segment `i` (points `i`, `i + 1`).
+    pub seg_bone: Vec<usize>,
+    pub length: f64,
+}
+
+impl KeyChain {
+    pub fn new(rig: &Rig, w: &WorldPose, chain: &Chain3) -> KeyChain {
+        let points = chain.points();
+        let pos: Vec<DVec3> = points.iter().map(|&p| point_position(rig, w, p)).collect();
+        let seg_length: Vec<f64> = pos.windows(2).map(|s| (s[1] - s[0]).length()).collect();
+        // The branch connector: where the path turns from going up the tree to going down
+        // (a pelvis or shoulder girdle), the segment climbing into the turn joint is a
+        // sideways jog that no line can follow. It gets no arc length, no tangent term, and
+        // its lower end no position term.
+        let parent_of = |a: ChainPoint, b: ChainPoint| match (a, b) {
+            (ChainPoint::Joint(a), ChainPoint::Joint(b)) => rig.parent[b] == Some(a),
+            _ => false,
+        };
+        let mut connector = vec![false; seg_length.len()];
+        for i in 1..points.len().saturating_sub(1) {
+            if parent_of(points[i], points[i - 1]) && parent_of(points[i], points[i + 1]) {
+                connector[i - 1] = true;
+            }
+        }
+        let mut matched = vec![true; points.len()];
+        for (i, c) in connector.iter().enumerate() {
+            if *c {
+                matched[i] = false;
+            }
+        }
+        let arc = |i: usize| if connector[i] { 0.0 } else { seg_length[i] };
+        let length: f64 = (0..seg_length.len()).map(arc).sum();
+        let mut u = Vec::with_capacity(points.len());
+        let mut s = 0.0;
+        u.push(0.0);
+        for i in 0..seg_length.len() {
+            s += arc(i);
+            u.push(if length > 0.0 { s / length } else { 0.0 });
+        }
+        let seg_bone = points
+            .windows(2)
+            .map(|s| match (s[0], s[1]) {
+                (_, ChainPoint::Tip(j)) | (ChainPoint::Tip(j), _) => j,
+                (ChainPoint::Joint(a), ChainPoint::Joint(b)) => {
+                    if rig.parent[b] == Some(a) {
+                        a
+                    } else {
+                        b
+                    }
+                }
+            })
+            .collect();
+        KeyChain {
+            points,
+            u,
+            matched,
+            connector,
+            seg_length,
+            seg_bone,
+            length,
+        }
+    }
+
+    fn index(&self, p: ChainPoint) -> Option<usize> {
+        self.points.iter().position(|&x| x == p)
+    }
+}
+
+/// Ω(t) and the line targets of frame `f` (index from the first keystroke), given the key
+/// chains (one per keystroke) and the keystroke frame offsets.
+pub(crate) fn line_targets(
+    keys: &[KeyChain],
+    key_offsets: &[usize],
+    f: usize,
+    line: &ImageLine,
+    out: &mut FrameTargets,
+) {
+    out.points.clear();
+    out.segments.clear();
+    out.bones.clear();
+    out.line_length = line.length();
+    // Interval [k, k + 1] containing f; at a keystroke, its own set.
+    let k = key_offsets.partition_point(|&o| o <= f).saturating_sub(1);
+    let at_key = key_offsets.get(k) == Some(&f) || k + 1 >= keys.len();
+    let (a, b, alpha) = if at_key {
+        (&keys[k], &keys[k], 0.0)
+    } else {
+        let (o0, o1) = (key_offsets[k], key_offsets[k + 1]);
+        (
+            &keys[k],
+            &keys[k + 1],
+            (f - o0) as f64 / (o1 - o0).max(1) as f64,
+        )
+    };
+    let u_of = |i: usize| -> Option<f64> {
+        let p = a.points[i];
+        let j = b.index(p)?;
+        Some(a.u[i] * (1.0 - alpha) + b.u[j] * alpha)
+    };
+    let matched = |i: usize| a.matched[i] && b.index(a.points[i]).is_some_and(|j| b.matched[j]);
+    for i in 0..a.points.len() {
+        if !matched(i) {
+            continue;
+        }
+        if let Some(u) = u_of(i) {
+            out.points.push(PointTarget {
+                point: a.points[i],
+                target: line.at(u),
+            });
+        }
+    }
+    for i in 0..a.points.len().saturating_sub(1) {
+        let (p, q) = (a.points[i], a.points[i + 1]);
+        // The segment must be consecutive in both chains.
+        let consecutive = match (b.index(p), b.index(q)) {
+            (Some(x), Some(y)) => x.abs_diff(y) == 1,
+            _ => false,
+        };
+        if !consecutive || a.seg_length[i] <= 0.0 || a.connector[i] {
+            continue;
+        }
+        let (Some(u0), Some(u1)) = (u_of(i), u_of(i + 1)) else {
+            continue;
+        };
+        let chord = line.at(u1) - line.at(u0);
+        let Some(tangent) = chord.try_normalize() else {
+            continue;
+        };
+        out.segments.push(SegmentTarget {
+            a: p,
+            b: q,
+            tangent,
+            inv_length: 1.0 / a.seg_length[i],
+        });
+        if !out.bones.contains(&a.seg_bone[i]) {
+            out.bones.push(a.seg_bone[i]);
+        }
+    }
+}
+
+/// Direction of a joint's bone (towards its children's average, or its tip), unit.
+pub(crate) fn bone_direction(rig: &Rig, w: &WorldPose, j: usize) -> DVec3 {
+    let kids = &rig.children[j];
+    let tip = if kids.is_empty() {
+        w.tip(rig, j)
+    } else {
+        kids.iter().map(|&c| w.position[c]).sum::<DVec3>() / kids.len() as f64
+    };
+    (tip - w.position[j])
+        .try_normalize()
+        .unwrap_or_else(|| w.rotation[j] * DVec3::Y)
+}
+
+/// Twist "can" target: the stage-1 orientation turned by `angle` about the bone's own axis.
+pub(crate) fn twist_target(rig: &Rig, w: &WorldPose, j: usize, angle: f64) -> DQuat {
+    exp(bone_direction(rig, w, j) * angle) * w.rotation[j]
+}

@@ -1,0 +1,327 @@
+//! What the effects read per point and frame: positions (and their trajectories), motion
+//! offsets, velocities, painted weights — gathered once so every effect builds its
+//! [`StyleInput`]s the same way.
+
+use std::borrow::Cow;
+
+use anim::MeshAnimation;
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::{StyleInput, Trajectories};
+use crate::{MotionOffsets, Result, SmearError, SurfacePoint};
+
+/// Default frame step: every frame is its own drawing ("on ones").
+pub const DEFAULT_FRAME_STEP: usize = 1;
+
+/// The sampled animation of a set of points (mesh vertices, or surface points such as motion
+/// line seeds) with everything a stylization function may read.
+///
+/// Offsets are computed beforehand with whatever [`OffsetOptions`](crate::OffsetOptions) the
+/// user chose (smoothing, pruning, whole-body, camera), so every effect honours them.
+#[derive(Debug, Clone)]
+pub struct EffectInputs<'a> {
+    positions: Cow<'a, [Vec3]>,
+    frames: usize,
+    points: usize,
+    offsets: Cow<'a, MotionOffsets>,
+    velocities: Vec<Vec3>,
+    weights: Option<Vec<f32>>,
+}
+
+fn mismatch(name: &'static str, expected: usize, found: usize) -> SmearError {
+    SmearError::InvalidParameter {
+        name,
+        reason: format!("expected {expected} values, got {found}"),
+    }
+}
+
+impl<'a> EffectInputs<'a> {
+    /// The vertices of a point cache with their motion offsets.
+    ///
+    /// # Errors
+    /// [`SmearError::FrameMismatch`] / [`SmearError::InvalidParameter`] when the offsets do
+    /// not have the animation's frames and vertices.
+    ///
+    /// # Performance
+    /// Computes the velocities (central differences, parallel over frames).
+    pub fn new(anim: &'a MeshAnimation, offsets: &'a MotionOffsets) -> Result<EffectInputs<'a>> {
+        Self::build(
+            Cow::Borrowed(anim.positions()),
+            anim.frame_count(),
+            anim.vertex_count(),
+            Cow::Borrowed(offsets),
+        )
+    }
+
+    /// Surface points of a point cache (e.g. motion-line seeds, Section 4.3) with their
+    /// offsets (from [`OffsetSolver::surface_offsets`](crate::OffsetSolver::surface_offsets)).
+    /// Positions are blended barycentrically per frame, which makes their trajectories the
+    /// blends of the corner trajectories.
+    ///
+    /// # Errors
+    /// [`SmearError::InvalidSurfacePoint`] for a missing triangle or unusable barycentric
+    /// coordinates; a mismatch as in [`EffectInputs::new`].
+    pub fn at_surface_points(
+        anim: &MeshAnimation,
+        points: &[SurfacePoint],
+        offsets: MotionOffsets,
+    ) -> Result<EffectInputs<'static>> {
+        let corners = corners(&anim.mesh.triangles, points)?;
+        let (frames, n, k) = (anim.frame_count(), anim.vertex_count(), points.len());
+        let mut positions = vec![Vec3::ZERO; frames * k];
+        if k > 0 && n > 0 {
+            positions
+                .par_chunks_mut(k)
+                .zip(anim.positions().par_chunks(n))
+                .for_each(|(dst, src)| {
+                    for (d, c) in dst.iter_mut().zip(&corners) {
+                        *d = c.iter().map(|&(v, w)| src[v] * w).sum();
+                    }
+                });
+        }
+        EffectInputs::build(Cow::Owned(positions), frames, k, Cow::Owned(offsets))
+    }
+
+    fn build(
+        positions: Cow<'a, [Vec3]>,
+        frames: usize,
+        points: usize,
+        offsets: Cow<'a, MotionOffsets>,
+    ) -> Result<EffectInputs<'a>> {
+        if offsets.frame_count() != frames {
+            return Err(SmearError::FrameMismatch {
+                expected: frames,
+                found: offsets.frame_count(),
+            });
+        }
+        if offsets.vertex_count() != points {
+            return Err(mismatch(
+                "offsets per frame",
+                points,
+                offsets.vertex_count(),
+            ));
+        }
+        let velocities = central_differences(&positions, frames, points);
+        Ok(EffectInputs {
+            positions,
+            frames,
+            points,
+            offsets,
+            velocities,
+            weights: None,
+        })
+    }
+
+    /// Sets painted weights ω_i ∈ [0, 1] (one per point; default 1).
+    ///
+    /// # Errors
+    /// [`SmearError::InvalidParameter`] when there is not one weight per point.
+    pub fn with_weights(mut self, weights: Vec<f32>) -> Result<Self> {
+        if weights.len() != self.points {
+            return Err(mismatch("weights", self.points, weights.len()));
+        }
+        self.weights = Some(weights);
+        Ok(self)
+    }
+
+    /// Replaces the velocities (frame-major, units per frame), e.g. by camera-relative ones
+    /// from [`camera_vertex_velocities`](crate::camera_vertex_velocities).
+    ///
+    /// # Errors
+    /// [`SmearError::InvalidParameter`] when the length is not `frames × points`.
+    pub fn with_velocities(mut self, velocities: Vec<Vec3>) -> Result<Self> {
+        if velocities.len() != self.frames * self.points {
+            return Err(mismatch(
+                "velocities",
+                self.frames * self.points,
+                velocities.len(),
+            ));
+        }
+        self.velocities = velocities;
+        Ok(self)
+    }
+
+    /// Number of frames.
+    pub fn frame_count(&self) -> usize {
+        self.frames
+    }
+
+    /// Number of points.
+    pub fn point_count(&self) -> usize {
+        self.points
+    }
+
+    /// All positions, frame-major.
+    pub fn positions(&self) -> &[Vec3] {
+        &self.positions
+    }
+
+    /// The motion offsets.
+    pub fn offsets(&self) -> &MotionOffsets {
+        &self.offsets
+    }
+
+    /// The velocities, frame-major.
+    pub fn velocities(&self) -> &[Vec3] {
+        &self.velocities
+    }
+
+    /// The trajectories of the points (Section 4.1).
+    pub fn trajectories(&self) -> Trajectories<'_> {
+        Trajectories::new(&self.positions, self.frames, self.points)
+            .expect("length checked on construction")
+    }
+
+    /// The stylization inputs of point `i` at frame `f` (`m` and `t` left 0). `f` and `i`
+    /// must be in range.
+    #[inline]
+    pub fn style_input(&self, f: usize, i: usize) -> StyleInput {
+        let k = f * self.points + i;
+        let velocity = self.velocities[k];
+        StyleInput {
+            delta: self.offsets.values()[k],
+            speed: velocity.length(),
+            velocity,
+            weight: self.weights.as_ref().map_or(1.0, |w| w[i]),
+            rest: self.positions[i],
+            frame: f as f32,
+            m: 0.0,
+            t: 0.0,
+        }
+    }
+}
+
+/// "On twos" (paper Section 5.2): with a frame step `s`, output frame `f` shows the drawing of
+/// frame `⌊f / s⌋·s`, and displacements β, β_m and τ are scaled by `s`. A step of 0 counts as 1.
+#[inline]
+pub fn held_frame(f: usize, step: usize) -> usize {
+    let s = step.max(1);
+    f - f % s
+}
+
+pub(crate) fn check_step(step: usize) -> Result<usize> {
+    if step == 0 {
+        return Err(SmearError::InvalidParameter {
+            name: "frame step",
+            reason: "must be ≥ 1 (1 = on ones, 2 = on twos)".into(),
+        });
+    }
+    Ok(step)
+}
+
+pub(crate) fn check_frame(f: usize, frames: usize) -> Result<()> {
+    if f >= frames {
+        return Err(SmearError::InvalidParameter {
+            name: "frame",
+            reason: format!("frame {f} is past the last frame ({frames} frames)"),
+        });
+    }
+    Ok(())
+}
+
+/// Per point: the three corners (vertex, normalized weight).
+fn corners(triangles: &[[u32; 3]], points: &[SurfacePoint]) -> Result<Vec<[(usize, f32); 3]>> {
+    points
+        .iter()
+        .enumerate()
+        .map(|(index, pt)| {
+            let bad = |reason: String| SmearError::InvalidSurfacePoint { index, reason };
+            let tri = triangles.get(pt.triangle as usize).ok_or_else(|| {
+                bad(format!(
+                    "triangle {} does not exist ({} triangles)",
+                    pt.triangle,
+                    triangles.len()
+                ))
+            })?;
+            let b = pt.barycentric;
+            let sum = b[0] + b[1] + b[2];
+            if !(b.iter().all(|x| x.is_finite() && *x >= 0.0) && sum > 0.0) {
+                return Err(bad(format!(
+                    "barycentric coordinates {b:?} must be finite, ≥ 0, not all 0"
+                )));
+            }
+            Ok([0, 1, 2].map(|j| (tri[j] as usize, b[j] / sum)))
+        })
+        .collect()
+}
+
+/// SPEC.md velocities: `(p(f+1) − p(f−1))/2`, one-sided at the ends, 0 for one frame.
+fn central_differences(positions: &[Vec3], frames: usize, points: usize) -> Vec<Vec3> {
+    let mut out = vec![Vec3::ZERO; frames * points];
+    if frames < 2 || points == 0 {
+        return out;
+    }
+    out.par_chunks_mut(points).enumerate().for_each(|(f, dst)| {
+        let (a, b, s) = match f {
+            0 => (0, 1, 1.0),
+            _ if f + 1 == frames => (f - 1, f, 1.0),
+            _ => (f - 1, f + 1, 0.5),
+        };
+        let (pa, pb) = (
+            &positions[a * points..(a + 1) * points],
+            &positions[b * points..(b + 1) * points],
+        );
+        for ((d, p), q) in dst.iter_mut().zip(pa).zip(pb) {
+            *d = (*q - *p) * s;
+        }
+    });
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use anim::Mesh;
+
+    fn sliding_triangle(frames: usize) -> MeshAnimation {
+        let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+        let mesh = Mesh::new("tri", p.clone(), vec![[0, 1, 2]]);
+        let pos = (0..frames)
+            .flat_map(|f| p.iter().map(move |q| *q + Vec3::Z * (f * f) as f32))
+            .collect();
+        MeshAnimation::new(mesh, 24.0, pos).unwrap()
+    }
+
+    #[test]
+    fn inputs_match_vertex_velocities_and_surface_points_blend_corners() {
+        let anim = sliding_triangle(5);
+        let off = MotionOffsets::zeros(5, 3);
+        let inputs = EffectInputs::new(&anim, &off).unwrap();
+        assert_eq!(
+            inputs.velocities(),
+            crate::vertex_velocities(&anim).as_slice()
+        );
+        let x = inputs.style_input(2, 1);
+        assert_eq!(
+            (x.speed, x.weight, x.rest, x.frame),
+            (4.0, 1.0, Vec3::X, 2.0)
+        );
+        let pt = SurfacePoint {
+            triangle: 0,
+            barycentric: [2.0, 1.0, 1.0],
+        };
+        let seeds = EffectInputs::at_surface_points(&anim, &[pt], MotionOffsets::zeros(5, 1))
+            .unwrap()
+            .with_weights(vec![0.5])
+            .unwrap();
+        let q = seeds.positions()[3];
+        assert!((q - Vec3::new(0.25, 0.25, 9.0)).length() < 1e-6, "{q}");
+        assert_eq!(seeds.style_input(3, 0).weight, 0.5);
+        let bad = SurfacePoint {
+            triangle: 4,
+            barycentric: [1.0; 3],
+        };
+        assert!(
+            EffectInputs::at_surface_points(&anim, &[bad], MotionOffsets::zeros(5, 1)).is_err()
+        );
+        assert!(EffectInputs::new(&anim, &MotionOffsets::zeros(4, 3)).is_err());
+    }
+
+    #[test]
+    fn held_frames_on_twos() {
+        let held: Vec<usize> = (0..6).map(|f| held_frame(f, 2)).collect();
+        assert_eq!(held, [0, 0, 2, 2, 4, 4]);
+        assert_eq!(held_frame(5, 0), 5);
+    }
+}

@@ -1,0 +1,359 @@
+//! Motion lines (Section 4.3, Eq. 13): tubes traced along the trajectories of surface seeds.
+
+use anim::Mesh;
+use rayon::prelude::*;
+
+use super::inputs::{check_frame, check_step, held_frame};
+use super::tube::{sweep, Ring};
+use super::{EffectInputs, Stylize, DEFAULT_FRAME_STEP};
+use crate::{Result, SmearError};
+
+/// Default number of sides of a line's tube.
+pub const DEFAULT_LINE_SIDES: usize = 6;
+/// Default number of rings along a line.
+pub const DEFAULT_LINE_SAMPLES: usize = 16;
+
+/// The stylization functions of motion lines; each sees the seed's inputs with `t ∈ [0, 1]`
+/// the position along the line (0 at the surface end) — `t` is 0 for `length`.
+#[derive(Clone, Copy)]
+pub struct LineStyle<'s> {
+    /// τ = S_L(x) (Eq. 13): signed length in frames along the trajectory, like β in
+    /// Section 4.1 (τ < 0 traces the past, τ > 0 the future; the paper's example
+    /// S_L(δ; τ_max) = δ·τ_max makes trailing seeds trail). τ = 0 draws nothing.
+    pub length: &'s dyn Stylize,
+    /// Tube radius in scene units along the line.
+    pub thickness: &'s dyn Stylize,
+    /// Opacity in [0, 1] along the line (e.g. `1 − t`: fading out, Fig. 15).
+    pub opacity: &'s dyn Stylize,
+}
+
+impl std::fmt::Debug for LineStyle<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("LineStyle { .. }")
+    }
+}
+
+/// Options of [`motion_lines`] / [`motion_lines_frame`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LineOptions {
+    /// Sides of each tube (≥ 3).
+    pub sides: usize,
+    /// Rings along each line (≥ 2).
+    pub samples: usize,
+    /// Gap between the surface and the line, in frames along the trajectory (Fig. 15: seeds
+    /// displaced along their trajectory). Lines not longer than the gap are not drawn.
+    pub gap: f32,
+    /// Speed threshold v_min (units per frame): seeds slower than it draw no line — the
+    /// Heaviside factor H(‖v‖ − v_min) of Section 5.2.
+    pub min_speed: f32,
+    /// Only trace the past (τ clamped to ≤ 0, the δ⁻ = min(δ, 0) of Fig. 15).
+    pub past_only: bool,
+    /// Frame step: 2 = "on twos" (τ scaled by 2, drawings held; Section 5.2).
+    pub step: usize,
+    /// RGB colour of the lines (alpha comes from [`LineStyle::opacity`]).
+    pub color: [f32; 3],
+}
+
+impl Default for LineOptions {
+    fn default() -> Self {
+        LineOptions {
+            sides: DEFAULT_LINE_SIDES,
+            samples: DEFAULT_LINE_SAMPLES,
+            gap: 0.0,
+            min_speed: 0.0,
+            past_only: false,
+            step: DEFAULT_FRAME_STEP,
+            color: [0.05, 0.05, 0.05],
+        }
+    }
+}
+
+/// The motion lines of one frame: one tube mesh (positions, triangles, RGBA vertex colours)
+/// holding every visible line. Reusable across frames to avoid reallocating.
+#[derive(Debug, Clone)]
+pub struct LineFrame {
+    /// All tubes of the frame; empty when no line is visible.
+    pub mesh: Mesh,
+    /// Number of lines drawn.
+    pub lines: usize,
+    rings: Vec<Ring>,
+}
+
+impl Default for LineFrame {
+    fn default() -> Self {
+        LineFrame {
+            mesh: Mesh::new("motion_lines", Vec::new(), Vec::new()),
+            lines: 0,
+            rings: Vec::new(),
+        }
+    }
+}
+
+fn check(options: &LineOptions) -> Result<usize> {
+    let bad = |name, reason: &str| {
+        Err(SmearError::InvalidParameter {
+            name,
+            reason: reason.into(),
+        })
+    };
+    if options.sides < 3 {
+        return bad("line sides", "a tube needs at least 3 sides");
+    }
+    if options.samples < 2 {
+        return bad("line samples", "a line needs at least 2 rings");
+    }
+    if !(options.gap.is_finite() && options.gap >= 0.0) {
+        return bad("line gap", "must be a finite number of frames ≥ 0");
+    }
+    if options.min_speed.is_nan() {
+        return bad("minimum speed", "must be a number");
+    }
+    check_step(options.step)
+}
+
+/// Traces the lines of the drawing at frame `h` into `out`.
+fn trace(
+    seeds: &EffectInputs<'_>,
+    style: &LineStyle<'_>,
+    h: usize,
+    options: &LineOptions,
+    out: &mut LineFrame,
+) {
+    out.mesh.positions.clear();
+    out.mesh.triangles.clear();
+    out.mesh.colors = Some(out.mesh.colors.take().unwrap_or_default());
+    if let Some(c) = out.mesh.colors.as_mut() {
+        c.clear();
+    }
+    out.lines = 0;
+    let tr = seeds.trajectories();
+    let scale = options.step as f32;
+    let [r, g, b] = options.color;
+    for l in 0..seeds.point_count() {
+        let mut x = seeds.style_input(h, l);
+        if x.speed < options.min_speed {
+            continue;
+        }
+        let mut tau = scale * style.length.eval(&x);
+        if options.past_only {
+            tau = tau.min(0.0);
+        }
+        if !tau.is_finite() || tau.abs() <= options.gap || tau == 0.0 {
+            continue;
+        }
+        let start = h as f32 + options.gap * tau.signum();
+        let end = h as f32 + tau;
+        out.rings.clear();
+        let n = options.samples;
+        for j in 0..n {
+            let t = j as f32 / (n - 1) as f32;
+            let center = tr.at(l, start + (end - start) * t);
+            // Beyond the clip the trajectory clamps: drop repeated points.
+            if out
+                .rings
+                .last()
+                .is_some_and(|q| q.center.distance(center) <= 1e-7)
+            {
+                continue;
+            }
+            x.t = t;
+            let alpha = style.opacity.eval(&x);
+            out.rings.push(Ring {
+                center,
+                radius: style.thickness.eval(&x),
+                color: [
+                    r,
+                    g,
+                    b,
+                    if alpha.is_finite() {
+                        alpha.clamp(0.0, 1.0)
+                    } else {
+                        0.0
+                    },
+                ],
+            });
+        }
+        if sweep(&out.rings, options.sides, &mut out.mesh) {
+            out.lines += 1;
+        }
+    }
+}
+
+/// The motion lines of one frame (Section 4.3): seed ℓ's line runs along its trajectory from
+/// time `f + gap·sign(τ)` to `f + τ`, with `τ_ℓ(f) = step · S_L(x_ℓ(f))` (Eq. 13), sampled at
+/// `samples` rings whose radius and opacity are `style.thickness` / `style.opacity` at
+/// `t = j / (samples − 1)`. Seeds slower than `min_speed`, τ = 0 or non-finite, and still
+/// trajectories draw nothing.
+///
+/// # Arguments
+/// * `seeds` — the seeds' inputs, from [`EffectInputs::at_surface_points`] with offsets
+///   evaluated at the seeds ([`OffsetSolver::surface_offsets`](crate::OffsetSolver::surface_offsets)).
+/// * `out` — overwritten; reuse it across frames to avoid reallocating.
+///
+/// # Errors
+/// [`SmearError::InvalidParameter`] for a bad frame or option (see [`LineOptions`]).
+///
+/// # Performance
+/// Sequential over lines; no allocation once `out` has grown to size.
+pub fn motion_lines_frame(
+    seeds: &EffectInputs<'_>,
+    style: &LineStyle<'_>,
+    frame: usize,
+    options: &LineOptions,
+    out: &mut LineFrame,
+) -> Result<()> {
+    let step = check(options)?;
+    check_frame(frame, seeds.frame_count())?;
+    trace(seeds, style, held_frame(frame, step), options, out);
+    Ok(())
+}
+
+/// The motion lines of every frame (see [`motion_lines_frame`]).
+///
+/// # Errors
+/// As [`motion_lines_frame`].
+///
+/// # Performance
+/// Parallel over frames.
+pub fn motion_lines(
+    seeds: &EffectInputs<'_>,
+    style: &LineStyle<'_>,
+    options: &LineOptions,
+) -> Result<Vec<LineFrame>> {
+    let step = check(options)?;
+    Ok((0..seeds.frame_count())
+        .into_par_iter()
+        .map(|f| {
+            let mut out = LineFrame::default();
+            trace(seeds, style, held_frame(f, step), options, &mut out);
+            out
+        })
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::effects::test_util::translating_ball;
+    use crate::effects::{sample_surface, StyleInput};
+    use crate::{OffsetOptions, OffsetSolver};
+
+    fn seeds_of(anim: &anim::MeshAnimation, count: usize) -> EffectInputs<'static> {
+        let solver = OffsetSolver::from_animation(anim, &OffsetOptions::default(), &[]).unwrap();
+        let pts = sample_surface(anim.frame(0), &anim.mesh.triangles, count, 3);
+        let off = solver.surface_offsets(0, &pts).unwrap();
+        EffectInputs::at_surface_points(anim, &pts, off).unwrap()
+    }
+
+    #[test]
+    fn fig3e_line_length_is_tau_max_at_unit_offset() {
+        // S_L(δ; τ_max) = δ·τ_max on a ball moving 0.5 per frame: a seed with |δ| = 1 traces
+        // τ_max frames, i.e. 0.5·τ_max units (straight trajectory).
+        let anim = translating_ball(30, 0.5);
+        let seeds = seeds_of(&anim, 400);
+        let tau_max = 4.0;
+        let length = move |x: &StyleInput| x.delta * tau_max;
+        let thin = |_: &StyleInput| 0.01;
+        let fade = |x: &StyleInput| 1.0 - x.t;
+        let style = LineStyle {
+            length: &length,
+            thickness: &thin,
+            opacity: &fade,
+        };
+        let opts = LineOptions::default();
+        let f = 15;
+        let mut out = LineFrame::default();
+        motion_lines_frame(&seeds, &style, f, &opts, &mut out).unwrap();
+        // The most trailing seed: its line spans |δ|·τ_max·0.5 along −X.
+        let d = seeds.offsets().frame(f);
+        let (l, dl) = d
+            .iter()
+            .enumerate()
+            .min_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(l, v)| (l, *v))
+            .unwrap();
+        assert!(dl < -0.95, "most trailing seed has δ = {dl}");
+        let tr = seeds.trajectories();
+        let (p0, p1) = (tr.at(l, f as f32), tr.at(l, f as f32 + dl * tau_max));
+        assert!(((p0 - p1).length() - 0.5 * tau_max * dl.abs()).abs() < 1e-4);
+        // The mesh's extent behind the ball reaches τ_max frames back (up to the tube radius).
+        let min_x = out
+            .mesh
+            .positions
+            .iter()
+            .map(|p| p.x)
+            .fold(f32::MAX, f32::min);
+        let ball_min = anim.frame(f).iter().map(|p| p.x).fold(f32::MAX, f32::min);
+        let reach = ball_min - min_x;
+        assert!(
+            (reach - 0.5 * tau_max).abs() < 0.06,
+            "lines reach {reach} behind the ball"
+        );
+        assert!(out.lines > 300 && out.lines <= 400, "{} lines", out.lines);
+        let per_line = opts.samples * opts.sides;
+        assert_eq!(out.mesh.positions.len(), out.lines * per_line);
+        // Opacity fades from 1 at the surface to 0 at the end.
+        let c = out.mesh.colors.as_ref().unwrap();
+        assert_eq!((c[0][3], c[per_line - 1][3]), (1.0, 0.0));
+    }
+
+    #[test]
+    fn zero_length_slow_seeds_and_past_only_draw_less() {
+        let anim = translating_ball(12, 0.5);
+        let seeds = seeds_of(&anim, 100);
+        let length = |x: &StyleInput| x.delta * 3.0;
+        let zero = |_: &StyleInput| 0.0;
+        let one = |_: &StyleInput| 1.0;
+        let thin = |_: &StyleInput| 0.02;
+        let mut style = LineStyle {
+            length: &zero,
+            thickness: &thin,
+            opacity: &one,
+        };
+        let opts = LineOptions::default();
+        let all = motion_lines(&seeds, &style, &opts).unwrap();
+        assert!(all
+            .iter()
+            .all(|fr| fr.lines == 0 && fr.mesh.positions.is_empty()));
+        style.length = &length;
+        let signed = motion_lines(&seeds, &style, &opts).unwrap()[6].lines;
+        let past = LineOptions {
+            past_only: true,
+            ..opts
+        };
+        let trailing = motion_lines(&seeds, &style, &past).unwrap()[6].lines;
+        let n_trailing = seeds
+            .offsets()
+            .frame(6)
+            .iter()
+            .filter(|d| **d < 0.0)
+            .count();
+        assert_eq!(trailing, n_trailing);
+        assert!(signed > trailing);
+        let slow = LineOptions {
+            min_speed: 0.6,
+            ..opts
+        };
+        assert_eq!(motion_lines(&seeds, &style, &slow).unwrap()[6].lines, 0);
+        let gap = LineOptions { gap: 1.5, ..opts };
+        let with_gap = motion_lines(&seeds, &style, &gap).unwrap()[6].lines;
+        let longer = seeds
+            .offsets()
+            .frame(6)
+            .iter()
+            .filter(|d| d.abs() * 3.0 > 1.5)
+            .count();
+        assert_eq!(with_gap, longer);
+        let bad = LineOptions { sides: 2, ..opts };
+        assert!(motion_lines(&seeds, &style, &bad).is_err());
+        // Still clip: no line.
+        let still = translating_ball(5, 0.0);
+        let seeds = seeds_of(&still, 10);
+        let big = |_: &StyleInput| 2.0;
+        style.length = &big;
+        assert!(motion_lines(&seeds, &style, &opts)
+            .unwrap()
+            .iter()
+            .all(|fr| fr.lines == 0));
+    }
+}

@@ -1,0 +1,361 @@
+//! Multiple in-betweens (Section 4.2, Eqs. 11–12): displaced copies of the whole mesh in the
+//! past and future, each vertex with its own opacity.
+
+use anim::MeshAnimation;
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::inputs::{check_frame, check_step, held_frame};
+use super::{EffectInputs, StyleInput, Stylize, DEFAULT_FRAME_STEP};
+use crate::{smoothstep, Result, SmearError};
+
+/// Default temporal spacing Δf between copies (Section 4.2's example: half a frame).
+pub const DEFAULT_SPACING: f32 = 0.5;
+
+/// How far apart the copies are in time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Spacing {
+    /// Δf in frames, given directly (Fig. 10 top: Δf = 0.7, a stroboscopic effect).
+    Frames(f32),
+    /// Derived from the wanted number N∩ of copies overlapping between consecutive frames
+    /// (Section 5.2): Δf(N∩) = 1 / (m_p + m_n + 1 − N∩), N∩ ∈ [1, m_p + m_n].
+    Overlap(usize),
+}
+
+/// Options of [`multiples`] / [`multiples_frame`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MultiplesOptions {
+    /// Copies in the past, m_p (indices −m_p..−1).
+    pub past: usize,
+    /// Copies in the future, m_n (indices 1..m_n).
+    pub future: usize,
+    /// Temporal spacing Δf.
+    pub spacing: Spacing,
+    /// Frame step: 2 = "on twos" (β_m scaled by 2, drawings held; Section 5.2).
+    pub step: usize,
+}
+
+impl Default for MultiplesOptions {
+    fn default() -> Self {
+        MultiplesOptions {
+            past: 1,
+            future: 1,
+            spacing: Spacing::Frames(DEFAULT_SPACING),
+            step: DEFAULT_FRAME_STEP,
+        }
+    }
+}
+
+impl MultiplesOptions {
+    /// The multiple indices m ∈ [−m_p, m_n], m ≠ 0 (the current frame is the mesh itself), in
+    /// increasing order.
+    pub fn indices(&self) -> Vec<i32> {
+        let (p, n) = (self.past as i32, self.future as i32);
+        (-p..=n).filter(|&m| m != 0).collect()
+    }
+
+    /// Δf in frames.
+    ///
+    /// # Errors
+    /// [`SmearError::InvalidParameter`] for a non-finite Δf, or N∩ outside [1, m_p + m_n].
+    pub fn spacing_frames(&self) -> Result<f32> {
+        match self.spacing {
+            Spacing::Frames(df) if df.is_finite() => Ok(df),
+            Spacing::Frames(df) => Err(SmearError::InvalidParameter {
+                name: "spacing",
+                reason: format!("Δf must be a finite number of frames, got {df}"),
+            }),
+            Spacing::Overlap(n) => overlap_spacing(self.past, self.future, n),
+        }
+    }
+}
+
+/// Section 5.2: the spacing Δf(N∩) = 1 / (m_p + m_n + 1 − N∩) for which N∩ copies overlap
+/// between consecutive frames (retinal persistence).
+///
+/// # Errors
+/// [`SmearError::InvalidParameter`] unless 1 ≤ N∩ ≤ m_p + m_n.
+pub fn overlap_spacing(past: usize, future: usize, overlap: usize) -> Result<f32> {
+    let total = past + future;
+    if overlap == 0 || overlap > total {
+        return Err(SmearError::InvalidParameter {
+            name: "overlap",
+            reason: format!(
+                "N∩ must be in [1, m_p + m_n] = [1, {total}], got {overlap}{}",
+                if total == 0 { " (no copies)" } else { "" }
+            ),
+        });
+    }
+    Ok(1.0 / (total + 1 - overlap) as f32)
+}
+
+/// Eq. 12: `S_M(δ, m; m_max) = H(δm) · S((|δ| − δ_m) / (1 − δ_m))`, `δ_m = (|m| − 1) / m_max`,
+/// with H the Heaviside step (H(0) = 0) and S the smoothstep. Past copies (m < 0) show only
+/// trailing vertices (δ < 0), future copies only leading ones.
+///
+/// When δ_m ≥ 1 (|m| > m_max) the gradient degenerates to its limit, a step at |δ| = 1.
+/// Non-finite inputs give 0.
+pub fn multiple_opacity(delta: f32, m: f32, m_max: f32) -> f32 {
+    let side = delta * m;
+    if side.is_nan() || side <= 0.0 || !m_max.is_finite() || m_max <= 0.0 {
+        return 0.0;
+    }
+    let dm = (m.abs() - 1.0) / m_max;
+    let a = delta.abs();
+    if dm >= 1.0 {
+        return if a >= 1.0 { 1.0 } else { 0.0 };
+    }
+    smoothstep((a - dm) / (1.0 - dm))
+}
+
+/// Eq. 12 as a stylization function S_M(δ, m; m_max).
+pub fn eq12_opacity(m_max: f32) -> impl Stylize + Copy {
+    move |x: &StyleInput| multiple_opacity(x.delta, x.m, m_max)
+}
+
+/// The copies of one multiple index over the whole clip.
+#[derive(Debug, Clone)]
+pub struct MultipleCopy {
+    /// The index m (negative = past).
+    pub m: i32,
+    /// Its displacement β_m = m·Δf (before the frame-step scaling).
+    pub beta: f32,
+    /// The copy at every frame (same mesh and topology as the input).
+    pub animation: MeshAnimation,
+    /// Opacity α_{i,m}(f) ∈ [0, 1] per frame and vertex (frame-major), Eq. 11.
+    pub alpha: Vec<f32>,
+}
+
+fn clamp_alpha(a: f32) -> f32 {
+    if a.is_finite() {
+        a.clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
+}
+
+/// Writes copy `m`'s positions and opacities of the drawing at frame `h`.
+#[allow(clippy::too_many_arguments)]
+fn fill(
+    inputs: &EffectInputs<'_>,
+    style: &dyn Stylize,
+    h: usize,
+    m: i32,
+    beta: f32,
+    pos: &mut [Vec3],
+    alpha: &mut [f32],
+) {
+    let tr = inputs.trajectories();
+    for (i, (p, a)) in pos.iter_mut().zip(alpha.iter_mut()).enumerate() {
+        let mut x = inputs.style_input(h, i);
+        x.m = m as f32;
+        *a = clamp_alpha(style.eval(&x));
+        *p = tr.displaced(h, i, beta);
+    }
+}
+
+/// The multiple in-betweens of one frame (for interactive scrubbing): copy `k` (in
+/// [`MultiplesOptions::indices`] order) is written to `positions[k·n..(k+1)·n]` and its
+/// opacities to `alpha[k·n..(k+1)·n]`, with `n` the point count.
+///
+/// Every vertex of copy m moves by the same β_m(f) = step · m·Δf (Section 4.2); its opacity is
+/// `α_{i,m}(f) = S_M(x_i(f))` (Eq. 11) with `x.m = m`, clamped to [0, 1] (non-finite → 0).
+///
+/// # Errors
+/// [`SmearError::InvalidParameter`] for a bad spacing, step, frame or buffer length.
+///
+/// # Performance
+/// Allocation-free; parallel over copies.
+pub fn multiples_frame(
+    inputs: &EffectInputs<'_>,
+    style: &dyn Stylize,
+    frame: usize,
+    options: &MultiplesOptions,
+    positions: &mut [Vec3],
+    alpha: &mut [f32],
+) -> Result<()> {
+    let step = check_step(options.step)?;
+    let df = options.spacing_frames()?;
+    check_frame(frame, inputs.frame_count())?;
+    let n = inputs.point_count();
+    let ms = options.indices();
+    let want = ms.len() * n;
+    if positions.len() != want || alpha.len() != want {
+        return Err(SmearError::InvalidParameter {
+            name: "output buffers",
+            reason: format!(
+                "expected {want} positions and opacities ({} copies × {n}), got {} and {}",
+                ms.len(),
+                positions.len(),
+                alpha.len()
+            ),
+        });
+    }
+    if n == 0 {
+        return Ok(());
+    }
+    let h = held_frame(frame, step);
+    positions
+        .par_chunks_mut(n)
+        .zip(alpha.par_chunks_mut(n))
+        .zip(ms.par_iter())
+        .for_each(|((p, a), &m)| fill(inputs, style, h, m, step as f32 * m as f32 * df, p, a));
+    Ok(())
+}
+
+/// The multiple in-betweens of the whole clip: one [`MultipleCopy`] per index m ≠ 0 (past
+/// first), each a full animation with per-frame vertex opacities, ready to be written next to
+/// the original as alpha-blended flipbooks.
+///
+/// # Errors
+/// As [`multiples_frame`], or when `inputs` were not built from `anim`.
+///
+/// # Performance
+/// Parallel over frames; allocates only the outputs (copies × frames × vertices).
+pub fn multiples(
+    anim: &MeshAnimation,
+    inputs: &EffectInputs<'_>,
+    style: &dyn Stylize,
+    options: &MultiplesOptions,
+) -> Result<Vec<MultipleCopy>> {
+    let step = check_step(options.step)?;
+    let df = options.spacing_frames()?;
+    let (frames, n) = (inputs.frame_count(), inputs.point_count());
+    if anim.frame_count() != frames || anim.vertex_count() != n {
+        return Err(SmearError::InvalidParameter {
+            name: "inputs",
+            reason: format!(
+                "built for {frames} frames × {n} points, the animation has {} × {}",
+                anim.frame_count(),
+                anim.vertex_count()
+            ),
+        });
+    }
+    options
+        .indices()
+        .into_iter()
+        .map(|m| {
+            let beta = m as f32 * df;
+            let mut pos = vec![Vec3::ZERO; frames * n];
+            let mut alpha = vec![0.0f32; frames * n];
+            if n > 0 {
+                pos.par_chunks_mut(n)
+                    .zip(alpha.par_chunks_mut(n))
+                    .enumerate()
+                    .for_each(|(f, (p, a))| {
+                        fill(
+                            inputs,
+                            style,
+                            held_frame(f, step),
+                            m,
+                            step as f32 * beta,
+                            p,
+                            a,
+                        )
+                    });
+            }
+            let mut mesh = anim.mesh.clone();
+            mesh.name = format!("{}_m{m:+}", anim.mesh.name);
+            let mut copy = MeshAnimation::new(mesh, anim.fps, pos)
+                .map_err(|e| SmearError::InvalidScene(e.to_string()))?;
+            copy.start_time = anim.start_time;
+            Ok(MultipleCopy {
+                m,
+                beta,
+                animation: copy,
+                alpha,
+            })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::effects::test_util::translating_ball;
+    use crate::{mesh_offsets, OffsetOptions};
+
+    #[test]
+    fn fig10_overlap_two_gives_unit_spacing() {
+        // Section 5.2 / Fig. 10 bottom: m_p = m_n = 1, N∩ = 2 → Δf = 1; Fig. 1: m_p = 2,
+        // m_n = 1, N∩ = 1 → Δf = 1/3; Fig. 15: m_p = 4, m_n = 0, N∩ = 1 → Δf = 1/4.
+        assert_eq!(overlap_spacing(1, 1, 2).unwrap(), 1.0);
+        assert!((overlap_spacing(2, 1, 1).unwrap() - 1.0 / 3.0).abs() < 1e-7);
+        assert_eq!(overlap_spacing(4, 0, 1).unwrap(), 0.25);
+        assert!(overlap_spacing(1, 1, 3).is_err());
+        assert!(overlap_spacing(0, 0, 1).is_err());
+        let o = MultiplesOptions {
+            past: 2,
+            future: 1,
+            ..Default::default()
+        };
+        assert_eq!(o.indices(), [-2, -1, 1]);
+    }
+
+    #[test]
+    fn eq12_hides_leading_vertices_in_past_copies() {
+        assert_eq!(multiple_opacity(0.8, -1.0, 1.0), 0.0);
+        assert_eq!(multiple_opacity(-0.8, 1.0, 1.0), 0.0);
+        assert_eq!(multiple_opacity(0.0, 1.0, 1.0), 0.0);
+        // m = ±1: δ_m = 0 → S(|δ|).
+        assert!((multiple_opacity(-0.5, -1.0, 2.0) - 0.5).abs() < 1e-6);
+        assert_eq!(multiple_opacity(1.0, 1.0, 2.0), 1.0);
+        // m = 2, m_max = 2: δ_m = 0.5, the gradient starts at |δ| = 0.5.
+        assert_eq!(multiple_opacity(0.5, 2.0, 2.0), 0.0);
+        assert!((multiple_opacity(0.75, 2.0, 2.0) - 0.5).abs() < 1e-6);
+        // |m| > m_max: the limit step.
+        assert_eq!(multiple_opacity(0.99, 2.0, 1.0), 0.0);
+        assert_eq!(multiple_opacity(-1.0, -2.0, 1.0), 1.0);
+        assert_eq!(multiple_opacity(f32::NAN, 1.0, 1.0), 0.0);
+    }
+
+    #[test]
+    fn fig10_copies_sit_on_neighbour_frames() {
+        let anim = translating_ball(7, 1.0);
+        let delta = mesh_offsets(&anim, &OffsetOptions::default()).unwrap();
+        let inputs = EffectInputs::new(&anim, &delta).unwrap();
+        let opts = MultiplesOptions {
+            past: 1,
+            future: 1,
+            spacing: Spacing::Overlap(2),
+            step: 1,
+        };
+        let copies = multiples(&anim, &inputs, &eq12_opacity(1.0), &opts).unwrap();
+        assert_eq!(copies.iter().map(|c| c.m).collect::<Vec<_>>(), [-1, 1]);
+        let f = 3;
+        for c in &copies {
+            let there = anim.frame((f as i32 + c.m) as usize);
+            let err = c
+                .animation
+                .frame(f)
+                .iter()
+                .zip(there)
+                .map(|(a, b)| (*a - *b).length())
+                .fold(0.0f32, f32::max);
+            assert!(err < 1e-5, "copy {} off by {err}", c.m);
+            // Past copy: only trailing vertices (δ < 0) are visible, and the trailing pole
+            // (δ = −1) is opaque.
+            let n = anim.vertex_count();
+            let (d, a) = (delta.frame(f), &c.alpha[f * n..(f + 1) * n]);
+            let visible_wrong_side = d
+                .iter()
+                .zip(a)
+                .filter(|(d, a)| **a > 0.0 && **d * c.m as f32 <= 0.0)
+                .count();
+            assert_eq!(visible_wrong_side, 0);
+            let pole = d
+                .iter()
+                .enumerate()
+                .max_by(|x, y| (x.1 * c.m as f32).total_cmp(&(y.1 * c.m as f32)))
+                .unwrap()
+                .0;
+            assert!((a[pole] - 1.0).abs() < 1e-5);
+        }
+        // Per-frame entry point agrees.
+        let n = anim.vertex_count();
+        let (mut p, mut a) = (vec![Vec3::ZERO; 2 * n], vec![0.0; 2 * n]);
+        multiples_frame(&inputs, &eq12_opacity(1.0), f, &opts, &mut p, &mut a).unwrap();
+        assert_eq!(&p[n..], copies[1].animation.frame(f));
+        assert_eq!(&a[..n], &copies[0].alpha[f * n..(f + 1) * n]);
+    }
+}

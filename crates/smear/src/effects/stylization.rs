@@ -1,0 +1,37 @@
+//! The contract between the effects (Section 4) and the stylization functions (paper G3,
+//! S_E / S_M / S_L): the inputs a function may read and the trait it implements.
+
+/// Everything a stylization function (paper G3, S_E / S_M / S_L) may read at one vertex or
+/// motion-line sample. Unused inputs are 0.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StyleInput {
+    /// Motion offset δ ∈ [−1, 1] (Section 3).
+    pub delta: f32,
+    /// Speed |v| in units per frame (central differences).
+    pub speed: f32,
+    /// Velocity vector (units per frame).
+    pub velocity: glam::Vec3,
+    /// Painted weight (vertex attribute / weight group), 1 when none.
+    pub weight: f32,
+    /// Position in the rest (first) frame, for noise.
+    pub rest: glam::Vec3,
+    /// Frame index (as f32; fractional for on-twos etc.).
+    pub frame: f32,
+    /// Multiple index m (negative = past copies, positive = future), 0 otherwise.
+    pub m: f32,
+    /// Position along a motion line t ∈ [0, 1] (0 at the surface), 0 otherwise.
+    pub t: f32,
+}
+
+/// A stylization function: maps the inputs at one vertex to a scalar (β for elongation,
+/// opacity for multiples, τ / thickness / opacity for lines). Must be pure and thread-safe.
+pub trait Stylize: Send + Sync {
+    /// Evaluates the function at one vertex / sample.
+    fn eval(&self, x: &StyleInput) -> f32;
+}
+
+impl<F: Fn(&StyleInput) -> f32 + Send + Sync> Stylize for F {
+    fn eval(&self, x: &StyleInput) -> f32 {
+        self(x)
+    }
+}

@@ -1,0 +1,43 @@
+//! Errors of style files and stylization functions. Every variant says how to fix the input.
+
+use thiserror::Error;
+
+/// An invalid style or stylization function.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum StyleError {
+    /// A user expression does not parse. Check the syntax: operators `+ - * / ^`, functions
+    /// written `f(x)` (`min(a, b)`, `max(a, b)`, `abs`, `step`, `smoothstep`, `sqrt`, ...).
+    #[error("expression '{expr}': {problem}")]
+    Expression {
+        /// The expression text.
+        expr: String,
+        /// What the parser reported.
+        problem: String,
+    },
+    /// A user expression reads a variable that is neither an input nor a declared parameter.
+    /// Use one of the listed names, or declare it under `params`.
+    #[error("expression '{expr}': unknown variable '{name}'; known: {known}")]
+    UnknownVariable {
+        /// The expression text.
+        expr: String,
+        /// The unknown name.
+        name: String,
+        /// Comma-separated names that may be used.
+        known: String,
+    },
+    /// A parameter is out of its range, not finite, or a keyframe curve is empty or its frames
+    /// do not increase. Give finite values in range and keyframes sorted by frame.
+    #[error("parameter '{name}': {problem}")]
+    Parameter {
+        /// Which parameter (e.g. `warp.s`).
+        name: String,
+        /// What is wrong.
+        problem: String,
+    },
+    /// A function gives both `expr` and `stages`. Give one of them.
+    #[error("a stylization function takes either 'expr' or 'stages', not both")]
+    ExprAndStages,
+    /// The style text is not valid TOML for a style. The message names the line and key.
+    #[error("style: {0}")]
+    Syntax(String),
+}

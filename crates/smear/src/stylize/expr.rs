@@ -1,0 +1,278 @@
+//! User stylization expressions (paper G3: "more experienced artists can freely create their
+//! own" functions), compiled once with `exmex` and evaluated per vertex.
+
+use std::collections::BTreeMap;
+
+use exmex::{BinOp, Express, FlatEx, FloatOpsFactory, MakeOperators, Operator};
+
+use super::error::StyleError;
+use super::param::Param;
+use super::voronoi::voronoi_f1;
+use super::warp::warp_offset;
+use crate::effects::StyleInput;
+
+/// Most variables (inputs + parameters) one expression may use.
+pub const MAX_EXPRESSION_VARIABLES: usize = 32;
+
+/// Names of the inputs an expression may read, in the order of [`Input`].
+pub const EXPRESSION_INPUTS: [&str; 13] = [
+    "delta", "speed", "weight", "noise", "frame", "m", "t", "vx", "vy", "vz", "x", "y", "z",
+];
+
+/// exmex's float operators plus `step(x)` (Heaviside, 1 for x ≥ 0), `smoothstep(x)` (on x
+/// clamped to [0, 1]), `clamp01(x)`, `past(x)` = min(x, 0), `future(x)` = max(x, 0) and
+/// `hise(δ, s)` (Hise's warp δ'(s, 0.5); other pivots: the `warp` stage). Binary operators are
+/// written as functions: `min(a, b)`, `max(a, b)`, `atan2(y, x)`.
+#[derive(Debug, Clone)]
+pub struct StyleOps;
+
+impl MakeOperators<f64> for StyleOps {
+    fn make<'a>() -> Vec<Operator<'a, f64>> {
+        let mut ops = FloatOpsFactory::<f64>::make();
+        ops.push(Operator::make_unary("step", |a| {
+            if a >= 0.0 {
+                1.0
+            } else {
+                0.0
+            }
+        }));
+        ops.push(Operator::make_unary("smoothstep", |a| {
+            let x = a.clamp(0.0, 1.0);
+            x * x * (3.0 - 2.0 * x)
+        }));
+        ops.push(Operator::make_unary("clamp01", |a| a.clamp(0.0, 1.0)));
+        ops.push(Operator::make_unary("past", |a| a.min(0.0)));
+        ops.push(Operator::make_unary("future", |a| a.max(0.0)));
+        ops.push(Operator::make_bin(
+            "hise",
+            BinOp {
+                // hise(δ, s): Hise's warp with pivot 0.5 (the paper's Fig. 1 δ'(0.8, 0.5)).
+                apply: |d, s| warp_offset(d as f32, s as f32, 0.5) as f64,
+                prio: 0,
+                is_commutative: false,
+            },
+        ));
+        ops
+    }
+}
+
+/// Where each variable of a compiled expression takes its value from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Slot {
+    /// Index into [`EXPRESSION_INPUTS`].
+    Input(usize),
+    /// Index into the declared parameters.
+    Param(usize),
+}
+
+/// A compiled user expression over [`EXPRESSION_INPUTS`] and declared keyframeable parameters.
+///
+/// ```
+/// use smear::{Expression, StyleInput, Stylize};
+/// let f = Expression::compile("beta * speed * min(delta, 0)", 1.0.into(), 0,
+///     [("beta".to_string(), 15.0.into())].into_iter().collect())?;
+/// let x = StyleInput { delta: -0.5, speed: 0.2, ..Default::default() };
+/// assert!((f.eval(&x) + 1.5).abs() < 1e-6);
+/// # Ok::<(), smear::StyleError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct Expression {
+    text: String,
+    flat: FlatEx<f64, StyleOps>,
+    slots: Vec<Slot>,
+    params: Vec<Param>,
+    kappa: Param,
+    seed: u64,
+    uses_noise: bool,
+}
+
+impl Expression {
+    /// Parses and checks `text`.
+    ///
+    /// Arguments: `kappa` and `seed` define the `noise` input (Voronoi F1 at the rest position
+    /// scaled by κ); `params` are named, keyframeable constants.
+    ///
+    /// Returns [`StyleError::Expression`] on a syntax error, [`StyleError::UnknownVariable`]
+    /// for a name that is neither an input nor a parameter, [`StyleError::Parameter`] for a
+    /// parameter that shadows an input or is not finite.
+    pub fn compile(
+        text: &str,
+        kappa: Param,
+        seed: u64,
+        params: BTreeMap<String, Param>,
+    ) -> Result<Self, StyleError> {
+        let problem = |p: String| StyleError::Expression {
+            expr: text.to_string(),
+            problem: p,
+        };
+        if text.trim().is_empty() {
+            return Err(problem("empty expression".into()));
+        }
+        kappa.validate("kappa", (0.0, true), (1e9, false))?;
+        for (name, p) in &params {
+            if EXPRESSION_INPUTS.contains(&name.as_str()) {
+                return Err(StyleError::Parameter {
+                    name: name.clone(),
+                    problem: "has the name of an input; rename it".into(),
+                });
+            }
+            p.validate_finite(name)?;
+        }
+        let flat = FlatEx::<f64, StyleOps>::parse(text).map_err(|e| problem(e.to_string()))?;
+        let names: Vec<&String> = params.keys().collect();
+        let mut slots = Vec::new();
+        for v in flat.var_names() {
+            let slot = if let Some(i) = EXPRESSION_INPUTS.iter().position(|n| n == v) {
+                Slot::Input(i)
+            } else if let Some(i) = names.iter().position(|n| *n == v) {
+                Slot::Param(i)
+            } else {
+                let mut known: Vec<&str> = EXPRESSION_INPUTS.to_vec();
+                known.extend(names.iter().map(|s| s.as_str()));
+                return Err(StyleError::UnknownVariable {
+                    expr: text.to_string(),
+                    name: v.clone(),
+                    known: known.join(", "),
+                });
+            };
+            slots.push(slot);
+        }
+        if slots.len() > MAX_EXPRESSION_VARIABLES {
+            return Err(problem(format!(
+                "uses {} variables, at most {MAX_EXPRESSION_VARIABLES} are supported",
+                slots.len()
+            )));
+        }
+        let uses_noise = slots.contains(&Slot::Input(3));
+        Ok(Expression {
+            text: text.to_string(),
+            flat,
+            slots,
+            params: params.into_values().collect(),
+            kappa,
+            seed,
+            uses_noise,
+        })
+    }
+
+    /// The expression text.
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// Evaluates at one vertex; non-finite results (e.g. a division by zero) give 0.
+    ///
+    /// Performance: no allocation; ~100 ns plus 50 ns when `noise` is used.
+    pub fn evaluate(&self, i: &StyleInput) -> f32 {
+        let noise = if self.uses_noise {
+            voronoi_f1(i.rest, self.kappa.at(i.frame), self.seed)
+        } else {
+            0.0
+        };
+        let inputs = [
+            i.delta,
+            i.speed,
+            i.weight,
+            noise,
+            i.frame,
+            i.m,
+            i.t,
+            i.velocity.x,
+            i.velocity.y,
+            i.velocity.z,
+            i.rest.x,
+            i.rest.y,
+            i.rest.z,
+        ];
+        let mut vars = [0.0f64; MAX_EXPRESSION_VARIABLES];
+        for (v, s) in vars.iter_mut().zip(&self.slots) {
+            *v = match *s {
+                Slot::Input(k) => inputs[k] as f64,
+                Slot::Param(k) => self.params[k].at(i.frame) as f64,
+            };
+        }
+        match self.flat.eval(&vars[..self.slots.len()]) {
+            Ok(x) if x.is_finite() => x as f32,
+            _ => 0.0,
+        }
+    }
+}
+
+impl crate::effects::Stylize for Expression {
+    fn eval(&self, x: &StyleInput) -> f32 {
+        self.evaluate(x)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    fn compile(text: &str) -> Result<Expression, StyleError> {
+        Expression::compile(text, 1.0.into(), 0, BTreeMap::new())
+    }
+
+    #[test]
+    fn every_input_is_readable() {
+        let i = StyleInput {
+            delta: 0.5,
+            speed: 2.0,
+            velocity: Vec3::new(1.0, 2.0, 3.0),
+            weight: 0.25,
+            rest: Vec3::new(4.0, 5.0, 6.0),
+            frame: 7.0,
+            m: -2.0,
+            t: 0.75,
+        };
+        for (name, want) in [
+            ("delta", 0.5),
+            ("speed", 2.0),
+            ("weight", 0.25),
+            ("frame", 7.0),
+            ("m", -2.0),
+            ("t", 0.75),
+            ("vx + 10*vy + 100*vz", 321.0),
+            ("x + 10*y + 100*z", 654.0),
+            (
+                "step(delta) + smoothstep(0.5) + past(-delta) + future(-delta)",
+                1.0,
+            ),
+            ("min(delta, 0) + max(delta, 1) + abs(m)", 3.0),
+        ] {
+            let got = compile(name).unwrap().evaluate(&i);
+            assert!((got - want).abs() < 1e-5, "{name}: {got} != {want}");
+        }
+        let n = compile("noise").unwrap().evaluate(&i);
+        assert_eq!(n, voronoi_f1(i.rest, 1.0, 0));
+        assert_eq!(compile("1 / (delta - 0.5)").unwrap().evaluate(&i), 0.0);
+    }
+
+    #[test]
+    fn bad_expressions_are_errors_not_panics() {
+        let e = compile("delta * (speed").unwrap_err();
+        assert!(matches!(e, StyleError::Expression { .. }), "{e}");
+        assert!(e.to_string().contains("delta * (speed"), "{e}");
+        let e = compile("delta * velocity").unwrap_err();
+        match &e {
+            StyleError::UnknownVariable { name, .. } => assert_eq!(name, "velocity"),
+            other => panic!("wrong error {other}"),
+        }
+        assert!(compile("").is_err());
+        assert!(compile("delta +* 2").is_err());
+        let shadow: BTreeMap<_, _> = [("speed".to_string(), Param::Constant(1.0))].into();
+        assert!(Expression::compile("speed", 1.0.into(), 0, shadow).is_err());
+    }
+
+    #[test]
+    fn keyframed_expression_parameters() {
+        let params = [("b".to_string(), Param::Curve(vec![[0.0, 0.0], [10.0, 5.0]]))].into();
+        let f = Expression::compile("b * delta", 1.0.into(), 0, params).unwrap();
+        let i = StyleInput {
+            delta: 2.0,
+            frame: 4.0,
+            ..Default::default()
+        };
+        assert!((f.evaluate(&i) - 4.0).abs() < 1e-6);
+    }
+}

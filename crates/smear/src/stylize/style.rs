@@ -1,0 +1,438 @@
+//! Styles: which effects to apply to which objects, with which stylization functions and
+//! parameters (the paper's per-object stylization of Fig. 17, combined effects of Fig. 16).
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use super::error::StyleError;
+use super::function::{FunctionSpec, StyleFunction};
+use super::stage::Stage;
+use crate::{
+    ElongateOptions, LineOptions, MultiplesOptions, OffsetOptions, Spacing, DEFAULT_FRAME_STEP,
+    DEFAULT_LINE_SAMPLES, DEFAULT_LINE_SIDES, DEFAULT_SEED, DEFAULT_SPACING,
+};
+
+/// Default number of motion-line seeds.
+pub const DEFAULT_LINE_COUNT: usize = 40;
+
+/// Default motion-line radius as a fraction of the object's bounding-box diagonal.
+pub const DEFAULT_LINE_THICKNESS: f32 = 0.002;
+
+fn yes() -> bool {
+    true
+}
+
+fn one() -> usize {
+    DEFAULT_FRAME_STEP
+}
+
+/// Elongated in-betweens (Section 4.1).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ElongateStyle {
+    /// false turns the effect off (e.g. for one object).
+    pub enabled: bool,
+    /// Frame step: 2 = "on twos" (Section 5.2).
+    pub step: usize,
+    /// S_E of Eq. 10: β in frames along the trajectory.
+    pub function: FunctionSpec,
+}
+
+impl Default for ElongateStyle {
+    fn default() -> Self {
+        ElongateStyle {
+            enabled: yes(),
+            step: one(),
+            function: FunctionSpec::linear(1.0),
+        }
+    }
+}
+
+/// Multiple in-betweens (Section 4.2).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MultiplesStyle {
+    /// false turns the effect off.
+    pub enabled: bool,
+    /// Copies in the past, m_p.
+    pub past: usize,
+    /// Copies in the future, m_n.
+    pub future: usize,
+    /// Δf in frames (exclusive with `overlap`; default 0.5).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spacing: Option<f32>,
+    /// N∩: copies overlapping between consecutive frames, Δf = 1/(m_p + m_n + 1 − N∩).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub overlap: Option<usize>,
+    /// Frame step: 2 = "on twos".
+    pub step: usize,
+    /// S_M of Eq. 11: opacity per vertex and copy (default Eq. 12 with m_max = max(m_p, m_n)).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub opacity: Option<FunctionSpec>,
+}
+
+impl Default for MultiplesStyle {
+    fn default() -> Self {
+        MultiplesStyle {
+            enabled: yes(),
+            past: 1,
+            future: 1,
+            spacing: None,
+            overlap: None,
+            step: one(),
+            opacity: None,
+        }
+    }
+}
+
+impl MultiplesStyle {
+    /// The effect's options.
+    ///
+    /// Returns [`StyleError::Parameter`] when both `spacing` and `overlap` are given.
+    pub fn options(&self) -> Result<MultiplesOptions, StyleError> {
+        let spacing = match (self.spacing, self.overlap) {
+            (Some(_), Some(_)) => {
+                return Err(StyleError::Parameter {
+                    name: "multiples.spacing".into(),
+                    problem: "give either 'spacing' or 'overlap', not both".into(),
+                })
+            }
+            (Some(df), None) => Spacing::Frames(df),
+            (None, Some(n)) => Spacing::Overlap(n),
+            (None, None) => Spacing::Frames(DEFAULT_SPACING),
+        };
+        let options = MultiplesOptions {
+            past: self.past,
+            future: self.future,
+            spacing,
+            step: self.step,
+        };
+        options
+            .spacing_frames()
+            .map_err(|e| StyleError::Parameter {
+                name: "multiples".into(),
+                problem: e.to_string(),
+            })?;
+        Ok(options)
+    }
+
+    /// The opacity function (Eq. 12 with m_max = max(m_p, m_n, 1) when none is given).
+    pub fn opacity_spec(&self) -> FunctionSpec {
+        self.opacity
+            .clone()
+            .unwrap_or_else(|| FunctionSpec::multiples(self.past.max(self.future).max(1) as f32))
+    }
+}
+
+/// Motion lines (Section 4.3).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LinesStyle {
+    /// false turns the effect off.
+    pub enabled: bool,
+    /// Number of seeds sampled on the surface (area-uniform).
+    pub count: usize,
+    /// Seed of the seed sampling.
+    pub seed: u64,
+    /// Gap between the surface and the line, in frames along the trajectory.
+    pub gap: f32,
+    /// Seeds slower than this (units per frame) draw no line.
+    pub min_speed: f32,
+    /// Only trace the past.
+    pub past_only: bool,
+    /// Tube sides.
+    pub sides: usize,
+    /// Rings along a line.
+    pub samples: usize,
+    /// Frame step: 2 = "on twos".
+    pub step: usize,
+    /// RGB colour.
+    pub color: [f32; 3],
+    /// S_L of Eq. 13: signed length τ in frames (default S_L(δ; 1) = δ).
+    pub length: FunctionSpec,
+    /// Tube radius in scene units along the line (default [`DEFAULT_LINE_THICKNESS`] × the
+    /// bounding-box diagonal).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub thickness: Option<FunctionSpec>,
+    /// Opacity along the line (default 1 − t, fading toward the end).
+    pub opacity: FunctionSpec,
+}
+
+impl Default for LinesStyle {
+    fn default() -> Self {
+        LinesStyle {
+            enabled: yes(),
+            count: DEFAULT_LINE_COUNT,
+            seed: DEFAULT_SEED,
+            gap: 0.0,
+            min_speed: 0.0,
+            past_only: false,
+            sides: DEFAULT_LINE_SIDES,
+            samples: DEFAULT_LINE_SAMPLES,
+            step: one(),
+            color: LineOptions::default().color,
+            length: FunctionSpec::linear(1.0),
+            thickness: None,
+            opacity: FunctionSpec::stages(vec![Stage::Set { value: 1.0.into() }, Stage::Fade]),
+        }
+    }
+}
+
+impl LinesStyle {
+    /// The effect's options.
+    pub fn options(&self) -> LineOptions {
+        LineOptions {
+            sides: self.sides,
+            samples: self.samples,
+            gap: self.gap,
+            min_speed: self.min_speed,
+            past_only: self.past_only,
+            step: self.step,
+            color: self.color,
+        }
+    }
+
+    /// The thickness function, given the object's bounding-box diagonal for the default.
+    pub fn thickness_spec(&self, diagonal: f32) -> FunctionSpec {
+        self.thickness.clone().unwrap_or_else(|| {
+            FunctionSpec::stages(vec![Stage::Set {
+                value: (DEFAULT_LINE_THICKNESS * diagonal).into(),
+            }])
+        })
+    }
+}
+
+/// Per-object overrides: a section given here replaces the style's section for the object
+/// (mesh) of that name; missing sections fall back to the style's.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ObjectStyle {
+    /// Painted weights ω for this object (an expression over `x, y, z`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub weights: Option<FunctionSpec>,
+    /// Elongation for this object.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub elongate: Option<ElongateStyle>,
+    /// Multiples for this object.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub multiples: Option<MultiplesStyle>,
+    /// Motion lines for this object.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lines: Option<LinesStyle>,
+}
+
+/// A whole style: the motion-offset options and up to three effects, each with its
+/// stylization functions, plus per-object overrides (paper Figs. 16, 17).
+///
+/// ```
+/// let style = smear::Style::from_toml_str(r#"
+///     [elongate]
+///     function = { stages = [{ op = "speed" }, { op = "scale", by = 6 }] }
+///     [lines]
+///     count = 20
+///     length = { expr = "10 * step(speed - 0.01) * delta" }
+/// "#)?;
+/// let fx = style.for_object("Robot");
+/// assert!(fx.elongate.is_some() && fx.lines.is_some() && fx.multiples.is_none());
+/// # Ok::<(), smear::StyleError>(())
+/// ```
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Style {
+    /// Motion-offset options (Section 3).
+    pub offsets: OffsetOptions,
+    /// Painted weights ω (paper Fig. 15b): a function evaluated once per vertex at its rest
+    /// position (`x, y, z`; other inputs 0), clamped to [0, 1]. Default 1.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub weights: Option<FunctionSpec>,
+    /// Elongated in-betweens.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub elongate: Option<ElongateStyle>,
+    /// Multiple in-betweens.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub multiples: Option<MultiplesStyle>,
+    /// Motion lines.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lines: Option<LinesStyle>,
+    /// Per-object overrides keyed by mesh name.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub objects: BTreeMap<String, ObjectStyle>,
+}
+
+/// The effects that apply to one object (disabled ones are `None`).
+#[derive(Debug, Clone, Copy)]
+pub struct ObjectEffects<'a> {
+    /// Painted weights, if any.
+    pub weights: Option<&'a FunctionSpec>,
+    /// Elongation.
+    pub elongate: Option<&'a ElongateStyle>,
+    /// Multiples.
+    pub multiples: Option<&'a MultiplesStyle>,
+    /// Motion lines.
+    pub lines: Option<&'a LinesStyle>,
+}
+
+impl Style {
+    /// Parses and validates a style from TOML text (every function is compiled once to check
+    /// it).
+    ///
+    /// Returns [`StyleError::Syntax`] naming the line and key for malformed TOML or unknown
+    /// keys, the validation errors of [`Style::validate`] otherwise.
+    pub fn from_toml_str(text: &str) -> Result<Style, StyleError> {
+        let style: Style =
+            toml::from_str(text).map_err(|e| StyleError::Syntax(one_line(&e.to_string())))?;
+        style.validate()?;
+        Ok(style)
+    }
+
+    /// The style as TOML text ([`Style::from_toml_str`] reads it back to an equal style).
+    pub fn to_toml_string(&self) -> Result<String, StyleError> {
+        toml::to_string(self).map_err(|e| StyleError::Syntax(e.to_string()))
+    }
+
+    /// Compiles every function and checks every option.
+    pub fn validate(&self) -> Result<(), StyleError> {
+        let sections = std::iter::once((
+            "",
+            ObjectStyle {
+                weights: self.weights.clone(),
+                elongate: self.elongate.clone(),
+                multiples: self.multiples.clone(),
+                lines: self.lines.clone(),
+            },
+        ))
+        .chain(self.objects.iter().map(|(k, v)| (k.as_str(), v.clone())));
+        for (object, s) in sections {
+            let at = |e: StyleError| match e {
+                StyleError::Parameter { name, problem } if !object.is_empty() => {
+                    StyleError::Parameter {
+                        name: format!("objects.{object}.{name}"),
+                        problem,
+                    }
+                }
+                e => e,
+            };
+            if let Some(w) = &s.weights {
+                w.compile().map_err(at)?;
+            }
+            if let Some(e) = &s.elongate {
+                e.function.compile().map_err(at)?;
+                check_step("elongate.step", e.step).map_err(at)?;
+            }
+            if let Some(m) = &s.multiples {
+                m.options().map_err(at)?;
+                m.opacity_spec().compile().map_err(at)?;
+                check_step("multiples.step", m.step).map_err(at)?;
+            }
+            if let Some(l) = &s.lines {
+                l.length.compile().map_err(at)?;
+                l.opacity.compile().map_err(at)?;
+                l.thickness_spec(1.0).compile().map_err(at)?;
+                check_step("lines.step", l.step).map_err(at)?;
+                if l.sides < 3 || l.samples < 2 || !(l.gap >= 0.0 && l.gap.is_finite()) {
+                    return Err(at(StyleError::Parameter {
+                        name: "lines".into(),
+                        problem: "need sides ≥ 3, samples ≥ 2 and a finite gap ≥ 0".into(),
+                    }));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The effects for the object (mesh) `name`: its overrides, else the style's sections;
+    /// disabled sections are `None`.
+    pub fn for_object(&self, name: &str) -> ObjectEffects<'_> {
+        let o = self.objects.get(name);
+        let elongate = pick(o.and_then(|o| o.elongate.as_ref()), self.elongate.as_ref());
+        let multiples = pick(
+            o.and_then(|o| o.multiples.as_ref()),
+            self.multiples.as_ref(),
+        );
+        let lines = pick(o.and_then(|o| o.lines.as_ref()), self.lines.as_ref());
+        ObjectEffects {
+            weights: o.and_then(|o| o.weights.as_ref()).or(self.weights.as_ref()),
+            elongate: elongate.filter(|e| e.enabled),
+            multiples: multiples.filter(|e| e.enabled),
+            lines: lines.filter(|e| e.enabled),
+        }
+    }
+}
+
+fn pick<'a, T>(local: Option<&'a T>, global: Option<&'a T>) -> Option<&'a T> {
+    local.or(global)
+}
+
+fn check_step(name: &str, step: usize) -> Result<(), StyleError> {
+    if step == 0 {
+        return Err(StyleError::Parameter {
+            name: name.into(),
+            problem: "the frame step must be ≥ 1 (1 = on ones, 2 = on twos)".into(),
+        });
+    }
+    Ok(())
+}
+
+fn one_line(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// Compiled functions of one object's effects (see [`ObjectEffects::compile`]).
+#[derive(Debug, Clone)]
+pub struct CompiledEffects {
+    /// Painted weights.
+    pub weights: Option<StyleFunction>,
+    /// S_E and the elongation options.
+    pub elongate: Option<(StyleFunction, ElongateOptions)>,
+    /// S_M and the multiples options.
+    pub multiples: Option<(StyleFunction, MultiplesOptions)>,
+    /// S_L length, thickness, opacity and the line options.
+    pub lines: Option<CompiledLines>,
+}
+
+/// Compiled motion-line functions.
+#[derive(Debug, Clone)]
+pub struct CompiledLines {
+    /// τ = S_L.
+    pub length: StyleFunction,
+    /// Radius.
+    pub thickness: StyleFunction,
+    /// Opacity.
+    pub opacity: StyleFunction,
+    /// Options.
+    pub options: LineOptions,
+    /// Number of seeds.
+    pub count: usize,
+    /// Seed of the sampling.
+    pub seed: u64,
+}
+
+impl ObjectEffects<'_> {
+    /// Compiles the functions; `diagonal` is the object's bounding-box diagonal (default line
+    /// thickness).
+    pub fn compile(&self, diagonal: f32) -> Result<CompiledEffects, StyleError> {
+        Ok(CompiledEffects {
+            weights: self.weights.map(|w| w.compile()).transpose()?,
+            elongate: match self.elongate {
+                Some(e) => Some((e.function.compile()?, ElongateOptions { step: e.step })),
+                None => None,
+            },
+            multiples: match self.multiples {
+                Some(m) => Some((m.opacity_spec().compile()?, m.options()?)),
+                None => None,
+            },
+            lines: match self.lines {
+                Some(l) => Some(CompiledLines {
+                    length: l.length.compile()?,
+                    thickness: l.thickness_spec(diagonal).compile()?,
+                    opacity: l.opacity.compile()?,
+                    options: l.options(),
+                    count: l.count,
+                    seed: l.seed,
+                }),
+                None => None,
+            },
+        })
+    }
+}

@@ -1,0 +1,126 @@
+//! Tests of style parsing, validation and per-object resolution.
+
+use super::*;
+use crate::{StyleInput, Stylize};
+
+const FIG16: &str = r#"
+# Fig. 16: all three effects at once.
+[offsets]
+smooth = 3
+
+[elongate]
+step = 2
+function = { stages = [{ op = "warp", s = 0.5, p = 0.8 }, { op = "speed" }, { op = "scale", by = [[0, 1.0], [10, 3.0]] }] }
+
+[multiples]
+past = 2
+future = 1
+overlap = 1
+opacity = { stages = [{ op = "threshold", min_speed = 0.01 }, { op = "warp", s = 0.8, p = 0.5 }, { op = "multiples", m_max = 1 }] }
+
+[lines]
+count = 12
+seed = 3
+length = { expr = "tau * step(speed - vmin) * delta", params = { tau = 10, vmin = 0.01 } }
+
+[objects.Sword]
+weights = { expr = "clamp01(y / 2)" }
+multiples = { enabled = false }
+"#;
+
+#[test]
+fn fig16_style_parses_and_resolves_per_object() {
+    let style = Style::from_toml_str(FIG16).unwrap();
+    assert_eq!(style.offsets.smooth, 3);
+    let e = style.elongate.as_ref().unwrap();
+    assert_eq!(e.step, 2);
+    assert_eq!(e.function.stages.len(), 3);
+    let m = style.multiples.as_ref().unwrap();
+    let opts = m.options().unwrap();
+    // Fig. 1: N∩ = 1, m_p = 2, m_n = 1 → Δf = 1/3.
+    assert!((opts.spacing_frames().unwrap() - 1.0 / 3.0).abs() < 1e-6);
+    let robot = style.for_object("Robot");
+    assert!(robot.multiples.is_some() && robot.weights.is_none());
+    let sword = style.for_object("Sword");
+    assert!(sword.multiples.is_none() && sword.elongate.is_some() && sword.lines.is_some());
+    let w = sword.compile(1.0).unwrap().weights.unwrap();
+    let at = |y: f32| {
+        w.eval(&StyleInput {
+            rest: glam::Vec3::new(0.0, y, 0.0),
+            ..Default::default()
+        })
+    };
+    assert!((at(1.0) - 0.5).abs() < 1e-6 && at(5.0) == 1.0 && at(-1.0) == 0.0);
+    // Keyframed β_max at frame 5 = 2: δ = 0 warps to −0.609375, speed 1 → β = −1.21875.
+    let fx = robot.compile(2.0).unwrap();
+    let (se, eo) = fx.elongate.unwrap();
+    assert_eq!(eo.step, 2);
+    let x = StyleInput {
+        delta: 0.0,
+        speed: 1.0,
+        frame: 5.0,
+        ..Default::default()
+    };
+    assert!((se.eval(&x) + 1.218_75).abs() < 1e-5, "{}", se.eval(&x));
+    // Line thickness defaults to DEFAULT_LINE_THICKNESS × diagonal.
+    let lines = fx.lines.unwrap();
+    assert!((lines.thickness.eval(&x) - 2.0 * DEFAULT_LINE_THICKNESS).abs() < 1e-7);
+    assert_eq!((lines.count, lines.seed), (12, 3));
+    // Default line opacity 1 − t.
+    let t = StyleInput { t: 0.25, ..x };
+    assert!((lines.opacity.eval(&t) - 0.75).abs() < 1e-6);
+}
+
+#[test]
+fn toml_round_trip_keeps_the_style() {
+    let style = Style::from_toml_str(FIG16).unwrap();
+    let text = style.to_toml_string().unwrap();
+    let back = Style::from_toml_str(&text).unwrap();
+    assert_eq!(back, style, "{text}");
+    let empty = Style::from_toml_str("").unwrap();
+    assert_eq!(empty, Style::default());
+    assert_eq!(
+        Style::from_toml_str(&empty.to_toml_string().unwrap()).unwrap(),
+        empty
+    );
+}
+
+#[test]
+fn bad_styles_are_errors_naming_the_problem() {
+    let cases = [
+        ("[elongate]\nfunction = { expr = \"delta *\" }", "delta *"),
+        (
+            "[elongate]\nfunction = { expr = \"bogus * delta\" }",
+            "bogus",
+        ),
+        ("[elongate]\nfunktion = 3", "funktion"),
+        (
+            "[elongate]\nfunction = { stages = [{ op = \"warp\", s = 1.5, p = 0.5 }] }",
+            "stages[0].s",
+        ),
+        (
+            "[elongate]\nfunction = { stages = [{ op = \"twirl\" }] }",
+            "twirl",
+        ),
+        ("[multiples]\nspacing = 0.5\noverlap = 1", "spacing"),
+        ("[multiples]\npast = 1\nfuture = 0\noverlap = 3", "overlap"),
+        ("[lines]\nstep = 0", "lines.step"),
+        (
+            "[objects.Tree.elongate]\nfunction = { stages = [{ op = \"noise\", kappa = 0 }] }",
+            "objects.Tree",
+        ),
+        (
+            "[elongate]\nfunction = { stages = [{ op = \"scale\", by = [[3, 1], [1, 2]] }] }",
+            "increase",
+        ),
+        ("[elongate\n", "style"),
+    ];
+    for (text, needle) in cases {
+        let e = Style::from_toml_str(text).expect_err(text).to_string();
+        assert!(
+            e.contains(needle),
+            "{text:?}: '{e}' does not name '{needle}'"
+        );
+        assert!(!e.contains('\n'), "multi-line error: {e}");
+    }
+}
