@@ -56,6 +56,35 @@ pub struct Channel {
 }
 
 impl Channel {
+    /// The STEP scale channel of frame `f` of a flipbook (one node per frame): scale 1 from
+    /// `times[f]`, 0 before (from `times[0]`) and from `times[f + 1]` on.
+    ///
+    /// Returns `None` for a one-frame flipbook (its node is simply always visible) or when
+    /// `f` is out of `times`.
+    pub fn flipbook_visibility(node: usize, f: usize, times: &[f32]) -> Option<Channel> {
+        if times.len() < 2 || f >= times.len() {
+            return None;
+        }
+        let (mut t, mut v) = (Vec::with_capacity(3), Vec::with_capacity(9));
+        if f > 0 {
+            t.push(times[0]);
+            v.extend([0.0; 3]);
+        }
+        t.push(times[f]);
+        v.extend([1.0; 3]);
+        if f + 1 < times.len() {
+            t.push(times[f + 1]);
+            v.extend([0.0; 3]);
+        }
+        Some(Channel {
+            node,
+            property: Property::Scale,
+            interpolation: Interpolation::Step,
+            times: t,
+            values: v,
+        })
+    }
+
     /// Number of floats stored per key (3× the components for cubic splines).
     pub fn stride(&self) -> usize {
         match self.interpolation {

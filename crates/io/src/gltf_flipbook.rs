@@ -138,26 +138,7 @@ fn flipbook<'a>(
             ..empty_node()
         });
         children.push(node);
-        if frames > 1 {
-            let (mut t, mut v) = (Vec::new(), Vec::new());
-            if f > 0 {
-                t.push(times[0]);
-                v.extend([0.0; 3]);
-            }
-            t.push(times[f]);
-            v.extend([1.0; 3]);
-            if f + 1 < frames {
-                t.push(times[f + 1]);
-                v.extend([0.0; 3]);
-            }
-            channels.push(Channel {
-                node: node.value(),
-                property: Property::Scale,
-                interpolation: Interpolation::Step,
-                times: t,
-                values: v,
-            });
-        }
+        channels.extend(Channel::flipbook_visibility(node.value(), f, times));
     }
     Ok(b.root.push(json::Node {
         name: Some(name.to_string()),

@@ -35,6 +35,33 @@ pub struct SurfacePoint {
     pub barycentric: [f32; 3],
 }
 
+impl SurfacePoint {
+    /// The point's three corners as (vertex, weight) with the weights normalized to sum 1,
+    /// checked against the mesh's `triangles`; `index` names the point in errors.
+    pub(crate) fn corners(
+        &self,
+        index: usize,
+        triangles: &[[u32; 3]],
+    ) -> Result<[(usize, f32); 3]> {
+        let bad = |reason: String| SmearError::InvalidSurfacePoint { index, reason };
+        let tri = triangles.get(self.triangle as usize).ok_or_else(|| {
+            bad(format!(
+                "triangle {} does not exist ({} triangles)",
+                self.triangle,
+                triangles.len()
+            ))
+        })?;
+        let b = self.barycentric;
+        let sum = b[0] + b[1] + b[2];
+        if !(b.iter().all(|x| x.is_finite() && *x >= 0.0) && sum > 0.0) {
+            return Err(bad(format!(
+                "barycentric coordinates {b:?} must be finite, ≥ 0, not all 0"
+            )));
+        }
+        Ok([0, 1, 2].map(|j| (tri[j] as usize, b[j] / sum)))
+    }
+}
+
 #[derive(Debug)]
 struct Slot<'a> {
     anim: &'a MeshAnimation,
@@ -397,22 +424,7 @@ impl<'a> OffsetSolver<'a> {
         let (mut start, mut joints, mut weights) = (vec![0u32], Vec::new(), Vec::new());
         let mut row: Vec<(u32, f32)> = Vec::new();
         for (k, pt) in points.iter().enumerate() {
-            let bad = |reason: String| SmearError::InvalidSurfacePoint { index: k, reason };
-            let tri = tris.get(pt.triangle as usize).ok_or_else(|| {
-                bad(format!(
-                    "triangle {} does not exist ({} triangles)",
-                    pt.triangle,
-                    tris.len()
-                ))
-            })?;
-            let b = pt.barycentric;
-            let sum = b[0] + b[1] + b[2];
-            if !(b.iter().all(|x| x.is_finite() && *x >= 0.0) && sum > 0.0) {
-                return Err(bad(format!(
-                    "barycentric coordinates {b:?} must be finite, ≥ 0, not all 0"
-                )));
-            }
-            let c = [0, 1, 2].map(|j| (slot.base + tri[j] as usize, b[j] / sum));
+            let c = pt.corners(k, tris)?.map(|(v, w)| (slot.base + v, w));
             row.clear();
             if let Field::Ribbons(rf) = &grp.field {
                 for &(v, bw) in &c {

@@ -117,15 +117,37 @@ pub fn camera_vertex_velocities(anim: &MeshAnimation, camera: &Camera) -> Vec<Ve
     velocities_impl(anim, Some(&space))
 }
 
+/// Central-difference velocities of a frame-major buffer of `frames × points` positions
+/// (world space), as [`vertex_velocities`].
+pub(crate) fn buffer_velocities(positions: &[Vec3], frames: usize, points: usize) -> Vec<Vec3> {
+    differences(positions, frames, points, None)
+}
+
 fn velocities_impl(anim: &MeshAnimation, space: Option<&CameraSpace>) -> Vec<Vec3> {
-    let (frames, n) = (anim.frame_count(), anim.vertex_count());
+    differences(
+        anim.positions(),
+        anim.frame_count(),
+        anim.vertex_count(),
+        space,
+    )
+}
+
+fn differences(
+    positions: &[Vec3],
+    frames: usize,
+    n: usize,
+    space: Option<&CameraSpace>,
+) -> Vec<Vec3> {
     let mut out = vec![Vec3::ZERO; frames * n];
-    if n == 0 {
+    if n == 0 || positions.len() < frames * n {
         return out;
     }
     out.par_chunks_mut(n).enumerate().for_each(|(f, dst)| {
         let (a, b, s) = difference_frames(f, frames);
-        let (pa, pb) = (anim.frame(a), anim.frame(b));
+        let (pa, pb) = (
+            &positions[a * n..(a + 1) * n],
+            &positions[b * n..(b + 1) * n],
+        );
         match space {
             None => {
                 for ((d, p), q) in dst.iter_mut().zip(pa).zip(pb) {

@@ -52,10 +52,17 @@ pub struct OffsetsArgs {
     pub output: PathBuf,
     #[command(flatten)]
     pub input_args: InputArgs,
+    #[command(flatten)]
+    pub offsets: OffsetArgs,
+}
+
+/// Motion-offset options (Section 3), shared by `smear offsets` and every effect.
+#[derive(Debug, Clone, Args)]
+pub struct OffsetArgs {
     /// Temporal smoothing half-window N of Eq. 2 (0 = off).
     #[arg(long, default_value_t = smear::DEFAULT_SMOOTH)]
     pub smooth: usize,
-    /// Treat each skinned character as one rigid-like object with one separation plane.
+    /// Treat each skinned character as one object with one separation plane (Fig. 14).
     #[arg(long)]
     pub whole_body: bool,
     /// Bones to toggle off (comma-separated): their vertices follow the nearest kept ancestor.
@@ -64,9 +71,28 @@ pub struct OffsetsArgs {
     /// Compute offsets relative to this camera (node name, or index).
     #[arg(long)]
     pub camera: Option<String>,
-    /// Disable the collinear weight (paper Fig. 7, shows the shearing it prevents).
+    /// Disable the collinear weight of the ribbons (paper Fig. 7, shows the shearing it
+    /// prevents).
     #[arg(long)]
     pub no_collinear: bool,
+}
+
+impl OffsetArgs {
+    /// The library options; `--camera` is a camera name, or an index when no camera has that
+    /// name.
+    pub fn options(&self, sampled: &anim::SampledScene) -> OffsetOptions {
+        let camera = self.camera.as_ref().map(|c| match c.parse::<usize>() {
+            Ok(i) if !sampled.cameras.iter().any(|cam| cam.name == *c) => CameraSelect::Index(i),
+            _ => CameraSelect::Name(c.clone()),
+        });
+        OffsetOptions {
+            smooth: self.smooth,
+            whole_body: self.whole_body,
+            prune: self.prune.clone(),
+            camera,
+            collinear_weight: !self.no_collinear,
+        }
+    }
 }
 
 /// Runs `toonkit smear`.
@@ -107,17 +133,7 @@ fn offsets(ctx: &Context, args: OffsetsArgs) -> Result<()> {
     if sampled.objects.is_empty() {
         bail!("{}: the file has no mesh", args.input.display());
     }
-    let camera = args.camera.as_ref().map(|c| match c.parse::<usize>() {
-        Ok(i) if !sampled.cameras.iter().any(|cam| cam.name == *c) => CameraSelect::Index(i),
-        _ => CameraSelect::Name(c.clone()),
-    });
-    let options = OffsetOptions {
-        smooth: args.smooth,
-        whole_body: args.whole_body,
-        prune: args.prune.clone(),
-        camera,
-        collinear_weight: !args.no_collinear,
-    };
+    let options = args.offsets.options(&sampled);
     let spinner = crate::progress::spinner("computing motion offsets", ctx.json);
     let solver = OffsetSolver::new(&sampled, &options)
         .map_err(|e| anyhow::anyhow!("{}: {e}", args.input.display()))?;
@@ -156,7 +172,7 @@ fn offsets(ctx: &Context, args: OffsetsArgs) -> Result<()> {
         "frames": frames,
         "vertices": vertices,
         "fps": sampled.fps,
-        "smooth": args.smooth,
+        "smooth": args.offsets.smooth,
         "objects": objects,
         "min": lo,
         "max": hi,

@@ -19,39 +19,27 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anim::glam::Vec3;
-use anim::{Channel, Clip, Interpolation, MeshAnimation, Node, Property, Scene, SceneMesh};
+use anim::{Channel, Clip, MeshAnimation, Node, Scene, SceneMesh};
 use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
 use serde_json::json;
 use smear::{
-    CameraSelect, EffectInputs, ElongateOptions, FunctionSpec, LineFrame, LineOptions, LineStyle,
-    MotionOffsets, MultiplesOptions, OffsetOptions, OffsetSolver, Spacing, StyleFunction,
-    StyleInput, SurfacePoint,
+    EffectInputs, ElongateOptions, FunctionSpec, LineFrame, LineOptions, LineStyle, MotionOffsets,
+    MultiplesOptions, OffsetSolver, Spacing, StyleFunction, StyleInput, SurfacePoint,
 };
 use tkio::Format;
 
+use super::smear::OffsetArgs;
 use super::Context;
 use crate::input::{self, InputArgs};
 use crate::output::{self, Layout};
 
-/// Motion-offset options shared by every effect (as `toonkit smear offsets`).
+/// Options of every effect: the motion-offset options of `toonkit smear offsets` and the
+/// frame step.
 #[derive(Debug, Clone, Args)]
-pub struct OffsetArgs {
-    /// Temporal smoothing half-window N of Eq. 2 (0 = off).
-    #[arg(long, default_value_t = smear::DEFAULT_SMOOTH)]
-    pub smooth: usize,
-    /// Treat each skinned character as one object with one separation plane (Fig. 14).
-    #[arg(long)]
-    pub whole_body: bool,
-    /// Bones to toggle off (comma-separated): their vertices follow the nearest kept ancestor.
-    #[arg(long, value_delimiter = ',')]
-    pub prune: Vec<String>,
-    /// Compute offsets relative to this camera (node name, or index).
-    #[arg(long)]
-    pub camera: Option<String>,
-    /// Disable the collinear weight of the ribbons (paper Fig. 7).
-    #[arg(long)]
-    pub no_collinear: bool,
+pub struct EffectArgs {
+    #[command(flatten)]
+    pub offsets: OffsetArgs,
     /// Frame step: 2 = "on twos" (displacements scaled by 2, drawings held two frames).
     #[arg(long, default_value_t = smear::DEFAULT_FRAME_STEP)]
     pub step: usize,
@@ -79,7 +67,7 @@ pub struct ElongateArgs {
     #[command(flatten)]
     pub input_args: InputArgs,
     #[command(flatten)]
-    pub offsets: OffsetArgs,
+    pub offsets: EffectArgs,
     /// Stylization preset S_E.
     #[arg(long, value_enum, default_value_t = ElongatePreset::Linear)]
     pub preset: ElongatePreset,
@@ -108,7 +96,7 @@ pub struct MultiplesArgs {
     #[command(flatten)]
     pub input_args: InputArgs,
     #[command(flatten)]
-    pub offsets: OffsetArgs,
+    pub offsets: EffectArgs,
     /// Copies in the past, m_p.
     #[arg(long, default_value_t = 1)]
     pub past: usize,
@@ -140,7 +128,7 @@ pub struct LinesArgs {
     #[command(flatten)]
     pub input_args: InputArgs,
     #[command(flatten)]
-    pub offsets: OffsetArgs,
+    pub offsets: EffectArgs,
     /// Number of seeds K (random surface points, area-weighted).
     #[arg(long, default_value_t = smear::DEFAULT_LINE_COUNT)]
     pub count: usize,
@@ -185,26 +173,12 @@ struct Prepared {
     seconds: f64,
 }
 
-fn offset_options(a: &OffsetArgs, sampled: &anim::SampledScene) -> OffsetOptions {
-    let camera = a.camera.as_ref().map(|c| match c.parse::<usize>() {
-        Ok(i) if !sampled.cameras.iter().any(|cam| cam.name == *c) => CameraSelect::Index(i),
-        _ => CameraSelect::Name(c.clone()),
-    });
-    OffsetOptions {
-        smooth: a.smooth,
-        whole_body: a.whole_body,
-        prune: a.prune.clone(),
-        camera,
-        collinear_weight: !a.no_collinear,
-    }
-}
-
 /// Opens and merges the input and computes its offsets; with `seeds = Some((K, seed))` also
 /// samples K motion-line seeds (sorted by triangle) and their offsets, with the same solver.
 fn prepare(
     path: &Path,
     input_args: &InputArgs,
-    a: &OffsetArgs,
+    a: &EffectArgs,
     seeds: Option<(usize, u64)>,
 ) -> Result<Prepared> {
     let start = Instant::now();
@@ -213,7 +187,7 @@ fn prepare(
     }
     let sampled = input::open(path, input_args)?;
     let merged = input::merged(path, &sampled)?;
-    let options = offset_options(a, &sampled);
+    let options = a.offsets.options(&sampled);
     let solver = OffsetSolver::new(&sampled, &options).map_err(at_input(path))?;
     let offsets = MotionOffsets::concat(&solver.all())?;
     let seeds = match seeds {
@@ -444,26 +418,7 @@ fn lines_scene(body: &MeshAnimation, lines: &[LineFrame]) -> Scene {
                 }
                 scene.nodes.push(node);
                 scene.nodes[root].children.push(id);
-                if frames > 1 {
-                    let (mut t, mut v) = (Vec::new(), Vec::new());
-                    if f > 0 {
-                        t.push(times[0]);
-                        v.extend([0.0; 3]);
-                    }
-                    t.push(times[f]);
-                    v.extend([1.0; 3]);
-                    if f + 1 < frames {
-                        t.push(times[f + 1]);
-                        v.extend([0.0; 3]);
-                    }
-                    channels.push(Channel {
-                        node: id,
-                        property: Property::Scale,
-                        interpolation: Interpolation::Step,
-                        times: t,
-                        values: v,
-                    });
-                }
+                channels.extend(Channel::flipbook_visibility(id, f, &times));
             }
         };
     group(&mut scene, &body.mesh.name, &|f| Some(body.mesh_at(f)));

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anim::glam::Vec3;
-use anim::{Channel, Clip, Interpolation, Mesh, MeshAnimation, Property, SampledScene};
+use anim::{Channel, Clip, Mesh, MeshAnimation, SampledScene};
 use anyhow::{anyhow, bail, Context as _, Result};
 use clap::Args;
 use serde_json::json;
@@ -238,26 +238,7 @@ impl Styled {
                     mesh,
                     ..Default::default()
                 });
-                if self.frames > 1 {
-                    let (mut t, mut v) = (Vec::new(), Vec::new());
-                    if f > 0 {
-                        t.push(times[0]);
-                        v.extend([0.0; 3]);
-                    }
-                    t.push(times[f]);
-                    v.extend([1.0; 3]);
-                    if f + 1 < self.frames {
-                        t.push(times[f + 1]);
-                        v.extend([0.0; 3]);
-                    }
-                    channels.push(Channel {
-                        node,
-                        property: Property::Scale,
-                        interpolation: Interpolation::Step,
-                        times: t,
-                        values: v,
-                    });
-                }
+                channels.extend(Channel::flipbook_visibility(node, f, &times));
             }
         }
         if !channels.is_empty() {

@@ -102,7 +102,7 @@ impl<'a> EffectInputs<'a> {
                 offsets.vertex_count(),
             ));
         }
-        let velocities = central_differences(&positions, frames, points);
+        let velocities = crate::velocity::buffer_velocities(&positions, frames, points);
         Ok(EffectInputs {
             positions,
             frames,
@@ -225,48 +225,8 @@ fn corners(triangles: &[[u32; 3]], points: &[SurfacePoint]) -> Result<Vec<[(usiz
     points
         .iter()
         .enumerate()
-        .map(|(index, pt)| {
-            let bad = |reason: String| SmearError::InvalidSurfacePoint { index, reason };
-            let tri = triangles.get(pt.triangle as usize).ok_or_else(|| {
-                bad(format!(
-                    "triangle {} does not exist ({} triangles)",
-                    pt.triangle,
-                    triangles.len()
-                ))
-            })?;
-            let b = pt.barycentric;
-            let sum = b[0] + b[1] + b[2];
-            if !(b.iter().all(|x| x.is_finite() && *x >= 0.0) && sum > 0.0) {
-                return Err(bad(format!(
-                    "barycentric coordinates {b:?} must be finite, ≥ 0, not all 0"
-                )));
-            }
-            Ok([0, 1, 2].map(|j| (tri[j] as usize, b[j] / sum)))
-        })
+        .map(|(index, pt)| pt.corners(index, triangles))
         .collect()
-}
-
-/// SPEC.md velocities: `(p(f+1) − p(f−1))/2`, one-sided at the ends, 0 for one frame.
-fn central_differences(positions: &[Vec3], frames: usize, points: usize) -> Vec<Vec3> {
-    let mut out = vec![Vec3::ZERO; frames * points];
-    if frames < 2 || points == 0 {
-        return out;
-    }
-    out.par_chunks_mut(points).enumerate().for_each(|(f, dst)| {
-        let (a, b, s) = match f {
-            0 => (0, 1, 1.0),
-            _ if f + 1 == frames => (f - 1, f, 1.0),
-            _ => (f - 1, f + 1, 0.5),
-        };
-        let (pa, pb) = (
-            &positions[a * points..(a + 1) * points],
-            &positions[b * points..(b + 1) * points],
-        );
-        for ((d, p), q) in dst.iter_mut().zip(pa).zip(pb) {
-            *d = (*q - *p) * s;
-        }
-    });
-    out
 }
 
 #[cfg(test)]
