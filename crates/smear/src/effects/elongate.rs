@@ -123,17 +123,7 @@ pub fn elongate(
     options: &ElongateOptions,
 ) -> Result<MeshAnimation> {
     let step = check_step(options.step)?;
-    let (frames, n) = (inputs.frame_count(), inputs.point_count());
-    if anim.frame_count() != frames || anim.vertex_count() != n {
-        return Err(SmearError::InvalidParameter {
-            name: "inputs",
-            reason: format!(
-                "built for {frames} frames × {n} points, the animation has {} × {}",
-                anim.frame_count(),
-                anim.vertex_count()
-            ),
-        });
-    }
+    let (frames, n) = inputs.check_animation(anim)?;
     let mut positions = vec![Vec3::ZERO; frames * n];
     if n > 0 {
         positions

@@ -37,6 +37,26 @@ fn mismatch(name: &'static str, expected: usize, found: usize) -> SmearError {
 }
 
 impl<'a> EffectInputs<'a> {
+    /// Checks that these inputs were built for `anim` (same frame and point counts) and
+    /// returns `(frames, points)`.
+    ///
+    /// # Errors
+    /// [`SmearError::InvalidParameter`] naming both shapes otherwise.
+    pub(crate) fn check_animation(&self, anim: &anim::MeshAnimation) -> Result<(usize, usize)> {
+        let (frames, n) = (self.frame_count(), self.point_count());
+        if anim.frame_count() != frames || anim.vertex_count() != n {
+            return Err(SmearError::InvalidParameter {
+                name: "inputs",
+                reason: format!(
+                    "built for {frames} frames × {n} points, the animation has {} × {}",
+                    anim.frame_count(),
+                    anim.vertex_count()
+                ),
+            });
+        }
+        Ok((frames, n))
+    }
+
     /// The vertices of a point cache with their motion offsets.
     ///
     /// # Errors

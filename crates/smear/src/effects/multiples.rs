@@ -220,17 +220,7 @@ pub fn multiples(
 ) -> Result<Vec<MultipleCopy>> {
     let step = check_step(options.step)?;
     let df = options.spacing_frames()?;
-    let (frames, n) = (inputs.frame_count(), inputs.point_count());
-    if anim.frame_count() != frames || anim.vertex_count() != n {
-        return Err(SmearError::InvalidParameter {
-            name: "inputs",
-            reason: format!(
-                "built for {frames} frames × {n} points, the animation has {} × {}",
-                anim.frame_count(),
-                anim.vertex_count()
-            ),
-        });
-    }
+    let (frames, n) = inputs.check_animation(anim)?;
     options
         .indices()
         .into_iter()
