@@ -5,7 +5,7 @@
 //! Run: `cargo bench -p toonkit-smear --bench effects`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use glam::{Mat4, Quat, Vec3};
+use glam::Vec3;
 use smear::{
     elongate_frame, eq12_opacity, motion_lines_frame, multiples_frame, sample_surface,
     EffectInputs, ElongateOptions, LineFrame, LineOptions, LineStyle, MultiplesOptions,
@@ -19,28 +19,8 @@ const FRAMES: usize = 40;
 const FRAME: usize = 20;
 const SEEDS: usize = 200;
 
-fn tube_scene() -> anim::SampledScene {
-    let ys: Vec<f32> = (0..300).map(|i| i as f32 * 10.0 / 299.0).collect();
-    let mesh = common::tube(&ys, 50, |y| 0.3 + 0.1 * (2.0 * y).sin());
-    let w = common::chain_weights(&mesh, 10, 1.0, 0.25);
-    let skel = common::chain(10, 1.0, Quat::IDENTITY);
-    let l0 = common::bind_locals(&skel);
-    common::skinned_scene(mesh, skel, w, FRAMES, move |f| {
-        let t = f as f32;
-        let mut l = l0.clone();
-        l[0] =
-            Mat4::from_translation(Vec3::new(0.2 * t, 0.0, 0.0)) * Mat4::from_rotation_z(0.02 * t);
-        for k in 1..10 {
-            l[k] = l0[k]
-                * Mat4::from_rotation_z(0.3 * (0.4 * t + k as f32).sin())
-                * Mat4::from_rotation_x(0.1 * (0.3 * t).cos());
-        }
-        l
-    })
-}
-
 fn bench(c: &mut Criterion) {
-    let scene = tube_scene();
+    let scene = common::benchmark_tube(FRAMES);
     let anim = &scene.objects[0].animation;
     assert_eq!(anim.vertex_count(), 15_002);
     let solver = OffsetSolver::new(&scene, &OffsetOptions::default()).unwrap();

@@ -18,8 +18,8 @@ use super::reduction::Reduction;
 use super::rig::{Rig, WorldPose};
 use super::targets::FrameTargets;
 use super::terms::{
-    add2, add3, exp, jl_inv, log, orientation_residual, point_jacobian, point_position,
-    project_jacobian, Block, Columns, Dof, SparseJ,
+    add, exp, jl_inv, log, orientation_residual, point_jacobian, point_position, project_jacobian,
+    Block, Columns, Dof, SparseJ,
 };
 use super::Weights;
 
@@ -102,7 +102,7 @@ impl Stage<'_> {
                 point_jacobian(rig, cols, w, p.point, 1.0, &mut s.j3);
                 project_jacobian(cam, &s.j3, &mut s.j2);
             }
-            add2(b, &s.j2, r, sx, jac);
+            add(b, &s.j2, r, sx, jac);
         }
         let st = self.weights.tangent.sqrt();
         for g in &t.segments {
@@ -115,12 +115,12 @@ impl Stage<'_> {
                 point_jacobian(rig, cols, w, g.a, -g.inv_length, &mut s.j3);
                 project_jacobian(cam, &s.j3, &mut s.j2);
             }
-            add2(b, &s.j2, r, st, jac);
+            add(b, &s.j2, r, st, jac);
         }
         let sq = self.weights.twist.sqrt();
         for o in &t.twists {
             let r = orientation_residual(rig, cols, w, o.joint, o.rotation, &mut s.j3);
-            add3(b, &s.j3, r, sq, jac);
+            add(b, &s.j3, r, sq, jac);
         }
         let scp = self.weights.contact_position.sqrt() / self.height;
         let sco = self.weights.contact_orientation.sqrt();
@@ -131,9 +131,9 @@ impl Stage<'_> {
                 let p = super::bones::ChainPoint::Joint(c.joint);
                 point_jacobian(rig, cols, w, p, 1.0, &mut s.j3);
             }
-            add3(b, &s.j3, r, scp, jac);
+            add(b, &s.j3, r, scp, jac);
             let r = orientation_residual(rig, cols, w, c.joint, c.rotation, &mut s.j3);
-            add3(b, &s.j3, r, sco, jac);
+            add(b, &s.j3, r, sco, jac);
         }
     }
 

@@ -145,27 +145,27 @@ impl<V: Copy + std::ops::AddAssign> SparseJ<V> {
     }
 }
 
-/// Adds `‖s · r‖²` with Jacobian `s · J` to the block (2D residual).
-pub(crate) fn add2(block: &mut Block, j: &SparseJ<DVec2>, r: DVec2, s: f64, jacobian: bool) {
-    let r = r * s;
-    block.cost += r.length_squared();
-    if !jacobian {
-        return;
-    }
-    let n = block.n;
-    for (p, &cp) in j.cols.iter().enumerate() {
-        let dp = j.d[p] * s;
-        block.g[cp] += dp.dot(r);
-        for (q, &cq) in j.cols.iter().enumerate() {
-            block.h[cp * n + cq] += dp.dot(j.d[q] * s);
-        }
+/// A 2D or 3D residual vector.
+pub(crate) trait Residual: Copy + std::ops::Mul<f64, Output = Self> {
+    fn dot(self, other: Self) -> f64;
+}
+
+impl Residual for DVec2 {
+    fn dot(self, other: Self) -> f64 {
+        DVec2::dot(self, other)
     }
 }
 
-/// Adds `‖s · r‖²` with Jacobian `s · J` to the block (3D residual).
-pub(crate) fn add3(block: &mut Block, j: &SparseJ<DVec3>, r: DVec3, s: f64, jacobian: bool) {
+impl Residual for DVec3 {
+    fn dot(self, other: Self) -> f64 {
+        DVec3::dot(self, other)
+    }
+}
+
+/// Adds `‖s · r‖²` with Jacobian `s · J` to the block (Gauss–Newton: gradient Jᵀr, JᵀJ).
+pub(crate) fn add<V: Residual>(block: &mut Block, j: &SparseJ<V>, r: V, s: f64, jacobian: bool) {
     let r = r * s;
-    block.cost += r.length_squared();
+    block.cost += r.dot(r);
     if !jacobian {
         return;
     }

@@ -201,3 +201,25 @@ pub fn chain_weights(mesh: &Mesh, bones: usize, len: f32, blend: f32) -> VertexW
         inf
     }))
 }
+
+/// The benchmark scene (SPEC target): a 15,002-vertex wavy tube skinned to a 10-bone chain
+/// that translates, bends and twists over `frames` frames.
+pub fn benchmark_tube(frames: usize) -> SampledScene {
+    let ys: Vec<f32> = (0..300).map(|i| i as f32 * 10.0 / 299.0).collect();
+    let mesh = tube(&ys, 50, |y| 0.3 + 0.1 * (2.0 * y).sin());
+    let w = chain_weights(&mesh, 10, 1.0, 0.25);
+    let skel = chain(10, 1.0, Quat::IDENTITY);
+    let l0 = bind_locals(&skel);
+    skinned_scene(mesh, skel, w, frames, move |f| {
+        let t = f as f32;
+        let mut l = l0.clone();
+        l[0] =
+            Mat4::from_translation(Vec3::new(0.2 * t, 0.0, 0.0)) * Mat4::from_rotation_z(0.02 * t);
+        for k in 1..10 {
+            l[k] = l0[k]
+                * Mat4::from_rotation_z(0.3 * (0.4 * t + k as f32).sin())
+                * Mat4::from_rotation_x(0.1 * (0.3 * t).cos());
+        }
+        l
+    })
+}
