@@ -1,5 +1,7 @@
 //! Static triangle meshes.
 
+use std::collections::BTreeMap;
+
 use glam::Vec3;
 
 use crate::{AnimError, Result};
@@ -85,6 +87,9 @@ pub struct Mesh {
     pub uvs: Option<Vec<[f32; 2]>>,
     /// Per-vertex RGBA colours in linear space.
     pub colors: Option<Vec<[f32; 4]>>,
+    /// Scalar per-vertex attributes by name (glTF application-specific attributes such as
+    /// `_SMEAR_WEIGHT`, painted weights), one value per vertex each.
+    pub attributes: BTreeMap<String, Vec<f32>>,
 }
 
 impl Mesh {
@@ -133,6 +138,9 @@ impl Mesh {
         check("normals", self.normals.as_ref().map(Vec::len))?;
         check("uvs", self.uvs.as_ref().map(Vec::len))?;
         check("colors", self.colors.as_ref().map(Vec::len))?;
+        for (name, values) in &self.attributes {
+            check(&format!("attribute {name}"), Some(values.len()))?;
+        }
         if !self.positions.iter().all(|p| p.is_finite()) {
             return Err(AnimError::NonFinite {
                 what: format!("mesh '{}' positions", self.name),
@@ -173,6 +181,22 @@ impl Mesh {
         merge(&mut self.normals, &other.normals, n_self, n_other, Vec3::Y);
         merge(&mut self.uvs, &other.uvs, n_self, n_other, [0.0, 0.0]);
         merge(&mut self.colors, &other.colors, n_self, n_other, [1.0; 4]);
+        // An attribute missing on one side reads 0 there (nothing painted).
+        let names: Vec<String> = other
+            .attributes
+            .keys()
+            .filter(|k| !self.attributes.contains_key(*k))
+            .cloned()
+            .collect();
+        for name in names {
+            self.attributes.insert(name, vec![0.0; n_self]);
+        }
+        for (name, values) in &mut self.attributes {
+            match other.attributes.get(name) {
+                Some(b) => values.extend_from_slice(b),
+                None => values.extend(std::iter::repeat_n(0.0, n_other)),
+            }
+        }
         let self_polys = self.polygons.take();
         if self_polys.is_some() || other.polygons.is_some() {
             let mut polys = self_polys.unwrap_or_else(|| tri_polys(&self.triangles, 0));

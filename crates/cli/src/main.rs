@@ -34,13 +34,24 @@ enum Command {
     /// Preview an animation as PNG (one frame, onion skins) or GIF, coloured by motion offsets.
     Render(commands::render::RenderArgs),
     /// Smear frames: motion offsets (Basset et al. 2024).
-    Smear(commands::smear::SmearArgs),
+    Smear(Box<commands::smear::SmearArgs>),
     /// Replacement libraries for 3D-printed stop-motion (StopShop).
     Stopmo(commands::stopmo::StopmoArgs),
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if e.use_stderr() => {
+            // Usage errors in one line too (clap adds usage and a --help hint below).
+            let text = e.to_string();
+            let first = text.lines().next().unwrap_or("invalid arguments");
+            let first = first.strip_prefix("error: ").unwrap_or(first);
+            eprintln!("toonkit: error: {first} (see --help)");
+            return ExitCode::from(2);
+        }
+        Err(e) => e.exit(), // --help, --version
+    };
     let ctx = commands::Context { json: cli.json };
     let result = match cli.command {
         Command::Info(a) => commands::info::run(&ctx, a),
@@ -48,7 +59,7 @@ fn main() -> ExitCode {
         Command::Demo(a) => commands::demo::run(&ctx, a),
         Command::Loa(a) => commands::loa::run(&ctx, a),
         Command::Render(a) => commands::render::run(&ctx, a),
-        Command::Smear(a) => commands::smear::run(&ctx, a),
+        Command::Smear(a) => commands::smear::run(&ctx, *a),
         Command::Stopmo(a) => commands::stopmo::run(&ctx, a),
     };
     match result {

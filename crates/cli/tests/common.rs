@@ -14,6 +14,17 @@ pub fn data(rel: &str) -> PathBuf {
     p
 }
 
+/// A path as a command-line argument.
+pub fn s(p: &Path) -> &str {
+    p.to_str().expect("test paths are UTF-8")
+}
+
+/// Reads a `.pc2` written by toonkit with its rest `.obj` beside it (24 fps).
+pub fn read_pc2(path: &Path) -> anim::MeshAnimation {
+    let rest = tkio::obj::read(&std::fs::read(path.with_extension("obj")).unwrap()).unwrap();
+    tkio::pc2::read(&std::fs::read(path).unwrap(), rest, 24.0).unwrap()
+}
+
 /// Runs `toonkit` with arguments.
 pub fn toonkit(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_toonkit"))

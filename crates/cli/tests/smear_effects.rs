@@ -69,15 +69,6 @@ fn bouncing(f: f32) -> Vec3 {
     )
 }
 
-fn read_pc2(path: &Path) -> MeshAnimation {
-    let rest = tkio::obj::read(&std::fs::read(path.with_extension("obj")).unwrap()).unwrap();
-    tkio::pc2::read(&std::fs::read(path).unwrap(), rest, 24.0).unwrap()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
 #[test]
 fn fig9_elongate_ball_covers_neighbour_frames() {
     // Section 5.2 / Fig. 9b: S_E(δ; 1) stretches the ball over the previous and next frames.

@@ -6,7 +6,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{assert_bad_input, data, json, keep_for_validation};
+use common::{assert_bad_input, data, json, keep_for_validation, s};
 use serde_json::Value;
 
 const FPS: &str = "2";
@@ -15,10 +15,6 @@ const PART: &str = "Face";
 
 fn face() -> PathBuf {
     data("face/ict-face-talk.glb")
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
 }
 
 /// `stopmo library` on the whole face (one part, [`PART`]) with `extra` options; the summary.

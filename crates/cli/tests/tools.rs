@@ -103,6 +103,40 @@ fn render_writes_png_and_gif() {
         &["render", robot.to_str().unwrap(), "-o", "x.tiff"],
         "x.tiff",
     );
+    // Contact sheet: Punch has 21 frames → frames 0, 5, …, 20 on 3 columns × 2 rows.
+    let sheet = dir.path().join("sheet.png");
+    let v = json(&[
+        "render",
+        robot.to_str().unwrap(),
+        "-o",
+        sheet.to_str().unwrap(),
+        "--clip",
+        "Punch",
+        "--sheet",
+        "--every",
+        "5",
+        "--columns",
+        "3",
+        "--size",
+        "80x60",
+    ]);
+    assert_eq!(v["frames"], 5);
+    let img = render::decode_png(&std::fs::read(&sheet).unwrap()).unwrap();
+    let gap = render::DEFAULT_SHEET_GAP;
+    assert_eq!(
+        (img.width(), img.height()),
+        (3 * 80 + 4 * gap, 2 * 60 + 3 * gap)
+    );
+    assert_bad_input(
+        &[
+            "render",
+            robot.to_str().unwrap(),
+            "-o",
+            gif.to_str().unwrap(),
+            "--sheet",
+        ],
+        ".png",
+    );
 }
 
 #[test]

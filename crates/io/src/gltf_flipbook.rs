@@ -1,12 +1,15 @@
 //! A [`MeshAnimation`] as glTF: a *flipbook* (one node per frame, visibility keyed with STEP
 //! scale) or *morph targets* (one target per frame, STEP weights). Both open in Blender and
-//! three.js; the flipbook also carries per-frame vertex colours (with alpha).
+//! three.js; the flipbook also carries per-frame vertex colours (with alpha). The mesh's
+//! scalar attributes (`_NAME`, [`anim::Mesh::attributes`]) are on every frame; data that is the
+//! same in several frames or parts (triangles, UVs, attributes, still frames) is stored once.
 
 use anim::glam::Vec3;
 use anim::{Channel, Clip, Interpolation, MeshAnimation, Property};
 use gltf_json as json;
 
-use crate::gltf_write::{frame_mesh, write_clip, Builder, SharedTopology};
+use crate::gltf_accessors::Builder;
+use crate::gltf_write::{frame_mesh, write_clip};
 use crate::{IoError, Result};
 
 /// How a point cache is laid out in glTF.
@@ -125,12 +128,11 @@ fn flipbook<'a>(
     channels: &mut Vec<Channel>,
 ) -> Result<json::Index<json::Node>> {
     let frames = anim.frame_count();
-    let mut shared = SharedTopology::default();
     let name = mesh_name(anim);
     let mut children = Vec::with_capacity(frames);
     for f in 0..frames {
         let sm = frame_mesh(&anim.mesh, anim.frame(f), colors_of(f));
-        let mesh = b.mesh(&sm, &mut shared)?;
+        let mesh = b.mesh(&sm)?;
         let node = b.root.push(json::Node {
             mesh: Some(mesh),
             name: Some(format!("{name}_f{:04}", f + 1)),
@@ -171,7 +173,7 @@ fn morph(
             .collect();
         sm.default_weights = vec![0.0; frames];
     }
-    let mesh = b.mesh(&sm, &mut SharedTopology::default())?;
+    let mesh = b.mesh(&sm)?;
     let node = b.root.push(json::Node {
         mesh: Some(mesh),
         name: Some(mesh_name(anim).to_string()),

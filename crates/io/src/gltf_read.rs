@@ -2,7 +2,8 @@
 //!
 //! Parsing and validation of the JSON is the `gltf` crate's; this module maps the document
 //! onto the data model and checks what that crate assumes (accessor component types, counts,
-//! buffer ranges) so that bad bytes give an error, never a panic.
+//! buffer ranges) so that bad bytes give an error, never a panic. Application-specific scalar
+//! attributes (`_NAME`) go to [`anim::Mesh::attributes`] (see `gltf_attributes`).
 
 use std::path::Path;
 
@@ -360,6 +361,7 @@ fn read_mesh(mesh: &gltf::Mesh, buffers: &[&[u8]]) -> Result<SceneMesh> {
                     .collect(),
             );
         }
+        part.attributes = crate::gltf_attributes::read_attributes(&prim, buffers, n)?;
         check_len(&part, n)?;
         // Joint influences over every JOINTS_n / WEIGHTS_n pair.
         let mut influences: Vec<Vec<(u32, f32)>> = vec![Vec::new(); n];

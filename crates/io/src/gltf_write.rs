@@ -1,189 +1,18 @@
 //! glTF 2.0 binary (`.glb`) writer: a whole [`anim::Scene`] (nodes, meshes with morph targets
 //! and skins, cameras, clips). Writing is building `gltf-json` structures; the binary chunk
-//! holds tightly packed, 4-byte aligned buffer views with correct accessor bounds, so that
-//! the Khronos validator accepts every file.
-
-use std::borrow::Cow;
+//! holds tightly packed, 4-byte aligned buffer views with correct accessor bounds, identical
+//! data stored once (`gltf_accessors`), so that the Khronos validator accepts every file.
 
 use anim::glam::{Mat4, Quat, Vec3};
 use anim::{Interpolation, Mesh, Projection, Property, Scene, SceneMesh, VertexWeights};
 use gltf_json as json;
 use json::validation::Checked::Valid;
-use json::validation::USize64;
 use serde_json::json as js;
 
+use crate::gltf_accessors::{Builder, Usage};
 use crate::{IoError, Result};
 
-/// Where a buffer view is bound (vertex attributes or indices).
-#[derive(Clone, Copy)]
-pub(crate) enum Bind {
-    Vertex,
-    Index,
-    None,
-}
-
-/// Accumulates a glTF document and its binary chunk.
-pub(crate) struct Builder {
-    pub root: json::Root,
-    bin: Vec<u8>,
-    opaque: Option<json::Index<json::Material>>,
-    blend: Option<json::Index<json::Material>>,
-}
-
 impl Builder {
-    pub fn new() -> Builder {
-        let mut root = json::Root::default();
-        root.asset.generator = Some(format!("toonkit {}", env!("CARGO_PKG_VERSION")));
-        root.buffers.push(json::Buffer {
-            byte_length: USize64(0),
-            name: None,
-            uri: None,
-            extensions: None,
-            extras: Default::default(),
-        });
-        Builder {
-            root,
-            bin: Vec::new(),
-            opaque: None,
-            blend: None,
-        }
-    }
-
-    fn view(&mut self, bytes: &[u8], bind: Bind) -> json::Index<json::buffer::View> {
-        while !self.bin.len().is_multiple_of(4) {
-            self.bin.push(0);
-        }
-        let offset = self.bin.len();
-        self.bin.extend_from_slice(bytes);
-        let target = match bind {
-            Bind::Vertex => Some(Valid(json::buffer::Target::ArrayBuffer)),
-            Bind::Index => Some(Valid(json::buffer::Target::ElementArrayBuffer)),
-            Bind::None => None,
-        };
-        self.root.push(json::buffer::View {
-            buffer: json::Index::new(0),
-            byte_length: USize64(bytes.len() as u64),
-            byte_offset: Some(USize64(offset as u64)),
-            byte_stride: None,
-            name: None,
-            target,
-            extensions: None,
-            extras: Default::default(),
-        })
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn accessor(
-        &mut self,
-        bytes: &[u8],
-        count: usize,
-        ty: json::accessor::Type,
-        component: json::accessor::ComponentType,
-        bind: Bind,
-        bounds: Option<(Vec<f32>, Vec<f32>)>,
-        normalized: bool,
-    ) -> json::Index<json::Accessor> {
-        let view = self.view(bytes, bind);
-        let (min, max) = match bounds {
-            Some((a, b)) => (Some(js!(a)), Some(js!(b))),
-            None => (None, None),
-        };
-        self.root.push(json::Accessor {
-            buffer_view: Some(view),
-            byte_offset: None,
-            count: USize64(count as u64),
-            component_type: Valid(json::accessor::GenericComponentType(component)),
-            extensions: None,
-            extras: Default::default(),
-            type_: Valid(ty),
-            min,
-            max,
-            name: None,
-            normalized,
-            sparse: None,
-        })
-    }
-
-    /// Float accessor of `n`-component items, with min/max bounds when asked.
-    pub fn floats(
-        &mut self,
-        data: &[f32],
-        n: usize,
-        bind: Bind,
-        bounds: bool,
-    ) -> json::Index<json::Accessor> {
-        use json::accessor::Type;
-        let ty = match n {
-            1 => Type::Scalar,
-            2 => Type::Vec2,
-            3 => Type::Vec3,
-            4 => Type::Vec4,
-            _ => Type::Mat4,
-        };
-        let b = bounds.then(|| {
-            let mut lo = vec![f32::INFINITY; n];
-            let mut hi = vec![f32::NEG_INFINITY; n];
-            for item in data.chunks_exact(n) {
-                for k in 0..n {
-                    lo[k] = lo[k].min(item[k]);
-                    hi[k] = hi[k].max(item[k]);
-                }
-            }
-            (lo, hi)
-        });
-        let bytes: Vec<u8> = data.iter().flat_map(|f| f.to_le_bytes()).collect();
-        self.accessor(
-            &bytes,
-            data.len() / n,
-            ty,
-            json::accessor::ComponentType::F32,
-            bind,
-            b,
-            false,
-        )
-    }
-
-    pub fn vec3s(&mut self, data: &[Vec3], bounds: bool) -> json::Index<json::Accessor> {
-        let flat: Vec<f32> = data.iter().flat_map(|v| v.to_array()).collect();
-        self.floats(&flat, 3, Bind::Vertex, bounds)
-    }
-
-    pub fn indices(&mut self, tris: &[[u32; 3]]) -> json::Index<json::Accessor> {
-        let bytes: Vec<u8> = tris
-            .iter()
-            .flatten()
-            .flat_map(|i| i.to_le_bytes())
-            .collect();
-        use json::accessor::{ComponentType, Type};
-        self.accessor(
-            &bytes,
-            tris.len() * 3,
-            Type::Scalar,
-            ComponentType::U32,
-            Bind::Index,
-            None,
-            false,
-        )
-    }
-
-    fn joints(&mut self, data: &[[u16; 4]]) -> json::Index<json::Accessor> {
-        let bytes: Vec<u8> = data
-            .iter()
-            .flatten()
-            .flat_map(|i| i.to_le_bytes())
-            .collect();
-        use json::accessor::{ComponentType, Type};
-        self.accessor(
-            &bytes,
-            data.len(),
-            Type::Vec4,
-            ComponentType::U16,
-            Bind::Vertex,
-            None,
-            false,
-        )
-    }
-
     /// The shared material: opaque, or alpha-blended for translucent vertex colours.
     pub fn material(&mut self, blend: bool) -> json::Index<json::Material> {
         let slot = if blend { self.blend } else { self.opaque };
@@ -216,13 +45,9 @@ impl Builder {
         idx
     }
 
-    /// Adds a mesh; `shared` carries index/uv accessors reused across meshes with the same
-    /// topology (flipbooks).
-    pub fn mesh(
-        &mut self,
-        sm: &SceneMesh,
-        shared: &mut SharedTopology,
-    ) -> Result<json::Index<json::Mesh>> {
+    /// Adds a mesh. Identical accessor data (a flipbook's triangles, UVs and painted
+    /// attributes in every frame) is stored once.
+    pub fn mesh(&mut self, sm: &SceneMesh) -> Result<json::Index<json::Mesh>> {
         let m = &sm.mesh;
         if m.vertex_count() == 0 {
             return Err(IoError::unsupported(format!(
@@ -243,33 +68,24 @@ impl Builder {
         let nrm = self.vec3s(&normals, false);
         attributes.insert(Valid(json::mesh::Semantic::Normals), nrm);
         if let Some(uv) = &m.uvs {
-            let acc = match shared.uvs.filter(|_| shared.uv_data.as_ref() == Some(uv)) {
-                Some(a) => a,
-                None => {
-                    let flat: Vec<f32> = uv.iter().flatten().copied().collect();
-                    let a = self.floats(&flat, 2, Bind::Vertex, false);
-                    shared.uvs = Some(a);
-                    shared.uv_data = Some(uv.clone());
-                    a
-                }
-            };
+            let flat: Vec<f32> = uv.iter().flatten().copied().collect();
+            let acc = self.floats(&flat, 2, Usage::Vertex, false);
             attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), acc);
         }
         let mut blend = false;
         if let Some(c) = &m.colors {
-            let flat: Vec<f32> = c
-                .iter()
-                .flat_map(|v| v.map(|x| x.clamp(0.0, 1.0)))
-                .collect();
             blend = c.iter().any(|v| v[3] < 1.0);
-            let acc = self.floats(&flat, 4, Bind::Vertex, false);
+            let acc = self.colors(c);
             attributes.insert(Valid(json::mesh::Semantic::Colors(0)), acc);
+        }
+        for (semantic, acc) in self.scalar_attributes(m)? {
+            attributes.insert(Valid(semantic), acc);
         }
         if let Some(w) = &sm.joint_weights {
             for (set, (j, x)) in split_influences(w).into_iter().enumerate() {
                 let ja = self.joints(&j);
                 let flat: Vec<f32> = x.iter().flatten().copied().collect();
-                let wa = self.floats(&flat, 4, Bind::Vertex, false);
+                let wa = self.floats(&flat, 4, Usage::Vertex, false);
                 attributes.insert(Valid(json::mesh::Semantic::Joints(set as u32)), ja);
                 attributes.insert(Valid(json::mesh::Semantic::Weights(set as u32)), wa);
             }
@@ -277,18 +93,7 @@ impl Builder {
         let (mode, indices) = if m.triangles.is_empty() {
             (json::mesh::Mode::Points, None)
         } else {
-            let acc = match shared
-                .indices
-                .filter(|_| shared.index_data.as_ref() == Some(&m.triangles))
-            {
-                Some(a) => a,
-                None => {
-                    let a = self.indices(&m.triangles);
-                    shared.indices = Some(a);
-                    shared.index_data = Some(m.triangles.clone());
-                    a
-                }
-            };
+            let acc = self.indices(&m.triangles);
             (json::mesh::Mode::Triangles, Some(acc))
         };
         let targets = (!sm.morph_targets.is_empty()).then(|| {
@@ -328,45 +133,6 @@ impl Builder {
             weights,
         }))
     }
-
-    /// Serializes to GLB bytes.
-    pub fn finish(mut self) -> Result<Vec<u8>> {
-        while !self.bin.len().is_multiple_of(4) {
-            self.bin.push(0);
-        }
-        if self.bin.is_empty() {
-            self.root.buffers.clear();
-        } else {
-            self.root.buffers[0].byte_length = USize64(self.bin.len() as u64);
-        }
-        let json = json::serialize::to_vec(&self.root)
-            .map_err(|e| IoError::unsupported(format!("cannot serialize glTF: {e}")))?;
-        if self.bin.len() + json.len() > u32::MAX as usize - 64 {
-            return Err(IoError::unsupported(
-                "the result exceeds the 4 GiB limit of a .glb file",
-            ));
-        }
-        let glb = gltf::binary::Glb {
-            header: gltf::binary::Header {
-                magic: *b"glTF",
-                version: 2,
-                length: 0,
-            },
-            json: Cow::Owned(json),
-            bin: (!self.bin.is_empty()).then_some(Cow::Owned(self.bin)),
-        };
-        glb.to_vec()
-            .map_err(|e| IoError::unsupported(format!("cannot write GLB: {e}")))
-    }
-}
-
-/// Index and UV accessors of the last written topology, reused when identical.
-#[derive(Default)]
-pub(crate) struct SharedTopology {
-    indices: Option<json::Index<json::Accessor>>,
-    index_data: Option<Vec<[u32; 3]>>,
-    uvs: Option<json::Index<json::Accessor>>,
-    uv_data: Option<Vec<[f32; 2]>>,
 }
 
 /// Splits any number of influences into JOINTS_n/WEIGHTS_n sets of four, keeping the sum 1.
@@ -403,10 +169,9 @@ fn split_influences(w: &VertexWeights) -> Vec<InfluenceSet> {
 pub fn write_glb(scene: &Scene) -> Result<Vec<u8>> {
     scene.validate()?;
     let mut b = Builder::new();
-    let mut shared = SharedTopology::default();
     let mut meshes = Vec::new();
     for sm in &scene.meshes {
-        meshes.push(b.mesh(sm, &mut shared)?);
+        meshes.push(b.mesh(sm)?);
     }
     for c in &scene.cameras {
         let cam = match c.projection {
@@ -459,7 +224,7 @@ pub fn write_glb(scene: &Scene) -> Result<Vec<u8>> {
             .iter()
             .flat_map(Mat4::to_cols_array)
             .collect();
-        let ibm = b.floats(&flat, 16, Bind::None, false);
+        let ibm = b.floats(&flat, 16, Usage::InverseBind, false);
         b.root.push(json::Skin {
             extensions: None,
             extras: Default::default(),
@@ -517,12 +282,12 @@ pub(crate) fn write_clip(b: &mut Builder, clip: &anim::Clip) {
     let mut samplers = Vec::new();
     let mut channels = Vec::new();
     for ch in &clip.channels {
-        let input = b.floats(&ch.times, 1, Bind::None, true);
+        let input = b.floats(&ch.times, 1, Usage::AnimationInput, true);
         let comps = match ch.property {
             Property::Weights(_) => 1,
             p => p.components(),
         };
-        let output = b.floats(&ch.values, comps, Bind::None, false);
+        let output = b.floats(&ch.values, comps, Usage::AnimationOutput, false);
         let interpolation = match ch.interpolation {
             Interpolation::Linear => json::animation::Interpolation::Linear,
             Interpolation::Step => json::animation::Interpolation::Step,
@@ -579,6 +344,7 @@ pub(crate) fn frame_mesh(
         colors: colors
             .map(<[[f32; 4]]>::to_vec)
             .or_else(|| base.colors.clone()),
+        attributes: base.attributes.clone(),
     };
     SceneMesh {
         mesh,

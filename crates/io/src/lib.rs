@@ -23,6 +23,8 @@ pub use atomic::{read_file, write_atomic};
 pub use error::{FilePath, IoError, Result};
 
 mod detect;
+mod gltf_accessors;
+mod gltf_attributes;
 mod gltf_flipbook;
 mod gltf_read;
 mod gltf_write;

@@ -31,6 +31,14 @@ pub enum OutputFormat {
     Png,
     /// Every frame as a looping GIF.
     Gif,
+    /// A contact sheet PNG: every `every`-th frame (from 0) on a grid of `columns` columns
+    /// (0 = square-ish), each cell labelled with its frame number.
+    Sheet {
+        /// Frame stride (0 counts as 1).
+        every: usize,
+        /// Columns (0 picks ⌈√cells⌉).
+        columns: usize,
+    },
 }
 
 /// What `toonkit render` asks for.
@@ -157,6 +165,19 @@ pub fn preview_scene(scene: &SampledScene, options: &PreviewOptions) -> Result<V
                 .map(draw)
                 .collect::<Result<_>>()?;
             encode_gif(&images, options.fps.unwrap_or(scene.fps))
+        }
+        OutputFormat::Sheet { every, columns } => {
+            let picked: Vec<usize> = (0..frames).step_by(every.max(1)).collect();
+            let images: Vec<Image> = picked.par_iter().map(|&f| draw(f)).collect::<Result<_>>()?;
+            let sheet = crate::contact_sheet(
+                &images,
+                Some(&picked),
+                &crate::SheetOptions {
+                    columns,
+                    ..Default::default()
+                },
+            )?;
+            encode_png(&sheet)
         }
     }
 }

@@ -5,9 +5,10 @@ use thiserror::Error;
 /// Any error of the `smear` crate.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum SmearError {
-    /// A bone named in [`OffsetOptions::prune`](crate::OffsetOptions::prune) is not a joint of
-    /// the skeleton. Use one of the listed joint names (they are case-sensitive).
-    #[error("no joint named '{name}' to prune; joints are: {available}")]
+    /// A bone named in [`OffsetOptions::prune`](crate::OffsetOptions::prune) or in a weight
+    /// group is not a joint of the skeleton. Use one of the listed joint names (they are
+    /// case-sensitive).
+    #[error("no joint named '{name}'; joints are: {available}")]
     UnknownJoint {
         /// The name that was asked for.
         name: String,
@@ -23,6 +24,16 @@ pub enum SmearError {
     PruneWithoutAncestor {
         /// Name of the pruned joint.
         name: String,
+    },
+    /// The vertex attribute holding painted weights is not on the mesh. Export it as a scalar
+    /// glTF attribute whose name starts with `_` (e.g. `_SMEAR_WEIGHT`), or use one of the
+    /// listed names.
+    #[error("no vertex attribute '{name}'; the mesh has: {available}")]
+    UnknownAttribute {
+        /// The name that was asked for.
+        name: String,
+        /// Comma-separated attribute names.
+        available: String,
     },
     /// The camera asked for is not in the scene. Use one of the listed camera names or an
     /// index below the number of cameras.

@@ -48,11 +48,12 @@ mod stylize;
 mod velocity;
 
 pub use effects::{
-    elongate, elongate_frame, eq12_opacity, held_frame, motion_lines, motion_lines_frame,
-    multiple_opacity, multiples, multiples_frame, overlap_spacing, sample_surface, EffectInputs,
-    ElongateOptions, LineFrame, LineOptions, LineStyle, MultipleCopy, MultiplesOptions, Spacing,
-    StyleInput, Stylize, Trajectories, DEFAULT_FRAME_STEP, DEFAULT_LINE_SAMPLES,
-    DEFAULT_LINE_SIDES, DEFAULT_SEED, DEFAULT_SPACING,
+    attribute_weights, elongate, elongate_frame, eq12_opacity, group_weights, held_frame,
+    motion_lines, motion_lines_frame, multiple_opacity, multiples, multiples_frame,
+    overlap_spacing, sample_surface, surface_point_weights, EffectInputs, ElongateOptions,
+    LineFrame, LineOptions, LineStyle, MultipleCopy, MultiplesOptions, Spacing, StyleInput,
+    Stylize, Trajectories, DEFAULT_FRAME_STEP, DEFAULT_LINE_SAMPLES, DEFAULT_LINE_SIDES,
+    DEFAULT_SEED, DEFAULT_SPACING,
 };
 pub use error::{Result, SmearError};
 pub use offsets::MotionOffsets;
@@ -67,7 +68,8 @@ pub use solver::{mesh_offsets, scene_offsets, OffsetMode, OffsetSolver, SurfaceP
 pub use stylize::{
     apply_stages, hise_curve, voronoi_f1, warp_offset, CompiledEffects, CompiledLines,
     ElongateStyle, Expression, FunctionSpec, LinesStyle, MultiplesStyle, ObjectEffects,
-    ObjectStyle, Param, Stage, Style, StyleError, StyleFunction, StyleOps, DEFAULT_LINE_COUNT,
-    DEFAULT_LINE_THICKNESS, EXPRESSION_INPUTS, MAX_EXPRESSION_VARIABLES,
+    ObjectStyle, Param, Stage, Style, StyleError, StyleFunction, StyleOps, WeightAttribute,
+    WeightGroup, WeightSource, DEFAULT_LINE_COUNT, DEFAULT_LINE_THICKNESS, EXPRESSION_INPUTS,
+    MAX_EXPRESSION_VARIABLES,
 };
 pub use velocity::{camera_vertex_velocities, speeds, vertex_velocities};

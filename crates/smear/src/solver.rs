@@ -95,6 +95,17 @@ pub struct OffsetSolver<'a> {
     groups: Vec<Group<'a>>,
 }
 
+impl OffsetOptions {
+    /// The camera [`OffsetOptions::camera`] selects among `cameras` (`None` when no camera is
+    /// selected: world space).
+    ///
+    /// # Errors
+    /// [`SmearError::UnknownCamera`] listing the cameras when the selection matches none.
+    pub fn selected_camera<'c>(&self, cameras: &'c [Camera]) -> Result<Option<&'c Camera>> {
+        resolve_camera(cameras, &self.camera)
+    }
+}
+
 fn resolve_camera<'c>(
     cameras: &'c [Camera],
     select: &Option<CameraSelect>,

@@ -123,6 +123,16 @@ pub(crate) fn buffer_velocities(positions: &[Vec3], frames: usize, points: usize
     differences(positions, frames, points, None)
 }
 
+/// [`buffer_velocities`] relative to a camera (as [`camera_vertex_velocities`]).
+pub(crate) fn camera_buffer_velocities(
+    positions: &[Vec3],
+    frames: usize,
+    points: usize,
+    space: &CameraSpace,
+) -> Vec<Vec3> {
+    differences(positions, frames, points, Some(space))
+}
+
 fn velocities_impl(anim: &MeshAnimation, space: Option<&CameraSpace>) -> Vec<Vec3> {
     differences(
         anim.positions(),

@@ -542,3 +542,56 @@ fn vertex_pass_matches_pointwise_evaluation() {
     }
     assert!(worst <= 1e-6, "vertex orders differ by {worst}");
 }
+
+#[test]
+fn camera_following_the_ball_sees_no_speed() {
+    // With --camera, the speed that stylization functions read is camera-relative like the
+    // offsets: a ball the camera follows gets no speed-weighted smear (Fig. 11c preset).
+    let ball = translating(sphere(1.0), 6, |f| Vec3::X * f as f32);
+    let follow = camera(
+        (0..6)
+            .map(|f| Mat4::from_translation(Vec3::new(f as f32, 0.0, 8.0)))
+            .collect(),
+    );
+    let scene = rigid_scene(vec![ball.clone()], vec![follow]);
+    let options = OffsetOptions {
+        camera: Some(CameraSelect::Index(0)),
+        ..opts(0)
+    };
+    let cam = options.selected_camera(&scene.cameras).unwrap().unwrap();
+    let world = scene_offsets(&scene, &opts(0)).unwrap();
+    let world_inputs = smear::EffectInputs::new(&ball, &world[0]).unwrap();
+    let seen = world_inputs.clone().relative_to_camera(cam);
+    let world_speed = world_inputs.style_input(3, 0).speed;
+    assert!(
+        (world_speed - 1.0).abs() < 1e-5,
+        "world speed {world_speed}"
+    );
+    let max_seen = seen
+        .velocities()
+        .iter()
+        .map(|v| v.length())
+        .fold(0.0, f32::max);
+    assert!(max_seen < 1e-5, "camera-relative speed {max_seen}");
+    let speed_preset = smear::FunctionSpec::speed(2.0).compile().unwrap();
+    let options = smear::ElongateOptions::default();
+    let moved = |inputs: &smear::EffectInputs<'_>| {
+        let e = smear::elongate(&ball, inputs, &speed_preset, &options).unwrap();
+        e.positions()
+            .iter()
+            .zip(ball.positions())
+            .map(|(a, b)| a.distance(*b))
+            .fold(0.0f32, f32::max)
+    };
+    assert!(moved(&world_inputs) > 1.0);
+    assert!(moved(&seen) < 1e-4);
+    let unknown = OffsetOptions {
+        camera: Some(CameraSelect::Name("nope".into())),
+        ..opts(0)
+    };
+    let e = unknown
+        .selected_camera(&scene.cameras)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("nope") && e.contains("cam"), "{e}");
+}

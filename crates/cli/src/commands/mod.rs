@@ -9,6 +9,7 @@ mod loa_render;
 pub mod render;
 pub mod smear;
 pub mod smear_effects;
+mod smear_prepare;
 pub mod smear_style;
 pub mod stopmo;
 mod stopmo_curve;
@@ -24,14 +25,14 @@ pub struct Context {
 
 impl Context {
     /// Prints a summary: the JSON value with `--json`, otherwise the human text.
+    /// A closed stdout (`toonkit --json info X | head`) is not an error: the work is done.
     pub fn report(&self, value: &serde_json::Value, text: impl FnOnce() -> String) {
-        if self.json {
-            println!(
-                "{}",
-                serde_json::to_string_pretty(value).unwrap_or_default()
-            );
+        use std::io::Write as _;
+        let out = if self.json {
+            serde_json::to_string_pretty(value).unwrap_or_default()
         } else {
-            println!("{}", text());
-        }
+            text()
+        };
+        let _ = writeln!(std::io::stdout().lock(), "{out}");
     }
 }

@@ -1,6 +1,6 @@
 //! `toonkit render IN -o OUT.png|OUT.gif [--frame F] [--onion K] [--color none|offsets|speed]
 //! [--view front|back|side|top|three-quarter|camera:NAME] [--size WxH] [--supersample S]
-//! [--clip NAME] [--fps F]`.
+//! [--clip NAME] [--fps F] [--sheet [--every N] [--columns C]]`.
 
 use std::path::Path;
 use std::time::Instant;
@@ -52,6 +52,15 @@ pub struct RenderArgs {
     /// Supersampling per axis (1 = none, up to 4).
     #[arg(long, default_value_t = 2)]
     pub supersample: u32,
+    /// Write a contact sheet (`.png`): frames 0, N, 2N, … on a grid, numbered.
+    #[arg(long)]
+    pub sheet: bool,
+    /// Frame stride N of the contact sheet (default: about 16 cells).
+    #[arg(long, requires = "sheet")]
+    pub every: Option<usize>,
+    /// Columns of the contact sheet (default: square-ish).
+    #[arg(long, requires = "sheet", default_value_t = 0)]
+    pub columns: usize,
     #[command(flatten)]
     pub input_args: InputArgs,
 }
@@ -100,10 +109,25 @@ pub fn run(ctx: &Context, args: RenderArgs) -> Result<()> {
     let format = output_format(&args.output)?;
     let view = parse_view(&args.view)?;
     let (width, height) = parse_size(&args.size)?;
+    if args.sheet && format != OutputFormat::Png {
+        bail!(
+            "{}: a contact sheet is written as .png",
+            args.output.display()
+        );
+    }
     let sampled = input::open(&args.input, &args.input_args)?;
     if sampled.objects.is_empty() {
         bail!("{}: the file has no mesh to render", args.input.display());
     }
+    let clip_frames = sampled.frame_count.max(1);
+    let format = match (args.sheet, args.every) {
+        (false, _) => format,
+        (true, Some(0)) => bail!("--every must be ≥ 1"),
+        (true, every) => OutputFormat::Sheet {
+            every: every.unwrap_or(clip_frames.div_ceil(16)),
+            columns: args.columns,
+        },
+    };
     let field: Option<(Vec<f32>, ColorMap)> = match args.color {
         ColorArg::None => None,
         ColorArg::Offsets => {
@@ -145,7 +169,8 @@ pub fn run(ctx: &Context, args: RenderArgs) -> Result<()> {
     tkio::write_atomic(&args.output, &bytes)?;
     let frames = match format {
         OutputFormat::Png => 1,
-        OutputFormat::Gif => sampled.frame_count.max(1),
+        OutputFormat::Gif => clip_frames,
+        OutputFormat::Sheet { every, .. } => clip_frames.div_ceil(every.max(1)),
     };
     let seconds = start.elapsed().as_secs_f64();
     let summary = json!({

@@ -13,9 +13,7 @@ use anim::{Channel, Clip, Mesh, MeshAnimation, SampledScene};
 use anyhow::{anyhow, bail, Context as _, Result};
 use clap::Args;
 use serde_json::json;
-use smear::{
-    CompiledEffects, EffectInputs, LineFrame, LineStyle, OffsetSolver, Style, StyleInput, Stylize,
-};
+use smear::{CompiledEffects, EffectInputs, LineFrame, LineStyle, OffsetSolver, Style};
 
 use super::Context;
 use crate::input::{self, InputArgs};
@@ -74,6 +72,7 @@ pub fn apply(scene: &SampledScene, style: &Style) -> Result<Styled> {
     let t = Instant::now();
     let solver = OffsetSolver::new(scene, &style.offsets)?;
     let offsets = solver.all();
+    let camera = style.offsets.selected_camera(&scene.cameras)?;
     timings[0] = t.elapsed().as_secs_f64();
     let mut parts = Vec::new();
     let mut objects = Vec::new();
@@ -81,9 +80,13 @@ pub fn apply(scene: &SampledScene, style: &Style) -> Result<Styled> {
         let anim = &obj.animation;
         let diagonal = anim::Aabb::from_points(anim.frame(0)).diagonal();
         let fx: CompiledEffects = style.for_object(&obj.name).compile(diagonal)?;
-        let mut inputs = EffectInputs::new(anim, &offsets[i])?;
-        if let Some(w) = &fx.weights {
-            inputs = inputs.with_weights(weights(w, anim.frame(0)))?;
+        let weights = match &fx.weights {
+            Some(w) => Some(w.vertex_weights(scene, i)?),
+            None => None,
+        };
+        let mut inputs = in_camera(EffectInputs::new(anim, &offsets[i])?, camera);
+        if let Some(w) = &weights {
+            inputs = inputs.with_weights(w.clone())?;
         }
         let mut stats = json!({"name": obj.name, "vertices": anim.vertex_count()});
         let t = Instant::now();
@@ -108,7 +111,7 @@ pub fn apply(scene: &SampledScene, style: &Style) -> Result<Styled> {
                 parts.push(Part::Animation(c.animation, Some(colors)));
             }
             stats["multiples"] = json!(options.indices().len());
-            stats["multiples_spacing"] = json!(options.spacing_frames()?);
+            stats["multiples_spacing"] = json!(options.spacing_at(0.0)?);
             stats["multiples_visible_vertices"] = json!(visible);
         }
         timings[2] += t.elapsed().as_secs_f64();
@@ -117,12 +120,16 @@ pub fn apply(scene: &SampledScene, style: &Style) -> Result<Styled> {
             let points =
                 smear::sample_surface(anim.frame(0), &anim.mesh.triangles, l.count, l.seed);
             let seed_offsets = solver.surface_offsets(i, &points)?;
-            let seeds = EffectInputs::at_surface_points(anim, &points, seed_offsets)?;
-            let seeds = match &fx.weights {
-                Some(w) => {
-                    let rest = seeds.positions()[..seeds.point_count()].to_vec();
-                    seeds.with_weights(weights(w, &rest))?
-                }
+            let seeds = in_camera(
+                EffectInputs::at_surface_points(anim, &points, seed_offsets)?,
+                camera,
+            );
+            let seeds = match &weights {
+                Some(w) => seeds.with_weights(smear::surface_point_weights(
+                    w,
+                    &anim.mesh.triangles,
+                    &points,
+                )?)?,
                 None => seeds,
             };
             let line_style = LineStyle {
@@ -152,22 +159,12 @@ pub fn apply(scene: &SampledScene, style: &Style) -> Result<Styled> {
     })
 }
 
-/// Painted weights ω ∈ [0, 1] from the style's function at rest positions.
-fn weights(f: &dyn Stylize, rest: &[Vec3]) -> Vec<f32> {
-    rest.iter()
-        .map(|&p| {
-            let w = f.eval(&StyleInput {
-                rest: p,
-                weight: 1.0,
-                ..Default::default()
-            });
-            if w.is_finite() {
-                w.clamp(0.0, 1.0)
-            } else {
-                0.0
-            }
-        })
-        .collect()
+/// Speeds measured against the style's camera, if it names one (as its offsets are).
+fn in_camera<'a>(inputs: EffectInputs<'a>, camera: Option<&anim::Camera>) -> EffectInputs<'a> {
+    match camera {
+        Some(c) => inputs.relative_to_camera(c),
+        None => inputs,
+    }
 }
 
 /// Largest vertex displacement between two animations of the same mesh.

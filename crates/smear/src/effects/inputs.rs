@@ -162,6 +162,23 @@ impl<'a> EffectInputs<'a> {
         Ok(self)
     }
 
+    /// Measures the velocities — hence the `speed` stylization functions read — relative to a
+    /// (moving) camera, as the offsets are with [`OffsetOptions::camera`](crate::OffsetOptions):
+    /// an object the camera follows is slow on screen and gets no speed-driven smear.
+    ///
+    /// # Performance
+    /// One pass over the positions, parallel over frames.
+    pub fn relative_to_camera(mut self, camera: &anim::Camera) -> Self {
+        let space = crate::velocity::CameraSpace::new(camera, self.frames);
+        self.velocities = crate::velocity::camera_buffer_velocities(
+            &self.positions,
+            self.frames,
+            self.points,
+            &space,
+        );
+        self
+    }
+
     /// Number of frames.
     pub fn frame_count(&self) -> usize {
         self.frames

@@ -6,7 +6,7 @@ use rayon::prelude::*;
 use super::inputs::{check_frame, check_step, held_frame};
 use super::tube::{sweep, Ring};
 use super::{EffectInputs, Stylize, DEFAULT_FRAME_STEP};
-use crate::{Result, SmearError};
+use crate::{Param, Result, SmearError};
 
 /// Default number of sides of a line's tube.
 pub const DEFAULT_LINE_SIDES: usize = 6;
@@ -33,8 +33,9 @@ impl std::fmt::Debug for LineStyle<'_> {
     }
 }
 
-/// Options of [`motion_lines`] / [`motion_lines_frame`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Options of [`motion_lines`] / [`motion_lines_frame`]. `gap`, `min_speed` and `count` may
+/// be keyframed (Section 5.1).
+#[derive(Debug, Clone, PartialEq)]
 pub struct LineOptions {
     /// Sides of each tube (≥ 3).
     pub sides: usize,
@@ -42,10 +43,14 @@ pub struct LineOptions {
     pub samples: usize,
     /// Gap between the surface and the line, in frames along the trajectory (Fig. 15: seeds
     /// displaced along their trajectory). Lines not longer than the gap are not drawn.
-    pub gap: f32,
+    pub gap: Param,
     /// Speed threshold v_min (units per frame): seeds slower than it draw no line — the
     /// Heaviside factor H(‖v‖ − v_min) of Section 5.2.
-    pub min_speed: f32,
+    pub min_speed: Param,
+    /// How many of the seeds may draw a line at each frame (rounded); `None` = all. The
+    /// subset is a fixed pseudo-random ranking of the seeds, so raising the count adds lines
+    /// and lowering it removes some without the others jumping.
+    pub count: Option<Param>,
     /// Only trace the past (τ clamped to ≤ 0, the δ⁻ = min(δ, 0) of Fig. 15).
     pub past_only: bool,
     /// Frame step: 2 = "on twos" (τ scaled by 2, drawings held; Section 5.2).
@@ -59,8 +64,9 @@ impl Default for LineOptions {
         LineOptions {
             sides: DEFAULT_LINE_SIDES,
             samples: DEFAULT_LINE_SAMPLES,
-            gap: 0.0,
-            min_speed: 0.0,
+            gap: Param::Constant(0.0),
+            min_speed: Param::Constant(0.0),
+            count: None,
             past_only: false,
             step: DEFAULT_FRAME_STEP,
             color: [0.05, 0.05, 0.05],
@@ -102,13 +108,40 @@ fn check(options: &LineOptions) -> Result<usize> {
     if options.samples < 2 {
         return bad("line samples", "a line needs at least 2 rings");
     }
-    if !(options.gap.is_finite() && options.gap >= 0.0) {
+    if options
+        .gap
+        .validate("gap", (0.0, false), (f32::MAX, false))
+        .is_err()
+    {
         return bad("line gap", "must be a finite number of frames ≥ 0");
     }
-    if options.min_speed.is_nan() {
-        return bad("minimum speed", "must be a number");
+    if options.min_speed.validate_finite("min_speed").is_err() {
+        return bad("minimum speed", "must be a finite number (units per frame)");
+    }
+    if let Some(c) = &options.count {
+        if c.validate("count", (0.0, false), (1e9, false)).is_err() {
+            return bad("line count", "must be a number of lines ≥ 0");
+        }
     }
     check_step(options.step)
+}
+
+/// Rank of every seed in a fixed pseudo-random order (SplitMix64 of the index): seeds with a
+/// rank below the frame's count draw.
+fn seed_ranks(count: usize) -> Vec<u32> {
+    let mix = |i: u64| {
+        let mut z = i.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    };
+    let mut order: Vec<u32> = (0..count as u32).collect();
+    order.sort_by_key(|&i| (mix(i as u64), i));
+    let mut rank = vec![0u32; count];
+    for (r, &i) in order.iter().enumerate() {
+        rank[i as usize] = r as u32;
+    }
+    rank
 }
 
 /// Traces the lines of the drawing at frame `h` into `out`.
@@ -117,6 +150,7 @@ fn trace(
     style: &LineStyle<'_>,
     h: usize,
     options: &LineOptions,
+    ranks: &[u32],
     out: &mut LineFrame,
 ) {
     out.mesh.positions.clear();
@@ -129,19 +163,27 @@ fn trace(
     let tr = seeds.trajectories();
     let scale = options.step as f32;
     let [r, g, b] = options.color;
+    let (gap, min_speed) = (options.gap.at(h as f32), options.min_speed.at(h as f32));
+    let drawn = options
+        .count
+        .as_ref()
+        .map_or(u32::MAX, |c| c.at(h as f32).round().max(0.0) as u32);
     for l in 0..seeds.point_count() {
+        if ranks.get(l).is_some_and(|&r| r >= drawn) {
+            continue;
+        }
         let mut x = seeds.style_input(h, l);
-        if x.speed < options.min_speed {
+        if x.speed < min_speed {
             continue;
         }
         let mut tau = scale * style.length.eval(&x);
         if options.past_only {
             tau = tau.min(0.0);
         }
-        if !tau.is_finite() || tau.abs() <= options.gap || tau == 0.0 {
+        if !tau.is_finite() || tau.abs() <= gap || tau == 0.0 {
             continue;
         }
-        let start = h as f32 + options.gap * tau.signum();
+        let start = h as f32 + gap * tau.signum();
         let end = h as f32 + tau;
         out.rings.clear();
         let n = options.samples;
@@ -194,7 +236,8 @@ fn trace(
 /// [`SmearError::InvalidParameter`] for a bad frame or option (see [`LineOptions`]).
 ///
 /// # Performance
-/// Sequential over lines; no allocation once `out` has grown to size.
+/// Sequential over lines; no allocation once `out` has grown to size (a keyframed `count`
+/// ranks the seeds once per call: O(K log K)).
 pub fn motion_lines_frame(
     seeds: &EffectInputs<'_>,
     style: &LineStyle<'_>,
@@ -204,7 +247,8 @@ pub fn motion_lines_frame(
 ) -> Result<()> {
     let step = check(options)?;
     check_frame(frame, seeds.frame_count())?;
-    trace(seeds, style, held_frame(frame, step), options, out);
+    let ranks = ranks_for(seeds, options);
+    trace(seeds, style, held_frame(frame, step), options, &ranks, out);
     Ok(())
 }
 
@@ -221,14 +265,23 @@ pub fn motion_lines(
     options: &LineOptions,
 ) -> Result<Vec<LineFrame>> {
     let step = check(options)?;
+    let ranks = ranks_for(seeds, options);
     Ok((0..seeds.frame_count())
         .into_par_iter()
         .map(|f| {
             let mut out = LineFrame::default();
-            trace(seeds, style, held_frame(f, step), options, &mut out);
+            trace(seeds, style, held_frame(f, step), options, &ranks, &mut out);
             out
         })
         .collect())
+}
+
+/// The seed ranks when a count is set (none otherwise: every seed draws).
+fn ranks_for(seeds: &EffectInputs<'_>, options: &LineOptions) -> Vec<u32> {
+    match options.count {
+        Some(_) => seed_ranks(seeds.point_count()),
+        None => Vec::new(),
+    }
 }
 
 #[cfg(test)]
@@ -291,7 +344,8 @@ mod tests {
         );
         assert!(out.lines > 300 && out.lines <= 400, "{} lines", out.lines);
         let per_line = opts.samples * opts.sides;
-        assert_eq!(out.mesh.positions.len(), out.lines * per_line);
+        // Rings plus the two cap centres of each line.
+        assert_eq!(out.mesh.positions.len(), out.lines * (per_line + 2));
         // Opacity fades from 1 at the surface to 0 at the end.
         let c = out.mesh.colors.as_ref().unwrap();
         assert_eq!((c[0][3], c[per_line - 1][3]), (1.0, 0.0));
@@ -319,7 +373,7 @@ mod tests {
         let signed = motion_lines(&seeds, &style, &opts).unwrap()[6].lines;
         let past = LineOptions {
             past_only: true,
-            ..opts
+            ..opts.clone()
         };
         let trailing = motion_lines(&seeds, &style, &past).unwrap()[6].lines;
         let n_trailing = seeds
@@ -331,11 +385,14 @@ mod tests {
         assert_eq!(trailing, n_trailing);
         assert!(signed > trailing);
         let slow = LineOptions {
-            min_speed: 0.6,
-            ..opts
+            min_speed: 0.6.into(),
+            ..opts.clone()
         };
         assert_eq!(motion_lines(&seeds, &style, &slow).unwrap()[6].lines, 0);
-        let gap = LineOptions { gap: 1.5, ..opts };
+        let gap = LineOptions {
+            gap: 1.5.into(),
+            ..opts.clone()
+        };
         let with_gap = motion_lines(&seeds, &style, &gap).unwrap()[6].lines;
         let longer = seeds
             .offsets()
@@ -344,7 +401,10 @@ mod tests {
             .filter(|d| d.abs() * 3.0 > 1.5)
             .count();
         assert_eq!(with_gap, longer);
-        let bad = LineOptions { sides: 2, ..opts };
+        let bad = LineOptions {
+            sides: 2,
+            ..opts.clone()
+        };
         assert!(motion_lines(&seeds, &style, &bad).is_err());
         // Still clip: no line.
         let still = translating_ball(5, 0.0);
@@ -355,5 +415,59 @@ mod tests {
             .unwrap()
             .iter()
             .all(|fr| fr.lines == 0));
+    }
+
+    #[test]
+    fn keyframed_count_gap_and_threshold_change_lines_per_frame() {
+        // Section 5.1: every parameter may be keyframed. Count ramps 0 → 40 over frames
+        // 2..10: the drawn lines grow with it and keep the lines already drawn.
+        let anim = translating_ball(14, 0.5);
+        let seeds = seeds_of(&anim, 60);
+        let length = |x: &StyleInput| x.delta.abs() * 3.0;
+        let thin = |_: &StyleInput| 0.02;
+        let one = |_: &StyleInput| 1.0;
+        let style = LineStyle {
+            length: &length,
+            thickness: &thin,
+            opacity: &one,
+        };
+        let ramp = LineOptions {
+            count: Some("2:0,10:40".parse().unwrap()),
+            ..LineOptions::default()
+        };
+        let frames = motion_lines(&seeds, &style, &ramp).unwrap();
+        let all = motion_lines(&seeds, &style, &LineOptions::default()).unwrap();
+        assert_eq!(frames[1].lines, 0);
+        assert_eq!(frames[6].lines, 20.min(all[6].lines));
+        assert_eq!(frames[12].lines, 40.min(all[12].lines));
+        assert!(frames[4].lines < frames[6].lines && frames[6].lines < frames[8].lines);
+        // The 20 lines of frame 6 are among the 40 of frame 12 (same ranking, same seeds).
+        let ranks = seed_ranks(60);
+        assert_eq!(ranks.iter().filter(|&&r| r < 20).count(), 20);
+        // A gap keyed from 0 to 10 frames: no line is longer than 3 frames, so none draws
+        // once the gap passes 3.
+        let gap = LineOptions {
+            gap: Param::Curve(vec![[0.0, 0.0], [10.0, 10.0]]),
+            ..LineOptions::default()
+        };
+        let g = motion_lines(&seeds, &style, &gap).unwrap();
+        assert!(
+            g[1].lines > 0 && g[5].lines == 0,
+            "{} {}",
+            g[1].lines,
+            g[5].lines
+        );
+        // A threshold above the speed from frame 8 on.
+        let slow = LineOptions {
+            min_speed: Param::Curve(vec![[7.0, 0.0], [8.0, 1.0]]),
+            ..LineOptions::default()
+        };
+        let t = motion_lines(&seeds, &style, &slow).unwrap();
+        assert!(t[6].lines > 0 && t[9].lines == 0);
+        let bad = LineOptions {
+            count: Some(Param::Constant(-1.0)),
+            ..LineOptions::default()
+        };
+        assert!(motion_lines(&seeds, &style, &bad).is_err());
     }
 }

@@ -11,6 +11,7 @@ mod stylization;
 mod test_util;
 mod trajectory;
 mod tube;
+mod weights;
 
 pub use elongate::{elongate, elongate_frame, ElongateOptions};
 pub use inputs::{held_frame, EffectInputs, DEFAULT_FRAME_STEP};
@@ -25,3 +26,4 @@ pub use multiples::{
 pub use seeds::{sample_surface, DEFAULT_SEED};
 pub use stylization::{StyleInput, Stylize};
 pub use trajectory::Trajectories;
+pub use weights::{attribute_weights, group_weights, surface_point_weights};

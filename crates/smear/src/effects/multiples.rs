@@ -7,23 +7,24 @@ use rayon::prelude::*;
 
 use super::inputs::{check_frame, check_step, held_frame};
 use super::{EffectInputs, StyleInput, Stylize, DEFAULT_FRAME_STEP};
-use crate::{smoothstep, Result, SmearError};
+use crate::{smoothstep, Param, Result, SmearError};
 
 /// Default temporal spacing Δf between copies (Section 4.2's example: half a frame).
 pub const DEFAULT_SPACING: f32 = 0.5;
 
 /// How far apart the copies are in time.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Spacing {
-    /// Δf in frames, given directly (Fig. 10 top: Δf = 0.7, a stroboscopic effect).
-    Frames(f32),
+    /// Δf in frames, given directly (Fig. 10 top: Δf = 0.7, a stroboscopic effect); may be
+    /// keyframed (Section 5.1), e.g. to spread the copies during the fastest frames.
+    Frames(Param),
     /// Derived from the wanted number N∩ of copies overlapping between consecutive frames
     /// (Section 5.2): Δf(N∩) = 1 / (m_p + m_n + 1 − N∩), N∩ ∈ [1, m_p + m_n].
     Overlap(usize),
 }
 
 /// Options of [`multiples`] / [`multiples_frame`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct MultiplesOptions {
     /// Copies in the past, m_p (indices −m_p..−1).
     pub past: usize,
@@ -40,7 +41,7 @@ impl Default for MultiplesOptions {
         MultiplesOptions {
             past: 1,
             future: 1,
-            spacing: Spacing::Frames(DEFAULT_SPACING),
+            spacing: Spacing::Frames(Param::Constant(DEFAULT_SPACING)),
             step: DEFAULT_FRAME_STEP,
         }
     }
@@ -54,18 +55,22 @@ impl MultiplesOptions {
         (-p..=n).filter(|&m| m != 0).collect()
     }
 
-    /// Δf in frames.
+    /// Δf in frames at `frame` (a keyframed spacing interpolates).
     ///
     /// # Errors
-    /// [`SmearError::InvalidParameter`] for a non-finite Δf, or N∩ outside [1, m_p + m_n].
-    pub fn spacing_frames(&self) -> Result<f32> {
-        match self.spacing {
-            Spacing::Frames(df) if df.is_finite() => Ok(df),
-            Spacing::Frames(df) => Err(SmearError::InvalidParameter {
-                name: "spacing",
-                reason: format!("Δf must be a finite number of frames, got {df}"),
-            }),
-            Spacing::Overlap(n) => overlap_spacing(self.past, self.future, n),
+    /// [`SmearError::InvalidParameter`] for a non-finite Δf or a bad keyframe curve, or N∩
+    /// outside [1, m_p + m_n].
+    pub fn spacing_at(&self, frame: f32) -> Result<f32> {
+        match &self.spacing {
+            Spacing::Frames(df) => {
+                df.validate_finite("spacing")
+                    .map_err(|e| SmearError::InvalidParameter {
+                        name: "spacing",
+                        reason: format!("Δf must be a finite number of frames ({e})"),
+                    })?;
+                Ok(df.at(frame))
+            }
+            Spacing::Overlap(n) => overlap_spacing(self.past, self.future, *n),
         }
     }
 }
@@ -118,7 +123,8 @@ pub fn eq12_opacity(m_max: f32) -> impl Stylize + Copy {
 pub struct MultipleCopy {
     /// The index m (negative = past).
     pub m: i32,
-    /// Its displacement β_m = m·Δf (before the frame-step scaling).
+    /// Its displacement β_m = m·Δf at frame 0 (before the frame-step scaling; a keyframed
+    /// Δf changes it per frame).
     pub beta: f32,
     /// The copy at every frame (same mesh and topology as the input).
     pub animation: MeshAnimation,
@@ -175,8 +181,9 @@ pub fn multiples_frame(
     alpha: &mut [f32],
 ) -> Result<()> {
     let step = check_step(options.step)?;
-    let df = options.spacing_frames()?;
     check_frame(frame, inputs.frame_count())?;
+    let h = held_frame(frame, step);
+    let df = options.spacing_at(h as f32)?;
     let n = inputs.point_count();
     let ms = options.indices();
     let want = ms.len() * n;
@@ -194,7 +201,6 @@ pub fn multiples_frame(
     if n == 0 {
         return Ok(());
     }
-    let h = held_frame(frame, step);
     positions
         .par_chunks_mut(n)
         .zip(alpha.par_chunks_mut(n))
@@ -219,13 +225,17 @@ pub fn multiples(
     options: &MultiplesOptions,
 ) -> Result<Vec<MultipleCopy>> {
     let step = check_step(options.step)?;
-    let df = options.spacing_frames()?;
     let (frames, n) = inputs.check_animation(anim)?;
+    // Δf of every held drawing, checked once.
+    let spacing = (0..frames)
+        .map(|f| options.spacing_at(held_frame(f, step) as f32))
+        .collect::<Result<Vec<f32>>>()?;
+    let df0 = options.spacing_at(0.0)?;
     options
         .indices()
         .into_iter()
         .map(|m| {
-            let beta = m as f32 * df;
+            let beta = m as f32 * df0;
             let mut pos = vec![Vec3::ZERO; frames * n];
             let mut alpha = vec![0.0f32; frames * n];
             if n > 0 {
@@ -238,7 +248,7 @@ pub fn multiples(
                             style,
                             held_frame(f, step),
                             m,
-                            step as f32 * beta,
+                            step as f32 * m as f32 * spacing[f],
                             p,
                             a,
                         )

@@ -19,9 +19,10 @@ fn orthogonal(t: Vec3) -> Vec3 {
 }
 
 /// Appends a tube of `sides` sides through `rings` to `mesh` (positions, triangles and
-/// colours), with rotation-minimizing frames (parallel transport) so it does not twist.
-/// Consecutive rings must be distinct; fewer than 2 rings or fewer than 3 sides append
-/// nothing. Returns whether anything was appended.
+/// colours), with rotation-minimizing frames (parallel transport) so it does not twist, closed
+/// by a flat cap at each end (a fan around one centre vertex with the ring's colour) so the
+/// tube is a closed, outward-oriented surface. Consecutive rings must be distinct; fewer than
+/// 2 rings or fewer than 3 sides append nothing. Returns whether anything was appended.
 pub(crate) fn sweep(rings: &[Ring], sides: usize, mesh: &mut Mesh) -> bool {
     if rings.len() < 2 || sides < 3 {
         return false;
@@ -59,13 +60,27 @@ pub(crate) fn sweep(rings: &[Ring], sides: usize, mesh: &mut Mesh) -> bool {
         }
     }
     let s = sides as u32;
-    for j in 0..rings.len() as u32 - 1 {
+    let last = rings.len() as u32 - 1;
+    for j in 0..last {
         for k in 0..s {
             let a = base + j * s + k;
             let b = base + j * s + (k + 1) % s;
             let (c, d) = (a + s, b + s);
             mesh.triangles.push([a, b, c]);
             mesh.triangles.push([c, b, d]);
+        }
+    }
+    // Caps: the start one faces back along the tangent, the end one forward.
+    for (j, flip) in [(0, true), (last, false)] {
+        let r = &rings[j as usize];
+        let centre = mesh.positions.len() as u32;
+        mesh.positions.push(r.center);
+        colors.push(r.color);
+        for k in 0..s {
+            let a = base + j * s + k;
+            let b = base + j * s + (k + 1) % s;
+            mesh.triangles
+                .push(if flip { [centre, b, a] } else { [centre, a, b] });
         }
     }
     true
@@ -89,9 +104,29 @@ mod tests {
             .collect();
         let mut mesh = Mesh::new("lines", Vec::new(), Vec::new());
         assert!(sweep(&rings, 6, &mut mesh));
-        assert_eq!(mesh.positions.len(), 60);
-        assert_eq!(mesh.triangles.len(), 9 * 6 * 2);
-        assert_eq!(mesh.colors.as_ref().unwrap().len(), 60);
+        assert_eq!(mesh.positions.len(), 62);
+        assert_eq!(mesh.triangles.len(), 9 * 6 * 2 + 2 * 6);
+        assert_eq!(mesh.colors.as_ref().unwrap().len(), 62);
+        // Closed and consistently oriented: every directed edge appears once and its reverse
+        // once; the enclosed volume is positive (outward normals).
+        let mut edges = std::collections::HashMap::new();
+        for t in &mesh.triangles {
+            for e in 0..3 {
+                *edges.entry((t[e], t[(e + 1) % 3])).or_insert(0) += 1;
+            }
+        }
+        assert!(edges
+            .iter()
+            .all(|(&(a, b), &n)| n == 1 && edges.get(&(b, a)) == Some(&1)));
+        let volume: f32 = mesh
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum();
+        assert!(volume > 0.0, "volume {volume}");
         for (j, r) in rings.iter().enumerate() {
             for k in 0..6 {
                 let d = (mesh.positions[j * 6 + k] - r.center).length();
@@ -101,7 +136,7 @@ mod tests {
         mesh.validate().unwrap();
         // A second tube is appended after the first.
         assert!(sweep(&rings[..2], 4, &mut mesh));
-        assert_eq!(mesh.positions.len(), 68);
+        assert_eq!(mesh.positions.len(), 62 + 10);
         assert!(!sweep(&rings[..1], 6, &mut mesh));
     }
 }

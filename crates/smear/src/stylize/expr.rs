@@ -118,7 +118,8 @@ impl Expression {
             }
             p.validate_finite(name)?;
         }
-        let flat = FlatEx::<f64, StyleOps>::parse(text).map_err(|e| problem(e.to_string()))?;
+        let flat = FlatEx::<f64, StyleOps>::parse(&expand_exponents(text))
+            .map_err(|e| problem(e.to_string()))?;
         let names: Vec<&String> = params.keys().collect();
         let mut slots = Vec::new();
         for v in flat.var_names() {
@@ -204,6 +205,49 @@ impl crate::effects::Stylize for Expression {
     }
 }
 
+/// Rewrites scientific literals (`1e-3`, `2.5E4`) as plain decimals, which the expression
+/// parser reads (it would take the `e` for a variable). Identifiers such as `x1e3` are kept.
+fn expand_exponents(text: &str) -> String {
+    let b = text.as_bytes();
+    let ident = |c: u8| c.is_ascii_alphanumeric() || c == b'_';
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    while i < b.len() {
+        let starts_number = (b[i].is_ascii_digit() || b[i] == b'.')
+            && (i == 0 || !(ident(b[i - 1]) || b[i - 1] == b'.'));
+        if !starts_number {
+            let c = text[i..].chars().next().unwrap_or(' ');
+            out.push(c);
+            i += c.len_utf8();
+            continue;
+        }
+        let mut j = i;
+        while j < b.len() && (b[j].is_ascii_digit() || b[j] == b'.') {
+            j += 1;
+        }
+        let mut k = j;
+        if k < b.len() && (b[k] == b'e' || b[k] == b'E') {
+            k += 1;
+            if k < b.len() && (b[k] == b'+' || b[k] == b'-') {
+                k += 1;
+            }
+            let digits = k;
+            while k < b.len() && b[k].is_ascii_digit() {
+                k += 1;
+            }
+            let whole = k > digits && (k == b.len() || !ident(b[k]));
+            if let (true, Ok(v)) = (whole, text[i..k].parse::<f64>()) {
+                out.push_str(&format!("{v}"));
+                i = k;
+                continue;
+            }
+        }
+        out.push_str(&text[i..j]);
+        i = j;
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -211,6 +255,22 @@ mod tests {
 
     fn compile(text: &str) -> Result<Expression, StyleError> {
         Expression::compile(text, 1.0.into(), 0, BTreeMap::new())
+    }
+
+    #[test]
+    fn scientific_literals_are_numbers() {
+        assert_eq!(
+            expand_exponents("1e-3 * x1e3 + 2.5E2"),
+            "0.001 * x1e3 + 250"
+        );
+        assert_eq!(expand_exponents("delta*1e+2-.5e1"), "delta*100-5");
+        assert_eq!(expand_exponents("3e + 1"), "3e + 1");
+        let e = compile("delta * 1e-3").unwrap();
+        let x = StyleInput {
+            delta: 2.0,
+            ..Default::default()
+        };
+        assert!((e.evaluate(&x) - 0.002).abs() < 1e-9);
     }
 
     #[test]

@@ -50,27 +50,27 @@ impl FunctionSpec {
         }
     }
 
-    /// A user expression with named parameters.
-    pub fn expr(text: &str, params: &[(&str, f32)]) -> Self {
+    /// A user expression with named (possibly keyframed) parameters.
+    pub fn expr(text: &str, params: &[(&str, Param)]) -> Self {
         FunctionSpec {
             expr: Some(text.to_string()),
             params: params
                 .iter()
-                .map(|(k, v)| (k.to_string(), Param::Constant(*v)))
+                .map(|(k, v)| (k.to_string(), v.clone()))
                 .collect(),
             ..Default::default()
         }
     }
 
     /// S_E(δ; β_max) = β_max·δ (Eq. 10; also S_L(δ; τ_max) = τ_max·δ, Eq. 13).
-    pub fn linear(beta_max: f32) -> Self {
+    pub fn linear(beta_max: impl Into<Param>) -> Self {
         Self::stages(vec![Stage::Scale {
             by: beta_max.into(),
         }])
     }
 
     /// S_E^speed(δ; v, β_max) = β_max‖v‖δ (Fig. 11c).
-    pub fn speed(beta_max: f32) -> Self {
+    pub fn speed(beta_max: impl Into<Param>) -> Self {
         Self::stages(vec![
             Stage::Speed,
             Stage::Scale {
@@ -80,7 +80,7 @@ impl FunctionSpec {
     }
 
     /// S_E^noise(δ−; v, κ, β_max) = β_max‖v‖F1(p(0), κ)δ− (Fig. 11d).
-    pub fn noise(kappa: f32, beta_max: f32) -> Self {
+    pub fn noise(kappa: impl Into<Param>, beta_max: impl Into<Param>) -> Self {
         Self::stages(vec![
             Stage::Past,
             Stage::Speed,
@@ -95,7 +95,7 @@ impl FunctionSpec {
     }
 
     /// S_M(δ, m; m_max) of Eq. 12.
-    pub fn multiples(m_max: f32) -> Self {
+    pub fn multiples(m_max: impl Into<Param>) -> Self {
         Self::stages(vec![Stage::Multiples {
             m_max: m_max.into(),
         }])
@@ -190,7 +190,7 @@ mod tests {
         );
         assert_same(
             &FunctionSpec::speed(6.0),
-            &FunctionSpec::expr("b * speed * delta", &[("b", 6.0)]),
+            &FunctionSpec::expr("b * speed * delta", &[("b", 6.0.into())]),
         );
         let mut noise = FunctionSpec::expr("10 * speed * noise * min(delta, 0)", &[]);
         noise.kappa = Some(18.0.into());

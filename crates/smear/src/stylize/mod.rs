@@ -19,6 +19,7 @@ mod style;
 mod style_tests;
 mod voronoi;
 mod warp;
+mod weights;
 
 pub use error::StyleError;
 pub use expr::{Expression, StyleOps, EXPRESSION_INPUTS, MAX_EXPRESSION_VARIABLES};
@@ -31,3 +32,4 @@ pub use style::{
 };
 pub use voronoi::voronoi_f1;
 pub use warp::{hise_curve, warp_offset};
+pub use weights::{WeightAttribute, WeightGroup, WeightSource};

@@ -91,9 +91,68 @@ impl Param {
         Ok(())
     }
 
+    /// The largest value the parameter takes (a curve's largest key).
+    pub fn max_value(&self) -> f32 {
+        match self {
+            Param::Constant(v) => *v,
+            Param::Curve(keys) => keys.iter().map(|k| k[1]).fold(f32::NEG_INFINITY, f32::max),
+        }
+    }
+
+    /// Whether the parameter is a keyframed curve.
+    pub fn is_keyframed(&self) -> bool {
+        matches!(self, Param::Curve(_))
+    }
+
     /// [`Param::validate`] for any finite value.
     pub fn validate_finite(&self, name: &str) -> Result<(), StyleError> {
         self.validate(name, (f32::MIN, false), (f32::MAX, false))
+    }
+}
+
+/// Command-line form: a number (`2.5`) or keys `FRAME:VALUE` separated by commas
+/// (`0:0,12:4,24:0`).
+impl std::str::FromStr for Param {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Param, String> {
+        let number = |t: &str| {
+            t.trim()
+                .parse::<f32>()
+                .map_err(|_| format!("'{}' is not a number", t.trim()))
+        };
+        if !s.contains(':') {
+            return number(s).map(Param::Constant);
+        }
+        let keys = s
+            .split(',')
+            .map(|key| match key.split_once(':') {
+                Some((f, v)) => Ok([number(f)?, number(v)?]),
+                None => Err(format!(
+                    "'{}' is not a FRAME:VALUE key (write keys as 0:1.0,12:4.0)",
+                    key.trim()
+                )),
+            })
+            .collect::<Result<Vec<_>, String>>()
+            .map_err(|e| format!("{e} (keyframes are FRAME:VALUE,FRAME:VALUE,...)"))?;
+        let p = Param::Curve(keys);
+        p.validate_finite("keyframes").map_err(|e| e.to_string())?;
+        Ok(p)
+    }
+}
+
+/// The command-line form read by [`FromStr`](std::str::FromStr) (`2.5` or `0:0,12:4`).
+impl std::fmt::Display for Param {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Param::Constant(v) => write!(f, "{v}"),
+            Param::Curve(keys) => {
+                for (i, [frame, value]) in keys.iter().enumerate() {
+                    write!(f, "{}{frame}:{value}", if i > 0 { "," } else { "" })?;
+                }
+                Ok(())
+            }
+        }
     }
 }
 
@@ -129,6 +188,20 @@ mod tests {
         assert_eq!(p.at(25.0), -1.0);
         assert_eq!(p.at(f32::NAN), 1.0);
         assert_eq!(Param::Constant(4.5).at(100.0), 4.5);
+    }
+
+    #[test]
+    fn command_line_keyframes_parse() {
+        assert_eq!("2.5".parse::<Param>(), Ok(Param::Constant(2.5)));
+        let p: Param = "0:0, 12:4,24:0".parse().unwrap();
+        assert_eq!(p, Param::Curve(vec![[0.0, 0.0], [12.0, 4.0], [24.0, 0.0]]));
+        assert_eq!(p.max_value(), 4.0);
+        assert_eq!(p.to_string().parse::<Param>(), Ok(p.clone()));
+        assert_eq!(Param::Constant(0.5).to_string(), "0.5");
+        assert!(p.is_keyframed());
+        assert!("0:1,x:2".parse::<Param>().is_err());
+        assert!("3:1,1:2".parse::<Param>().unwrap_err().contains("increase"));
+        assert!("1e-3".parse::<Param>().is_ok());
     }
 
     #[test]

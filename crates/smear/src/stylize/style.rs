@@ -7,7 +7,9 @@ use serde::{Deserialize, Serialize};
 
 use super::error::StyleError;
 use super::function::{FunctionSpec, StyleFunction};
+use super::param::Param;
 use super::stage::Stage;
+use super::weights::WeightSource;
 use crate::{
     ElongateOptions, LineOptions, MultiplesOptions, OffsetOptions, Spacing, DEFAULT_FRAME_STEP,
     DEFAULT_LINE_SAMPLES, DEFAULT_LINE_SIDES, DEFAULT_SEED, DEFAULT_SPACING,
@@ -59,9 +61,9 @@ pub struct MultiplesStyle {
     pub past: usize,
     /// Copies in the future, m_n.
     pub future: usize,
-    /// Δf in frames (exclusive with `overlap`; default 0.5).
+    /// Δf in frames (exclusive with `overlap`; default 0.5); keyframeable.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub spacing: Option<f32>,
+    pub spacing: Option<Param>,
     /// N∩: copies overlapping between consecutive frames, Δf = 1/(m_p + m_n + 1 − N∩).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub overlap: Option<usize>,
@@ -91,7 +93,7 @@ impl MultiplesStyle {
     ///
     /// Returns [`StyleError::Parameter`] when both `spacing` and `overlap` are given.
     pub fn options(&self) -> Result<MultiplesOptions, StyleError> {
-        let spacing = match (self.spacing, self.overlap) {
+        let spacing = match (self.spacing.clone(), self.overlap) {
             (Some(_), Some(_)) => {
                 return Err(StyleError::Parameter {
                     name: "multiples.spacing".into(),
@@ -100,7 +102,7 @@ impl MultiplesStyle {
             }
             (Some(df), None) => Spacing::Frames(df),
             (None, Some(n)) => Spacing::Overlap(n),
-            (None, None) => Spacing::Frames(DEFAULT_SPACING),
+            (None, None) => Spacing::Frames(DEFAULT_SPACING.into()),
         };
         let options = MultiplesOptions {
             past: self.past,
@@ -108,12 +110,10 @@ impl MultiplesStyle {
             spacing,
             step: self.step,
         };
-        options
-            .spacing_frames()
-            .map_err(|e| StyleError::Parameter {
-                name: "multiples".into(),
-                problem: e.to_string(),
-            })?;
+        options.spacing_at(0.0).map_err(|e| StyleError::Parameter {
+            name: "multiples".into(),
+            problem: e.to_string(),
+        })?;
         Ok(options)
     }
 
@@ -131,14 +131,15 @@ impl MultiplesStyle {
 pub struct LinesStyle {
     /// false turns the effect off.
     pub enabled: bool,
-    /// Number of seeds sampled on the surface (area-uniform).
-    pub count: usize,
+    /// Number of lines (seeds sampled on the surface, area-uniform); keyframeable — a curve
+    /// samples as many seeds as its largest key and draws a fixed random subset of them.
+    pub count: Param,
     /// Seed of the seed sampling.
     pub seed: u64,
-    /// Gap between the surface and the line, in frames along the trajectory.
-    pub gap: f32,
-    /// Seeds slower than this (units per frame) draw no line.
-    pub min_speed: f32,
+    /// Gap between the surface and the line, in frames along the trajectory; keyframeable.
+    pub gap: Param,
+    /// Seeds slower than this (units per frame) draw no line; keyframeable.
+    pub min_speed: Param,
     /// Only trace the past.
     pub past_only: bool,
     /// Tube sides.
@@ -163,10 +164,10 @@ impl Default for LinesStyle {
     fn default() -> Self {
         LinesStyle {
             enabled: yes(),
-            count: DEFAULT_LINE_COUNT,
+            count: Param::Constant(DEFAULT_LINE_COUNT as f32),
             seed: DEFAULT_SEED,
-            gap: 0.0,
-            min_speed: 0.0,
+            gap: Param::Constant(0.0),
+            min_speed: Param::Constant(0.0),
             past_only: false,
             sides: DEFAULT_LINE_SIDES,
             samples: DEFAULT_LINE_SAMPLES,
@@ -185,11 +186,22 @@ impl LinesStyle {
         LineOptions {
             sides: self.sides,
             samples: self.samples,
-            gap: self.gap,
-            min_speed: self.min_speed,
+            gap: self.gap.clone(),
+            min_speed: self.min_speed.clone(),
+            count: self.count.is_keyframed().then(|| self.count.clone()),
             past_only: self.past_only,
             step: self.step,
             color: self.color,
+        }
+    }
+
+    /// How many seeds to sample: the largest value of `count` (rounded).
+    pub fn seed_count(&self) -> usize {
+        let c = self.count.max_value();
+        if c.is_finite() {
+            c.round().clamp(0.0, 1e7) as usize
+        } else {
+            0
         }
     }
 
@@ -208,9 +220,9 @@ impl LinesStyle {
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ObjectStyle {
-    /// Painted weights ω for this object (an expression over `x, y, z`).
+    /// Painted weights ω for this object (see [`WeightSource`]).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub weights: Option<FunctionSpec>,
+    pub weights: Option<WeightSource>,
     /// Elongation for this object.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub elongate: Option<ElongateStyle>,
@@ -242,10 +254,10 @@ pub struct ObjectStyle {
 pub struct Style {
     /// Motion-offset options (Section 3).
     pub offsets: OffsetOptions,
-    /// Painted weights ω (paper Fig. 15b): a function evaluated once per vertex at its rest
-    /// position (`x, y, z`; other inputs 0), clamped to [0, 1]. Default 1.
+    /// Painted weights ω (paper Fig. 15b): a weight group, a vertex attribute or a function
+    /// of the rest position (see [`WeightSource`]). Default 1.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub weights: Option<FunctionSpec>,
+    pub weights: Option<WeightSource>,
     /// Elongated in-betweens.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub elongate: Option<ElongateStyle>,
@@ -264,7 +276,7 @@ pub struct Style {
 #[derive(Debug, Clone, Copy)]
 pub struct ObjectEffects<'a> {
     /// Painted weights, if any.
-    pub weights: Option<&'a FunctionSpec>,
+    pub weights: Option<&'a WeightSource>,
     /// Elongation.
     pub elongate: Option<&'a ElongateStyle>,
     /// Multiples.
@@ -314,7 +326,7 @@ impl Style {
                 e => e,
             };
             if let Some(w) = &s.weights {
-                w.compile().map_err(at)?;
+                w.validate().map_err(at)?;
             }
             if let Some(e) = &s.elongate {
                 e.function.compile().map_err(at)?;
@@ -330,10 +342,17 @@ impl Style {
                 l.opacity.compile().map_err(at)?;
                 l.thickness_spec(1.0).compile().map_err(at)?;
                 check_step("lines.step", l.step).map_err(at)?;
-                if l.sides < 3 || l.samples < 2 || !(l.gap >= 0.0 && l.gap.is_finite()) {
+                l.gap
+                    .validate("lines.gap", (0.0, false), (f32::MAX, false))
+                    .map_err(at)?;
+                l.min_speed.validate_finite("lines.min_speed").map_err(at)?;
+                l.count
+                    .validate("lines.count", (0.0, false), (1e7, false))
+                    .map_err(at)?;
+                if l.sides < 3 || l.samples < 2 {
                     return Err(at(StyleError::Parameter {
                         name: "lines".into(),
-                        problem: "need sides ≥ 3, samples ≥ 2 and a finite gap ≥ 0".into(),
+                        problem: "need sides ≥ 3 and samples ≥ 2".into(),
                     }));
                 }
             }
@@ -381,8 +400,9 @@ fn one_line(s: &str) -> String {
 /// Compiled functions of one object's effects (see [`ObjectEffects::compile`]).
 #[derive(Debug, Clone)]
 pub struct CompiledEffects {
-    /// Painted weights.
-    pub weights: Option<StyleFunction>,
+    /// Where the painted weights come from (resolve with
+    /// [`WeightSource::vertex_weights`]).
+    pub weights: Option<WeightSource>,
     /// S_E and the elongation options.
     pub elongate: Option<(StyleFunction, ElongateOptions)>,
     /// S_M and the multiples options.
@@ -402,7 +422,7 @@ pub struct CompiledLines {
     pub opacity: StyleFunction,
     /// Options.
     pub options: LineOptions,
-    /// Number of seeds.
+    /// Number of seeds to sample (the largest keyed count).
     pub count: usize,
     /// Seed of the sampling.
     pub seed: u64,
@@ -413,7 +433,7 @@ impl ObjectEffects<'_> {
     /// thickness).
     pub fn compile(&self, diagonal: f32) -> Result<CompiledEffects, StyleError> {
         Ok(CompiledEffects {
-            weights: self.weights.map(|w| w.compile()).transpose()?,
+            weights: self.weights.cloned(),
             elongate: match self.elongate {
                 Some(e) => Some((e.function.compile()?, ElongateOptions { step: e.step })),
                 None => None,
@@ -428,7 +448,7 @@ impl ObjectEffects<'_> {
                     thickness: l.thickness_spec(diagonal).compile()?,
                     opacity: l.opacity.compile()?,
                     options: l.options(),
-                    count: l.count,
+                    count: l.seed_count(),
                     seed: l.seed,
                 }),
                 None => None,

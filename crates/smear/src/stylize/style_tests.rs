@@ -38,12 +38,15 @@ fn fig16_style_parses_and_resolves_per_object() {
     let m = style.multiples.as_ref().unwrap();
     let opts = m.options().unwrap();
     // Fig. 1: N∩ = 1, m_p = 2, m_n = 1 → Δf = 1/3.
-    assert!((opts.spacing_frames().unwrap() - 1.0 / 3.0).abs() < 1e-6);
+    assert!((opts.spacing_at(7.0).unwrap() - 1.0 / 3.0).abs() < 1e-6);
     let robot = style.for_object("Robot");
     assert!(robot.multiples.is_some() && robot.weights.is_none());
     let sword = style.for_object("Sword");
     assert!(sword.multiples.is_none() && sword.elongate.is_some() && sword.lines.is_some());
-    let w = sword.compile(1.0).unwrap().weights.unwrap();
+    let Some(WeightSource::Function(w)) = sword.compile(1.0).unwrap().weights else {
+        panic!("the sword's weights are a function");
+    };
+    let w = w.compile().unwrap();
     let at = |y: f32| {
         w.eval(&StyleInput {
             rest: glam::Vec3::new(0.0, y, 0.0),
@@ -122,5 +125,75 @@ fn bad_styles_are_errors_naming_the_problem() {
             "{text:?}: '{e}' does not name '{needle}'"
         );
         assert!(!e.contains('\n'), "multi-line error: {e}");
+    }
+}
+
+#[test]
+fn fig15b_weight_sources_and_keyframed_effect_options_parse() {
+    // Painted weights from a weight group or a vertex attribute (Fig. 15b), and keyframes on
+    // the effects' own options (Section 5.1).
+    let style = Style::from_toml_str(
+        r#"
+weights = { group = ["Head", "ShoulderL"] }
+[multiples]
+spacing = [[0, 0.25], [20, 1.0]]
+[lines]
+count = [[0, 5], [10, 30]]
+gap = [[0, 0], [10, 2]]
+min_speed = 0.01
+[objects.Sword]
+weights = { attribute = "_SMEAR_WEIGHT" }
+[objects.Cape]
+weights = { group = ["Spine"], descendants = false }
+"#,
+    )
+    .unwrap();
+    assert_eq!(
+        style.weights,
+        Some(WeightSource::Group(WeightGroup {
+            group: vec!["Head".into(), "ShoulderL".into()],
+            descendants: true
+        }))
+    );
+    assert!(matches!(
+        style.for_object("Sword").weights,
+        Some(WeightSource::Attribute(a)) if a.attribute == "_SMEAR_WEIGHT"
+    ));
+    assert!(matches!(
+        style.for_object("Cape").weights,
+        Some(WeightSource::Group(g)) if !g.descendants
+    ));
+    let m = style.multiples.as_ref().unwrap().options().unwrap();
+    assert!((m.spacing_at(10.0).unwrap() - 0.625).abs() < 1e-6);
+    let lines = style
+        .for_object("Robot")
+        .compile(1.0)
+        .unwrap()
+        .lines
+        .unwrap();
+    assert_eq!(lines.count, 30, "seeds sampled for the largest keyed count");
+    let count = lines.options.count.as_ref().unwrap();
+    assert_eq!(count.at(5.0), 17.5);
+    assert_eq!(lines.options.gap.at(5.0), 1.0);
+    assert_eq!(lines.options.min_speed.at(99.0), 0.01);
+    // A constant count draws every sampled seed.
+    let constant = Style::from_toml_str("[lines]\ncount = 12").unwrap();
+    let l = constant.lines.as_ref().unwrap();
+    assert_eq!((l.seed_count(), l.options().count), (12, None));
+    let back = Style::from_toml_str(&style.to_toml_string().unwrap()).unwrap();
+    assert_eq!(back, style);
+    for (text, needle) in [
+        ("weights = { group = [] }", "weights.group"),
+        ("weights = { attribute = \"_\" }", "weights.attribute"),
+        ("weights = { grup = [\"Head\"] }", "weights"),
+        ("[lines]\ngap = [[0, 1], [5, -1]]", "lines.gap"),
+        ("[lines]\ncount = -3", "lines.count"),
+        ("[multiples]\nspacing = [[4, 1], [2, 1]]", "increase"),
+    ] {
+        let e = Style::from_toml_str(text).expect_err(text).to_string();
+        assert!(
+            e.contains(needle),
+            "{text:?}: '{e}' does not name '{needle}'"
+        );
     }
 }

@@ -1,0 +1,26 @@
+//! Helpers shared by the io integration tests.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+
+/// Path of a shared test asset; panics (fails loudly) if it is missing.
+pub fn data(rel: &str) -> PathBuf {
+    let p = PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/data/"
+    ))
+    .join(rel);
+    assert!(p.exists(), "missing test asset {}", p.display());
+    p
+}
+
+/// Keeps `bytes` as `<name>.glb` for CI's Khronos validator run, like
+/// `crates/cli/tests/common.rs`.
+pub fn keep_for_validation(bytes: &[u8], name: &str) {
+    let Ok(dest) = std::env::var("TOONKIT_VALIDATE_DIR") else {
+        return;
+    };
+    let dest = PathBuf::from(dest);
+    std::fs::create_dir_all(&dest).unwrap();
+    std::fs::write(dest.join(format!("{name}.glb")), bytes).unwrap();
+}

@@ -1,0 +1,124 @@
+//! Where a style's painted weights ω come from (paper Fig. 15b).
+
+use anim::SampledScene;
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use super::error::StyleError;
+use super::function::FunctionSpec;
+use crate::effects::{attribute_weights, group_weights, StyleInput, Stylize};
+use crate::SmearError;
+
+fn yes() -> bool {
+    true
+}
+
+/// A weight group: the skin weights of some joints.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WeightGroup {
+    /// Joint names (case-sensitive).
+    pub group: Vec<String>,
+    /// Include every joint below the named ones (default true).
+    #[serde(default = "yes")]
+    pub descendants: bool,
+}
+
+/// A scalar vertex attribute painted in the animation package.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WeightAttribute {
+    /// Attribute name, e.g. `_SMEAR_WEIGHT` (the leading `_` may be omitted), or a vertex
+    /// colour channel `COLOR_0.r` / `.g` / `.b` / `.a`.
+    pub attribute: String,
+}
+
+/// Painted weights ω ∈ [0, 1] per vertex, one of:
+///
+/// * `weights = { group = ["Head"], descendants = true }` — a weight group
+///   ([`group_weights`](crate::group_weights));
+/// * `weights = { attribute = "_SMEAR_WEIGHT" }` — a painted vertex attribute
+///   ([`attribute_weights`](crate::attribute_weights));
+/// * `weights = { expr = "...", params = { ... } }` (or `stages`) — a function of the rest
+///   position `x, y, z` (other inputs 0), clamped to [0, 1].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum WeightSource {
+    /// A weight group.
+    Group(WeightGroup),
+    /// A vertex attribute.
+    Attribute(WeightAttribute),
+    /// A function of the rest position.
+    Function(FunctionSpec),
+}
+
+impl From<FunctionSpec> for WeightSource {
+    fn from(f: FunctionSpec) -> Self {
+        WeightSource::Function(f)
+    }
+}
+
+impl WeightSource {
+    /// Checks what can be checked without a scene (functions compile).
+    pub fn validate(&self) -> Result<(), StyleError> {
+        match self {
+            WeightSource::Function(f) => f.compile().map(|_| ()),
+            WeightSource::Group(g) if g.group.is_empty() => Err(StyleError::Parameter {
+                name: "weights.group".into(),
+                problem: "name at least one joint".into(),
+            }),
+            WeightSource::Attribute(a) if a.attribute.trim_start_matches('_').is_empty() => {
+                Err(StyleError::Parameter {
+                    name: "weights.attribute".into(),
+                    problem: "give the attribute's name, e.g. \"_SMEAR_WEIGHT\"".into(),
+                })
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// The weights of every vertex of object `object` of `scene`.
+    ///
+    /// # Errors
+    /// An unknown joint or attribute (naming the available ones), an object index out of
+    /// range, or a function that does not compile.
+    pub fn vertex_weights(
+        &self,
+        scene: &SampledScene,
+        object: usize,
+    ) -> Result<Vec<f32>, SmearError> {
+        let obj = scene.objects.get(object).ok_or(SmearError::UnknownObject {
+            index: object,
+            count: scene.objects.len(),
+        })?;
+        match self {
+            WeightSource::Group(g) => group_weights(scene, object, &g.group, g.descendants),
+            WeightSource::Attribute(a) => attribute_weights(&obj.animation.mesh, &a.attribute),
+            WeightSource::Function(f) => {
+                let f = f.compile().map_err(|e| SmearError::InvalidParameter {
+                    name: "weights",
+                    reason: e.to_string(),
+                })?;
+                Ok(function_weights(&f, obj.animation.frame(0)))
+            }
+        }
+    }
+}
+
+/// ω = f(rest position), clamped to [0, 1]; non-finite values read 0.
+fn function_weights(f: &dyn Stylize, rest: &[Vec3]) -> Vec<f32> {
+    rest.iter()
+        .map(|&p| {
+            let w = f.eval(&StyleInput {
+                rest: p,
+                weight: 1.0,
+                ..Default::default()
+            });
+            if w.is_finite() {
+                w.clamp(0.0, 1.0)
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
