@@ -252,20 +252,34 @@ fn keyframed_effect_options_from_the_command_line() {
         .collect();
     assert_eq!(per[0], 0);
     assert!(per[5] <= 30 && per[20] > per[5], "{per:?}");
-    let mut a = vec![
-        "smear",
-        "multiples",
-        s(&robot),
-        "-o",
-        s(&glb),
-        "--spacing",
-        "0:0.25,20:1",
-    ];
-    a.extend(base);
-    let v = json(&a);
+    let multiples = |options: &[&str]| {
+        let mut a = vec![
+            "smear",
+            "multiples",
+            s(&robot),
+            "-o",
+            s(&glb),
+            "--clip",
+            "Punch",
+        ];
+        a.extend_from_slice(options);
+        json(&a)
+    };
+    let v = multiples(&["--spacing", "0:0.25,20:1"]);
     assert_eq!(
         (v["spacing"].as_f64(), v["spacing_keyframed"].as_bool()),
         (Some(0.25), Some(true))
+    );
+    // Past copies fading in: m_p keyed 0 → 2 over the first 10 frames; copy −2 shows on
+    // fewer frames than copy −1.
+    let v = multiples(&["--past", "0:0,10:2", "--future", "0", "--overlap", "1"]);
+    let copies = v["copies"].as_array().unwrap();
+    let seen = |k: usize| copies[k]["visible_fraction"].as_f64().unwrap();
+    assert_eq!(copies.len(), 2);
+    assert!(seen(0) > 0.0 && seen(0) < seen(1), "{copies:?}");
+    assert_bad_input(
+        &["smear", "lines", s(&robot), "-o", s(&glb), "--color", "1,0"],
+        "R,G,B",
     );
     assert_bad_input(
         &[

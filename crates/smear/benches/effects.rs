@@ -41,9 +41,9 @@ fn bench(c: &mut Criterion) {
     });
 
     let mopts = MultiplesOptions {
-        past: 2,
-        future: 1,
-        spacing: Spacing::Overlap(1),
+        past: 2.0.into(),
+        future: 1.0.into(),
+        spacing: Spacing::Overlap(1.0.into()),
         step: 1,
     };
     let n = 3 * anim.vertex_count();

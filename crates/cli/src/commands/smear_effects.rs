@@ -75,18 +75,19 @@ pub struct MultiplesArgs {
     pub io: EffectIo,
     #[command(flatten)]
     pub offsets: EffectArgs,
-    /// Copies in the past, m_p.
-    #[arg(long, default_value_t = 1)]
-    pub past: usize,
-    /// Copies in the future, m_n.
-    #[arg(long, default_value_t = 1)]
-    pub future: usize,
+    /// Copies in the past, m_p; keyframes (FRAME:VALUE,...) fade copies in and out.
+    #[arg(long, default_value = "1")]
+    pub past: Param,
+    /// Copies in the future, m_n; keyframeable.
+    #[arg(long, default_value = "1")]
+    pub future: Param,
     /// Temporal spacing Δf between copies, in frames; keyframes as FRAME:VALUE,...
     #[arg(long, conflicts_with = "overlap")]
     pub spacing: Option<Param>,
-    /// Copies overlapping between consecutive frames, N∩: Δf = 1/(m_p + m_n + 1 − N∩).
+    /// Copies overlapping between consecutive frames, N∩: Δf = 1/(m_p + m_n + 1 − N∩);
+    /// keyframeable.
     #[arg(long)]
-    pub overlap: Option<usize>,
+    pub overlap: Option<Param>,
     /// m_max of Eq. 12 (default: max(m_p, m_n); keyframeable).
     #[arg(long)]
     pub m_max: Option<Param>,
@@ -131,6 +132,9 @@ pub struct LinesArgs {
     /// Seeds slower than this (units per frame) draw no line; keyframeable.
     #[arg(long, default_value = "0")]
     pub min_speed: Param,
+    /// Line colour, linear R,G,B in [0, 1] (default near-black).
+    #[arg(long, value_delimiter = ',')]
+    pub color: Vec<f32>,
     /// Only trace the past (τ clamped to ≤ 0).
     #[arg(long)]
     pub past_only: bool,
@@ -214,25 +218,23 @@ pub fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
 pub fn multiples(ctx: &Context, args: MultiplesArgs) -> Result<()> {
     let start = Instant::now();
     require_glb(&args.io.output, "multiples")?;
-    if args.past + args.future == 0 {
-        bail!("--past and --future are both 0: there is no copy to draw");
-    }
-    let spacing = match (args.spacing.clone(), args.overlap) {
+    let spacing = match (args.spacing.clone(), args.overlap.clone()) {
         (_, Some(n)) => Spacing::Overlap(n),
         (Some(df), None) => Spacing::Frames(df),
         (None, None) => Spacing::Frames(smear::DEFAULT_SPACING.into()),
     };
     let options = MultiplesOptions {
-        past: args.past,
-        future: args.future,
+        past: args.past.clone(),
+        future: args.future.clone(),
         spacing,
         step: args.offsets.step,
     };
+    if options.indices().is_empty() {
+        bail!("--past and --future are both 0: there is no copy to draw");
+    }
     let df = options.spacing_at(0.0)?;
-    let m_max = args
-        .m_max
-        .clone()
-        .unwrap_or(Param::Constant(args.past.max(args.future) as f32));
+    let largest = args.past.max_value().max(args.future.max_value()).round();
+    let m_max = args.m_max.clone().unwrap_or(Param::Constant(largest));
     let spec = match &args.opacity_expr {
         Some(e) => FunctionSpec::expr(e, &[("m_max", m_max.clone())]),
         None => args
@@ -402,9 +404,16 @@ pub fn lines(ctx: &Context, args: LinesArgs) -> Result<()> {
         gap: args.gap.clone(),
         min_speed: args.min_speed.clone(),
         count: args.count.is_keyframed().then(|| args.count.clone()),
+        color: match args.color.as_slice() {
+            [] => LineOptions::default().color,
+            &[r, g, b] => [r, g, b].map(Param::Constant),
+            c => bail!(
+                "--color takes R,G,B (3 numbers in [0, 1]), got {} numbers",
+                c.len()
+            ),
+        },
         past_only: args.past_only,
         step: args.offsets.step,
-        ..Default::default()
     };
     let frames = smear::motion_lines(&seeds, &style, &line_options)?;
     let effect_seconds = t.elapsed().as_secs_f64();

@@ -56,7 +56,7 @@ pub struct LineOptions {
     /// Frame step: 2 = "on twos" (τ scaled by 2, drawings held; Section 5.2).
     pub step: usize,
     /// RGB colour of the lines (alpha comes from [`LineStyle::opacity`]).
-    pub color: [f32; 3],
+    pub color: [Param; 3],
 }
 
 impl Default for LineOptions {
@@ -69,7 +69,7 @@ impl Default for LineOptions {
             count: None,
             past_only: false,
             step: DEFAULT_FRAME_STEP,
-            color: [0.05, 0.05, 0.05],
+            color: [0.05, 0.05, 0.05].map(Param::Constant),
         }
     }
 }
@@ -118,6 +118,11 @@ fn check(options: &LineOptions) -> Result<usize> {
     if options.min_speed.validate_finite("min_speed").is_err() {
         return bad("minimum speed", "must be a finite number (units per frame)");
     }
+    for (c, name) in options.color.iter().zip(["red", "green", "blue"]) {
+        if c.validate(name, (0.0, false), (1.0, false)).is_err() {
+            return bad("line colour", "RGB components must be numbers in [0, 1]");
+        }
+    }
     if let Some(c) = &options.count {
         if c.validate("count", (0.0, false), (1e9, false)).is_err() {
             return bad("line count", "must be a number of lines ≥ 0");
@@ -162,7 +167,10 @@ fn trace(
     out.lines = 0;
     let tr = seeds.trajectories();
     let scale = options.step as f32;
-    let [r, g, b] = options.color;
+    let [r, g, b] = options
+        .color
+        .each_ref()
+        .map(|c| c.at(h as f32).clamp(0.0, 1.0));
     let (gap, min_speed) = (options.gap.at(h as f32), options.min_speed.at(h as f32));
     let drawn = options
         .count

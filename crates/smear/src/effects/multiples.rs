@@ -12,6 +12,9 @@ use crate::{smoothstep, Param, Result, SmearError};
 /// Default temporal spacing Δf between copies (Section 4.2's example: half a frame).
 pub const DEFAULT_SPACING: f32 = 0.5;
 
+/// Most copies on either side (a guard against a typo asking for millions of meshes).
+pub const MAX_MULTIPLES: usize = 64;
+
 /// How far apart the copies are in time.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Spacing {
@@ -19,17 +22,20 @@ pub enum Spacing {
     /// keyframed (Section 5.1), e.g. to spread the copies during the fastest frames.
     Frames(Param),
     /// Derived from the wanted number N∩ of copies overlapping between consecutive frames
-    /// (Section 5.2): Δf(N∩) = 1 / (m_p + m_n + 1 − N∩), N∩ ∈ [1, m_p + m_n].
-    Overlap(usize),
+    /// (Section 5.2): Δf(N∩) = 1 / (m_p + m_n + 1 − N∩), N∩ ∈ [1, m_p + m_n]; keyframeable
+    /// (rounded per frame).
+    Overlap(Param),
 }
 
-/// Options of [`multiples`] / [`multiples_frame`].
+/// Options of [`multiples`] / [`multiples_frame`]. The copy counts, the spacing and the
+/// overlap may be keyframed (Section 5.1).
 #[derive(Debug, Clone, PartialEq)]
 pub struct MultiplesOptions {
-    /// Copies in the past, m_p (indices −m_p..−1).
-    pub past: usize,
-    /// Copies in the future, m_n (indices 1..m_n).
-    pub future: usize,
+    /// Copies in the past, m_p (indices −m_p..−1). Keyframed, the output holds the largest
+    /// count of copies and those beyond `round(m_p(f))` are transparent at frame f.
+    pub past: Param,
+    /// Copies in the future, m_n (indices 1..m_n); keyframeable like `past`.
+    pub future: Param,
     /// Temporal spacing Δf.
     pub spacing: Spacing,
     /// Frame step: 2 = "on twos" (β_m scaled by 2, drawings held; Section 5.2).
@@ -39,38 +45,97 @@ pub struct MultiplesOptions {
 impl Default for MultiplesOptions {
     fn default() -> Self {
         MultiplesOptions {
-            past: 1,
-            future: 1,
+            past: Param::Constant(1.0),
+            future: Param::Constant(1.0),
             spacing: Spacing::Frames(Param::Constant(DEFAULT_SPACING)),
             step: DEFAULT_FRAME_STEP,
         }
     }
 }
 
+/// A keyframed count at `frame`, rounded (negative and NaN read 0).
+fn count_at(p: &Param, frame: f32) -> usize {
+    let v = p.at(frame).round();
+    if v >= 1.0 {
+        (v as usize).min(MAX_MULTIPLES)
+    } else {
+        0
+    }
+}
+
 impl MultiplesOptions {
     /// The multiple indices m ∈ [−m_p, m_n], m ≠ 0 (the current frame is the mesh itself), in
-    /// increasing order.
+    /// increasing order, for the largest keyed counts: one copy per index in the output.
     pub fn indices(&self) -> Vec<i32> {
-        let (p, n) = (self.past as i32, self.future as i32);
+        let largest = |p: &Param| count_at(&Param::Constant(p.max_value()), 0.0) as i32;
+        let (p, n) = (largest(&self.past), largest(&self.future));
         (-p..=n).filter(|&m| m != 0).collect()
     }
 
-    /// Δf in frames at `frame` (a keyframed spacing interpolates).
+    /// (m_p, m_n) at `frame`.
+    pub fn counts_at(&self, frame: f32) -> (usize, usize) {
+        (count_at(&self.past, frame), count_at(&self.future, frame))
+    }
+
+    /// Checks the counts and the spacing at every key.
     ///
     /// # Errors
-    /// [`SmearError::InvalidParameter`] for a non-finite Δf or a bad keyframe curve, or N∩
-    /// outside [1, m_p + m_n].
-    pub fn spacing_at(&self, frame: f32) -> Result<f32> {
+    /// [`SmearError::InvalidParameter`] for counts outside [0, [`MAX_MULTIPLES`]], no copy at
+    /// all, a non-finite Δf or a bad keyframe curve.
+    pub fn check(&self) -> Result<()> {
+        let bad = |name: &'static str, e: crate::StyleError| SmearError::InvalidParameter {
+            name,
+            reason: e.to_string(),
+        };
+        let range = ((0.0, false), (MAX_MULTIPLES as f32, false));
+        self.past
+            .validate("past", range.0, range.1)
+            .map_err(|e| bad("past", e))?;
+        self.future
+            .validate("future", range.0, range.1)
+            .map_err(|e| bad("future", e))?;
+        if self.indices().is_empty() {
+            return Err(SmearError::InvalidParameter {
+                name: "past/future",
+                reason: "m_p and m_n are both 0: there is no copy to draw".into(),
+            });
+        }
         match &self.spacing {
             Spacing::Frames(df) => {
                 df.validate_finite("spacing")
                     .map_err(|e| SmearError::InvalidParameter {
                         name: "spacing",
                         reason: format!("Δf must be a finite number of frames ({e})"),
-                    })?;
-                Ok(df.at(frame))
+                    })
             }
-            Spacing::Overlap(n) => overlap_spacing(self.past, self.future, *n),
+            Spacing::Overlap(n) => n
+                .validate("overlap", (1.0, false), (2.0 * MAX_MULTIPLES as f32, false))
+                .map_err(|e| bad("overlap", e)),
+        }
+    }
+
+    /// Δf in frames at `frame` (keyframes interpolate; 0 when no copy shows at that frame).
+    ///
+    /// # Errors
+    /// As [`MultiplesOptions::check`], or N∩ outside [1, m_p + m_n] at that frame.
+    pub fn spacing_at(&self, frame: f32) -> Result<f32> {
+        self.check()?;
+        match &self.spacing {
+            Spacing::Frames(df) => Ok(df.at(frame)),
+            Spacing::Overlap(n) => {
+                let (p, f) = self.counts_at(frame);
+                if p + f == 0 {
+                    return Ok(0.0);
+                }
+                let n = n.at(frame).round().max(0.0) as usize;
+                overlap_spacing(p, f, n).map_err(|e| match e {
+                    SmearError::InvalidParameter { name, reason } => SmearError::InvalidParameter {
+                        name,
+                        reason: format!("{reason} at frame {frame}"),
+                    },
+                    e => e,
+                })
+            }
         }
     }
 }
@@ -148,11 +213,23 @@ fn fill(
     h: usize,
     m: i32,
     beta: f32,
+    (past, future): (usize, usize),
     pos: &mut [Vec3],
     alpha: &mut [f32],
 ) {
     let tr = inputs.trajectories();
+    // A copy beyond this frame's (keyframed) counts stays in place, transparent.
+    let shown = if m < 0 {
+        m.unsigned_abs() as usize <= past
+    } else {
+        m as usize <= future
+    };
     for (i, (p, a)) in pos.iter_mut().zip(alpha.iter_mut()).enumerate() {
+        if !shown {
+            *a = 0.0;
+            *p = inputs.positions()[h * inputs.point_count() + i];
+            continue;
+        }
         let mut x = inputs.style_input(h, i);
         x.m = m as f32;
         *a = clamp_alpha(style.eval(&x));
@@ -171,7 +248,7 @@ fn fill(
 /// [`SmearError::InvalidParameter`] for a bad spacing, step, frame or buffer length.
 ///
 /// # Performance
-/// Allocation-free; parallel over copies.
+/// Allocates only the list of indices; parallel over copies.
 pub fn multiples_frame(
     inputs: &EffectInputs<'_>,
     style: &dyn Stylize,
@@ -184,6 +261,7 @@ pub fn multiples_frame(
     check_frame(frame, inputs.frame_count())?;
     let h = held_frame(frame, step);
     let df = options.spacing_at(h as f32)?;
+    let counts = options.counts_at(h as f32);
     let n = inputs.point_count();
     let ms = options.indices();
     let want = ms.len() * n;
@@ -205,7 +283,10 @@ pub fn multiples_frame(
         .par_chunks_mut(n)
         .zip(alpha.par_chunks_mut(n))
         .zip(ms.par_iter())
-        .for_each(|((p, a), &m)| fill(inputs, style, h, m, step as f32 * m as f32 * df, p, a));
+        .for_each(|((p, a), &m)| {
+            let beta = step as f32 * m as f32 * df;
+            fill(inputs, style, h, m, beta, counts, p, a)
+        });
     Ok(())
 }
 
@@ -226,10 +307,13 @@ pub fn multiples(
 ) -> Result<Vec<MultipleCopy>> {
     let step = check_step(options.step)?;
     let (frames, n) = inputs.check_animation(anim)?;
-    // Δf of every held drawing, checked once.
+    // Δf and copy counts of every held drawing, checked once.
     let spacing = (0..frames)
         .map(|f| options.spacing_at(held_frame(f, step) as f32))
         .collect::<Result<Vec<f32>>>()?;
+    let counts: Vec<(usize, usize)> = (0..frames)
+        .map(|f| options.counts_at(held_frame(f, step) as f32))
+        .collect();
     let df0 = options.spacing_at(0.0)?;
     options
         .indices()
@@ -249,6 +333,7 @@ pub fn multiples(
                             held_frame(f, step),
                             m,
                             step as f32 * m as f32 * spacing[f],
+                            counts[f],
                             p,
                             a,
                         )
@@ -285,8 +370,8 @@ mod tests {
         assert!(overlap_spacing(1, 1, 3).is_err());
         assert!(overlap_spacing(0, 0, 1).is_err());
         let o = MultiplesOptions {
-            past: 2,
-            future: 1,
+            past: 2.0.into(),
+            future: 1.0.into(),
             ..Default::default()
         };
         assert_eq!(o.indices(), [-2, -1, 1]);
@@ -315,9 +400,9 @@ mod tests {
         let delta = mesh_offsets(&anim, &OffsetOptions::default()).unwrap();
         let inputs = EffectInputs::new(&anim, &delta).unwrap();
         let opts = MultiplesOptions {
-            past: 1,
-            future: 1,
-            spacing: Spacing::Overlap(2),
+            past: 1.0.into(),
+            future: 1.0.into(),
+            spacing: Spacing::Overlap(2.0.into()),
             step: 1,
         };
         let copies = multiples(&anim, &inputs, &eq12_opacity(1.0), &opts).unwrap();
@@ -357,5 +442,50 @@ mod tests {
         multiples_frame(&inputs, &eq12_opacity(1.0), f, &opts, &mut p, &mut a).unwrap();
         assert_eq!(&p[n..], copies[1].animation.frame(f));
         assert_eq!(&a[..n], &copies[0].alpha[f * n..(f + 1) * n]);
+    }
+
+    #[test]
+    fn keyframed_copy_counts_fade_copies_in_and_overlap_follows() {
+        // Section 5.1: m_p keyed 0 → 2 over frames 0..4, N∩ = 1: the output holds two past
+        // copies; at frame 0 both are transparent, at frame 2 one shows (Δf = 1/(1+1−1) = 1),
+        // from frame 4 both (Δf = 1/(2+1−1) = 1/2).
+        let anim = translating_ball(7, 1.0);
+        let delta = mesh_offsets(&anim, &OffsetOptions::default()).unwrap();
+        let inputs = EffectInputs::new(&anim, &delta).unwrap();
+        let opts = MultiplesOptions {
+            past: Param::Curve(vec![[0.0, 0.0], [4.0, 2.0]]),
+            future: 0.0.into(),
+            spacing: Spacing::Overlap(1.0.into()),
+            step: 1,
+        };
+        assert_eq!(opts.indices(), [-2, -1]);
+        assert_eq!(opts.spacing_at(0.0).unwrap(), 0.0);
+        assert_eq!(opts.spacing_at(2.0).unwrap(), 1.0);
+        assert_eq!(opts.spacing_at(5.0).unwrap(), 0.5);
+        let copies = multiples(&anim, &inputs, &eq12_opacity(2.0), &opts).unwrap();
+        let n = anim.vertex_count();
+        let shown =
+            |c: &MultipleCopy, f: usize| c.alpha[f * n..(f + 1) * n].iter().any(|a| *a > 0.0);
+        let (far, near) = (&copies[0], &copies[1]);
+        assert!(!shown(far, 0) && !shown(near, 0));
+        assert!(!shown(far, 2) && shown(near, 2));
+        assert!(shown(far, 5) && shown(near, 5));
+        // The near copy sits Δf = 1 frame back at frame 2, 1/2 at frame 5 (1 unit per frame).
+        let back = |f: usize| anim.frame(f)[0].x - near.animation.frame(f)[0].x;
+        assert!((back(2) - 1.0).abs() < 1e-4 && (back(5) - 0.5).abs() < 1e-4);
+        let none = MultiplesOptions {
+            past: 0.0.into(),
+            future: 0.0.into(),
+            ..Default::default()
+        };
+        assert!(none.check().is_err());
+        let too_many = MultiplesOptions {
+            past: 1.0.into(),
+            future: 1.0.into(),
+            spacing: Spacing::Overlap(3.0.into()),
+            step: 1,
+        };
+        let e = too_many.spacing_at(1.0).unwrap_err().to_string();
+        assert!(e.contains("N∩") && e.contains("frame 1"), "{e}");
     }
 }

@@ -57,16 +57,17 @@ impl Default for ElongateStyle {
 pub struct MultiplesStyle {
     /// false turns the effect off.
     pub enabled: bool,
-    /// Copies in the past, m_p.
-    pub past: usize,
-    /// Copies in the future, m_n.
-    pub future: usize,
+    /// Copies in the past, m_p; keyframeable (copies beyond the count are transparent).
+    pub past: Param,
+    /// Copies in the future, m_n; keyframeable.
+    pub future: Param,
     /// Δf in frames (exclusive with `overlap`; default 0.5); keyframeable.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub spacing: Option<Param>,
-    /// N∩: copies overlapping between consecutive frames, Δf = 1/(m_p + m_n + 1 − N∩).
+    /// N∩: copies overlapping between consecutive frames, Δf = 1/(m_p + m_n + 1 − N∩);
+    /// keyframeable.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub overlap: Option<usize>,
+    pub overlap: Option<Param>,
     /// Frame step: 2 = "on twos".
     pub step: usize,
     /// S_M of Eq. 11: opacity per vertex and copy (default Eq. 12 with m_max = max(m_p, m_n)).
@@ -78,8 +79,8 @@ impl Default for MultiplesStyle {
     fn default() -> Self {
         MultiplesStyle {
             enabled: yes(),
-            past: 1,
-            future: 1,
+            past: Param::Constant(1.0),
+            future: Param::Constant(1.0),
             spacing: None,
             overlap: None,
             step: one(),
@@ -93,7 +94,7 @@ impl MultiplesStyle {
     ///
     /// Returns [`StyleError::Parameter`] when both `spacing` and `overlap` are given.
     pub fn options(&self) -> Result<MultiplesOptions, StyleError> {
-        let spacing = match (self.spacing.clone(), self.overlap) {
+        let spacing = match (self.spacing.clone(), self.overlap.clone()) {
             (Some(_), Some(_)) => {
                 return Err(StyleError::Parameter {
                     name: "multiples.spacing".into(),
@@ -105,23 +106,35 @@ impl MultiplesStyle {
             (None, None) => Spacing::Frames(DEFAULT_SPACING.into()),
         };
         let options = MultiplesOptions {
-            past: self.past,
-            future: self.future,
+            past: self.past.clone(),
+            future: self.future.clone(),
             spacing,
             step: self.step,
         };
-        options.spacing_at(0.0).map_err(|e| StyleError::Parameter {
-            name: "multiples".into(),
-            problem: e.to_string(),
-        })?;
+        // Check the spacing at frame 0 and at every key of the counts and the overlap.
+        let keys = |p: &Option<&Param>| match p {
+            Some(Param::Curve(k)) => k.iter().map(|k| k[0]).collect(),
+            _ => Vec::new(),
+        };
+        let frames = std::iter::once(0.0)
+            .chain(keys(&Some(&self.past)))
+            .chain(keys(&Some(&self.future)))
+            .chain(keys(&self.overlap.as_ref()));
+        for f in frames {
+            options.spacing_at(f).map_err(|e| StyleError::Parameter {
+                name: "multiples".into(),
+                problem: e.to_string(),
+            })?;
+        }
         Ok(options)
     }
 
     /// The opacity function (Eq. 12 with m_max = max(m_p, m_n, 1) when none is given).
     pub fn opacity_spec(&self) -> FunctionSpec {
-        self.opacity
-            .clone()
-            .unwrap_or_else(|| FunctionSpec::multiples(self.past.max(self.future).max(1) as f32))
+        self.opacity.clone().unwrap_or_else(|| {
+            let largest = self.past.max_value().max(self.future.max_value()).round();
+            FunctionSpec::multiples(largest.max(1.0))
+        })
     }
 }
 
@@ -148,8 +161,9 @@ pub struct LinesStyle {
     pub samples: usize,
     /// Frame step: 2 = "on twos".
     pub step: usize,
-    /// RGB colour.
-    pub color: [f32; 3],
+    /// Linear RGB colour in [0, 1]; each component keyframeable, e.g.
+    /// `color = [[[0, 0.0], [12, 1.0]], 0.1, 0.1]` turns the lines red.
+    pub color: [Param; 3],
     /// S_L of Eq. 13: signed length τ in frames (default S_L(δ; 1) = δ).
     pub length: FunctionSpec,
     /// Tube radius in scene units along the line (default [`DEFAULT_LINE_THICKNESS`] × the
@@ -191,7 +205,7 @@ impl LinesStyle {
             count: self.count.is_keyframed().then(|| self.count.clone()),
             past_only: self.past_only,
             step: self.step,
-            color: self.color,
+            color: self.color.clone(),
         }
     }
 
@@ -346,6 +360,10 @@ impl Style {
                     .validate("lines.gap", (0.0, false), (f32::MAX, false))
                     .map_err(at)?;
                 l.min_speed.validate_finite("lines.min_speed").map_err(at)?;
+                for c in &l.color {
+                    c.validate("lines.color", (0.0, false), (1.0, false))
+                        .map_err(at)?;
+                }
                 l.count
                     .validate("lines.count", (0.0, false), (1e7, false))
                     .map_err(at)?;

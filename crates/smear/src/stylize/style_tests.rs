@@ -136,8 +136,10 @@ fn fig15b_weight_sources_and_keyframed_effect_options_parse() {
         r#"
 weights = { group = ["Head", "ShoulderL"] }
 [multiples]
+past = [[0, 0], [8, 3]]
 spacing = [[0, 0.25], [20, 1.0]]
 [lines]
+color = [[[0, 0.0], [10, 1.0]], 0.1, 0.1]
 count = [[0, 5], [10, 30]]
 gap = [[0, 0], [10, 2]]
 min_speed = 0.01
@@ -176,6 +178,9 @@ weights = { group = ["Spine"], descendants = false }
     assert_eq!(count.at(5.0), 17.5);
     assert_eq!(lines.options.gap.at(5.0), 1.0);
     assert_eq!(lines.options.min_speed.at(99.0), 0.01);
+    assert_eq!(lines.options.color[0].at(5.0), 0.5);
+    assert_eq!(m.indices(), [-3, -2, -1, 1]);
+    assert_eq!(m.counts_at(4.0), (2, 1));
     // A constant count draws every sampled seed.
     let constant = Style::from_toml_str("[lines]\ncount = 12").unwrap();
     let l = constant.lines.as_ref().unwrap();
@@ -189,6 +194,11 @@ weights = { group = ["Spine"], descendants = false }
         ("[lines]\ngap = [[0, 1], [5, -1]]", "lines.gap"),
         ("[lines]\ncount = -3", "lines.count"),
         ("[multiples]\nspacing = [[4, 1], [2, 1]]", "increase"),
+        (
+            "[multiples]\npast = [[0, 1], [9, 2]]\nfuture = 0\noverlap = [[0, 1], [9, 3]]",
+            "frame 9",
+        ),
+        ("[lines]\ncolor = [1.5, 0, 0]", "lines.color"),
     ] {
         let e = Style::from_toml_str(text).expect_err(text).to_string();
         assert!(
