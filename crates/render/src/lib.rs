@@ -41,6 +41,7 @@ mod colormap;
 mod draw;
 mod encode;
 mod error;
+mod follow;
 mod font;
 mod image;
 mod lines;
@@ -65,6 +66,7 @@ pub use draw::{
 };
 pub use encode::{decode_png, encode_gif, encode_png, DEFAULT_GIF_SAMPLE_FACTOR};
 pub use error::{RenderError, Result};
+pub use follow::{follow_views, DEFAULT_FOLLOW_SMOOTHING};
 pub use font::{draw_text, text_size, GLYPH_HEIGHT, GLYPH_WIDTH};
 pub use image::{Image, ImageDiff, MAX_IMAGE_SIZE};
 pub use lines::DEFAULT_LINE_DEPTH_BIAS;

@@ -22,6 +22,9 @@ pub enum ViewSpec {
     Direction(ViewDirection),
     /// The scene camera of this name (animated cameras follow the frame).
     Camera(String),
+    /// Orthographic from a direction, following the subject at a constant scale
+    /// ([`follow_views`](crate::follow_views)): for characters travelling across the scene.
+    Follow(ViewDirection),
 }
 
 /// Output encoding.
@@ -111,22 +114,32 @@ pub fn preview_scene(scene: &SampledScene, options: &PreviewOptions) -> Result<V
                 }
             },
         )?),
-        ViewSpec::Direction(_) => None,
+        ViewSpec::Direction(_) | ViewSpec::Follow(_) => None,
     };
-    let fitted = match &options.view {
+    let fitted: Vec<View> = match &options.view {
         ViewSpec::Direction(d) => {
             let b = scene
                 .objects
                 .iter()
                 .fold(Aabb::EMPTY, |b, o| b.union(animation_bbox(&o.animation)));
-            Some(View::fit(b, *d, renderer.aspect()))
+            vec![View::fit(b, *d, renderer.aspect())]
         }
-        ViewSpec::Camera(_) => None,
+        ViewSpec::Follow(d) => {
+            let parts: Vec<&anim::MeshAnimation> =
+                scene.objects.iter().map(|o| &o.animation).collect();
+            crate::follow_views(
+                &parts,
+                *d,
+                renderer.aspect(),
+                crate::DEFAULT_FOLLOW_SMOOTHING,
+            )
+        }
+        ViewSpec::Camera(_) => Vec::new(),
     };
-    let view_of = |f: usize| match (camera, fitted) {
-        (Some(c), _) => View::camera(c, f, renderer.aspect()),
-        (None, Some(v)) => v,
-        (None, None) => unreachable!("either a camera or a fitted view"),
+    let view_of = |f: usize| match camera {
+        Some(c) => View::camera(c, f, renderer.aspect()),
+        // One fitted view, or one per frame when following.
+        None => fitted[f.min(fitted.len() - 1)],
     };
     let draw = |f: usize| -> Result<Image> {
         let list = scene_list(scene, f, colors.as_deref(), None);

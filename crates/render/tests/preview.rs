@@ -106,6 +106,47 @@ fn camera_png_follows_the_frame() {
     assert!((centroid_x(&first) + centroid_x(&last) - 80.0).abs() < 2.0);
 }
 
+/// Number of non-background pixels.
+fn coverage(img: &render::Image) -> usize {
+    img.pixels()
+        .iter()
+        .filter(|p| p[..3] != [255, 255, 255])
+        .count()
+}
+
+#[test]
+fn follow_view_keeps_the_travelling_cube_centred_and_large() {
+    // The cube travels 3 units (six of its widths): a whole-motion fit shows it small and
+    // moving; a following view keeps it in the centre at the same, larger size.
+    let s = sampled();
+    let png = |view: ViewSpec, frame: usize| {
+        let o = PreviewOptions {
+            width: 80,
+            height: 80,
+            view,
+            frame,
+            supersample: 1,
+            ..PreviewOptions::default()
+        };
+        decode_png(&preview_scene(&s, &o).unwrap()).unwrap()
+    };
+    let follow = ViewSpec::Follow(ViewDirection::Front);
+    let fitted = ViewSpec::Direction(ViewDirection::Front);
+    let (f0, f6) = (png(follow.clone(), 0), png(follow, 6));
+    let (w0, w6) = (png(fitted.clone(), 0), png(fitted, 6));
+    for img in [&f0, &f6] {
+        assert!((centroid_x(img) - 40.0).abs() < 1.5, "{}", centroid_x(img));
+    }
+    assert!((centroid_x(&w6) - centroid_x(&w0)) > 30.0);
+    assert_eq!(coverage(&f0), coverage(&f6));
+    assert!(
+        coverage(&f0) > 4 * coverage(&w0),
+        "{} vs {}",
+        coverage(&f0),
+        coverage(&w0)
+    );
+}
+
 #[test]
 fn gif_with_onion_and_scalar_field() {
     let s = sampled();

@@ -42,8 +42,9 @@ pub struct RenderArgs {
     /// Surface colouring.
     #[arg(long, value_enum, default_value_t = ColorArg::None)]
     pub color: ColorArg,
-    /// View: front, back, side, top, three-quarter (orthographic, fitted to the motion) or
-    /// camera:NAME (a scene camera).
+    /// View: front, back, side, top, three-quarter (orthographic, fitted to the whole
+    /// motion), follow[:DIRECTION] (same scale, tracking a travelling subject) or camera:NAME
+    /// (a scene camera).
     #[arg(long, default_value = "three-quarter")]
     pub view: String,
     /// Image size, WxH.
@@ -69,14 +70,24 @@ fn parse_view(s: &str) -> Result<ViewSpec> {
     if let Some(name) = s.strip_prefix("camera:") {
         return Ok(ViewSpec::Camera(name.to_string()));
     }
-    Ok(ViewSpec::Direction(match s {
-        "front" => ViewDirection::Front,
-        "back" => ViewDirection::Back,
-        "side" => ViewDirection::Side,
-        "top" => ViewDirection::Top,
-        "three-quarter" | "3/4" => ViewDirection::ThreeQuarter,
-        _ => bail!("--view {s}: expected front, back, side, top, three-quarter or camera:NAME"),
-    }))
+    let direction = |d: &str| {
+        Ok(match d {
+            "front" => ViewDirection::Front,
+            "back" => ViewDirection::Back,
+            "side" => ViewDirection::Side,
+            "top" => ViewDirection::Top,
+            "three-quarter" | "3/4" => ViewDirection::ThreeQuarter,
+            _ => bail!(
+                "--view {s}: expected front, back, side, top, three-quarter, follow[:DIRECTION] \
+                 or camera:NAME"
+            ),
+        })
+    };
+    match s.strip_prefix("follow") {
+        Some("") => Ok(ViewSpec::Follow(ViewDirection::ThreeQuarter)),
+        Some(rest) if rest.starts_with(':') => Ok(ViewSpec::Follow(direction(&rest[1..])?)),
+        _ => Ok(ViewSpec::Direction(direction(s)?)),
+    }
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32)> {
@@ -209,6 +220,16 @@ mod tests {
             ViewSpec::Direction(ViewDirection::Top)
         );
         assert!(parse_view("diagonal").is_err());
+        assert_eq!(
+            parse_view("follow").unwrap(),
+            ViewSpec::Follow(ViewDirection::ThreeQuarter)
+        );
+        assert_eq!(
+            parse_view("follow:side").unwrap(),
+            ViewSpec::Follow(ViewDirection::Side)
+        );
+        assert!(parse_view("follow:up").is_err());
+        assert!(parse_view("followme").is_err());
         assert!(output_format(Path::new("a.jpg")).is_err());
         assert_eq!(
             output_format(Path::new("a.GIF")).unwrap(),
