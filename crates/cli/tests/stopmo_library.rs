@@ -336,6 +336,10 @@ fn run_with_plugs_adds_a_pin_and_a_socket_shell_fig13() {
         "--restarts",
         "1",
         "--plugs",
+        "--plug-radius",
+        "1.2",
+        "--plug-clearance",
+        "0.2",
     ]);
     let plugs = r["library"]["plugs"].as_array().unwrap();
     assert_eq!(plugs.len(), 1, "{plugs:?}");
@@ -361,14 +365,15 @@ fn run_with_plugs_adds_a_pin_and_a_socket_shell_fig13() {
         f("length_mm"),
     );
     assert!(
-        (r_bore - r_pin - 0.15).abs() < 1e-5 && (r_out - 1.95).abs() < 1e-5,
+        (r_pin - 1.2).abs() < 1e-5 && (r_bore - r_pin - 0.2).abs() < 1e-5,
         "{p}"
     );
+    assert!((r_out - (1.2 + 0.2 + 0.8)).abs() < 1e-5, "{p}");
     assert!(
         v3("axis").dot(v3("normal")).abs() < 1e-4,
         "axis leaves the tangent plane: {p}"
     );
-    // 24-gon prisms: boss + pin (male), tube (female), clearance 0.15 mm.
+    // 24-gon prisms: boss + pin (male), tube (female), clearance 0.2 mm.
     let area = |r: f64| 12.0 * r * r * (std::f64::consts::TAU / 24.0).sin();
     let c = r_bore - r_pin;
     let male = area(r_out) * (len / 2.0 - c / 2.0) + area(r_pin) * (len / 2.0 + c / 2.0);

@@ -114,6 +114,18 @@ pub struct LibraryOptionsArgs {
     /// report.json under "plugs".
     #[arg(long)]
     pub plugs: bool,
+    /// Pin radius of the plugs in millimetres.
+    #[arg(long, value_name = "MM", requires = "plugs",
+          default_value_t = stopmo::library::DEFAULT_PLUG_RADIUS_MM)]
+    pub plug_radius: f64,
+    /// Plug length (boss + pin) in millimetres.
+    #[arg(long, value_name = "MM", requires = "plugs",
+          default_value_t = stopmo::library::DEFAULT_PLUG_LENGTH_MM)]
+    pub plug_length: f64,
+    /// Radial clearance between pin and socket in millimetres (tune to the printer).
+    #[arg(long, value_name = "MM", requires = "plugs",
+          default_value_t = stopmo::library::DEFAULT_PLUG_CLEARANCE_MM)]
+    pub plug_clearance: f64,
     /// Also write the JSON report here (it is always written to DIR/report.json).
     #[arg(long)]
     pub report: Option<PathBuf>,
@@ -343,7 +355,14 @@ pub(super) fn build_and_write(
     let lib = build_library(&inputs, &opts).with_context(|| input.display().to_string())?;
     spinner.finish_and_clear();
     let plugs = if args.plugs {
-        plan_part_plugs(&lib, anims, args.thickness)?
+        let opts = PlugOptions {
+            radius_mm: args.plug_radius,
+            length_mm: args.plug_length,
+            clearance_mm: args.plug_clearance,
+            thickness_mm: args.thickness,
+            ..PlugOptions::default()
+        };
+        plan_part_plugs(&lib, anims, &opts)?
     } else {
         Vec::new()
     };
@@ -457,7 +476,11 @@ pub(super) fn build_and_write(
 
 /// One plug per seam between two parts, placed on the average geometry in millimetres (the
 /// STL coordinates).
-fn plan_part_plugs(lib: &Library, anims: &[MeshAnimation], thickness: f64) -> Result<Vec<Plug>> {
+fn plan_part_plugs(
+    lib: &Library,
+    anims: &[MeshAnimation],
+    opts: &PlugOptions,
+) -> Result<Vec<Plug>> {
     let surfaces: Vec<anim::Mesh> = anims
         .iter()
         .map(|a| {
@@ -466,11 +489,7 @@ fn plan_part_plugs(lib: &Library, anims: &[MeshAnimation], thickness: f64) -> Re
             scaled(&m, lib.mm_per_unit as f32)
         })
         .collect();
-    let opts = PlugOptions {
-        thickness_mm: thickness,
-        ..PlugOptions::default()
-    };
-    Ok(plan_plugs(&surfaces, &opts)?)
+    Ok(plan_plugs(&surfaces, opts)?)
 }
 
 /// `DIR/pieces/<id>.obj` (surface, model units) and `<id>.stl` (printable solid, mm, with the
