@@ -22,7 +22,8 @@ pub enum Layout {
 /// Writes a point cache to `path` in the format its extension names. PC2 and MDD caches get
 /// their rest mesh as a same-name `.obj` beside them. Returns every file written.
 ///
-/// `colors`: optional per-frame RGBA vertex colours (frame-major), used by glTF flipbooks.
+/// `colors`: optional per-frame RGBA vertex colours (frame-major), used by glTF flipbooks and
+/// USD (`primvars:displayColor`/`displayOpacity`).
 pub fn write_animation(
     path: &Path,
     anim: &MeshAnimation,
@@ -31,7 +32,7 @@ pub fn write_animation(
 ) -> Result<Vec<PathBuf>> {
     let format = Format::from_extension(path).ok_or_else(|| {
         anyhow::anyhow!(
-            "{}: unknown output extension (use .glb, .pc2, .mdd, .obj, .stl or .npy)",
+            "{}: unknown output extension (use .glb, .usda, .pc2, .mdd, .obj, .stl or .npy)",
             path.display()
         )
     })?;
@@ -86,6 +87,10 @@ pub fn write_animation(
             )?;
         }
         Format::Bvh => bail!("{}: BVH output holds skeletons, not meshes", path.display()),
+        Format::Usda => {
+            let text = tkio::usda::write_animation(anim, colors).map_err(|e| e.at(path))?;
+            put(path, text.as_bytes())?;
+        }
     }
     Ok(written)
 }

@@ -52,7 +52,8 @@ pub fn json(args: &[&str]) -> serde_json::Value {
 }
 
 /// Keeps a copy of every glTF in `dir` for CI's Khronos validation run
-/// (`TOONKIT_VALIDATE_DIR`), under a name prefixed by `tag`.
+/// (`TOONKIT_VALIDATE_DIR`), under a name prefixed by `tag`; CI runs the Khronos validator
+/// on the glTF files and Pixar's USD (`.ci/validate_usd.py`) on the `.usda` files.
 pub fn keep_for_validation(dir: &Path, tag: &str) {
     let Ok(dest) = std::env::var("TOONKIT_VALIDATE_DIR") else {
         return;
@@ -60,7 +61,9 @@ pub fn keep_for_validation(dir: &Path, tag: &str) {
     let dest = PathBuf::from(dest);
     std::fs::create_dir_all(&dest).unwrap();
     for e in walk(dir) {
-        if e.extension().is_some_and(|x| x == "glb" || x == "gltf") {
+        if e.extension()
+            .is_some_and(|x| x == "glb" || x == "gltf" || x == "usda")
+        {
             let name = format!("{tag}_{}", e.file_name().unwrap().to_string_lossy());
             std::fs::copy(&e, dest.join(name)).unwrap();
         }

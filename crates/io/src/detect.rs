@@ -25,6 +25,8 @@ pub enum Format {
     Stl,
     /// NumPy array.
     Npy,
+    /// USD layer (`.usda`): written by toonkit, never read.
+    Usda,
 }
 
 impl Format {
@@ -40,6 +42,7 @@ impl Format {
             "bvh" => Format::Bvh,
             "stl" => Format::Stl,
             "npy" => Format::Npy,
+            "usda" => Format::Usda,
             _ => return None,
         })
     }
@@ -57,6 +60,9 @@ pub fn detect(bytes: &[u8], path: &Path) -> Option<Format> {
     }
     if bytes.starts_with(b"\x93NUMPY") {
         return Some(Format::Npy);
+    }
+    if bytes.starts_with(b"#usda") || bytes.starts_with(b"PXR-USDC") {
+        return Some(Format::Usda);
     }
     if bytes.len() >= 84 {
         let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
@@ -161,6 +167,9 @@ fn load_as(path: &Path, bytes: &[u8], format: Format, options: &LoadOptions) -> 
             }
         }
         Format::Npy => Err(IoError::unsupported("a .npy array is not an animation")),
+        Format::Usda => Err(IoError::unsupported(
+            "USD input is not supported (toonkit only writes .usda; export glTF/GLB instead)",
+        )),
         #[allow(unreachable_patterns)]
         _ => Err(IoError::unsupported(format!(
             "{format:?} support was not compiled in"

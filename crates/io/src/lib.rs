@@ -1,9 +1,9 @@
 //! # toonkit-io
 //!
 //! Reading and writing animation files: glTF 2.0 (`.gltf`/`.glb`), OBJ and OBJ sequences, PC2
-//! and MDD point caches, binary STL, BVH motion capture, and NPY arrays. Formats are detected
-//! by content. Every reader returns [`IoError`] on bad bytes, never panics; every writer
-//! produces bytes, and [`write_atomic`] puts them on disk.
+//! and MDD point caches, binary STL, BVH motion capture, and NPY arrays; USD layers (`.usda`)
+//! are written only. Formats are detected by content. Every reader returns [`IoError`] on bad
+//! bytes, never panics; every writer produces bytes, and [`write_atomic`] puts them on disk.
 //!
 //! This crate does no algorithm work beyond format conversion.
 
@@ -18,6 +18,7 @@ pub mod obj;
 pub mod pc2;
 #[cfg(feature = "stl")]
 pub mod stl;
+pub mod usda;
 
 pub use atomic::{read_file, write_atomic};
 pub use error::{FilePath, IoError, Result};

@@ -18,7 +18,7 @@ use crate::output::{self, Layout};
 pub struct ConvertArgs {
     /// Input animation (glTF/GLB, OBJ or OBJ sequence, PC2/MDD + rest OBJ, BVH).
     pub input: PathBuf,
-    /// Output file; the extension picks the format (.glb, .pc2, .mdd, .obj, .stl, .npy).
+    /// Output file; the extension picks the format (.glb, .usda, .pc2, .mdd, .obj, .stl, .npy).
     pub output: PathBuf,
     #[command(flatten)]
     pub input_args: InputArgs,

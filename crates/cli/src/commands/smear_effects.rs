@@ -3,13 +3,14 @@
 //!
 //! * `elongate IN -o OUT [--preset linear|speed|noise] [--beta-max X] [--kappa K]
 //!   [--expr "..."]`: every frame replaced by its elongated in-between (Eq. 10); `.glb`
-//!   (flipbook or `--layout morph`), `.pc2`/`.mdd` + rest `.obj`, or an `.obj` sequence
-//!   (`--layout sequence`), on the input topology.
-//! * `multiples IN -o OUT.glb --past M --future M [--spacing DF | --overlap N] [--m-max X]
-//!   [--opacity-expr "..."]`: the original plus displaced copies with per-vertex opacity
-//!   (Eqs. 11–12), each an alpha-blended flipbook node.
-//! * `lines IN -o OUT.glb --count K --length-max T [--seed S] [--length-expr "..."]`: the
-//!   original as a flipbook plus one motion-line tube mesh per frame (Eq. 13).
+//!   (flipbook or `--layout morph`), `.usda`, `.pc2`/`.mdd` + rest `.obj`, or an `.obj`
+//!   sequence (`--layout sequence`), on the input topology.
+//! * `multiples IN -o OUT.glb|OUT.usda --past M --future M [--spacing DF | --overlap N]
+//!   [--m-max X] [--opacity-expr "..."]`: the original plus displaced copies with per-vertex
+//!   opacity (Eqs. 11–12), each an alpha-blended flipbook node (a Mesh prim in `.usda`).
+//! * `lines IN -o OUT.glb|OUT.usda --count K --length-max T [--seed S]
+//!   [--length-expr "..."]`: the original as a flipbook plus one motion-line tube mesh per
+//!   frame (Eq. 13); in `.usda`, one Mesh prim whose topology changes per frame.
 //!
 //! Expressions are those of `smear::Expression` (inputs `delta`, `speed`, `weight`, `noise`,
 //! `frame`, `m`, `t`, …) with the command's maximum bound as a parameter (`beta_max`,
@@ -150,11 +151,19 @@ fn compile(spec: FunctionSpec, what: &str) -> Result<StyleFunction> {
     spec.compile().map_err(|e| anyhow::anyhow!("{what}: {e}"))
 }
 
-fn require_glb(path: &Path, what: &str) -> Result<()> {
-    if Format::from_extension(path) != Some(Format::Glb) {
-        bail!("{}: smear {what} writes .glb", path.display());
+fn require_scene_output(path: &Path, what: &str) -> Result<()> {
+    if !matches!(
+        Format::from_extension(path),
+        Some(Format::Glb | Format::Usda)
+    ) {
+        bail!("{}: smear {what} writes .glb or .usda", path.display());
     }
     Ok(())
+}
+
+/// True when `path` names a USD layer (`.usda`).
+fn is_usda(path: &Path) -> bool {
+    Format::from_extension(path) == Some(Format::Usda)
 }
 
 /// Runs `toonkit smear elongate`.
@@ -162,7 +171,7 @@ pub fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
     let start = Instant::now();
     if Format::from_extension(&args.io.output).is_none() {
         bail!(
-            "{}: unknown output extension (use .glb, .pc2, .mdd or .obj)",
+            "{}: unknown output extension (use .glb, .usda, .pc2, .mdd or .obj)",
             args.io.output.display()
         );
     }
@@ -217,7 +226,7 @@ pub fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
 /// Runs `toonkit smear multiples`.
 pub fn multiples(ctx: &Context, args: MultiplesArgs) -> Result<()> {
     let start = Instant::now();
-    require_glb(&args.io.output, "multiples")?;
+    require_scene_output(&args.io.output, "multiples")?;
     let spacing = match (args.spacing.clone(), args.overlap.clone()) {
         (_, Some(n)) => Spacing::Overlap(n),
         (Some(df), None) => Spacing::Frames(df),
@@ -260,8 +269,12 @@ pub fn multiples(ctx: &Context, args: MultiplesArgs) -> Result<()> {
             .zip(&colors)
             .map(|(c, col)| (&c.animation, Some(col.as_slice()))),
     );
-    let bytes = tkio::gltf::write_animations(&parts, tkio::gltf::AnimationLayout::Flipbook)
-        .map_err(|e| e.at(&args.io.output))?;
+    let bytes = if is_usda(&args.io.output) {
+        tkio::usda::write_parts(&parts).map(String::into_bytes)
+    } else {
+        tkio::gltf::write_animations(&parts, tkio::gltf::AnimationLayout::Flipbook)
+    }
+    .map_err(|e| e.at(&args.io.output))?;
     tkio::write_atomic(&args.io.output, &bytes)?;
     spinner.finish_and_clear();
     let copies_json: Vec<_> = copies
@@ -341,7 +354,7 @@ fn lines_scene(body: &MeshAnimation, lines: &[LineFrame]) -> Scene {
 /// Runs `toonkit smear lines`.
 pub fn lines(ctx: &Context, args: LinesArgs) -> Result<()> {
     let start = Instant::now();
-    require_glb(&args.io.output, "lines")?;
+    require_scene_output(&args.io.output, "lines")?;
     if let Some(t) = &args.thickness {
         if t.validate("--thickness", (0.0, true), (f32::MAX, false))
             .is_err()
@@ -418,8 +431,18 @@ pub fn lines(ctx: &Context, args: LinesArgs) -> Result<()> {
     let frames = smear::motion_lines(&seeds, &style, &line_options)?;
     let effect_seconds = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let scene = lines_scene(&p.merged, &frames);
-    let bytes = tkio::gltf::write_glb(&scene).map_err(|e| e.at(&args.io.output))?;
+    let bytes = if is_usda(&args.io.output) {
+        use tkio::usda::{UsdMesh, UsdStage};
+        let lines = UsdMesh::frames("motion_lines", frames.iter().map(|f| &f.mesh).collect());
+        let stage = UsdStage::new(
+            p.merged.fps,
+            vec![UsdMesh::animation(&p.merged, None), lines],
+        );
+        tkio::usda::write(&stage).map(String::into_bytes)
+    } else {
+        tkio::gltf::write_glb(&lines_scene(&p.merged, &frames))
+    }
+    .map_err(|e| e.at(&args.io.output))?;
     tkio::write_atomic(&args.io.output, &bytes)?;
     spinner.finish_and_clear();
     let per_frame: Vec<usize> = frames.iter().map(|f| f.lines).collect();

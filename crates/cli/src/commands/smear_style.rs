@@ -1,4 +1,5 @@
-//! `toonkit smear IN --style STYLE.toml -o OUT.glb [--gif PREVIEW.gif] [--clip NAME] [--fps F]`.
+//! `toonkit smear IN --style STYLE.toml -o OUT.glb|OUT.usda [--gif PREVIEW.gif] [--clip NAME]
+//! [--fps F]`.
 //!
 //! Applies a whole style (Basset et al. 2024, Section 4 effects with the Section 5
 //! stylization functions; format in `examples/smear/`): per object, the elongated
@@ -29,7 +30,7 @@ pub struct StyleArgs {
     /// Style file (TOML, see examples/smear/).
     #[arg(long)]
     pub style: Option<PathBuf>,
-    /// Output `.glb`: every effect of the style as flipbooks.
+    /// Output `.glb` (every effect of the style as flipbooks) or `.usda` (one Mesh per part).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Also render a GIF preview of the result.
@@ -247,6 +248,26 @@ impl Styled {
         scene
     }
 
+    /// All parts as one USD layer (`.usda`): one `Mesh` prim per part, point caches with
+    /// their per-frame colours, motion lines with per-frame topology.
+    ///
+    /// # Errors
+    /// Inconsistent parts (frame counts, colour lengths).
+    pub fn to_usda(&self) -> tkio::Result<String> {
+        use tkio::usda::{UsdMesh, UsdStage};
+        let meshes = self
+            .parts
+            .iter()
+            .map(|part| match part {
+                Part::Animation(a, colors) => UsdMesh::animation(a, colors.as_deref()),
+                Part::Frames(name, meshes) => {
+                    UsdMesh::frames(name.clone(), meshes.iter().collect())
+                }
+            })
+            .collect();
+        tkio::usda::write(&UsdStage::new(self.fps, meshes))
+    }
+
     /// A GIF of the result: every part of every frame, fitted to the whole motion.
     ///
     /// # Errors
@@ -310,11 +331,15 @@ pub fn run(ctx: &Context, args: StyleArgs) -> Result<()> {
         (&args.input, &args.style, &args.output)
     else {
         bail!(
-            "usage: toonkit smear IN --style STYLE.toml -o OUT.glb (or a subcommand, see --help)"
+            "usage: toonkit smear IN --style STYLE.toml -o OUT.glb|OUT.usda (or a subcommand, see --help)"
         );
     };
-    if tkio::Format::from_extension(output) != Some(tkio::Format::Glb) {
-        bail!("{}: a styled smear is written as .glb", output.display());
+    let usda = tkio::Format::from_extension(output) == Some(tkio::Format::Usda);
+    if !usda && tkio::Format::from_extension(output) != Some(tkio::Format::Glb) {
+        bail!(
+            "{}: a styled smear is written as .glb or .usda",
+            output.display()
+        );
     }
     let style = read_style(style_path)?;
     let sampled = input::open(input_path, &args.input_args)?;
@@ -324,7 +349,12 @@ pub fn run(ctx: &Context, args: StyleArgs) -> Result<()> {
     let spinner = crate::progress::spinner("applying the style", ctx.json);
     let styled = apply(&sampled, &style).map_err(|e| anyhow!("{}: {e:#}", input_path.display()))?;
     let t = Instant::now();
-    let bytes = tkio::gltf::write_glb(&styled.to_scene()).map_err(|e| e.at(output))?;
+    let bytes = if usda {
+        styled.to_usda().map(String::into_bytes)
+    } else {
+        tkio::gltf::write_glb(&styled.to_scene())
+    }
+    .map_err(|e| e.at(output))?;
     tkio::write_atomic(output, &bytes)?;
     let write_seconds = t.elapsed().as_secs_f64();
     let mut outputs = vec![output.clone()];

@@ -1,0 +1,181 @@
+#!/usr/bin/env python3
+"""Validates every `*.usda` in DIR with Pixar's USD (`pip install usd-core`).
+
+Usage: python3 .ci/validate_usd.py DIR
+
+Per layer:
+1. `Usd.Stage.Open` must succeed with no composition error and no diagnostic (parse warnings
+   and errors are captured with UsdUtils.CoalescingDiagnosticDelegate).
+2. Pixar's compliance rules: `UsdUtils.ComplianceChecker` when the installed usd-core still
+   has it (≤ 25.x); newer releases (26.x) replaced it by the UsdValidation framework that
+   `usdchecker` runs, so every registered validator runs instead. Errors are failures;
+   warnings are printed. Skipped, because they only concern `.usdz` packages (byte alignment,
+   compression, files inside a package) and never apply to a plain `.usda` layer: the usdz
+   package rules listed in USDZ_ONLY.
+3. Geometry, for every UsdGeom.Mesh at every authored time code (or the default time):
+   max(faceVertexIndices) + 1 <= len(points), sum(faceVertexCounts) == len(faceVertexIndices),
+   every face count >= 3, UsdGeom.Mesh.ValidateTopology, finite points, an extent of two
+   corners that contains every point, and vertex-interpolated primvars with one value per
+   point.
+Tested with usd-core 24.11 (ComplianceChecker) and 26.11 (UsdValidation).
+Prints one line per failure, then "USD validation: N passed, M failed"; exits 1 on any failure
+(and 1 when DIR holds no .usda at all, so a broken test setup cannot pass silently).
+"""
+
+import pathlib
+import sys
+
+from pxr import Usd, UsdGeom, UsdUtils, Sdf
+
+# Validators / compliance rules that only apply to .usdz packages.
+USDZ_ONLY = {
+    "usdUtilsValidators:RootPackageValidator",
+    "usdUtilsValidators:UsdzPackageValidator",
+    "usdUtilsValidators:PackageEncapsulationValidator",
+    "usdUtilsValidators:FileExtensionValidator",
+    "ByteAlignmentChecker",
+    "CompressionChecker",
+}
+
+
+def compliance(path):
+    """Errors of Pixar's compliance rules (list of strings); warnings are printed."""
+    checker_class = getattr(UsdUtils, "ComplianceChecker", None)
+    errors = []
+    if checker_class is not None:
+        checker = checker_class(arkit=False, skipARKitRootLayerCheck=False, rootPackageOnly=False,
+                                skipVariants=False, verbose=False)
+        checker.CheckCompliance(str(path))
+        errors += [e for e in checker.GetErrors()
+                   if not any(r in e for r in USDZ_ONLY)]
+        failed = [f for f in checker.GetFailedChecks() if not any(r in f for r in USDZ_ONLY)]
+        errors += [f"failed check: {f}" for f in failed]
+        for w in checker.GetWarnings():
+            print(f"{path.name}: warning: {w}")
+        return errors
+    from pxr import UsdValidation
+
+    registry = UsdValidation.ValidationRegistry()
+    validators = [v for v in registry.GetOrLoadAllValidators()
+                  if v.GetMetadata().name not in USDZ_ONLY]
+    stage = Usd.Stage.Open(str(path))
+    context = UsdValidation.ValidationContext(validators)
+    for e in context.Validate(stage):
+        if e.HasNoError():
+            continue
+        line = f"{e.GetValidator().GetMetadata().name}: {e.GetMessage()}"
+        if e.GetType() == UsdValidation.ValidationErrorType.Error:
+            errors.append(line)
+        else:
+            print(f"{path.name}: {e.GetType()}: {line}")
+    return errors
+
+
+def time_codes(mesh):
+    """Every authored time code of the mesh's attributes, or [Default] for static data."""
+    times = set()
+    for attr in mesh.GetPrim().GetAttributes():
+        times.update(attr.GetTimeSamples())
+    return sorted(times) if times else [Usd.TimeCode.Default()]
+
+
+def check_mesh(mesh):
+    """Failures (strings) of one mesh over all its time codes."""
+    out = []
+    where = str(mesh.GetPath())
+    primvars = UsdGeom.PrimvarsAPI(mesh).GetPrimvars()
+    for t in time_codes(mesh):
+        tc = Usd.TimeCode(t) if not isinstance(t, Usd.TimeCode) else t
+        at = f"{where} @ {'default' if tc.IsDefault() else t}"
+        points = mesh.GetPointsAttr().Get(tc) or []
+        counts = mesh.GetFaceVertexCountsAttr().Get(tc) or []
+        indices = mesh.GetFaceVertexIndicesAttr().Get(tc) or []
+        if sum(counts) != len(indices):
+            out.append(f"{at}: sum(faceVertexCounts) = {sum(counts)} != "
+                       f"len(faceVertexIndices) = {len(indices)}")
+        if any(c < 3 for c in counts):
+            out.append(f"{at}: a face has fewer than 3 vertices")
+        if len(indices) and max(indices) + 1 > len(points):
+            out.append(f"{at}: max index + 1 = {max(indices) + 1} > {len(points)} points")
+        if len(indices) and min(indices) < 0:
+            out.append(f"{at}: negative face vertex index")
+        ok, why = UsdGeom.Mesh.ValidateTopology(indices, counts, len(points))
+        if not ok:
+            out.append(f"{at}: ValidateTopology: {why}")
+        text = str(points).lower()  # formatted in C++: fast even for large arrays
+        if "nan" in text or "inf" in text:
+            out.append(f"{at}: non-finite point")
+        extent = mesh.GetExtentAttr().Get(tc)
+        if extent is None or len(extent) != 2:
+            out.append(f"{at}: extent missing or not two corners")
+        elif len(points):
+            lo, hi = extent
+            # The points' own bounding box (computed by USD), then containment per axis.
+            plo, phi = UsdGeom.PointBased.ComputeExtent(points)
+            if any(plo[k] < lo[k] or phi[k] > hi[k] for k in range(3)):
+                out.append(f"{at}: points span {tuple(plo)}..{tuple(phi)}, outside extent "
+                           f"{tuple(lo)}..{tuple(hi)}")
+        for pv in primvars:
+            if pv.GetInterpolation() != UsdGeom.Tokens.vertex or not pv.HasValue():
+                continue
+            value = pv.Get(tc)
+            if value is not None and len(value) != len(points):
+                out.append(f"{at}: primvar {pv.GetPrimvarName()} has {len(value)} values for "
+                           f"{len(points)} points")
+    if mesh.GetSubdivisionSchemeAttr().Get() != UsdGeom.Tokens.none:
+        out.append(f"{where}: subdivisionScheme is not \"none\"")
+    return out
+
+
+def validate(path):
+    """Failures (strings) of one layer."""
+    failures = []
+    delegate = UsdUtils.CoalescingDiagnosticDelegate()
+    try:
+        stage = Usd.Stage.Open(str(path))
+    except Exception as e:  # Tf.ErrorException on parse errors
+        why = [d.commentary for d in delegate.TakeUncoalescedDiagnostics()] or [repr(e)]
+        return [f"cannot open: {' | '.join(w.replace(chr(10), ' ') for w in why)}"]
+    diagnostics = delegate.TakeUncoalescedDiagnostics()
+    for d in diagnostics:
+        failures.append(f"diagnostic while opening: {d.commentary}")
+    get_errors = getattr(stage, "GetCompositionErrors", None)
+    if get_errors is not None:
+        failures += [f"composition error: {e}" for e in get_errors()]
+    if not stage.GetDefaultPrim():
+        failures.append("no defaultPrim")
+    if UsdGeom.GetStageUpAxis(stage) != UsdGeom.Tokens.y:
+        failures.append("upAxis is not Y")
+    if stage.GetTimeCodesPerSecond() != stage.GetFramesPerSecond():
+        failures.append("timeCodesPerSecond != framesPerSecond")
+    failures += [f"compliance: {e}" for e in compliance(path)]
+    meshes = [UsdGeom.Mesh(p) for p in stage.Traverse() if p.IsA(UsdGeom.Mesh)]
+    if not meshes:
+        failures.append("no Mesh prim")
+    for mesh in meshes:
+        failures += check_mesh(mesh)
+    return failures
+
+
+def main():
+    if len(sys.argv) != 2:
+        print(__doc__.splitlines()[2])
+        return 2
+    files = sorted(pathlib.Path(sys.argv[1]).rglob("*.usda"))
+    passed = failed = 0
+    for path in files:
+        failures = validate(path)
+        if failures:
+            failed += 1
+            for f in failures:
+                print(f"{path}: {f}")
+        else:
+            passed += 1
+    if not files:
+        print(f"no .usda file in {sys.argv[1]}")
+    print(f"USD validation: {passed} passed, {failed} failed")
+    return 1 if failed or not files else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,259 @@
+//! USD (`.usda`) outputs of `toonkit convert`, `smear elongate|multiples|lines` and
+//! `smear --style` on RobotExpressive, checked against the other formats' numbers. Every
+//! layer is kept in `$TOONKIT_VALIDATE_DIR` for `.ci/validate_usd.py` (Pixar's `pxr`).
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::{data, json, keep_for_validation, read_pc2, s, toonkit};
+
+fn robot() -> PathBuf {
+    data("characters/RobotExpressive.glb")
+}
+
+/// The `.timeSamples` of `decl` inside `text` (file order), as the text of each value; one
+/// entry for a static (default) value.
+fn samples<'a>(text: &'a str, decl: &str) -> Vec<&'a str> {
+    let head = format!("{decl}.timeSamples = {{\n");
+    if let Some(start) = text.find(&head) {
+        let body = &text[start + head.len()..];
+        let end = body.find("\n        }").unwrap();
+        return body[..end]
+            .lines()
+            .map(|l| l.split_once(": ").unwrap().1.trim_end_matches(','))
+            .collect();
+    }
+    let head = format!("{decl} = ");
+    let start = text.find(&head).unwrap_or_else(|| panic!("no {decl}")) + head.len();
+    vec![text[start..].lines().next().unwrap()]
+}
+
+/// Parses `[(x, y, z), ...]`.
+fn vec3s(v: &str) -> Vec<[f32; 3]> {
+    let inner = v.trim().trim_start_matches('[').trim_end_matches(']');
+    if inner.is_empty() {
+        return Vec::new();
+    }
+    inner
+        .trim_start_matches('(')
+        .trim_end_matches(')')
+        .split("), (")
+        .map(|t| {
+            let c: Vec<f32> = t.split(", ").map(|x| x.parse().unwrap()).collect();
+            [c[0], c[1], c[2]]
+        })
+        .collect()
+}
+
+/// The text of the `def Mesh "name"` prim (up to the next prim).
+fn prim<'a>(text: &'a str, name: &str) -> &'a str {
+    let start = text
+        .find(&format!("def Mesh \"{name}\""))
+        .unwrap_or_else(|| panic!("no Mesh {name}"));
+    let rest = &text[start + 1..];
+    &text[start..start + 1 + rest.find("def Mesh").unwrap_or(rest.len())]
+}
+
+fn mesh_names(text: &str) -> Vec<&str> {
+    text.lines()
+        .filter_map(|l| l.trim().strip_prefix("def Mesh \""))
+        .map(|l| l.trim_end_matches('"'))
+        .collect()
+}
+
+/// Largest coordinate difference between a `.usda` point cache and a `.pc2` one.
+fn max_difference(usda: &str, pc2: &anim::MeshAnimation) -> f32 {
+    let frames = samples(usda, "point3f[] points");
+    assert_eq!(frames.len(), pc2.frame_count());
+    let mut max = 0.0f32;
+    for (f, v) in frames.iter().enumerate() {
+        let pts = vec3s(v);
+        assert_eq!(pts.len(), pc2.vertex_count());
+        for (a, b) in pts.iter().zip(pc2.frame(f)) {
+            for k in 0..3 {
+                max = max.max((a[k] - b[k]).abs());
+            }
+        }
+    }
+    max
+}
+
+#[test]
+fn convert_robot_punch_to_usda_matches_the_pc2_cache_exactly() {
+    let dir = tempfile::tempdir().unwrap();
+    let usda = dir.path().join("punch.usda");
+    let pc2 = dir.path().join("punch.pc2");
+    let v = json(&["convert", s(&robot()), s(&usda), "--clip", "Punch"]);
+    json(&["convert", s(&robot()), s(&pc2), "--clip", "Punch"]);
+    let frames = v["frames"].as_u64().unwrap() as usize;
+    assert_eq!(v["outputs"][0].as_str().unwrap(), s(&usda));
+    let text = std::fs::read_to_string(&usda).unwrap();
+    assert!(text.starts_with("#usda 1.0\n"));
+    assert!(text.contains(&format!("    endTimeCode = {frames}\n")));
+    assert_eq!(mesh_names(&text), ["RobotExpressive"]);
+    // The same numbers as the PC2 cache, bit for bit.
+    assert_eq!(max_difference(&text, &read_pc2(&pc2)), 0.0);
+    keep_for_validation(dir.path(), "usd_convert");
+}
+
+#[test]
+fn smear_elongate_robot_punch_usda_matches_pc2() {
+    let dir = tempfile::tempdir().unwrap();
+    let usda = dir.path().join("e.usda");
+    let pc2 = dir.path().join("e.pc2");
+    let robot = robot();
+    let run = |out: &Path| {
+        json(&[
+            "smear",
+            "elongate",
+            s(&robot),
+            "--clip",
+            "Punch",
+            "-o",
+            s(out),
+        ])
+    };
+    let v = run(&usda);
+    run(&pc2);
+    let text = std::fs::read_to_string(&usda).unwrap();
+    let smeared = read_pc2(&pc2);
+    assert_eq!(
+        v["frames"].as_u64().unwrap() as usize,
+        smeared.frame_count()
+    );
+    assert_eq!(max_difference(&text, &smeared), 0.0);
+    assert!(v["max_displacement"].as_f64().unwrap() > 0.0);
+    keep_for_validation(dir.path(), "usd_elongate");
+}
+
+#[test]
+fn smear_multiples_usda_has_one_mesh_per_copy_with_opacity() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("m.usda");
+    let v = json(&[
+        "smear",
+        "multiples",
+        s(&robot()),
+        "-o",
+        s(&out),
+        "--clip",
+        "Punch",
+        "--fps",
+        "12",
+        "--past",
+        "2",
+        "--future",
+        "1",
+    ]);
+    let text = std::fs::read_to_string(&out).unwrap();
+    let copies = v["copies"].as_array().unwrap().len();
+    assert_eq!(copies, 3);
+    let names = mesh_names(&text);
+    assert_eq!(names.len(), 1 + copies, "{names:?}");
+    let frames = v["frames"].as_u64().unwrap() as usize;
+    for name in &names[1..] {
+        let p = prim(&text, name);
+        let opacity = samples(p, "float[] primvars:displayOpacity");
+        assert!(opacity.len() == frames || opacity.len() == 1, "{name}");
+        assert!(p.contains("interpolation = \"vertex\""));
+    }
+    keep_for_validation(dir.path(), "usd_multiples");
+}
+
+#[test]
+fn smear_lines_usda_changes_topology_per_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("l.usda");
+    let v = json(&[
+        "smear",
+        "lines",
+        s(&robot()),
+        "-o",
+        s(&out),
+        "--clip",
+        "Punch",
+        "--fps",
+        "12",
+        "--count",
+        "0:0,4:40",
+        "--length-max",
+        "4",
+    ]);
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(mesh_names(&text), ["RobotExpressive", "motion_lines"]);
+    let lines = prim(&text, "motion_lines");
+    let per_frame: Vec<u64> = v["lines_per_frame"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_u64().unwrap())
+        .collect();
+    // No line on frame 0 (count keyed to 0), lines later.
+    assert_eq!(per_frame[0], 0);
+    assert!(per_frame.iter().any(|&n| n > 0), "{per_frame:?}");
+    let counts = samples(lines, "int[] faceVertexCounts");
+    assert_eq!(counts.len(), per_frame.len());
+    let vis = samples(lines, "token visibility");
+    for (f, &n) in per_frame.iter().enumerate() {
+        // A frame with no line: empty topology and invisible.
+        assert_eq!(counts[f] == "[]", n == 0, "frame {f}: {n} lines");
+        assert_eq!(vis[f] == "\"invisible\"", n == 0, "frame {f}");
+    }
+    keep_for_validation(dir.path(), "usd_lines");
+}
+
+#[test]
+fn smear_style_fig16_usda_has_every_part() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s.usda");
+    let style = PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/smear/fig16_combined.toml"
+    ));
+    assert!(style.exists(), "missing example style {}", style.display());
+    let v = json(&[
+        "smear",
+        s(&robot()),
+        "--style",
+        s(&style),
+        "--clip",
+        "Punch",
+        "--fps",
+        "8",
+        "-o",
+        s(&out),
+    ]);
+    let text = std::fs::read_to_string(&out).unwrap();
+    let names = mesh_names(&text);
+    assert_eq!(
+        names.len() as u64,
+        v["parts"].as_u64().unwrap(),
+        "{names:?}"
+    );
+    let unique: std::collections::BTreeSet<_> = names.iter().collect();
+    assert_eq!(
+        unique.len(),
+        names.len(),
+        "prim names must be unique: {names:?}"
+    );
+    let fps = v["fps"].as_f64().unwrap() as f32;
+    assert!(text.contains(&format!("    framesPerSecond = {fps}\n")));
+    keep_for_validation(dir.path(), "usd_style");
+}
+
+#[test]
+fn usda_input_is_refused_with_exit_2_and_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let usda = dir.path().join("in.usda");
+    json(&["convert", s(&data("characters/SimpleSkin.gltf")), s(&usda)]);
+    let out = toonkit(&["convert", s(&usda), s(&dir.path().join("x.glb"))]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("USD input is not supported") && err.contains("in.usda"),
+        "{err}"
+    );
+    keep_for_validation(dir.path(), "usd_bad_input");
+}
