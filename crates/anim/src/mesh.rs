@@ -83,7 +83,8 @@ pub struct Mesh {
     pub polygons: Option<Vec<Vec<u32>>>,
     /// Per-vertex normals.
     pub normals: Option<Vec<Vec3>>,
-    /// Per-vertex texture coordinates.
+    /// Per-vertex texture coordinates in glTF's convention: `u` right and `v` down from the
+    /// image's top-left corner (readers of other conventions convert, e.g. OBJ's `v ← 1 − v`).
     pub uvs: Option<Vec<[f32; 2]>>,
     /// Per-vertex RGBA colours in linear space.
     pub colors: Option<Vec<[f32; 4]>>,

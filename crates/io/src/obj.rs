@@ -20,6 +20,10 @@
 //!   vertices would break the vertex order.
 //! * The first `o` name (else the first `g` name) as [`Mesh::name`]; empty when there is none.
 //!
+//! Texture coordinates are converted to toonkit's convention (glTF's: `v` down from the top of
+//! the image) on reading, `v ← 1 − v`, and back on writing, so a textured glTF converted to OBJ
+//! (or OBJ to glTF) keeps its texture the right way up. Read → write → read is exact.
+//!
 //! Materials, smoothing groups, curves and free-form surfaces are ignored.
 
 use std::fmt::Write as _;
@@ -83,7 +87,8 @@ pub fn read(bytes: &[u8]) -> Result<Mesh> {
                 if v.is_empty() {
                     return Err(bad("texture coordinate has no value".into()));
                 }
-                uvs.push([v[0], v.get(1).copied().unwrap_or(0.0)]);
+                // OBJ's v runs up from the image's bottom; toonkit's (glTF's) down from its top.
+                uvs.push([v[0], 1.0 - v.get(1).copied().unwrap_or(0.0)]);
             }
             "vn" => {
                 let v = nums(words, "normal")?;
@@ -257,7 +262,7 @@ pub fn write(mesh: &Mesh) -> String {
         .as_ref()
         .filter(|n| n.len() == mesh.positions.len());
     for uv in uvs.into_iter().flatten() {
-        let _ = writeln!(out, "vt {} {}", uv[0], uv[1]);
+        let _ = writeln!(out, "vt {} {}", uv[0], 1.0 - uv[1]);
     }
     for n in normals.into_iter().flatten() {
         let _ = writeln!(out, "vn {} {} {}", n.x, n.y, n.z);
@@ -421,8 +426,9 @@ mod tests {
         assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3], [1, 3, 4]]);
         assert_eq!(m.polygons.as_ref().unwrap()[0], vec![0, 1, 2, 3]);
         // Relative corners reuse each vertex's own vt, so UVs are per position.
-        assert_eq!(m.uvs.as_ref().unwrap()[3], [0.0, 1.0]);
-        assert_eq!(m.uvs.as_ref().unwrap()[4], [0.0, 1.0]);
+        // (OBJ v = 1 is the top of the image: glTF v = 0.)
+        assert_eq!(m.uvs.as_ref().unwrap()[3], [0.0, 0.0]);
+        assert_eq!(m.uvs.as_ref().unwrap()[4], [0.0, 0.0]);
         let again = read(write(&m).as_bytes()).unwrap();
         assert_eq!(again, m);
     }

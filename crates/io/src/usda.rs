@@ -43,10 +43,12 @@
 //! interpolates `points` linearly between time codes when two samples have the same length;
 //! motion lines change from frame to frame, so read them on whole frames.
 //!
+//! **Texture coordinates** of point caches are written as `primvars:st` (vertex
+//! interpolation) with `v ← 1 − v`: toonkit's meshes use glTF's convention (v down from the
+//! image top), USD's `st` has v up.
+//!
 //! **Not written:** normals (with `subdivisionScheme = "none"` every USD client computes
-//! smooth vertex normals from the points of each frame), UVs (toonkit's meshes keep each
-//! source's UV convention, glTF's v axis points down and USD's `st` up: a texture would come
-//! out flipped), materials, skeletons.
+//! smooth vertex normals from the points of each frame), materials, skeletons.
 //!
 //! **Numbers.** Finite floats are written with Rust's shortest round-trip formatting, so
 //! parsing the text gives back the exact `f32`. NaN and ±∞ are never written: they become 0

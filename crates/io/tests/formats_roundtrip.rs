@@ -289,3 +289,30 @@ fn corrupt_real_files_are_errors() {
     let n = npy::write_f32(&[2, 2], &[0.0; 4]).unwrap();
     assert!(npy::read_f32(&n[..n.len() - 2]).is_err());
 }
+
+#[test]
+fn cesium_man_texture_stays_upright_in_obj() {
+    // glTF's v runs down from the image top, OBJ's up from the bottom: converting must flip v
+    // so the texture maps the same way in both files.
+    let scene = tkio::gltf::read(&asset("characters/CesiumMan.glb")).unwrap();
+    let mesh = &scene.meshes[0].mesh;
+    let uvs = mesh.uvs.as_ref().expect("CesiumMan has TEXCOORD_0");
+    let text = obj::write(mesh);
+    let vt: Vec<[f32; 2]> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("vt "))
+        .map(|l| {
+            let v: Vec<f32> = l.split(' ').map(|x| x.parse().unwrap()).collect();
+            [v[0], v[1]]
+        })
+        .collect();
+    assert_eq!(vt.len(), uvs.len());
+    for (o, g) in vt.iter().zip(uvs) {
+        assert_eq!(o[0], g[0]);
+        assert!((o[1] - (1.0 - g[1])).abs() < 1e-6, "{o:?} vs {g:?}");
+    }
+    let back = obj::read(text.as_bytes()).unwrap();
+    for (a, b) in back.uvs.unwrap().iter().zip(uvs) {
+        assert!((a[1] - b[1]).abs() < 1e-6);
+    }
+}

@@ -385,7 +385,45 @@ fn obj_polygons_are_kept_as_n_gons() {
         samples(&text, "int[] faceVertexIndices")[0].1,
         "[0, 1, 2, 3]"
     );
-    // UVs are not written: toonkit's meshes keep each source's UV convention (glTF has v
-    // pointing down, USD's `st` up), so a texture could come out flipped.
-    assert!(!text.contains("primvars:st"));
+    // UVs (glTF convention) are written as USD `st` with v flipped.
+    assert_eq!(
+        samples(&text, "texCoord2f[] primvars:st")[0].1,
+        "[(0, 1), (1, 1), (1, 0), (0, 0)]"
+    );
+}
+
+#[test]
+fn cesium_man_texture_coordinates_are_st_with_v_up() {
+    // toonkit's UVs follow glTF (v down from the image top); USD's `st` has v up.
+    let scene = tkio::gltf::read(Path::new(&data("characters/CesiumMan.glb"))).unwrap();
+    let options = SampleOptions {
+        fps: 6.0,
+        clip: Some(0),
+        meshes: Vec::new(),
+    };
+    let anim = sample(&scene, &options)
+        .unwrap()
+        .merged("CesiumMan")
+        .unwrap();
+    let uvs = anim.mesh.uvs.clone().expect("CesiumMan has TEXCOORD_0");
+    let text = usda::write_animation(&anim, None).unwrap();
+    let st = samples(&text, "texCoord2f[] primvars:st");
+    assert_eq!(st.len(), 1, "static: one value for every frame");
+    let values: Vec<[f32; 2]> = st[0]
+        .1
+        .trim_start_matches("[(")
+        .trim_end_matches(")]")
+        .split("), (")
+        .map(|t| {
+            let c: Vec<f32> = t.split(", ").map(|x| x.parse().unwrap()).collect();
+            [c[0], c[1]]
+        })
+        .collect();
+    assert_eq!(values.len(), uvs.len());
+    for (st, uv) in values.iter().zip(&uvs) {
+        assert_eq!(st[0], uv[0]);
+        assert_eq!(st[1], 1.0 - uv[1]);
+    }
+    assert!(text.contains("interpolation = \"vertex\""));
+    keep_usda(&text, "io_usda_cesium_st");
 }

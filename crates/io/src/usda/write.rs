@@ -336,6 +336,24 @@ impl<'a> Source<'a> {
             &extent,
         );
 
+        // Texture coordinates of a point cache (fixed topology): USD's `st` has v up from
+        // the image's bottom, toonkit's (glTF's) v down from its top.
+        if let UsdGeometry::Animation { animation, .. } = self.geometry {
+            let n = animation.vertex_count();
+            if let Some(uvs) = animation
+                .mesh
+                .uvs
+                .as_ref()
+                .filter(|u| u.len() == n && n > 0)
+            {
+                let st = |o: &mut String, _: usize| {
+                    write_list(o, uvs.iter(), |o, uv| push_tuple(o, &[uv[0], 1.0 - uv[1]]))
+                };
+                let decl = "texCoord2f[] primvars:st";
+                attribute(out, decl, VERTEX, true, frames, t0, &st);
+            }
+        }
+
         if self.colors(0).is_some() {
             let colors_static = topology_static
                 && all_same(&|f| self.colors(f).unwrap().same(&self.colors(0).unwrap()));

@@ -340,7 +340,9 @@ pub fn multiples(
                     });
             }
             let mut mesh = anim.mesh.clone();
-            mesh.name = format!("{}_m{m:+}", anim.mesh.name);
+            // `robot_past2`, `robot_future1`: readable, and valid USD/glTF names as they are.
+            let side = if m < 0 { "past" } else { "future" };
+            mesh.name = format!("{}_{side}{}", anim.mesh.name, m.unsigned_abs());
             let mut copy = MeshAnimation::new(mesh, anim.fps, pos)
                 .map_err(|e| SmearError::InvalidScene(e.to_string()))?;
             copy.start_time = anim.start_time;
@@ -407,6 +409,11 @@ mod tests {
         };
         let copies = multiples(&anim, &inputs, &eq12_opacity(1.0), &opts).unwrap();
         assert_eq!(copies.iter().map(|c| c.m).collect::<Vec<_>>(), [-1, 1]);
+        let names: Vec<&str> = copies
+            .iter()
+            .map(|c| c.animation.mesh.name.as_str())
+            .collect();
+        assert_eq!(names, ["ball_past1", "ball_future1"]);
         let f = 3;
         for c in &copies {
             let there = anim.frame((f as i32 + c.m) as usize);
