@@ -561,7 +561,7 @@ fn camera_following_the_ball_sees_no_speed() {
     let cam = options.selected_camera(&scene.cameras).unwrap().unwrap();
     let world = scene_offsets(&scene, &opts(0)).unwrap();
     let world_inputs = smear::EffectInputs::new(&ball, &world[0]).unwrap();
-    let seen = world_inputs.clone().relative_to_camera(cam);
+    let seen = world_inputs.clone().relative_to_camera(Some(cam));
     let world_speed = world_inputs.style_input(3, 0).speed;
     assert!(
         (world_speed - 1.0).abs() < 1e-5,

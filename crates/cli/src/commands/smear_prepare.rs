@@ -188,10 +188,7 @@ impl Prepared {
         if let Some(w) = weights {
             inputs = inputs.with_weights(w)?;
         }
-        if let Some(c) = &self.camera {
-            inputs = inputs.relative_to_camera(c);
-        }
-        Ok(inputs)
+        Ok(inputs.relative_to_camera(self.camera.as_ref()))
     }
 }
 

@@ -85,7 +85,7 @@ pub fn apply(scene: &SampledScene, style: &Style) -> Result<Styled> {
             Some(w) => Some(w.vertex_weights(scene, i)?),
             None => None,
         };
-        let mut inputs = in_camera(EffectInputs::new(anim, &offsets[i])?, camera);
+        let mut inputs = EffectInputs::new(anim, &offsets[i])?.relative_to_camera(camera);
         if let Some(w) = &weights {
             inputs = inputs.with_weights(w.clone())?;
         }
@@ -121,10 +121,8 @@ pub fn apply(scene: &SampledScene, style: &Style) -> Result<Styled> {
             let points =
                 smear::sample_surface(anim.frame(0), &anim.mesh.triangles, l.count, l.seed);
             let seed_offsets = solver.surface_offsets(i, &points)?;
-            let seeds = in_camera(
-                EffectInputs::at_surface_points(anim, &points, seed_offsets)?,
-                camera,
-            );
+            let seeds = EffectInputs::at_surface_points(anim, &points, seed_offsets)?
+                .relative_to_camera(camera);
             let seeds = match &weights {
                 Some(w) => seeds.with_weights(smear::surface_point_weights(
                     w,
@@ -158,14 +156,6 @@ pub fn apply(scene: &SampledScene, style: &Style) -> Result<Styled> {
         objects,
         timings,
     })
-}
-
-/// Speeds measured against the style's camera, if it names one (as its offsets are).
-fn in_camera<'a>(inputs: EffectInputs<'a>, camera: Option<&anim::Camera>) -> EffectInputs<'a> {
-    match camera {
-        Some(c) => inputs.relative_to_camera(c),
-        None => inputs,
-    }
 }
 
 /// Largest vertex displacement between two animations of the same mesh.

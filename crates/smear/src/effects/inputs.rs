@@ -166,9 +166,14 @@ impl<'a> EffectInputs<'a> {
     /// (moving) camera, as the offsets are with [`OffsetOptions::camera`](crate::OffsetOptions):
     /// an object the camera follows is slow on screen and gets no speed-driven smear.
     ///
+    /// `None` (no camera selected: world space) keeps the inputs as they are.
+    ///
     /// # Performance
     /// One pass over the positions, parallel over frames.
-    pub fn relative_to_camera(mut self, camera: &anim::Camera) -> Self {
+    pub fn relative_to_camera(mut self, camera: Option<&anim::Camera>) -> Self {
+        let Some(camera) = camera else {
+            return self;
+        };
         let space = crate::velocity::CameraSpace::new(camera, self.frames);
         self.velocities = crate::velocity::camera_buffer_velocities(
             &self.positions,
