@@ -11,7 +11,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 fn robot() -> anim::Scene {
     let p = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/data/characters/RobotExpressive.glb"
+        "/../../assets/characters/RobotExpressive.glb"
     );
     assert!(Path::new(p).exists(), "missing benchmark asset {p}");
     tkio::gltf::read(Path::new(p)).expect("read RobotExpressive")

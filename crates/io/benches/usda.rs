@@ -10,7 +10,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 fn dance() -> MeshAnimation {
     let p = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/data/characters/RobotExpressive.glb"
+        "/../../assets/characters/RobotExpressive.glb"
     );
     assert!(Path::new(p).exists(), "missing benchmark asset {p}");
     let scene = tkio::gltf::read(Path::new(p)).expect("read RobotExpressive");

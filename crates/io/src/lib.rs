@@ -9,6 +9,7 @@
 
 mod atomic;
 mod error;
+mod save;
 
 pub mod bvh;
 pub mod mdd;
@@ -22,6 +23,7 @@ pub mod usda;
 
 pub use atomic::{read_file, write_atomic};
 pub use error::{FilePath, IoError, Result};
+pub use save::{save, Layout, Output};
 
 mod detect;
 mod gltf_accessors;

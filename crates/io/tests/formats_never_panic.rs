@@ -12,7 +12,7 @@ use tkio::{bvh, mdd, npy, obj, pc2, stl};
 fn asset(rel: &str) -> Vec<u8> {
     let p = PathBuf::from(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/data/"
+        "/../../assets/"
     ))
     .join(rel);
     std::fs::read(&p).unwrap_or_else(|e| panic!("test asset missing: {}: {e}", p.display()))

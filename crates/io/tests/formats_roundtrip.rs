@@ -1,5 +1,5 @@
 //! Round trips and corrupt-input checks of the OBJ, PC2, MDD, STL, BVH and NPY formats on the
-//! real assets in `shared/data`.
+//! real assets in `assets/`.
 
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -11,7 +11,7 @@ use tkio::{bvh, mdd, npy, obj, pc2, stl};
 fn asset(rel: &str) -> PathBuf {
     let p = PathBuf::from(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/data/"
+        "/../../assets/"
     ))
     .join(rel);
     assert!(p.is_file(), "test asset missing: {}", p.display());

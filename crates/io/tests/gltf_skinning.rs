@@ -6,7 +6,7 @@ use anim::{sample, SampleOptions};
 use base64::Engine;
 
 fn data(rel: &str) -> String {
-    let p = format!("{}/../../../shared/data/{rel}", env!("CARGO_MANIFEST_DIR"));
+    let p = format!("{}/../../assets/{rel}", env!("CARGO_MANIFEST_DIR"));
     assert!(std::path::Path::new(&p).exists(), "missing test asset {p}");
     p
 }

@@ -21,7 +21,7 @@ fn stroke(bow: f64, lean: f64) -> String {
 fn bench(c: &mut Criterion) {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/data/characters/RobotExpressive.glb"
+        "/../../assets/characters/RobotExpressive.glb"
     );
     let scene =
         tkio::gltf::read(std::path::Path::new(path)).unwrap_or_else(|e| panic!("{path}: {e}"));

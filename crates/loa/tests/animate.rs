@@ -10,7 +10,7 @@ use loa::{line_of_action, Keystrokes, LineOptions, Mode};
 fn data(rel: &str) -> PathBuf {
     let p = PathBuf::from(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/data/"
+        "/../../assets/"
     ))
     .join(rel);
     assert!(p.exists(), "missing test asset {}", p.display());

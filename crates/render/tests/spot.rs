@@ -10,7 +10,7 @@ use render::{
 
 const SPOT: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
-    "/../../../shared/data/meshes/spot.obj"
+    "/../../assets/meshes/spot.obj"
 );
 
 #[test]

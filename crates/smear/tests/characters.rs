@@ -9,7 +9,7 @@ use smear::{OffsetMode, OffsetOptions, OffsetSolver, SurfacePoint};
 fn data(name: &str) -> PathBuf {
     let p = PathBuf::from(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/data/characters/"
+        "/../../assets/characters/"
     ))
     .join(name);
     assert!(p.exists(), "test asset missing: {}", p.display());

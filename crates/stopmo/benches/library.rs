@@ -17,7 +17,7 @@ use stopmo::library::{PartProblem, PartSetup, SolveOptions, SubspaceOptions};
 
 const FACE: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
-    "/../../../shared/data/face/ict-face-talk.glb"
+    "/../../assets/face/ict-face-talk.glb"
 );
 
 fn arg(name: &str, default: usize) -> usize {

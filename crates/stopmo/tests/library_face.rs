@@ -11,7 +11,7 @@ use stopmo::library::{
 
 const FACE: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
-    "/../../../shared/data/face/ict-face-talk.glb"
+    "/../../assets/face/ict-face-talk.glb"
 );
 
 fn face() -> MeshAnimation {

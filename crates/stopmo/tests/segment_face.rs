@@ -13,7 +13,7 @@ use stopmo::segment::{
 
 const FACE: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
-    "/../../../shared/data/face/ict-face-talk.glb"
+    "/../../assets/face/ict-face-talk.glb"
 );
 
 struct Face {

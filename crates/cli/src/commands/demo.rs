@@ -12,8 +12,8 @@ use serde_json::json;
 use super::Context;
 use crate::output::{self, Layout};
 
-/// The bundled 3D sample: RobotExpressive (CC0, see assets/LICENSES.md).
-pub const SAMPLE_GLB: &[u8] = include_bytes!("../../../../assets/RobotExpressive.glb");
+/// The bundled 3D sample: RobotExpressive (CC0, see assets/README.md).
+pub const SAMPLE_GLB: &[u8] = include_bytes!("../../../../assets/characters/RobotExpressive.glb");
 /// The bundled smear style: all three effects (paper Fig. 16).
 pub const SAMPLE_STYLE: &str = include_str!("../../../../examples/smear/fig16_combined.toml");
 /// The bundled keystrokes: a jump-like arc.

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 pub fn data(rel: &str) -> PathBuf {
     let p = PathBuf::from(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/data/"
+        "/../../assets/"
     ))
     .join(rel);
     assert!(p.exists(), "missing test asset {}", p.display());

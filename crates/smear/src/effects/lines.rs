@@ -134,14 +134,8 @@ fn check(options: &LineOptions) -> Result<usize> {
 /// Rank of every seed in a fixed pseudo-random order (SplitMix64 of the index): seeds with a
 /// rank below the frame's count draw.
 fn seed_ranks(count: usize) -> Vec<u32> {
-    let mix = |i: u64| {
-        let mut z = i.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    };
     let mut order: Vec<u32> = (0..count as u32).collect();
-    order.sort_by_key(|&i| (mix(i as u64), i));
+    order.sort_by_key(|&i| (anim::mix(i as u64), i));
     let mut rank = vec![0u32; count];
     for (r, &i) in order.iter().enumerate() {
         rank[i as usize] = r as u32;

@@ -1,23 +1,16 @@
 //! Motion-line seeds (Section 4.3): random surface points, area-weighted, deterministic.
 
+use anim::SplitMix64;
 use glam::Vec3;
-use rand_chacha::rand_core::{RngCore, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 
 use crate::SurfacePoint;
 
 /// Default seed of the random generator.
 pub const DEFAULT_SEED: u64 = 0x5EED;
 
-/// Uniform float in [0, 1) from 24 random bits.
-#[inline]
-fn unit(rng: &mut ChaCha8Rng) -> f32 {
-    (rng.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
-}
-
 /// `count` points uniformly distributed over the surface (triangles picked with probability
-/// proportional to their area in `positions`, then a uniform point inside), from a ChaCha8
-/// generator seeded with `seed`: same inputs, same points on every platform.
+/// proportional to their area in `positions`, then a uniform point inside), from toonkit's one
+/// generator ([`anim::SplitMix64`]) seeded with `seed`: same inputs, same points on every platform.
 ///
 /// The paper picks random vertices "for simplicity"; surface samples spread lines evenly
 /// whatever the tessellation.
@@ -52,12 +45,12 @@ pub fn sample_surface(
     if total.is_nan() || total <= 0.0 {
         return Vec::new();
     }
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut rng = SplitMix64::new(seed, 0);
     (0..count)
         .map(|_| {
-            let r = (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64) * total;
+            let r = rng.next_f64() * total;
             let tri = cdf.partition_point(|&c| c <= r).min(cdf.len() - 1);
-            let (mut u, mut v) = (unit(&mut rng), unit(&mut rng));
+            let (mut u, mut v) = (rng.next_f32(), rng.next_f32());
             if u + v > 1.0 {
                 (u, v) = (1.0 - u, 1.0 - v);
             }

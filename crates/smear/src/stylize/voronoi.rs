@@ -1,5 +1,6 @@
 //! 3D Voronoi (Worley) noise F1 (paper Section 5.2, Fig. 11d; definition fixed in SPEC.md).
 
+use anim::mix;
 use glam::Vec3;
 
 /// Voronoi F1 at `position · kappa`: the distance to the nearest feature point, one feature
@@ -39,14 +40,6 @@ fn jitter(i: i64, j: i64, k: i64, seed: u64) -> Vec3 {
     }
     let unit = |bits: u64| (bits >> 40) as f32 / (1u64 << 24) as f32;
     Vec3::new(unit(h), unit(mix(h ^ 1)), unit(mix(h ^ 2)))
-}
-
-#[inline]
-fn mix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
 }
 
 #[cfg(test)]

@@ -49,7 +49,6 @@ mod fabricate;
 mod metrics;
 mod plugs;
 mod problem;
-mod rng;
 mod size;
 mod solver;
 mod subspace;

@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use super::error::{LibraryError, Result};
 use super::metrics::evaluate;
 use super::problem::PartProblem;
-use super::rng::SplitMix64;
+use anim::SplitMix64;
 use super::update::{right_hand_side, solve_pieces, system_matrix, Dense, Positions};
 use super::viterbi::{label_step, LabelInputs, ViterbiWork};
 

@@ -14,7 +14,7 @@ use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatRef, Par, Side};
 
 use super::error::{LibraryError, Result};
-use super::rng::SplitMix64;
+use anim::SplitMix64;
 
 /// Rank of the first random sketch.
 pub const DEFAULT_INITIAL_RANK: usize = 96;

@@ -236,7 +236,7 @@ pub(crate) fn label_step(
 
 #[cfg(test)]
 mod tests {
-    use super::super::rng::SplitMix64;
+    use anim::SplitMix64;
     use super::*;
 
     struct Case {

@@ -1,0 +1,259 @@
+//! Writing results by file extension: the mirror of [`load`](crate::load). One place picks the
+//! format for every result kind, and every file is written atomically (temporary file +
+//! rename), so an interrupted or failed write never leaves a partial file behind.
+
+use std::path::{Path, PathBuf};
+
+use anim::{Mesh, MeshAnimation};
+
+use crate::{write_atomic, Format, IoError, Result};
+
+/// How an animation is laid out in the output file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Layout {
+    /// glTF: one node per frame, visibility keyed (vertex colours per frame).
+    #[default]
+    Flipbook,
+    /// glTF: one morph target per frame, STEP weights.
+    Morph,
+    /// OBJ: one file per frame, `name_0001.obj`, ….
+    Sequence,
+}
+
+/// One result to write. The variant says what the data is; the path's extension says how.
+#[derive(Debug, Clone, Copy)]
+pub enum Output<'a> {
+    /// A point cache (one topology, many frames), with optional per-frame RGBA vertex colours
+    /// (frame-major) for glTF flipbooks and USD display colour/opacity.
+    Animation {
+        /// The animation.
+        animation: &'a MeshAnimation,
+        /// Flipbook, morph targets or OBJ sequence.
+        layout: Layout,
+        /// Per-frame vertex colours, `frames × vertices`.
+        colors: Option<&'a [[f32; 4]]>,
+    },
+    /// Several point caches with the same frames, as one multi-node glTF (one node or node
+    /// group per part).
+    Parts {
+        /// `(animation, per-frame colours)` per part.
+        parts: &'a [(&'a MeshAnimation, Option<&'a [[f32; 4]]>)],
+        /// Flipbook or morph targets.
+        layout: Layout,
+    },
+    /// A scalar per frame and vertex (`.npy`, float32, `frames × vertices`).
+    Field {
+        /// Number of frames.
+        frames: usize,
+        /// Number of vertices.
+        vertices: usize,
+        /// Values, frame-major.
+        values: &'a [f32],
+    },
+    /// One static mesh (`.obj`, `.stl`, `.glb`).
+    Mesh(&'a Mesh),
+    /// Text written as is (CSV, JSON, Markdown, …).
+    Text(&'a str),
+    /// Bytes written as is (an encoded PNG or GIF).
+    Bytes(&'a [u8]),
+}
+
+/// Writes `output` to `path` in the format its extension names and returns every file written
+/// (PC2 and MDD caches get their rest mesh as a same-name `.obj` beside them; OBJ sequences
+/// one file per frame).
+///
+/// # Errors
+/// [`IoError::Unsupported`] naming `path` when the extension is unknown or cannot hold the
+/// data; [`IoError::Io`] when the file cannot be written (the previous file, if any, is kept).
+pub fn save(path: &Path, output: &Output<'_>) -> Result<Vec<PathBuf>> {
+    let mut written = Vec::new();
+    let mut put = |p: &Path, bytes: &[u8]| -> Result<()> {
+        write_atomic(p, bytes)?;
+        written.push(p.to_path_buf());
+        Ok(())
+    };
+    match *output {
+        Output::Text(text) => put(path, text.as_bytes())?,
+        Output::Bytes(bytes) => put(path, bytes)?,
+        Output::Field {
+            frames,
+            vertices,
+            values,
+        } => {
+            expect_extension(path, Format::Npy, "a per-frame scalar field", ".npy")?;
+            put(path, &crate::npy::write_f32(&[frames, vertices], values).map_err(|e| e.at(path))?)?
+        }
+        Output::Mesh(mesh) => match output_format(path)? {
+            #[cfg(feature = "obj")]
+            Format::Obj => put(path, crate::obj::write(mesh).as_bytes())?,
+            #[cfg(feature = "stl")]
+            Format::Stl => put(path, &crate::stl::write_binary(mesh))?,
+            _ => {
+                let anim = MeshAnimation::new(mesh.clone(), anim::DEFAULT_FPS, mesh.positions.clone())
+                    .map_err(|e| IoError::from(e).at(path))?;
+                return save(
+                    path,
+                    &Output::Animation {
+                        animation: &anim,
+                        layout: Layout::Flipbook,
+                        colors: None,
+                    },
+                );
+            }
+        },
+        Output::Parts { parts, layout } => {
+            expect_extension(path, Format::Glb, "several parts", ".glb")?;
+            let bytes = crate::gltf::write_animations(parts, gltf_layout(layout))
+                .map_err(|e| e.at(path))?;
+            put(path, &bytes)?;
+        }
+        Output::Animation {
+            animation,
+            layout,
+            colors,
+        } => write_animation(path, animation, layout, colors, &mut put)?,
+    }
+    Ok(written)
+}
+
+/// The format of an output path, or an error naming the extensions toonkit writes.
+fn output_format(path: &Path) -> Result<Format> {
+    Format::from_extension(path).ok_or_else(|| {
+        IoError::unsupported(
+            "unknown output extension (use .glb, .usda, .pc2, .mdd, .obj, .stl or .npy)",
+        )
+        .at(path)
+    })
+}
+
+fn expect_extension(path: &Path, want: Format, what: &str, ext: &str) -> Result<()> {
+    if output_format(path)? != want {
+        return Err(IoError::unsupported(format!("{what} is written as {ext}")).at(path));
+    }
+    Ok(())
+}
+
+fn gltf_layout(layout: Layout) -> crate::gltf::AnimationLayout {
+    match layout {
+        Layout::Morph => crate::gltf::AnimationLayout::Morph,
+        _ => crate::gltf::AnimationLayout::Flipbook,
+    }
+}
+
+fn write_animation(
+    path: &Path,
+    anim: &MeshAnimation,
+    layout: Layout,
+    colors: Option<&[[f32; 4]]>,
+    put: &mut dyn FnMut(&Path, &[u8]) -> Result<()>,
+) -> Result<()> {
+    match output_format(path)? {
+        Format::Glb => {
+            let bytes = crate::gltf::write_animation(anim, gltf_layout(layout), colors)
+                .map_err(|e| e.at(path))?;
+            put(path, &bytes)
+        }
+        Format::Gltf => Err(IoError::unsupported(
+            "toonkit writes binary glTF: name the output .glb",
+        )
+        .at(path)),
+        format @ (Format::Pc2 | Format::Mdd) => {
+            let bytes = if format == Format::Pc2 {
+                crate::pc2::write(anim)
+            } else {
+                crate::mdd::write(anim)
+            };
+            put(path, &bytes)?;
+            rest_mesh(path, anim, put)
+        }
+        #[cfg(feature = "obj")]
+        Format::Obj => {
+            if layout == Layout::Sequence && anim.frame_count() > 1 {
+                for (p, text) in crate::obj::write_sequence(anim, &sequence_base(path)) {
+                    put(&p, text.as_bytes())?;
+                }
+                Ok(())
+            } else {
+                put(path, crate::obj::write(&anim.mesh_at(0)).as_bytes())
+            }
+        }
+        #[cfg(feature = "stl")]
+        Format::Stl => put(path, &crate::stl::write_binary(&anim.mesh_at(0))),
+        Format::Npy => {
+            let flat: Vec<f32> = anim.positions().iter().flat_map(|p| p.to_array()).collect();
+            let shape = [anim.frame_count(), anim.vertex_count(), 3];
+            put(path, &crate::npy::write_f32(&shape, &flat).map_err(|e| e.at(path))?)
+        }
+        Format::Bvh => Err(IoError::unsupported("BVH output holds skeletons, not meshes").at(path)),
+        Format::Usda => {
+            let text = crate::usda::write_animation(anim, colors).map_err(|e| e.at(path))?;
+            put(path, text.as_bytes())
+        }
+        #[allow(unreachable_patterns)]
+        _ => Err(IoError::unsupported("this build of toonkit cannot write that format").at(path)),
+    }
+}
+
+/// The rest mesh of a PC2/MDD cache, as a same-name `.obj` beside it.
+#[cfg(feature = "obj")]
+fn rest_mesh(
+    path: &Path,
+    anim: &MeshAnimation,
+    put: &mut dyn FnMut(&Path, &[u8]) -> Result<()>,
+) -> Result<()> {
+    put(&path.with_extension("obj"), crate::obj::write(&anim.mesh).as_bytes())
+}
+
+#[cfg(not(feature = "obj"))]
+fn rest_mesh(
+    _: &Path,
+    _: &MeshAnimation,
+    _: &mut dyn FnMut(&Path, &[u8]) -> Result<()>,
+) -> Result<()> {
+    Ok(())
+}
+
+/// `out/walk.obj` or `out/walk_0001.obj` → `out/walk` (frames are numbered from there).
+fn sequence_base(path: &Path) -> PathBuf {
+    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("frame");
+    let trimmed = stem.trim_end_matches(|c: char| c.is_ascii_digit());
+    let trimmed = if trimmed.len() < stem.len() {
+        trimmed.trim_end_matches('_')
+    } else {
+        stem
+    };
+    path.with_file_name(trimmed)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sequence_base_strips_frame_number() {
+        assert_eq!(
+            sequence_base(Path::new("o/walk_0001.obj")),
+            PathBuf::from("o/walk")
+        );
+        assert_eq!(
+            sequence_base(Path::new("o/walk.obj")),
+            PathBuf::from("o/walk")
+        );
+    }
+
+    #[test]
+    fn unknown_extension_names_the_file() {
+        let e = save(
+            Path::new("/nonexistent/x.foo"),
+            &Output::Field {
+                frames: 1,
+                vertices: 1,
+                values: &[0.0],
+            },
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.starts_with("/nonexistent/x.foo: "), "{e}");
+        assert!(e.contains("unknown output extension"), "{e}");
+    }
+}
