@@ -39,6 +39,34 @@ enum Command {
     Stopmo(commands::stopmo::StopmoArgs),
 }
 
+/// Runs a parsed command line; `quiet` silences its summary.
+fn run(cli: Cli, quiet: bool) -> anyhow::Result<()> {
+    let ctx = commands::Context {
+        json: cli.json,
+        quiet,
+    };
+    match cli.command {
+        Command::Info(a) => commands::info::run(&ctx, a),
+        Command::Convert(a) => commands::convert::run(&ctx, a),
+        Command::Demo(a) => commands::demo::run(&ctx, a),
+        Command::Loa(a) => commands::loa::run(&ctx, a),
+        Command::Render(a) => commands::render::run(&ctx, a),
+        Command::Smear(a) => commands::smear::run(&ctx, *a),
+        Command::Stopmo(a) => commands::stopmo::run(&ctx, a),
+    }
+}
+
+/// Runs `toonkit ARGS…` in this process without printing its summary: the demo's steps are
+/// exactly the command lines a user would type.
+pub(crate) fn run_args(args: &[String]) -> anyhow::Result<()> {
+    let argv = std::iter::once("toonkit").chain(args.iter().map(String::as_str));
+    let cli = Cli::try_parse_from(argv).map_err(|e| {
+        let text = e.to_string();
+        anyhow::anyhow!("{}", text.lines().next().unwrap_or("invalid arguments"))
+    })?;
+    run(cli, true)
+}
+
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
@@ -52,16 +80,7 @@ fn main() -> ExitCode {
         }
         Err(e) => e.exit(), // --help, --version
     };
-    let ctx = commands::Context { json: cli.json };
-    let result = match cli.command {
-        Command::Info(a) => commands::info::run(&ctx, a),
-        Command::Convert(a) => commands::convert::run(&ctx, a),
-        Command::Demo(a) => commands::demo::run(&ctx, a),
-        Command::Loa(a) => commands::loa::run(&ctx, a),
-        Command::Render(a) => commands::render::run(&ctx, a),
-        Command::Smear(a) => commands::smear::run(&ctx, *a),
-        Command::Stopmo(a) => commands::stopmo::run(&ctx, a),
-    };
+    let result = run(cli, false);
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

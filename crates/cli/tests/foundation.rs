@@ -244,12 +244,3 @@ fn corrupt_inputs_exit_2_with_one_line() {
         "Nope",
     );
 }
-
-#[test]
-fn demo_writes_valid_outputs() {
-    let dir = tempfile::tempdir().unwrap();
-    let v = json(&["demo", "--out", dir.path().to_str().unwrap()]);
-    assert!(v["frames"].as_u64().unwrap() > 10);
-    assert!(dir.path().join("robot.glb").exists());
-    keep_for_validation(dir.path(), "demo");
-}

@@ -9,12 +9,8 @@ use anim::{sample, SampleOptions};
 use criterion::{criterion_group, criterion_main, Criterion};
 
 fn robot() -> anim::Scene {
-    let p = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../assets/characters/RobotExpressive.glb"
-    );
-    assert!(Path::new(p).exists(), "missing benchmark asset {p}");
-    tkio::gltf::read(Path::new(p)).expect("read RobotExpressive")
+    let p = testdata::asset("characters/RobotExpressive.glb");
+    tkio::gltf::read(&p).expect("read RobotExpressive")
 }
 
 fn sampling(c: &mut Criterion) {

@@ -8,12 +8,8 @@ use anim::{sample, MeshAnimation, SampleOptions};
 use criterion::{criterion_group, criterion_main, Criterion};
 
 fn dance() -> MeshAnimation {
-    let p = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../assets/characters/RobotExpressive.glb"
-    );
-    assert!(Path::new(p).exists(), "missing benchmark asset {p}");
-    let scene = tkio::gltf::read(Path::new(p)).expect("read RobotExpressive");
+    let p = testdata::asset("characters/RobotExpressive.glb");
+    let scene = tkio::gltf::read(&p).expect("read RobotExpressive");
     let options = SampleOptions {
         fps: 24.0,
         clip: Some(scene.find_clip("Dance").unwrap()),

@@ -81,7 +81,10 @@ pub fn save(path: &Path, output: &Output<'_>) -> Result<Vec<PathBuf>> {
             values,
         } => {
             expect_extension(path, Format::Npy, "a per-frame scalar field", ".npy")?;
-            put(path, &crate::npy::write_f32(&[frames, vertices], values).map_err(|e| e.at(path))?)?
+            put(
+                path,
+                &crate::npy::write_f32(&[frames, vertices], values).map_err(|e| e.at(path))?,
+            )?
         }
         Output::Mesh(mesh) => match output_format(path)? {
             #[cfg(feature = "obj")]
@@ -89,8 +92,9 @@ pub fn save(path: &Path, output: &Output<'_>) -> Result<Vec<PathBuf>> {
             #[cfg(feature = "stl")]
             Format::Stl => put(path, &crate::stl::write_binary(mesh))?,
             _ => {
-                let anim = MeshAnimation::new(mesh.clone(), anim::DEFAULT_FPS, mesh.positions.clone())
-                    .map_err(|e| IoError::from(e).at(path))?;
+                let anim =
+                    MeshAnimation::new(mesh.clone(), anim::DEFAULT_FPS, mesh.positions.clone())
+                        .map_err(|e| IoError::from(e).at(path))?;
                 return save(
                     path,
                     &Output::Animation {
@@ -153,10 +157,9 @@ fn write_animation(
                 .map_err(|e| e.at(path))?;
             put(path, &bytes)
         }
-        Format::Gltf => Err(IoError::unsupported(
-            "toonkit writes binary glTF: name the output .glb",
-        )
-        .at(path)),
+        Format::Gltf => {
+            Err(IoError::unsupported("toonkit writes binary glTF: name the output .glb").at(path))
+        }
         format @ (Format::Pc2 | Format::Mdd) => {
             let bytes = if format == Format::Pc2 {
                 crate::pc2::write(anim)
@@ -182,7 +185,10 @@ fn write_animation(
         Format::Npy => {
             let flat: Vec<f32> = anim.positions().iter().flat_map(|p| p.to_array()).collect();
             let shape = [anim.frame_count(), anim.vertex_count(), 3];
-            put(path, &crate::npy::write_f32(&shape, &flat).map_err(|e| e.at(path))?)
+            put(
+                path,
+                &crate::npy::write_f32(&shape, &flat).map_err(|e| e.at(path))?,
+            )
         }
         Format::Bvh => Err(IoError::unsupported("BVH output holds skeletons, not meshes").at(path)),
         Format::Usda => {
@@ -201,7 +207,10 @@ fn rest_mesh(
     anim: &MeshAnimation,
     put: &mut dyn FnMut(&Path, &[u8]) -> Result<()>,
 ) -> Result<()> {
-    put(&path.with_extension("obj"), crate::obj::write(&anim.mesh).as_bytes())
+    put(
+        &path.with_extension("obj"),
+        crate::obj::write(&anim.mesh).as_bytes(),
+    )
 }
 
 #[cfg(not(feature = "obj"))]

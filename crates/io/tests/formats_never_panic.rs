@@ -1,7 +1,6 @@
 //! Property tests: arbitrary bytes, and real files with random byte edits, never make a reader
 //! panic (they return `Ok` or `Err`).
 
-use std::path::PathBuf;
 use std::sync::OnceLock;
 
 use anim::glam::Vec3;
@@ -10,12 +9,7 @@ use proptest::prelude::*;
 use tkio::{bvh, mdd, npy, obj, pc2, stl};
 
 fn asset(rel: &str) -> Vec<u8> {
-    let p = PathBuf::from(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../assets/"
-    ))
-    .join(rel);
-    std::fs::read(&p).unwrap_or_else(|e| panic!("test asset missing: {}: {e}", p.display()))
+    testdata::bytes(rel)
 }
 
 fn tri() -> Mesh {

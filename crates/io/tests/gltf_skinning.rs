@@ -6,9 +6,7 @@ use anim::{sample, SampleOptions};
 use base64::Engine;
 
 fn data(rel: &str) -> String {
-    let p = format!("{}/../../assets/{rel}", env!("CARGO_MANIFEST_DIR"));
-    assert!(std::path::Path::new(&p).exists(), "missing test asset {p}");
-    p
+    testdata::asset(rel).display().to_string()
 }
 
 fn f32s(b: &[u8], off: usize, n: usize) -> Vec<f32> {

@@ -19,12 +19,8 @@ fn stroke(bow: f64, lean: f64) -> String {
 }
 
 fn bench(c: &mut Criterion) {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../assets/characters/RobotExpressive.glb"
-    );
-    let scene =
-        tkio::gltf::read(std::path::Path::new(path)).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let path = testdata::asset("characters/RobotExpressive.glb");
+    let scene = tkio::gltf::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let skeleton = scene.skeleton().0;
     assert_eq!(skeleton.len(), 43);
     let keys: Vec<String> = [

@@ -8,14 +8,9 @@ use render::{
     Renderer, View, ViewDirection,
 };
 
-const SPOT: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../assets/meshes/spot.obj"
-);
-
 #[test]
 fn spot_three_quarter_preview() {
-    let (p, t) = common::read_obj(SPOT);
+    let (p, t) = common::read_obj(testdata::asset("meshes/spot.obj").to_str().unwrap());
     assert_eq!(p.len(), 2930);
     let mut o = RenderOptions::new(400, 400);
     o.supersample = 2;
@@ -64,7 +59,7 @@ fn spot_three_quarter_preview() {
 #[test]
 fn spot_onion_skin_preview() {
     use glam::{Quat, Vec3};
-    let (p, t) = common::read_obj(SPOT);
+    let (p, t) = common::read_obj(testdata::asset("meshes/spot.obj").to_str().unwrap());
     let frames = 7;
     // Spot (facing −Z) hops forward, rising and pitching a little: an arc like the paper's
     // bouncing ball. Seen from +X, forward is to the right.

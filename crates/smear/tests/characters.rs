@@ -7,13 +7,7 @@ use anim::{sample, SampleOptions};
 use smear::{OffsetMode, OffsetOptions, OffsetSolver, SurfacePoint};
 
 fn data(name: &str) -> PathBuf {
-    let p = PathBuf::from(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../assets/characters/"
-    ))
-    .join(name);
-    assert!(p.exists(), "test asset missing: {}", p.display());
-    p
+    testdata::asset(&format!("characters/{name}"))
 }
 
 fn check_clips(file: &str, options: &OffsetOptions) -> usize {

@@ -10,25 +10,22 @@ use stopmo::segment::{
     homogenize, resolve_seeds, PartSpec, Seed, SegmentationProblem, DEFAULT_GAMMA,
 };
 
-const FACE: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../assets/face/ict-face-talk.glb"
-);
 const RUNS: usize = 5;
 
 fn load_face() -> anim::MeshAnimation {
-    let scene =
-        tkio::gltf::read(std::path::Path::new(FACE)).unwrap_or_else(|e| panic!("{FACE}: {e}"));
+    let scene = tkio::gltf::read(testdata::asset("face/ict-face-talk.glb").as_path())
+        .unwrap_or_else(|e| panic!("face/ict-face-talk.glb: {e}"));
     let opts = anim::SampleOptions {
         fps: 30.0,
         ..Default::default()
     };
-    let sampled = anim::sample(&scene, &opts).unwrap_or_else(|e| panic!("{FACE}: {e}"));
+    let sampled =
+        anim::sample(&scene, &opts).unwrap_or_else(|e| panic!("face/ict-face-talk.glb: {e}"));
     sampled
         .objects
         .into_iter()
         .next()
-        .unwrap_or_else(|| panic!("{FACE}: no mesh"))
+        .unwrap_or_else(|| panic!("face/ict-face-talk.glb: no mesh"))
         .animation
 }
 

@@ -15,11 +15,6 @@ use anim::{sample, MeshAnimation, SampleOptions};
 use glam::Vec3;
 use stopmo::library::{PartProblem, PartSetup, SolveOptions, SubspaceOptions};
 
-const FACE: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../assets/face/ict-face-talk.glb"
-);
-
 fn arg(name: &str, default: usize) -> usize {
     let args: Vec<String> = std::env::args().collect();
     args.iter()
@@ -63,8 +58,8 @@ fn main() {
         arg("--labels", 200),
     );
     let restarts = arg("--restarts", 2);
-    let scene =
-        tkio::gltf::read(std::path::Path::new(FACE)).unwrap_or_else(|e| panic!("{FACE}: {e}"));
+    let scene = tkio::gltf::read(testdata::asset("face/ict-face-talk.glb").as_path())
+        .unwrap_or_else(|e| panic!("face/ict-face-talk.glb: {e}"));
     let sampled = sample(
         &scene,
         &SampleOptions {

@@ -1,22 +1,19 @@
 //! Acceptance on the ICT face talk animation (1,800 frames, 9,409 vertices): two parts with
 //! 20 + 30 pieces; Fig. 19's comparison of λ = 2, λ = 0 (k-means) and uniform sampling.
 
-use std::path::Path;
-
 use anim::{sample, Mesh, MeshAnimation, SampleOptions};
 use stopmo::library::{
     build_library, check_solid, shooting_order, Library, LibraryOptions, LibrarySize, Method,
     PartInput, PartSetup, SolveOptions,
 };
 
-const FACE: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../assets/face/ict-face-talk.glb"
-);
-
 fn face() -> MeshAnimation {
-    assert!(Path::new(FACE).exists(), "missing test asset {FACE}");
-    let scene = tkio::gltf::read(Path::new(FACE)).unwrap_or_else(|e| panic!("{FACE}: {e}"));
+    assert!(
+        testdata::asset("face/ict-face-talk.glb").as_path().exists(),
+        "missing test asset face/ict-face-talk.glb"
+    );
+    let scene = tkio::gltf::read(testdata::asset("face/ict-face-talk.glb").as_path())
+        .unwrap_or_else(|e| panic!("face/ict-face-talk.glb: {e}"));
     let sampled = sample(
         &scene,
         &SampleOptions {

@@ -11,11 +11,6 @@ use stopmo::segment::{
     SegmentationProblem,
 };
 
-const FACE: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../assets/face/ict-face-talk.glb"
-);
-
 struct Face {
     anim: MeshAnimation,
     problem: SegmentationProblem,
@@ -27,18 +22,20 @@ struct Face {
 fn face() -> &'static Face {
     static FACE_DATA: OnceLock<Face> = OnceLock::new();
     FACE_DATA.get_or_init(|| {
-        let path = std::path::Path::new(FACE);
-        let scene = tkio::gltf::read(path).unwrap_or_else(|e| panic!("cannot read {FACE}: {e}"));
+        let path = testdata::asset("face/ict-face-talk.glb");
+        let scene = tkio::gltf::read(&path)
+            .unwrap_or_else(|e| panic!("cannot read face/ict-face-talk.glb: {e}"));
         let opts = anim::SampleOptions {
             fps: 30.0,
             ..Default::default()
         };
-        let sampled = anim::sample(&scene, &opts).unwrap_or_else(|e| panic!("{FACE}: {e}"));
+        let sampled =
+            anim::sample(&scene, &opts).unwrap_or_else(|e| panic!("face/ict-face-talk.glb: {e}"));
         let anim = sampled
             .objects
             .into_iter()
             .next()
-            .unwrap_or_else(|| panic!("{FACE}: no mesh"))
+            .unwrap_or_else(|| panic!("face/ict-face-talk.glb: no mesh"))
             .animation;
         let problem = SegmentationProblem::with_defaults(&anim).expect("face problem");
         let avg = problem.average_positions();

@@ -21,6 +21,8 @@ mod stopmo_run;
 pub struct Context {
     /// Print JSON on stdout instead of human text.
     pub json: bool,
+    /// Print no summary at all (a step of `toonkit demo` or `toonkit batch`).
+    pub quiet: bool,
 }
 
 impl Context {
@@ -28,6 +30,9 @@ impl Context {
     /// A closed stdout (`toonkit --json info X | head`) is not an error: the work is done.
     pub fn report(&self, value: &serde_json::Value, text: impl FnOnce() -> String) {
         use std::io::Write as _;
+        if self.quiet {
+            return;
+        }
         let out = if self.json {
             serde_json::to_string_pretty(value).unwrap_or_default()
         } else {
