@@ -155,9 +155,9 @@ fn steps(out: &Path, clip: &str, fps: f32) -> Vec<Step> {
         ),
         step(
             "smear",
-            "The same smear as a numbered contact sheet: every second frame.",
+            "The same smear as a numbered contact sheet: every third frame.",
             &["render", &p("robot_smear.glb"), "-o", &p("robot_smear_sheet.png"), "--sheet",
-              "--every", "2", "--size", "200x200"],
+              "--every", "3", "--size", "200x200"],
             vec!["robot_smear_sheet.png"],
         ),
         step(
@@ -169,20 +169,20 @@ fn steps(out: &Path, clip: &str, fps: f32) -> Vec<Step> {
               "--part", "upper=point:0,10,13", "--part", "lower=point:0,-14,10",
               "--budget", "12", "--restarts", "2", "--render"],
             vec!["stopmo/segmentation.png", "stopmo/error_curve.png", "stopmo/assembly.csv",
-                 "stopmo/shooting_order.csv", "stopmo/report.json", "stopmo/reconstruction.glb"],
+                 "stopmo/shooting_order.csv", "stopmo/report.json"],
         ),
         step(
             "stopmo",
-            "The replacement animation: every frame assembled from library pieces.",
-            &["render", &p("stopmo/reconstruction.glb"), "-o", &p("stopmo/reconstruction.gif"),
-              "--view", "front", "--size", "240x240"],
-            vec!["stopmo/reconstruction.gif"],
+            "The replacement animation every 5 s (numbered frames): each face assembled from library pieces.",
+            &["render", &p("stopmo/reconstruction.glb"), "-o", &p("stopmo/reconstruction_sheet.png"),
+              "--sheet", "--every", "20", "--view", "front", "--size", "160x160"],
+            vec!["stopmo/reconstruction_sheet.png", "stopmo/reconstruction.glb"],
         ),
         step(
             "stopmo",
             "One printable piece of the lower face (closed STL solid, ready for a slicer).",
             &["render", &p("stopmo/pieces/lower_00.stl"), "-o", &p("stopmo/lower_00.png"),
-              "--view", "three-quarter", "--size", "300x300"],
+              "--view", "front", "--size", "300x300"],
             vec!["stopmo/lower_00.png", "stopmo/pieces/lower_00.stl"],
         ),
         step(
