@@ -18,6 +18,8 @@
 //! assert_eq!(anim.frame(2)[0], Vec3::new(2.0, 0.0, 0.0));
 //! ```
 
+#![warn(missing_docs, unreachable_pub)]
+
 mod camera;
 mod clip;
 mod error;

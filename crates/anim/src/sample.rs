@@ -9,7 +9,7 @@ use crate::{
 };
 
 /// Upper bound on sampled positions (frames × vertices), about 12 GB of `Vec3`.
-pub const MAX_SAMPLED_VALUES: usize = 1_000_000_000;
+pub(crate) const MAX_SAMPLED_VALUES: usize = 1_000_000_000;
 
 /// What to sample.
 #[derive(Debug, Clone, PartialEq)]

@@ -75,7 +75,7 @@ pub(crate) struct Builder {
 }
 
 impl Builder {
-    pub fn new() -> Builder {
+    pub(crate) fn new() -> Builder {
         let mut root = json::Root::default();
         root.asset.generator = Some(format!("toonkit {}", env!("CARGO_PKG_VERSION")));
         root.buffers.push(json::Buffer {
@@ -175,7 +175,7 @@ impl Builder {
 
     /// Float accessor of `n`-component items (1–4, or 16 for matrices), with min/max bounds
     /// when asked. Non-finite values are written as 0 (the validator rejects NaN/∞).
-    pub fn floats(
+    pub(crate) fn floats(
         &mut self,
         data: &[f32],
         n: usize,
@@ -213,14 +213,14 @@ impl Builder {
     }
 
     /// VEC3 float vertex attribute.
-    pub fn vec3s(&mut self, data: &[Vec3], bounds: bool) -> json::Index<json::Accessor> {
+    pub(crate) fn vec3s(&mut self, data: &[Vec3], bounds: bool) -> json::Index<json::Accessor> {
         let flat: Vec<f32> = data.iter().flat_map(|v| v.to_array()).collect();
         self.floats(&flat, 3, Usage::Vertex, bounds)
     }
 
     /// Triangle indices: UNSIGNED_SHORT when every index is at most [`MAX_U16_INDEX`]
     /// (half the bytes), else UNSIGNED_INT.
-    pub fn indices(&mut self, tris: &[[u32; 3]]) -> json::Index<json::Accessor> {
+    pub(crate) fn indices(&mut self, tris: &[[u32; 3]]) -> json::Index<json::Accessor> {
         let flat = tris.iter().flatten();
         let short = flat.clone().all(|&i| i <= MAX_U16_INDEX);
         let bytes: Vec<u8> = if short {
@@ -244,7 +244,7 @@ impl Builder {
     }
 
     /// VEC4 UNSIGNED_SHORT joint indices.
-    pub fn joints(&mut self, data: &[[u16; 4]]) -> json::Index<json::Accessor> {
+    pub(crate) fn joints(&mut self, data: &[[u16; 4]]) -> json::Index<json::Accessor> {
         let bytes: Vec<u8> = data
             .iter()
             .flatten()
@@ -263,7 +263,7 @@ impl Builder {
 
     /// RGBA colours as VEC4 normalized UNSIGNED_SHORT (`round(c · 65535)`, clamped to
     /// [0, 1], NaN → 0): half the bytes of floats, round-trip error ≤ 1/131070.
-    pub fn colors(&mut self, data: &[[f32; 4]]) -> json::Index<json::Accessor> {
+    pub(crate) fn colors(&mut self, data: &[[f32; 4]]) -> json::Index<json::Accessor> {
         let bytes: Vec<u8> = data
             .iter()
             .flatten()
@@ -281,7 +281,7 @@ impl Builder {
     }
 
     /// Serializes to GLB bytes.
-    pub fn finish(mut self) -> Result<Vec<u8>> {
+    pub(crate) fn finish(mut self) -> Result<Vec<u8>> {
         while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }

@@ -14,7 +14,7 @@ use crate::{IoError, Result};
 
 impl Builder {
     /// The shared material: opaque, or alpha-blended for translucent vertex colours.
-    pub fn material(&mut self, blend: bool) -> json::Index<json::Material> {
+    pub(crate) fn material(&mut self, blend: bool) -> json::Index<json::Material> {
         let slot = if blend { self.blend } else { self.opaque };
         if let Some(m) = slot {
             return m;
@@ -47,7 +47,7 @@ impl Builder {
 
     /// Adds a mesh. Identical accessor data (a flipbook's triangles, UVs and painted
     /// attributes in every frame) is stored once.
-    pub fn mesh(&mut self, sm: &SceneMesh) -> Result<json::Index<json::Mesh>> {
+    pub(crate) fn mesh(&mut self, sm: &SceneMesh) -> Result<json::Index<json::Mesh>> {
         let m = &sm.mesh;
         if m.vertex_count() == 0 {
             return Err(IoError::unsupported(format!(

@@ -7,6 +7,8 @@
 //!
 //! This crate does no algorithm work beyond format conversion.
 
+#![warn(missing_docs, unreachable_pub)]
+
 mod atomic;
 mod error;
 mod save;

@@ -35,6 +35,8 @@
 //! assert!(png.starts_with(b"\x89PNG"));
 //! ```
 
+#![warn(missing_docs, unreachable_pub)]
+
 mod animation;
 mod color;
 mod colormap;

@@ -30,7 +30,7 @@ pub(crate) struct Target {
 
 impl Target {
     /// A cleared target; `background` is straight alpha.
-    pub fn new(width: u32, height: u32, background: Color) -> Target {
+    pub(crate) fn new(width: u32, height: u32, background: Color) -> Target {
         let a = background[3].clamp(0.0, 1.0);
         let pm = [background[0] * a, background[1] * a, background[2] * a, a];
         let n = width as usize * height as usize;
