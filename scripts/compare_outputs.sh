@@ -3,8 +3,9 @@
 #
 # usage: scripts/compare_outputs.sh BASE_REV [CHARACTER.glb]
 #
-# Builds `toonkit` at BASE_REV (in a temporary git worktree) and at the working tree (dev
-# profile, sharing this repository's target directory so dependencies are not rebuilt), runs
+# Builds `toonkit` at BASE_REV (exported with `git archive` to a temporary folder) and at the working tree (the
+# profile of `cargo test`, PROFILE=test by default, sharing this repository's target
+# directory so dependencies and the tests' own build are reused), runs
 # every examples/smear/*.toml style (.glb, .usda, and a GIF preview for one) and
 # `smear offsets | elongate | multiples | lines` in several formats on the character
 # (default: assets/characters/RobotExpressive.glb), and `cmp`s every output.
@@ -16,19 +17,32 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 input=${2:-$root/assets/characters/RobotExpressive.glb}
 input=$(cd "$(dirname "$input")" && pwd)/$(basename "$input")
 target=${CARGO_TARGET_DIR:-$root/target}
+profile=${PROFILE:-test}
 work=$(mktemp -d)
-trap 'git -C "$root" worktree remove --force "$work/src" >/dev/null 2>&1 || true; rm -rf "$work"' EXIT
+trap 'rm -rf "$work"' EXIT
 
 build() { # SOURCE_DIR DEST_BINARY
-    (cd "$1" && CARGO_TARGET_DIR=$target cargo build -q -p toonkit-cli)
-    cp "$target/debug/toonkit" "$2"
+    (cd "$1" && CARGO_TARGET_DIR=$target cargo build -q --profile "$profile" -p toonkit-cli)
+    local dir=$profile
+    case $profile in dev | test) dir=debug ;; bench) dir=release ;; esac
+    cp "$target/$dir/toonkit" "$2"
 }
 
-git -C "$root" worktree add -q --detach "$work/src" "$base"
-echo "building $base ..."
-build "$work/src" "$work/toonkit-base"
-echo "building the working tree ..."
-build "$root" "$work/toonkit-head"
+# BASE_BIN / HEAD_BIN: binaries built beforehand (skips that build).
+if [ -n "${BASE_BIN:-}" ]; then
+    cp "$BASE_BIN" "$work/toonkit-base"
+else
+    mkdir -p "$work/src"
+    git -C "$root" archive "$base" | tar -x -C "$work/src"
+    echo "building $base ..."
+    build "$work/src" "$work/toonkit-base"
+fi
+if [ -n "${HEAD_BIN:-}" ]; then
+    cp "$HEAD_BIN" "$work/toonkit-head"
+else
+    echo "building the working tree ..."
+    build "$root" "$work/toonkit-head"
+fi
 
 run_all() { # BINARY OUT_DIR
     local bin=$1 out=$2

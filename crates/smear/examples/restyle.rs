@@ -35,7 +35,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let first_style = style("fig11c_speed.toml")?;
     let vertices = sampled.vertex_count();
     let frames = sampled.frame_count;
-    println!("{} '{clip}': {vertices} vertices × {frames} frames", input.display());
+    println!(
+        "{} '{clip}': {vertices} vertices × {frames} frames",
+        input.display()
+    );
 
     let t = Instant::now();
     let prepared = prepare(
@@ -56,15 +59,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         first_seconds * 1e3,
     );
     let solves = smear::offset_solves();
-    let mut names: Vec<PathBuf> = std::fs::read_dir(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/smear"),
-    )?
-    .filter_map(|e| e.ok().map(|e| e.path()))
-    .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-    .collect();
+    let mut names: Vec<PathBuf> =
+        std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/smear"))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+            .collect();
     names.sort();
     for path in names {
-        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or_default();
+        let name = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or_default();
         let second_style = style(name)?;
         if second_style.offsets != first_style.offsets {
             println!("second: {name} needs other offset options (prepare again), skipped");
@@ -80,6 +85,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             first_seconds / s
         );
     }
-    println!("offset solves during restyling: {}", smear::offset_solves() - solves);
+    println!(
+        "offset solves during restyling: {}",
+        smear::offset_solves() - solves
+    );
     Ok(())
 }

@@ -1,6 +1,6 @@
 //! Motion offsets of whole scenes: grouping objects, camera space, pruning, surface points.
 
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 use anim::{Aabb, Camera, MeshAnimation, SampledScene, Skin};
 use glam::Vec3;
@@ -15,14 +15,20 @@ use crate::{
     DEFAULT_ZERO_LENGTH, STILL_ROUNDING_FACTOR,
 };
 
-/// Offset solves run by this process (see [`offset_solves`]).
-static SOLVES: AtomicUsize = AtomicUsize::new(0);
+thread_local! {
+    /// Offset solves started on this thread (see [`offset_solves`]).
+    static SOLVES: Cell<usize> = const { Cell::new(0) };
+}
 
-/// Number of motion-offset solves (SMEAR Eqs. 1–9 over a scene or point cache) this process
-/// has run so far: lets tests and front ends check that restyling a
+fn count_solve() {
+    SOLVES.with(|n| n.set(n.get() + 1));
+}
+
+/// Number of motion-offset solves (SMEAR Eqs. 1–9 over a scene or point cache) started on
+/// the calling thread so far: lets tests and front ends check that restyling a
 /// [`Prepared`](crate::Prepared) scene reuses its offsets instead of solving them again.
 pub fn offset_solves() -> usize {
-    SOLVES.load(Ordering::Relaxed)
+    SOLVES.with(Cell::get)
 }
 
 /// How an object's offsets are computed.
@@ -282,7 +288,7 @@ fn group_keys(scene: &SampledScene, whole_body: bool) -> Vec<(Option<usize>, Vec
 impl SolvedField {
     /// Solves the offsets of every object of `scene` (see [`OffsetSolver::new`]).
     pub(crate) fn new(scene: &SampledScene, options: &OffsetOptions) -> Result<SolvedField> {
-        SOLVES.fetch_add(1, Ordering::Relaxed);
+        count_solve();
         check_scene(scene)?;
         let frames = scene.frame_count;
         let pruned = Pruned::new(&scene.skeleton, &options.prune)?;
@@ -359,7 +365,7 @@ impl SolvedField {
         options: &OffsetOptions,
         cameras: &[Camera],
     ) -> Result<SolvedField> {
-        SOLVES.fetch_add(1, Ordering::Relaxed);
+        count_solve();
         if let Some(name) = options.prune.first() {
             return Err(SmearError::UnknownJoint {
                 name: name.clone(),

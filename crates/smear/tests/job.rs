@@ -33,10 +33,13 @@ fn example_style(name: &str) -> Style {
 #[test]
 fn second_stylize_reuses_prepared_offsets() {
     let scene = robot_dance();
+    // Live tuning: the animator drags the elongation strength from 6 to 3 (paper Fig. 11c).
     let first_style = example_style("fig11c_speed.toml");
-    let mut second_style = first_style.clone();
-    second_style.elongate = None;
-    second_style.multiples = Some(smear::MultiplesStyle::default());
+    let second_style = Style::from_toml_str(
+        "[elongate]\nfunction = { stages = [{ op = \"speed\" }, { op = \"scale\", by = 3 }] }",
+    )
+    .unwrap();
+    assert_ne!(first_style, second_style);
     let options = PrepareOptions {
         offsets: first_style.offsets.clone(),
         ..PrepareOptions::default()
