@@ -96,6 +96,7 @@ mod rig;
 mod smooth;
 mod solver;
 mod stylize;
+mod surface;
 mod velocity;
 
 pub use effects::{
@@ -119,9 +120,7 @@ pub use options::{
 pub use plane::surface_centroid;
 pub use ribbon::smoothstep;
 pub use smooth::{smooth_in_time, smoothing_weights};
-pub use solver::{
-    mesh_offsets, offset_solves, scene_offsets, OffsetMode, OffsetSolver, SurfacePoint,
-};
+pub use solver::{mesh_offsets, offset_solves, scene_offsets, OffsetMode, OffsetSolver};
 pub use stylize::{
     apply_stages, hise_curve, voronoi_f1, warp_offset, CompiledEffects, CompiledLines,
     ElongateStyle, Expression, FunctionSpec, LinesStyle, MultiplesStyle, ObjectEffects,
@@ -129,4 +128,5 @@ pub use stylize::{
     WeightGroup, WeightSource, DEFAULT_LINE_COUNT, DEFAULT_LINE_THICKNESS, DEFAULT_MULTIPLE_COLOR,
     EXPRESSION_INPUTS, MAX_EXPRESSION_VARIABLES,
 };
+pub use surface::SurfacePoint;
 pub use velocity::{camera_vertex_velocities, speeds, vertex_velocities};
