@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anim::{Mesh, MeshAnimation};
+use anim::{Flipbook, Mesh, MeshAnimation};
 
 use crate::{write_atomic, Format, IoError, Result};
 
@@ -34,12 +34,25 @@ pub enum Output<'a> {
         colors: Option<&'a [[f32; 4]]>,
     },
     /// Several point caches with the same frames, as one multi-node glTF (one node or node
-    /// group per part).
+    /// group per part) or one USD layer (one Mesh prim per part, `.usda`).
     Parts {
         /// `(animation, per-frame colours)` per part.
         parts: &'a [(&'a MeshAnimation, Option<&'a [[f32; 4]]>)],
         /// Flipbook or morph targets.
         layout: Layout,
+    },
+    /// Parts with the same frames, some with a topology that changes per frame (a
+    /// stylization result): `.glb` (one root node per part, one child per frame with
+    /// geometry, visibility keyed) or `.usda` (one Mesh prim per part).
+    Flipbook(&'a Flipbook),
+    /// A body and its motion lines (one mesh per frame, possibly empty): `.glb` (the body's
+    /// and the lines' frames as visibility-keyed nodes) or `.usda` (the body's point cache and
+    /// one `motion_lines` Mesh prim with per-frame topology).
+    MotionLines {
+        /// The body's point cache.
+        body: &'a MeshAnimation,
+        /// The lines of every frame.
+        lines: &'a [Mesh],
     },
     /// A scalar per frame and vertex (`.npy`, float32, `frames × vertices`).
     Field {
@@ -106,9 +119,27 @@ pub fn save(path: &Path, output: &Output<'_>) -> Result<Vec<PathBuf>> {
             }
         },
         Output::Parts { parts, layout } => {
-            expect_extension(path, Format::Glb, "several parts", ".glb")?;
-            let bytes = crate::gltf::write_animations(parts, gltf_layout(layout))
-                .map_err(|e| e.at(path))?;
+            let bytes = match scene_format(path, "several parts")? {
+                Format::Usda => crate::usda::write_parts(parts).map(String::into_bytes),
+                _ => crate::gltf::write_animations(parts, gltf_layout(layout)),
+            }
+            .map_err(|e| e.at(path))?;
+            put(path, &bytes)?;
+        }
+        Output::Flipbook(book) => {
+            let bytes = match scene_format(path, "a flipbook")? {
+                Format::Usda => crate::flipbook::flipbook_usda(book).map(String::into_bytes),
+                _ => crate::gltf::write_glb(&crate::flipbook::flipbook_scene(book)),
+            }
+            .map_err(|e| e.at(path))?;
+            put(path, &bytes)?;
+        }
+        Output::MotionLines { body, lines } => {
+            let bytes = match scene_format(path, "motion lines")? {
+                Format::Usda => crate::flipbook::lines_usda(body, lines).map(String::into_bytes),
+                _ => crate::gltf::write_glb(&crate::flipbook::lines_scene(body, lines)),
+            }
+            .map_err(|e| e.at(path))?;
             put(path, &bytes)?;
         }
         Output::Animation {
@@ -135,6 +166,14 @@ fn expect_extension(path: &Path, want: Format, what: &str, ext: &str) -> Result<
         return Err(IoError::unsupported(format!("{what} is written as {ext}")).at(path));
     }
     Ok(())
+}
+
+/// `.glb` or `.usda` for outputs with several parts, else an error naming both.
+fn scene_format(path: &Path, what: &str) -> Result<Format> {
+    match output_format(path)? {
+        f @ (Format::Glb | Format::Usda) => Ok(f),
+        _ => Err(IoError::unsupported(format!("{what} is written as .glb or .usda")).at(path)),
+    }
 }
 
 fn gltf_layout(layout: Layout) -> crate::gltf::AnimationLayout {
