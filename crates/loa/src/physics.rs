@@ -252,6 +252,10 @@ pub struct Retarget {
     pub t_star: usize,
     /// Euclidean norm of the correction `Δγ` (radians).
     pub correction: f64,
+    /// The simulated frame actually laid onto the interval: the first local minimum of
+    /// LoA Eq. 2's distance (≤ `t_star`; Eq. 2's global minimum can be a later swing, whose
+    /// sped-up replay would strobe). Its correction is the one blended in.
+    pub first_pass: usize,
     /// Output frames after `from_frame` at which the line reaches the next pose: `t*` at the
     /// simulation's own speed, later when the per-frame motion cap slowed the approach, and
     /// the whole interval when `t*` lies beyond it (then the simulation is sped up, as in

@@ -29,10 +29,6 @@ use crate::{Chain, LoaError};
 /// line's length (the promise is ≤ 15 %; the margin covers the follow-through phase).
 pub const MAX_FRAME_MOTION: f64 = 0.1;
 
-/// Re-timing attempts of the approach before giving up on the motion cap (the keystrokes'
-/// own spacing can exceed it).
-const CAP_ATTEMPTS: usize = 6;
-
 /// Physically-based interpolation of the key poses (Section 3.2). The result passes exactly
 /// through every key pose at its frame; see the `timing` notes in the crate docs for how each
 /// simulated interval is laid onto the keystrokes' frames, and [`PhysicsOptions::settle`] for
@@ -62,20 +58,27 @@ pub fn interpolate_physics(
         let sim = simulate(from, to.chain.angles(), &velocity, m, options)?;
         let whole: Vec<Vec<f64>> = (0..=sim.frames()).map(|i| sim.frame(i)).collect();
         let t_star = closest_frame(&whole, to.chain.angles());
-        let correction: Vec<f64> = to
-            .chain
-            .angles()
-            .iter()
-            .zip(&sim.frame(t_star))
-            .map(|(a, b)| a - b)
-            .collect();
+        let delta = |t: usize| -> Vec<f64> {
+            let at = sim.frame(t);
+            to.chain
+                .angles()
+                .iter()
+                .zip(&at)
+                .map(|(a, b)| a - b)
+                .collect()
+        };
+        let correction = delta(t_star);
+        // The first pass: the first local minimum of Eq. 2's distance (a later, closer swing
+        // would force a sped-up replay of several swings, which strobes).
+        let first = first_pass(&whole, to.chain.angles()).min(t_star);
+        let applied = delta(first);
         let interval = Interval {
             from,
             to,
             line: &line,
             options,
         };
-        let laid = interval.lay(&sim, t_star, &correction)?;
+        let laid = interval.lay(&sim, first, &applied)?;
         for (f, chain) in (from.frame + 1..).zip(laid.chains) {
             frames.push(AnimationFrame { frame: f, chain });
         }
@@ -86,6 +89,7 @@ pub fn interpolate_physics(
             simulated_frames: m,
             t_star,
             correction: correction.iter().map(|d| d * d).sum::<f64>().sqrt(),
+            first_pass: first,
             arrival: laid.arrival,
         });
     }
@@ -136,17 +140,17 @@ impl Interval<'_> {
             .chain
             .total_length()
             .max(self.to.chain.total_length());
+        // The approach at the simulation's own speed; slowed down (once, in proportion) when
+        // one of its frames would move a chain point by more than the cap.
         let mut arrival = (t_star as f64).min(gap);
-        let mut laid = self.lay_at(sim, t_star, correction, arrival)?;
-        for _ in 0..CAP_ATTEMPTS {
-            let jump = max_jump(&self.from.chain, &laid.chains);
-            if jump <= MAX_FRAME_MOTION * length || arrival >= gap || !jump.is_finite() {
-                break;
-            }
-            arrival = (arrival * 1.1 * jump / (MAX_FRAME_MOTION * length)).min(gap);
-            laid = self.lay_at(sim, t_star, correction, arrival)?;
+        let laid = self.lay_at(sim, t_star, correction, arrival)?;
+        let approach = &laid.chains[..(arrival.floor() as usize).min(laid.chains.len())];
+        let jump = max_jump(&self.from.chain, approach);
+        if arrival >= gap || !(jump > MAX_FRAME_MOTION * length) {
+            return Ok(laid);
         }
-        Ok(laid)
+        arrival = (arrival * jump / (MAX_FRAME_MOTION * length)).min(gap);
+        self.lay_at(sim, t_star, correction, arrival)
     }
 
     fn lay_at(
@@ -208,7 +212,9 @@ impl Interval<'_> {
             } else {
                 self.to.chain.angles().to_vec()
             };
-            let time = self.from.frame as f64 + t;
+            // Root and lengths follow the approach: their Hermite curves are replayed over
+            // the approach and hold the next keystroke's during the follow-through.
+            let time = self.from.frame as f64 + gap * (t / arrival).min(1.0);
             chains.push(Chain::new(
                 self.line.root_at(time),
                 angles,
@@ -264,6 +270,15 @@ fn settle(
             Chain::new(key.chain.root(), angles, key.chain.lengths().to_vec())
         })
         .collect()
+}
+
+/// The first simulated frame `i ≥ 1` whose distance to `target` is not larger than the next
+/// frame's (the first local minimum of LoA Eq. 2's objective).
+fn first_pass(frames: &[Vec<f64>], target: &[f64]) -> usize {
+    let dist = |a: &[f64]| -> f64 { a.iter().zip(target).map(|(x, y)| (x - y) * (x - y)).sum() };
+    (1..frames.len())
+        .find(|&i| i + 1 >= frames.len() || dist(&frames[i]) <= dist(&frames[i + 1]))
+        .unwrap_or(1)
 }
 
 fn add_scaled(a: &[f64], d: &[f64], w: f64) -> Vec<f64> {

@@ -166,6 +166,9 @@ pub struct AnimateOptions {
     pub weights: Weights,
     /// Cap on accepted iterations per stage (0 = [`DEFAULT_MAX_ITERATIONS`]).
     pub max_iterations: usize,
+    /// Planar stage continuation that frees the pelvis/chest after a first solve with them
+    /// held (experimental, off by default; see the crate docs' SPEC decisions).
+    pub free_pelvis: bool,
 }
 
 /// A character: skeleton plus initial pose.

@@ -188,9 +188,10 @@ pub(crate) fn run(
     // The turn joint of a chain (pelvis, chest) carries a sideways branch connector: turning
     // it, or any of its ancestors, swaps the connector's side — a discrete flip the solver
     // takes mid-clip (the children counter-rotating) when it starts from the initial pose.
-    // Continuation: solve first with the turn joints and their ancestors at their initial
-    // orientation (limbs and spine turn, the root translates), then free them, starting from
-    // that solution, so the pelvis turns and translates too without flipping.
+    // The turn joints and their ancestors keep their initial orientation (limbs and spine
+    // turn, the root translates). With `free_pelvis`, a continuation then frees them,
+    // starting from that solution (opt-in: it still lets Fig. 5's bone-set switch turn joints
+    // by up to 38° in a frame).
     let mut held = dof.clone();
     for k in &keys {
         for (i, c) in k.connector.iter().enumerate() {
@@ -221,7 +222,7 @@ pub(crate) fn run(
         height,
     };
     let mut planar = planar_stage(&held).solve(&mut poses, max_iterations);
-    if held != dof {
+    if options.free_pelvis && held != dof {
         let free = planar_stage(&dof).solve(&mut poses, max_iterations);
         planar = StageReport {
             unknowns: free.unknowns,
