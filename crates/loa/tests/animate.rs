@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anim::Skeleton;
 use loa::animate::{animate, AnimateOptions, BoneSetKey, Character, ContactKey, Motion, TwistKey};
-use loa::{line_of_action, Keystrokes, LineOptions, Mode};
+use loa::{Keystrokes, LineOptions, Mode};
 
 fn data(rel: &str) -> PathBuf {
     testdata::asset(rel)
@@ -46,7 +46,7 @@ fn line(keys: &[(i64, f64, f64)]) -> loa::Animation {
         mode: Mode::Hermite,
         ..Default::default()
     };
-    line_of_action(&keys, &options).unwrap().animation
+    loa::line(&keys, &options).unwrap().animation
 }
 
 fn sets(s: &[(&str, i64)]) -> Vec<BoneSetKey> {
