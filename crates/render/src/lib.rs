@@ -36,6 +36,7 @@
 //! ```
 
 mod animation;
+pub mod chart;
 mod color;
 mod colormap;
 mod draw;

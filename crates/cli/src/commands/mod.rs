@@ -12,9 +12,6 @@ pub mod smear_effects;
 mod smear_prepare;
 pub mod smear_style;
 pub mod stopmo;
-mod stopmo_curve;
-mod stopmo_library;
-mod stopmo_run;
 
 /// Options every command sees.
 #[derive(Debug, Clone, Copy)]
