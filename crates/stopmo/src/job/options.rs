@@ -15,7 +15,7 @@ use crate::segment::{PartSpec, SegmentOptions};
 pub const DEFAULT_PIECES: usize = 20;
 
 /// Options of [`segment`](crate::segment()).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default)]
 pub struct SegmentJobOptions {
     /// Named parts with their seeds (at least two), unless `auto_parts` is given.
@@ -27,17 +27,6 @@ pub struct SegmentJobOptions {
     /// γ (StopShop Eq. 1), boundary smoothing, snapping, homogenization, welding.
     #[serde(flatten)]
     pub segment: SegmentOptions,
-}
-
-impl Default for SegmentJobOptions {
-    fn default() -> Self {
-        SegmentJobOptions {
-            parts: Vec::new(),
-            auto_parts: None,
-            figure: false,
-            segment: SegmentOptions::default(),
-        }
-    }
 }
 
 /// How many pieces each part gets.
