@@ -40,6 +40,7 @@
 #![warn(missing_docs, unreachable_pub)]
 
 mod animation;
+pub mod chart;
 mod color;
 mod colormap;
 mod draw;

@@ -17,7 +17,7 @@ const INFINITE_D: u32 = u32::MAX;
 /// [`MaxFlow::solve`], then read the minimum cut with [`MaxFlow::is_sink_side`].
 ///
 /// ```
-/// use stopmo::segment::MaxFlow;
+/// use stopmo::segment::solver::MaxFlow;
 /// let mut g = MaxFlow::new(2);
 /// g.add_tweights(0, 3.0, 0.0);
 /// g.add_tweights(1, 0.0, 2.0);
