@@ -6,6 +6,8 @@ use std::path::{Path, PathBuf};
 
 use anim::{Mesh, MeshAnimation};
 
+use crate::usda::{UsdMesh, UsdStage};
+
 use crate::{write_atomic, Format, IoError, Result};
 
 /// How an animation is laid out in the output file.
@@ -34,13 +36,17 @@ pub enum Output<'a> {
         colors: Option<&'a [[f32; 4]]>,
     },
     /// Several point caches with the same frames, as one multi-node glTF (one node or node
-    /// group per part).
+    /// group per part), or one scene cache (`.usda`, `.usdc`, `.usdz`, `.abc`: one mesh per
+    /// part).
     Parts {
         /// `(animation, per-frame colours)` per part.
         parts: &'a [(&'a MeshAnimation, Option<&'a [[f32; 4]]>)],
         /// Flipbook or morph targets.
         layout: Layout,
     },
+    /// A whole USD stage (mesh prims with point caches or per-frame topology, e.g. motion
+    /// lines) as a scene cache: `.usda`, `.usdc`, `.usdz` or `.abc` (one PolyMesh per prim).
+    Stage(&'a UsdStage<'a>),
     /// A scalar per frame and vertex (`.npy`, float32, `frames × vertices`).
     Field {
         /// Number of frames.
@@ -81,7 +87,10 @@ pub fn save(path: &Path, output: &Output<'_>) -> Result<Vec<PathBuf>> {
             values,
         } => {
             expect_extension(path, Format::Npy, "a per-frame scalar field", ".npy")?;
-            put(path, &crate::npy::write_f32(&[frames, vertices], values).map_err(|e| e.at(path))?)?
+            put(
+                path,
+                &crate::npy::write_f32(&[frames, vertices], values).map_err(|e| e.at(path))?,
+            )?
         }
         Output::Mesh(mesh) => match output_format(path)? {
             #[cfg(feature = "obj")]
@@ -89,8 +98,9 @@ pub fn save(path: &Path, output: &Output<'_>) -> Result<Vec<PathBuf>> {
             #[cfg(feature = "stl")]
             Format::Stl => put(path, &crate::stl::write_binary(mesh))?,
             _ => {
-                let anim = MeshAnimation::new(mesh.clone(), anim::DEFAULT_FPS, mesh.positions.clone())
-                    .map_err(|e| IoError::from(e).at(path))?;
+                let anim =
+                    MeshAnimation::new(mesh.clone(), anim::DEFAULT_FPS, mesh.positions.clone())
+                        .map_err(|e| IoError::from(e).at(path))?;
                 return save(
                     path,
                     &Output::Animation {
@@ -101,10 +111,14 @@ pub fn save(path: &Path, output: &Output<'_>) -> Result<Vec<PathBuf>> {
                 );
             }
         },
+        Output::Stage(stage) => put(path, &write_stage(path, stage)?)?,
         Output::Parts { parts, layout } => {
-            expect_extension(path, Format::Glb, "several parts", ".glb")?;
-            let bytes = crate::gltf::write_animations(parts, gltf_layout(layout))
-                .map_err(|e| e.at(path))?;
+            let bytes = if output_format(path)? == Format::Glb {
+                crate::gltf::write_animations(parts, gltf_layout(layout)).map_err(|e| e.at(path))?
+            } else {
+                let stage = UsdStage::from_parts(parts).map_err(|e| e.at(path))?;
+                write_stage(path, &stage)?
+            };
             put(path, &bytes)?;
         }
         Output::Animation {
@@ -120,10 +134,27 @@ pub fn save(path: &Path, output: &Output<'_>) -> Result<Vec<PathBuf>> {
 fn output_format(path: &Path) -> Result<Format> {
     Format::from_extension(path).ok_or_else(|| {
         IoError::unsupported(
-            "unknown output extension (use .glb, .usda, .pc2, .mdd, .obj, .stl or .npy)",
+            "unknown output extension (use .glb, .usda, .usdc, .usdz, .abc, .pc2, .mdd, .obj, .stl or .npy)",
         )
         .at(path)
     })
+}
+
+/// A stage as a scene cache in the format `path` names.
+fn write_stage(path: &Path, stage: &UsdStage) -> Result<Vec<u8>> {
+    let bytes = match output_format(path)? {
+        Format::Usda => crate::usda::write(stage).map(String::into_bytes),
+        Format::Usdc => crate::usdc::write(stage),
+        Format::Usdz => crate::usdc::write_usdz(stage),
+        Format::Abc => crate::abc::write(stage),
+        _ => {
+            return Err(IoError::unsupported(
+                "a scene cache is written as .usda, .usdc, .usdz, .abc (or .glb for parts)",
+            )
+            .at(path))
+        }
+    };
+    bytes.map_err(|e| e.at(path))
 }
 
 fn expect_extension(path: &Path, want: Format, what: &str, ext: &str) -> Result<()> {
@@ -153,10 +184,9 @@ fn write_animation(
                 .map_err(|e| e.at(path))?;
             put(path, &bytes)
         }
-        Format::Gltf => Err(IoError::unsupported(
-            "toonkit writes binary glTF: name the output .glb",
-        )
-        .at(path)),
+        Format::Gltf => {
+            Err(IoError::unsupported("toonkit writes binary glTF: name the output .glb").at(path))
+        }
         format @ (Format::Pc2 | Format::Mdd) => {
             let bytes = if format == Format::Pc2 {
                 crate::pc2::write(anim)
@@ -182,12 +212,15 @@ fn write_animation(
         Format::Npy => {
             let flat: Vec<f32> = anim.positions().iter().flat_map(|p| p.to_array()).collect();
             let shape = [anim.frame_count(), anim.vertex_count(), 3];
-            put(path, &crate::npy::write_f32(&shape, &flat).map_err(|e| e.at(path))?)
+            put(
+                path,
+                &crate::npy::write_f32(&shape, &flat).map_err(|e| e.at(path))?,
+            )
         }
         Format::Bvh => Err(IoError::unsupported("BVH output holds skeletons, not meshes").at(path)),
-        Format::Usda => {
-            let text = crate::usda::write_animation(anim, colors).map_err(|e| e.at(path))?;
-            put(path, text.as_bytes())
+        Format::Usda | Format::Usdc | Format::Usdz | Format::Abc => {
+            let stage = UsdStage::new(anim.fps, vec![UsdMesh::animation(anim, colors)]);
+            put(path, &write_stage(path, &stage)?)
         }
         #[allow(unreachable_patterns)]
         _ => Err(IoError::unsupported("this build of toonkit cannot write that format").at(path)),
@@ -201,7 +234,10 @@ fn rest_mesh(
     anim: &MeshAnimation,
     put: &mut dyn FnMut(&Path, &[u8]) -> Result<()>,
 ) -> Result<()> {
-    put(&path.with_extension("obj"), crate::obj::write(&anim.mesh).as_bytes())
+    put(
+        &path.with_extension("obj"),
+        crate::obj::write(&anim.mesh).as_bytes(),
+    )
 }
 
 #[cfg(not(feature = "obj"))]

@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
+pub mod batch;
 pub mod convert;
 pub mod demo;
 pub mod info;
@@ -21,6 +22,8 @@ mod stopmo_run;
 pub struct Context {
     /// Print JSON on stdout instead of human text.
     pub json: bool,
+    /// Print no summary at all (the caller reports: shots of `toonkit batch`).
+    pub quiet: bool,
 }
 
 impl Context {
@@ -28,6 +31,9 @@ impl Context {
     /// A closed stdout (`toonkit --json info X | head`) is not an error: the work is done.
     pub fn report(&self, value: &serde_json::Value, text: impl FnOnce() -> String) {
         use std::io::Write as _;
+        if self.quiet {
+            return;
+        }
         let out = if self.json {
             serde_json::to_string_pretty(value).unwrap_or_default()
         } else {
