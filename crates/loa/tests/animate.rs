@@ -8,7 +8,11 @@ use loa::animate::{animate, AnimateOptions, BoneSetKey, Character, ContactKey, M
 use loa::{line_of_action, Keystrokes, LineOptions, Mode};
 
 fn data(rel: &str) -> PathBuf {
-    let p = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/")).join(rel);
+    let p = PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../assets/"
+    ))
+    .join(rel);
     assert!(p.exists(), "missing test asset {}", p.display());
     p
 }

@@ -8,7 +8,10 @@ use render::{
     Renderer, View, ViewDirection,
 };
 
-const SPOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/meshes/spot.obj");
+const SPOT: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../assets/meshes/spot.obj"
+);
 
 #[test]
 fn spot_three_quarter_preview() {

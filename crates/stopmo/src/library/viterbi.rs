@@ -236,8 +236,8 @@ pub(crate) fn label_step(
 
 #[cfg(test)]
 mod tests {
-    use super::*;
     use anim::SplitMix64;
+    use super::*;
 
     struct Case {
         p: Vec<f64>,
