@@ -27,6 +27,8 @@
 //! assert!(bytes.starts_with(b"PXR-USDC"));
 //! ```
 
+mod children;
+
 use std::io::Cursor;
 
 use anim::glam::Vec3;
@@ -64,7 +66,7 @@ pub fn write(stage: &UsdStage) -> Result<Vec<u8>> {
     let data = layer(stage)?;
     let mut out = Cursor::new(Vec::new());
     openusd::usdc::CrateWriter::write(&data, &mut out).map_err(|e| IoError::encode("USD", e))?;
-    Ok(out.into_inner())
+    children::retype_children(out.into_inner())
 }
 
 /// Writes a stage as a `.usdz` package: one `.usdc` layer (named after the root prim) stored
@@ -82,10 +84,31 @@ pub fn write_usdz(stage: &UsdStage) -> Result<Vec<u8>> {
     Ok(out.into_inner())
 }
 
+/// Lengths of `int[]` arrays that `openusd` 0.6 compresses but Pixar's USD reads as
+/// uncompressed (Pixar compresses from 16 elements, `openusd` from 4): refused rather than
+/// written wrong.
+const MISREAD_INT_ARRAYS: std::ops::Range<usize> = 4..16;
+
 /// The whole layer as `openusd` scene description.
 fn layer(stage: &UsdStage) -> Result<sdf::Data> {
     let sources = check(stage)?;
     let frames = stage.frame_count();
+    for (mesh, source) in stage.meshes.iter().zip(&sources) {
+        let small = (0..frames).find(|&f| {
+            let faces = source.faces(f);
+            let (c, i) = (faces.counts().len(), faces.indices().len());
+            MISREAD_INT_ARRAYS.contains(&c) || MISREAD_INT_ARRAYS.contains(&i)
+        });
+        if let Some(f) = small {
+            return Err(IoError::unsupported(format!(
+                "USD mesh '{}' frame {}: meshes of 2 to 15 faces cannot be written as .usdc yet \
+                 (the openusd crate compresses their index arrays in a way Pixar's USD misreads); \
+                 write .usda or .abc",
+                mesh.name,
+                f + 1
+            )));
+        }
+    }
     let root = sanitize_name(&stage.root);
     let t0 = stage.start_time_code;
     let mut data = sdf::Data::new();

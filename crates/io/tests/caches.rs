@@ -77,13 +77,18 @@ fn abc_robot_punch_round_trips_bit_exactly() {
 
 /// Motion-line-like frames: topology changes, one frame empty, per-vertex colours.
 fn line_frames() -> Vec<Mesh> {
+    line_frames_from(3)
+}
+
+/// As [`line_frames`] with `first` vertices on frame 0 (one more per frame).
+fn line_frames_from(first: usize) -> Vec<Mesh> {
     let mut out = Vec::new();
     for f in 0..4usize {
         if f == 2 {
             out.push(Mesh::new("empty", Vec::new(), Vec::new()));
             continue;
         }
-        let n = 3 + f;
+        let n = first + f;
         let positions: Vec<Vec3> = (0..n)
             .map(|i| Vec3::new(i as f32, f as f32, (i * f) as f32 * 0.5))
             .collect();
@@ -231,7 +236,8 @@ fn usdc_robot_punch_has_the_usda_prims_and_samples_and_is_3x_smaller() {
 
 #[test]
 fn usdc_and_usdz_of_varying_topology_and_save_by_extension() {
-    let frames = line_frames();
+    // 16 triangles and more: small index arrays are refused by the .usdc writer (below).
+    let frames = line_frames_from(18);
     let refs: Vec<&Mesh> = frames.iter().collect();
     let stage = UsdStage::new(24.0, vec![UsdMesh::frames("lines", refs)]);
     let dir = tempfile::tempdir().unwrap();
@@ -267,6 +273,19 @@ fn usdc_and_usdz_of_varying_topology_and_save_by_extension() {
         })
         .collect();
     assert_eq!(tokens, ["inherited", "inherited", "invisible", "inherited"]);
+    // A mesh of 2 to 15 faces is refused as .usdc (openusd 0.6 would write index arrays that
+    // Pixar's USD misreads), in one line naming the file and the way out.
+    let small = line_frames();
+    let stage = UsdStage::new(24.0, vec![UsdMesh::frames("small", small.iter().collect())]);
+    let p = dir.path().join("small.usdc");
+    let err = tkio::save(&p, &tkio::Output::Stage(&stage))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("small.usdc") && err.contains(".abc") && !err.contains('\n'),
+        "{err}"
+    );
+    assert!(!p.exists());
     // Loading a scene cache is refused in one line naming the file.
     let p = dir.path().join("lines.abc");
     let err = tkio::load(&p, &tkio::LoadOptions::default())
