@@ -6,9 +6,15 @@
 //! section is rewritten with every token-array representation retyped as `TokenVector` (toonkit
 //! writes no other token array), and the sections after it and the table of contents are moved
 //! by the size difference. Newer `openusd` releases (which need Rust ≥ 1.96) are not used.
+//!
+//! The file is also labelled crate version 0.8.0 (Pixar's default for new files), as the
+//! layout it uses needs (64-bit array sizes since 0.7.0; no newer value type is written):
+//! `openusd` labels it 0.12.0, which the USD 24.x inside Blender 4.2 refuses to open.
 
 use crate::{IoError, Result};
 
+/// Crate file version written: major, minor, patch.
+const CRATE_VERSION: [u8; 3] = [0, 8, 0];
 /// Crate value types (Pixar's `TypeEnum`).
 const TOKEN: u64 = 11;
 const TOKEN_VECTOR: u64 = 41;
@@ -94,6 +100,7 @@ pub(crate) fn retype_children(bytes: Vec<u8>) -> Result<Vec<u8>> {
         out.extend_from_slice(&(size as u64).to_le_bytes());
     }
     out[16..24].copy_from_slice(&(new_toc as u64).to_le_bytes());
+    out[8..11].copy_from_slice(&CRATE_VERSION);
     Ok(out)
 }
 
