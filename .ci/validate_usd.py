@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Validates every `*.usda` in DIR with Pixar's USD (`pip install usd-core`).
+"""Validates every `*.usda`, `*.usdc` and `*.usdz` in DIR with Pixar's USD (`pip install usd-core`).
 
 Usage: python3 .ci/validate_usd.py DIR
 
@@ -10,8 +10,8 @@ Per layer:
    has it (≤ 25.x); newer releases (26.x) replaced it by the UsdValidation framework that
    `usdchecker` runs, so every registered validator runs instead. Errors are failures;
    warnings are printed. Skipped, because they only concern `.usdz` packages (byte alignment,
-   compression, files inside a package) and never apply to a plain `.usda` layer: the usdz
-   package rules listed in USDZ_ONLY.
+   compression, files inside a package) and never apply to a plain `.usda`/`.usdc` layer: the
+   usdz package rules listed in USDZ_ONLY (they do run on `.usdz` packages).
 3. Geometry, for every UsdGeom.Mesh at every authored time code (or the default time):
    max(faceVertexIndices) + 1 <= len(points), sum(faceVertexCounts) == len(faceVertexIndices),
    every face count >= 3, UsdGeom.Mesh.ValidateTopology, finite points, an extent of two
@@ -19,7 +19,7 @@ Per layer:
    point.
 Tested with usd-core 24.11 (ComplianceChecker) and 26.11 (UsdValidation).
 Prints one line per failure, then "USD validation: N passed, M failed"; exits 1 on any failure
-(and 1 when DIR holds no .usda at all, so a broken test setup cannot pass silently).
+(and 1 when DIR holds no USD file at all, so a broken test setup cannot pass silently).
 """
 
 import pathlib
@@ -40,6 +40,7 @@ USDZ_ONLY = {
 
 def compliance(path):
     """Errors of Pixar's compliance rules (list of strings); warnings are printed."""
+    skipped = set() if path.suffix == ".usdz" else USDZ_ONLY
     checker_class = getattr(UsdUtils, "ComplianceChecker", None)
     errors = []
     if checker_class is not None:
@@ -47,8 +48,8 @@ def compliance(path):
                                 skipVariants=False, verbose=False)
         checker.CheckCompliance(str(path))
         errors += [e for e in checker.GetErrors()
-                   if not any(r in e for r in USDZ_ONLY)]
-        failed = [f for f in checker.GetFailedChecks() if not any(r in f for r in USDZ_ONLY)]
+                   if not any(r in e for r in skipped)]
+        failed = [f for f in checker.GetFailedChecks() if not any(r in f for r in skipped)]
         errors += [f"failed check: {f}" for f in failed]
         for w in checker.GetWarnings():
             print(f"{path.name}: warning: {w}")
@@ -57,7 +58,7 @@ def compliance(path):
 
     registry = UsdValidation.ValidationRegistry()
     validators = [v for v in registry.GetOrLoadAllValidators()
-                  if v.GetMetadata().name not in USDZ_ONLY]
+                  if v.GetMetadata().name not in skipped]
     stage = Usd.Stage.Open(str(path))
     context = UsdValidation.ValidationContext(validators)
     for e in context.Validate(stage):
@@ -161,7 +162,8 @@ def main():
     if len(sys.argv) != 2:
         print(__doc__.splitlines()[2])
         return 2
-    files = sorted(pathlib.Path(sys.argv[1]).rglob("*.usda"))
+    files = sorted(p for p in pathlib.Path(sys.argv[1]).rglob("*")
+                   if p.suffix in (".usda", ".usdc", ".usdz"))
     passed = failed = 0
     for path in files:
         failures = validate(path)
@@ -172,7 +174,7 @@ def main():
         else:
             passed += 1
     if not files:
-        print(f"no .usda file in {sys.argv[1]}")
+        print(f"no .usda/.usdc/.usdz file in {sys.argv[1]}")
     print(f"USD validation: {passed} passed, {failed} failed")
     return 1 if failed or not files else 0
 

@@ -37,23 +37,8 @@ enum Command {
     Smear(Box<commands::smear::SmearArgs>),
     /// Replacement libraries for 3D-printed stop-motion (StopShop).
     Stopmo(commands::stopmo::StopmoArgs),
-}
-
-/// Runs a parsed command line; `quiet` silences its summary.
-fn run(cli: Cli, quiet: bool) -> anyhow::Result<()> {
-    let ctx = commands::Context {
-        json: cli.json,
-        quiet,
-    };
-    match cli.command {
-        Command::Info(a) => commands::info::run(&ctx, a),
-        Command::Convert(a) => commands::convert::run(&ctx, a),
-        Command::Demo(a) => commands::demo::run(&ctx, a),
-        Command::Loa(a) => commands::loa::run(&ctx, a),
-        Command::Render(a) => commands::render::run(&ctx, a),
-        Command::Smear(a) => commands::smear::run(&ctx, *a),
-        Command::Stopmo(a) => commands::stopmo::run(&ctx, a),
-    }
+    /// Many shots from a manifest: in parallel here, or as an Open Job Description farm job.
+    Batch(commands::batch::BatchArgs),
 }
 
 /// Runs `toonkit ARGS…` in this process without printing its summary: the demo's steps are
@@ -64,7 +49,11 @@ pub(crate) fn run_args(args: &[String]) -> anyhow::Result<()> {
         let text = e.to_string();
         anyhow::anyhow!("{}", text.lines().next().unwrap_or("invalid arguments"))
     })?;
-    run(cli, true)
+    let ctx = commands::Context {
+        json: cli.json,
+        quiet: true,
+    };
+    run(&ctx, cli.command)
 }
 
 fn main() -> ExitCode {
@@ -80,14 +69,37 @@ fn main() -> ExitCode {
         }
         Err(e) => e.exit(), // --help, --version
     };
-    let result = run(cli, false);
-    match result {
+    let ctx = commands::Context {
+        json: cli.json,
+        quiet: false,
+    };
+    match run(&ctx, cli.command) {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.is::<commands::batch::ShotsFailed>() => {
+            let failed = e.downcast_ref::<commands::batch::ShotsFailed>();
+            eprintln!("toonkit: error: {e}");
+            ExitCode::from(failed.map_or(2, |f| f.exit_code()))
+        }
         Err(e) => {
             // One line: the cause chain joined, the file named by the innermost error.
             let msg = format!("{e:#}").replace('\n', " ");
             eprintln!("toonkit: error: {msg}");
             ExitCode::from(2)
         }
+    }
+}
+
+/// Runs one parsed command (the binary's dispatcher; `toonkit batch` runs its shots through
+/// it too).
+fn run(ctx: &commands::Context, command: Command) -> anyhow::Result<()> {
+    match command {
+        Command::Info(a) => commands::info::run(ctx, a),
+        Command::Convert(a) => commands::convert::run(ctx, a),
+        Command::Demo(a) => commands::demo::run(ctx, a),
+        Command::Loa(a) => commands::loa::run(ctx, a),
+        Command::Render(a) => commands::render::run(ctx, a),
+        Command::Smear(a) => commands::smear::run(ctx, *a),
+        Command::Stopmo(a) => commands::stopmo::run(ctx, a),
+        Command::Batch(a) => commands::batch::run(ctx, a),
     }
 }

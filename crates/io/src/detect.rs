@@ -25,8 +25,14 @@ pub enum Format {
     Stl,
     /// NumPy array.
     Npy,
-    /// USD layer (`.usda`): written by toonkit, never read.
+    /// USD text layer (`.usda`): written by toonkit, never read.
     Usda,
+    /// USD binary crate file (`.usdc`): written by toonkit, never read.
+    Usdc,
+    /// USDZ package (`.usdz`, one `.usdc` layer): written by toonkit, never read.
+    Usdz,
+    /// Alembic archive (`.abc`, Ogawa): written by toonkit; [`crate::abc::read`] reads it back.
+    Abc,
 }
 
 impl Format {
@@ -43,6 +49,9 @@ impl Format {
             "stl" => Format::Stl,
             "npy" => Format::Npy,
             "usda" => Format::Usda,
+            "usdc" => Format::Usdc,
+            "usdz" => Format::Usdz,
+            "abc" => Format::Abc,
             _ => return None,
         })
     }
@@ -61,8 +70,17 @@ pub fn detect(bytes: &[u8], path: &Path) -> Option<Format> {
     if bytes.starts_with(b"\x93NUMPY") {
         return Some(Format::Npy);
     }
-    if bytes.starts_with(b"#usda") || bytes.starts_with(b"PXR-USDC") {
+    if bytes.starts_with(b"#usda") {
         return Some(Format::Usda);
+    }
+    if bytes.starts_with(b"PXR-USDC") {
+        return Some(Format::Usdc);
+    }
+    if crate::abc::is_ogawa(bytes) {
+        return Some(Format::Abc);
+    }
+    if bytes.starts_with(b"PK\x03\x04") && ext == Some(Format::Usdz) {
+        return Some(Format::Usdz);
     }
     if bytes.len() >= 84 {
         let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
@@ -169,8 +187,11 @@ fn load_as(path: &Path, bytes: &[u8], format: Format, options: &LoadOptions) -> 
             }
         }
         Format::Npy => Err(IoError::unsupported("a .npy array is not an animation")),
-        Format::Usda => Err(IoError::unsupported(
-            "USD input is not supported (toonkit only writes .usda; export glTF/GLB instead)",
+        Format::Usda | Format::Usdc | Format::Usdz => Err(IoError::unsupported(
+            "USD input is not supported (toonkit only writes .usda/.usdc/.usdz; export glTF/GLB instead)",
+        )),
+        Format::Abc => Err(IoError::unsupported(
+            "Alembic input is not supported (toonkit only writes .abc; export glTF/GLB instead)",
         )),
         #[allow(unreachable_patterns)]
         _ => Err(IoError::unsupported(format!(

@@ -49,6 +49,17 @@ pub enum IoError {
         /// What is not supported.
         message: String,
     },
+    /// A format library failed to encode the data (USD binary, USDZ). The message says why;
+    /// report it as a bug with the command that produced it.
+    #[error("{path}: cannot write {format}: {source}")]
+    Encode {
+        /// File.
+        path: FilePath,
+        /// Format name.
+        format: &'static str,
+        /// The library's error.
+        source: Box<dyn std::error::Error + Send + Sync + 'static>,
+    },
     /// The file parsed but its content is inconsistent (e.g. NaN positions, bad indices).
     #[error("{path}: {source}")]
     Anim {
@@ -77,6 +88,18 @@ impl IoError {
         }
     }
 
+    /// An encoding error of a format library, without a path yet.
+    pub fn encode(
+        format: &'static str,
+        source: impl Into<Box<dyn std::error::Error + Send + Sync + 'static>>,
+    ) -> IoError {
+        IoError::Encode {
+            path: FilePath::default(),
+            format,
+            source: source.into(),
+        }
+    }
+
     /// An OS error on `path`.
     pub fn io(path: &Path, source: std::io::Error) -> IoError {
         IoError::Io {
@@ -91,6 +114,7 @@ impl IoError {
             IoError::Io { path, .. }
             | IoError::Malformed { path, .. }
             | IoError::Unsupported { path, .. }
+            | IoError::Encode { path, .. }
             | IoError::Anim { path, .. } => path,
         };
         if slot.0.as_os_str().is_empty() {

@@ -1,8 +1,9 @@
 //! # toonkit-io
 //!
 //! Reading and writing animation files: glTF 2.0 (`.gltf`/`.glb`), OBJ and OBJ sequences, PC2
-//! and MDD point caches, binary STL, BVH motion capture, and NPY arrays; USD layers (`.usda`)
-//! are written only. Formats are detected by content. Every reader returns [`IoError`] on bad
+//! and MDD point caches, binary STL, BVH motion capture, and NPY arrays; scene caches are
+//! written only: USD layers (`.usda` text, `.usdc` binary, `.usdz` package) and Alembic
+//! archives (`.abc`, with a reader for checking them). Formats are detected by content. Every reader returns [`IoError`] on bad
 //! bytes, never panics; every writer produces bytes, and [`write_atomic`] puts them on disk.
 //!
 //! This crate does no algorithm work beyond format conversion.
@@ -13,6 +14,7 @@ mod atomic;
 mod error;
 mod save;
 
+pub mod abc;
 pub mod bvh;
 pub mod mdd;
 pub mod npy;
@@ -22,8 +24,9 @@ pub mod pc2;
 #[cfg(feature = "stl")]
 pub mod stl;
 pub mod usda;
+pub mod usdc;
 
-pub use atomic::{read_file, write_atomic};
+pub use atomic::{read_file, remove_stale_temps, write_atomic};
 pub use error::{FilePath, IoError, Result};
 pub use save::{save, Layout, Output};
 

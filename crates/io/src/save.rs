@@ -6,6 +6,8 @@ use std::path::{Path, PathBuf};
 
 use anim::{Flipbook, Mesh, MeshAnimation};
 
+use crate::usda::{UsdMesh, UsdStage};
+
 use crate::{write_atomic, Format, IoError, Result};
 
 /// How an animation is laid out in the output file.
@@ -34,7 +36,8 @@ pub enum Output<'a> {
         colors: Option<&'a [[f32; 4]]>,
     },
     /// Several point caches with the same frames, as one multi-node glTF (one node or node
-    /// group per part) or one USD layer (one Mesh prim per part, `.usda`).
+    /// group per part), or one scene cache (`.usda`, `.usdc`, `.usdz`, `.abc`: one mesh per
+    /// part).
     Parts {
         /// `(animation, per-frame colours)` per part.
         parts: &'a [(&'a MeshAnimation, Option<&'a [[f32; 4]]>)],
@@ -43,17 +46,21 @@ pub enum Output<'a> {
     },
     /// Parts with the same frames, some with a topology that changes per frame (a
     /// stylization result): `.glb` (one root node per part, one child per frame with
-    /// geometry, visibility keyed) or `.usda` (one Mesh prim per part).
+    /// geometry, visibility keyed) or a scene cache (`.usda`, `.usdc`, `.usdz`, `.abc`: one
+    /// mesh per part).
     Flipbook(&'a Flipbook),
     /// A body and its motion lines (one mesh per frame, possibly empty): `.glb` (the body's
-    /// and the lines' frames as visibility-keyed nodes) or `.usda` (the body's point cache and
-    /// one `motion_lines` Mesh prim with per-frame topology).
+    /// and the lines' frames as visibility-keyed nodes) or a scene cache (the body's point
+    /// cache and one `motion_lines` mesh with per-frame topology).
     MotionLines {
         /// The body's point cache.
         body: &'a MeshAnimation,
         /// The lines of every frame.
         lines: &'a [Mesh],
     },
+    /// A whole USD stage (mesh prims with point caches or per-frame topology, e.g. motion
+    /// lines) as a scene cache: `.usda`, `.usdc`, `.usdz` or `.abc` (one PolyMesh per prim).
+    Stage(&'a UsdStage<'a>),
     /// A scalar per frame and vertex (`.npy`, float32, `frames × vertices`).
     Field {
         /// Number of frames.
@@ -118,28 +125,32 @@ pub fn save(path: &Path, output: &Output<'_>) -> Result<Vec<PathBuf>> {
                 );
             }
         },
+        Output::Stage(stage) => put(path, &write_stage(path, stage)?)?,
         Output::Parts { parts, layout } => {
-            let bytes = match scene_format(path, "several parts")? {
-                Format::Usda => crate::usda::write_parts(parts).map(String::into_bytes),
-                _ => crate::gltf::write_animations(parts, gltf_layout(layout)),
-            }
-            .map_err(|e| e.at(path))?;
+            let bytes = if output_format(path)? == Format::Glb {
+                crate::gltf::write_animations(parts, gltf_layout(layout)).map_err(|e| e.at(path))?
+            } else {
+                let stage = UsdStage::from_parts(parts).map_err(|e| e.at(path))?;
+                write_stage(path, &stage)?
+            };
             put(path, &bytes)?;
         }
         Output::Flipbook(book) => {
-            let bytes = match scene_format(path, "a flipbook")? {
-                Format::Usda => crate::flipbook::flipbook_usda(book).map(String::into_bytes),
-                _ => crate::gltf::write_glb(&crate::flipbook::flipbook_scene(book)),
-            }
-            .map_err(|e| e.at(path))?;
+            let bytes = if output_format(path)? == Format::Glb {
+                crate::gltf::write_glb(&crate::flipbook::flipbook_scene(book))
+                    .map_err(|e| e.at(path))?
+            } else {
+                write_stage(path, &crate::flipbook::flipbook_stage(book))?
+            };
             put(path, &bytes)?;
         }
         Output::MotionLines { body, lines } => {
-            let bytes = match scene_format(path, "motion lines")? {
-                Format::Usda => crate::flipbook::lines_usda(body, lines).map(String::into_bytes),
-                _ => crate::gltf::write_glb(&crate::flipbook::lines_scene(body, lines)),
-            }
-            .map_err(|e| e.at(path))?;
+            let bytes = if output_format(path)? == Format::Glb {
+                crate::gltf::write_glb(&crate::flipbook::lines_scene(body, lines))
+                    .map_err(|e| e.at(path))?
+            } else {
+                write_stage(path, &crate::flipbook::lines_stage(body, lines))?
+            };
             put(path, &bytes)?;
         }
         Output::Animation {
@@ -155,10 +166,27 @@ pub fn save(path: &Path, output: &Output<'_>) -> Result<Vec<PathBuf>> {
 fn output_format(path: &Path) -> Result<Format> {
     Format::from_extension(path).ok_or_else(|| {
         IoError::unsupported(
-            "unknown output extension (use .glb, .usda, .pc2, .mdd, .obj, .stl or .npy)",
+            "unknown output extension (use .glb, .usda, .usdc, .usdz, .abc, .pc2, .mdd, .obj, .stl or .npy)",
         )
         .at(path)
     })
+}
+
+/// A stage as a scene cache in the format `path` names.
+fn write_stage(path: &Path, stage: &UsdStage) -> Result<Vec<u8>> {
+    let bytes = match output_format(path)? {
+        Format::Usda => crate::usda::write(stage).map(String::into_bytes),
+        Format::Usdc => crate::usdc::write(stage),
+        Format::Usdz => crate::usdc::write_usdz(stage),
+        Format::Abc => crate::abc::write(stage),
+        _ => {
+            return Err(IoError::unsupported(
+                "a scene cache is written as .usda, .usdc, .usdz, .abc (or .glb for parts)",
+            )
+            .at(path))
+        }
+    };
+    bytes.map_err(|e| e.at(path))
 }
 
 fn expect_extension(path: &Path, want: Format, what: &str, ext: &str) -> Result<()> {
@@ -166,14 +194,6 @@ fn expect_extension(path: &Path, want: Format, what: &str, ext: &str) -> Result<
         return Err(IoError::unsupported(format!("{what} is written as {ext}")).at(path));
     }
     Ok(())
-}
-
-/// `.glb` or `.usda` for outputs with several parts, else an error naming both.
-fn scene_format(path: &Path, what: &str) -> Result<Format> {
-    match output_format(path)? {
-        f @ (Format::Glb | Format::Usda) => Ok(f),
-        _ => Err(IoError::unsupported(format!("{what} is written as .glb or .usda")).at(path)),
-    }
 }
 
 fn gltf_layout(layout: Layout) -> crate::gltf::AnimationLayout {
@@ -230,9 +250,9 @@ fn write_animation(
             )
         }
         Format::Bvh => Err(IoError::unsupported("BVH output holds skeletons, not meshes").at(path)),
-        Format::Usda => {
-            let text = crate::usda::write_animation(anim, colors).map_err(|e| e.at(path))?;
-            put(path, text.as_bytes())
+        Format::Usda | Format::Usdc | Format::Usdz | Format::Abc => {
+            let stage = UsdStage::new(anim.fps, vec![UsdMesh::animation(anim, colors)]);
+            put(path, &write_stage(path, &stage)?)
         }
         #[allow(unreachable_patterns)]
         _ => Err(IoError::unsupported("this build of toonkit cannot write that format").at(path)),

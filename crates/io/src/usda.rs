@@ -73,6 +73,7 @@
 //! ```
 
 mod names;
+pub(crate) mod source;
 mod stage;
 mod write;
 

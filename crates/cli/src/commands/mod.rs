@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
+pub mod batch;
 pub mod convert;
 pub mod demo;
 pub mod info;
@@ -13,7 +14,8 @@ pub mod stopmo;
 pub struct Context {
     /// Print JSON on stdout instead of human text.
     pub json: bool,
-    /// Print no summary at all (a step of `toonkit demo` or `toonkit batch`).
+    /// Print no summary at all (the caller reports: steps of `toonkit demo`, shots of
+    /// `toonkit batch`).
     pub quiet: bool,
 }
 

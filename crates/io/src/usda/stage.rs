@@ -2,6 +2,8 @@
 
 use anim::{Mesh, MeshAnimation, DEFAULT_FPS};
 
+use crate::{IoError, Result};
+
 /// Name of the root `Xform` prim (the layer's `defaultPrim`) unless the caller picks one.
 pub const DEFAULT_ROOT_NAME: &str = "root";
 /// Time code of the first frame: frame `k` is written at `DEFAULT_START_TIME_CODE + k`
@@ -92,6 +94,22 @@ impl<'a> UsdStage<'a> {
             meters_per_unit: DEFAULT_METERS_PER_UNIT,
             meshes,
         }
+    }
+
+    /// Several point caches with the same frames: one mesh prim per cache (named after its
+    /// mesh, with its optional per-frame colours), the first cache's frame rate.
+    ///
+    /// # Errors
+    /// When `parts` is empty.
+    pub fn from_parts(parts: &'a [(&'a MeshAnimation, Option<&'a [[f32; 4]]>)]) -> Result<Self> {
+        let Some((first, _)) = parts.first() else {
+            return Err(IoError::unsupported("nothing to write"));
+        };
+        let meshes = parts
+            .iter()
+            .map(|(a, c)| UsdMesh::animation(a, *c))
+            .collect();
+        Ok(UsdStage::new(first.fps, meshes))
     }
 
     /// Number of frames: the longest geometry (at least 1).

@@ -3,21 +3,18 @@
 use std::fmt::Write as _;
 
 use anim::glam::Vec3;
-use anim::{Mesh, MeshAnimation};
+use anim::MeshAnimation;
 use rayon::prelude::*;
 
 use super::names::{sanitize_name, UniqueNames};
-use super::stage::{UsdGeometry, UsdMesh, UsdStage};
-use crate::{IoError, Result};
+use super::source::{check, extent, ColorsOf, Faces, Source};
+use super::stage::UsdStage;
+use crate::Result;
 
 /// Indentation of a mesh prim's properties (inside `def Xform { def Mesh { … } }`).
 const PROP: &str = "        ";
 /// Indentation of one time sample.
 const SAMPLE: &str = "            ";
-/// Colour of present frames that carry no vertex colour while others do (white, opaque,
-/// as glTF renders a primitive without `COLOR_0`).
-const NO_COLOR: [f32; 4] = [1.0, 1.0, 1.0, 1.0];
-
 /// Writes one point cache as a `.usda` layer: a root `Xform` with one `Mesh`.
 ///
 /// # Arguments
@@ -42,14 +39,7 @@ pub fn write_animation(anim: &MeshAnimation, colors: Option<&[[f32; 4]]>) -> Res
 /// When there is nothing to write, frame counts differ, colours have the wrong length, or
 /// a triangle indexes a missing vertex.
 pub fn write_parts(parts: &[(&MeshAnimation, Option<&[[f32; 4]]>)]) -> Result<String> {
-    let Some((first, _)) = parts.first() else {
-        return Err(IoError::unsupported("nothing to write"));
-    };
-    let meshes = parts
-        .iter()
-        .map(|(a, c)| UsdMesh::animation(a, *c))
-        .collect();
-    write(&UsdStage::new(first.fps, meshes))
+    write(&UsdStage::from_parts(parts)?)
 }
 
 /// Writes a whole stage as `.usda` text (see the [module documentation](super) for the
@@ -59,25 +49,8 @@ pub fn write_parts(parts: &[(&MeshAnimation, Option<&[[f32; 4]]>)]) -> Result<St
 /// A non-positive or non-finite frame rate or unit scale, point caches whose frame counts
 /// differ from the stage's, colour arrays of the wrong length, faces indexing missing vertices.
 pub fn write(stage: &UsdStage) -> Result<String> {
-    if !(stage.fps.is_finite() && stage.fps > 0.0) {
-        return Err(IoError::unsupported(format!(
-            "USD export needs a positive frame rate, got {}",
-            stage.fps
-        )));
-    }
-    let units_ok = stage.meters_per_unit.is_finite() && stage.meters_per_unit > 0.0;
-    if !(stage.start_time_code.is_finite() && units_ok) {
-        return Err(IoError::unsupported(format!(
-            "USD export needs a finite start time code and a positive metersPerUnit, got {} and {}",
-            stage.start_time_code, stage.meters_per_unit
-        )));
-    }
+    let sources = check(stage)?;
     let frames = stage.frame_count();
-    let sources = stage
-        .meshes
-        .iter()
-        .map(|m| Source::new(m, frames))
-        .collect::<Result<Vec<_>>>()?;
     let root = sanitize_name(&stage.root);
     let t0 = stage.start_time_code;
     let mut out = String::with_capacity(estimate(&sources));
@@ -112,40 +85,7 @@ fn estimate(sources: &[Source]) -> usize {
         + 1024
 }
 
-/// The faces of a frame.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Faces<'a> {
-    Triangles(&'a [[u32; 3]]),
-    Polygons(&'a [Vec<u32>]),
-}
-
 impl Faces<'_> {
-    /// Faces of a mesh: its polygons when it has usable ones (≥ 3 sides each), else triangles.
-    fn of(mesh: &Mesh) -> Faces<'_> {
-        match &mesh.polygons {
-            Some(p) if !p.is_empty() && p.iter().all(|f| f.len() >= 3) => Faces::Polygons(p),
-            _ => Faces::Triangles(&mesh.triangles),
-        }
-    }
-
-    fn check(&self, vertices: usize, what: &str) -> Result<()> {
-        let bad = |i: u32| {
-            Err(IoError::unsupported(format!(
-                "{what}: a face uses vertex {i} but the mesh has {vertices} vertices"
-            )))
-        };
-        match self {
-            Faces::Triangles(t) => match t.iter().flatten().find(|&&i| i as usize >= vertices) {
-                Some(&i) => bad(i),
-                None => Ok(()),
-            },
-            Faces::Polygons(p) => match p.iter().flatten().find(|&&i| i as usize >= vertices) {
-                Some(&i) => bad(i),
-                None => Ok(()),
-            },
-        }
-    }
-
     fn write_counts(&self, out: &mut String) {
         match self {
             Faces::Triangles(t) => write_list(out, t.iter(), |o, _| o.push('3')),
@@ -165,134 +105,16 @@ impl Faces<'_> {
     }
 }
 
-/// One mesh prim's frames, checked.
-struct Source<'a> {
-    geometry: &'a UsdGeometry<'a>,
-    frames: usize,
-}
-
-impl<'a> Source<'a> {
-    fn new(mesh: &'a UsdMesh<'a>, frames: usize) -> Result<Source<'a>> {
-        let what = format!("USD mesh '{}'", mesh.name);
-        match &mesh.geometry {
-            UsdGeometry::Animation { animation, colors } => {
-                if animation.frame_count() != frames {
-                    return Err(IoError::unsupported(format!(
-                        "{what} has {} frames, expected {frames} like the other meshes",
-                        animation.frame_count()
-                    )));
-                }
-                let n = animation.vertex_count();
-                if let Some(c) = colors {
-                    if c.len() != n * frames {
-                        return Err(IoError::unsupported(format!(
-                            "{what}: expected {} vertex colours (frames × vertices), got {}",
-                            n * frames,
-                            c.len()
-                        )));
-                    }
-                }
-                Faces::of(&animation.mesh).check(n, &what)?;
-            }
-            UsdGeometry::Frames(meshes) => {
-                for (f, m) in meshes.iter().enumerate() {
-                    let what = format!("{what} frame {}", f + 1);
-                    Faces::of(m).check(m.vertex_count(), &what)?;
-                    if let Some(c) = m.colors.as_ref().filter(|c| c.len() != m.vertex_count()) {
-                        return Err(IoError::unsupported(format!(
-                            "{what}: {} vertex colours for {} vertices",
-                            c.len(),
-                            m.vertex_count()
-                        )));
-                    }
-                }
-            }
-        }
-        Ok(Source {
-            geometry: &mesh.geometry,
-            frames,
-        })
-    }
-
-    /// The mesh of frame `f` when the geometry is per-frame and the frame has a drawable one.
-    fn frame_mesh(&self, f: usize) -> Option<&'a Mesh> {
-        match self.geometry {
-            UsdGeometry::Frames(m) => m
-                .get(f)
-                .copied()
-                .filter(|m| m.vertex_count() > 0 && !m.triangles.is_empty()),
-            UsdGeometry::Animation { .. } => None,
-        }
-    }
-
-    fn points(&self, f: usize) -> &'a [Vec3] {
-        match self.geometry {
-            UsdGeometry::Animation { animation, .. } => match animation.vertex_count() {
-                0 => &[],
-                _ => animation.frame(f),
-            },
-            UsdGeometry::Frames(_) => self.frame_mesh(f).map_or(&[], |m| &m.positions),
-        }
-    }
-
-    fn faces(&self, f: usize) -> Faces<'a> {
-        match self.geometry {
-            UsdGeometry::Animation { animation, .. } => Faces::of(&animation.mesh),
-            UsdGeometry::Frames(_) => self
-                .frame_mesh(f)
-                .map_or(Faces::Triangles(&[]), |m| Faces::of(m)),
-        }
-    }
-
-    /// Colours of frame `f`, `None` when the prim has no colour at all.
-    fn colors(&self, f: usize) -> Option<ColorsOf<'a>> {
-        match self.geometry {
-            UsdGeometry::Animation { animation, colors } => {
-                let n = animation.vertex_count();
-                colors.map(|c| ColorsOf::Given(&c[f * n..(f + 1) * n]))
-            }
-            UsdGeometry::Frames(meshes) => {
-                if !meshes.iter().any(|m| m.colors.is_some()) {
-                    return None;
-                }
-                Some(match self.frame_mesh(f) {
-                    Some(m) => match &m.colors {
-                        Some(c) => ColorsOf::Given(c),
-                        None => ColorsOf::Default(m.vertex_count()),
-                    },
-                    None => ColorsOf::Given(&[]),
-                })
-            }
-        }
-    }
-
-    /// Whether frame `f` shows anything: some face, and (with colours) some non-zero alpha.
-    fn present(&self, f: usize) -> bool {
-        match self.geometry {
-            UsdGeometry::Animation { animation, colors } => {
-                let n = animation.vertex_count();
-                let has_faces = match Faces::of(&animation.mesh) {
-                    Faces::Triangles(t) => !t.is_empty(),
-                    Faces::Polygons(p) => !p.is_empty(),
-                };
-                n > 0
-                    && has_faces
-                    && colors.is_none_or(|c| c[f * n..(f + 1) * n].iter().any(|c| c[3] > 0.0))
-            }
-            UsdGeometry::Frames(_) => self.frame_mesh(f).is_some(),
-        }
-    }
-
+impl Source<'_> {
     /// Writes every property of the prim.
     fn write(&self, out: &mut String, t0: f64) {
         let frames = self.frames;
-        let all_same = |eq: &dyn Fn(usize) -> bool| (1..frames).all(eq);
         out.push_str(PROP);
         out.push_str("uniform token orientation = \"rightHanded\"\n");
         out.push_str(PROP);
         out.push_str("uniform token subdivisionScheme = \"none\"\n");
 
-        let topology_static = all_same(&|f| self.faces(f) == self.faces(0));
+        let topology_static = self.topology_static();
         let counts = |o: &mut String, f: usize| self.faces(f).write_counts(o);
         let indices = |o: &mut String, f: usize| self.faces(f).write_indices(o);
         attribute(
@@ -314,7 +136,7 @@ impl<'a> Source<'a> {
             &indices,
         );
 
-        let points_static = all_same(&|f| same_bits(self.points(f), self.points(0)));
+        let points_static = self.points_static();
         let points = |o: &mut String, f: usize| write_points(o, self.points(f));
         let extent = |o: &mut String, f: usize| write_extent(o, self.points(f));
         attribute(
@@ -338,25 +160,16 @@ impl<'a> Source<'a> {
 
         // Texture coordinates of a point cache (fixed topology): USD's `st` has v up from
         // the image's bottom, toonkit's (glTF's) v down from its top.
-        if let UsdGeometry::Animation { animation, .. } = self.geometry {
-            let n = animation.vertex_count();
-            if let Some(uvs) = animation
-                .mesh
-                .uvs
-                .as_ref()
-                .filter(|u| u.len() == n && n > 0)
-            {
-                let st = |o: &mut String, _: usize| {
-                    write_list(o, uvs.iter(), |o, uv| push_tuple(o, &[uv[0], 1.0 - uv[1]]))
-                };
-                let decl = "texCoord2f[] primvars:st";
-                attribute(out, decl, VERTEX, true, frames, t0, &st);
-            }
+        if let Some(uvs) = self.uvs() {
+            let st = |o: &mut String, _: usize| {
+                write_list(o, uvs.iter(), |o, uv| push_tuple(o, &[uv[0], 1.0 - uv[1]]))
+            };
+            let decl = "texCoord2f[] primvars:st";
+            attribute(out, decl, VERTEX, true, frames, t0, &st);
         }
 
         if self.colors(0).is_some() {
-            let colors_static = topology_static
-                && all_same(&|f| self.colors(f).unwrap().same(&self.colors(0).unwrap()));
+            let colors_static = self.colors_static();
             let rgb = |o: &mut String, f: usize| self.colors(f).unwrap().write_rgb(o);
             let alpha = |o: &mut String, f: usize| self.colors(f).unwrap().write_alpha(o);
             let (c, a) = (
@@ -367,7 +180,7 @@ impl<'a> Source<'a> {
             attribute(out, a, VERTEX, colors_static, frames, t0, &alpha);
         }
 
-        if (0..frames).any(|f| !self.present(f)) {
+        if self.any_absent() {
             let vis = |o: &mut String, f: usize| {
                 o.push_str(if self.present(f) {
                     "\"inherited\""
@@ -375,7 +188,7 @@ impl<'a> Source<'a> {
                     "\"invisible\""
                 })
             };
-            let vis_static = all_same(&|f| self.present(f) == self.present(0));
+            let vis_static = self.presence_static();
             attribute(out, "token visibility", None, vis_static, frames, t0, &vis);
         }
     }
@@ -384,34 +197,7 @@ impl<'a> Source<'a> {
 /// Metadata of vertex-interpolated primvars.
 const VERTEX: Option<&str> = Some("interpolation = \"vertex\"");
 
-/// Colours of one frame: given, or `n` times [`NO_COLOR`].
-#[derive(Debug, Clone, Copy)]
-enum ColorsOf<'a> {
-    Given(&'a [[f32; 4]]),
-    Default(usize),
-}
-
 impl ColorsOf<'_> {
-    fn get(&self, i: usize) -> [f32; 4] {
-        match self {
-            ColorsOf::Given(c) => c[i],
-            ColorsOf::Default(_) => NO_COLOR,
-        }
-    }
-
-    fn len(&self) -> usize {
-        match self {
-            ColorsOf::Given(c) => c.len(),
-            ColorsOf::Default(n) => *n,
-        }
-    }
-
-    fn same(&self, other: &ColorsOf) -> bool {
-        self.len() == other.len()
-            && (0..self.len())
-                .all(|i| self.get(i).map(f32::to_bits) == other.get(i).map(f32::to_bits))
-    }
-
     fn write_rgb(&self, out: &mut String) {
         write_list(out, 0..self.len(), |o, i| {
             let c = self.get(i);
@@ -512,26 +298,8 @@ fn write_points(out: &mut String, points: &[Vec3]) {
     write_list(out, points.iter(), |o, p| push_tuple(o, &p.to_array()));
 }
 
-/// `[(min), (max)]` of the points as written (non-finite coordinates count as 0); the
-/// zero box for no point.
+/// `[(min), (max)]` of the points as written (see [`extent`]).
 fn write_extent(out: &mut String, points: &[Vec3]) {
-    let clean = |v: f32| if v.is_finite() { v } else { 0.0 };
-    let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-    for p in points {
-        let q = Vec3::new(clean(p.x), clean(p.y), clean(p.z));
-        lo = lo.min(q);
-        hi = hi.max(q);
-    }
-    if points.is_empty() {
-        (lo, hi) = (Vec3::ZERO, Vec3::ZERO);
-    }
+    let (lo, hi) = extent(points);
     write_list(out, [lo, hi].iter(), |o, p| push_tuple(o, &p.to_array()));
-}
-
-/// Bitwise equality of two point sets (so that NaN frames compare equal to themselves).
-fn same_bits(a: &[Vec3], b: &[Vec3]) -> bool {
-    a.len() == b.len()
-        && a.iter()
-            .zip(b)
-            .all(|(p, q)| p.to_array().map(f32::to_bits) == q.to_array().map(f32::to_bits))
 }

@@ -1,0 +1,304 @@
+//! `toonkit batch`: shots from a manifest in parallel, skip/resume by stamp (a killed batch
+//! re-run finishes without redoing a completed shot), failing shots reported with the exit
+//! code, Open Job Description templates.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::{Duration, Instant, SystemTime};
+
+use common::{data, s, toonkit};
+
+/// A manifest of `shots` (TOML tables without the `[[shot]]` line) written in `dir`.
+fn manifest(dir: &Path, shots: &[String]) -> PathBuf {
+    let text: String = shots.iter().map(|t| format!("[[shot]]\n{t}\n\n")).collect();
+    let p = dir.join("shots.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn shot(name: &str, tool: &str, input: &Path, clip: &str, outputs: &[&str]) -> String {
+    format!(
+        "name = \"{name}\"\ntool = \"{tool}\"\ninput = \"{}\"\nclip = \"{clip}\"\noutputs = {outputs:?}",
+        s(input)
+    )
+}
+
+/// Stamps present in `out`, with their modification times.
+fn stamps(out: &Path) -> Vec<(String, SystemTime)> {
+    let Ok(dir) = std::fs::read_dir(out.join(".toonkit-batch")) else {
+        return Vec::new();
+    };
+    let mut v: Vec<_> = dir
+        .flatten()
+        .filter(|e| e.path().extension().is_some_and(|x| x == "json"))
+        .map(|e| {
+            let name = e.path().file_stem().unwrap().to_string_lossy().into_owned();
+            (name, e.metadata().unwrap().modified().unwrap())
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+fn mtime(p: &Path) -> SystemTime {
+    std::fs::metadata(p).unwrap().modified().unwrap()
+}
+
+/// Every output is a valid file of its format.
+fn assert_valid(path: &Path) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    match path.extension().unwrap().to_str().unwrap() {
+        "abc" => {
+            let a = tkio::abc::read(&bytes).unwrap();
+            assert!(!a.meshes[0].frames.is_empty(), "{}", path.display());
+        }
+        "usdc" => assert_eq!(tkio::detect(&bytes, path), Some(tkio::Format::Usdc)),
+        "pc2" => {
+            let c = common::read_pc2(path);
+            assert!(c.frame_count() > 1, "{}", path.display());
+        }
+        other => panic!("unexpected output .{other}"),
+    }
+}
+
+#[test]
+fn killed_batch_resumes_without_redoing_completed_shots() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = data("characters/RobotExpressive.glb");
+    let shots = vec![
+        shot(
+            "a_punch",
+            "convert",
+            &robot,
+            "Punch",
+            &["a/punch.pc2", "a/punch.abc"],
+        ),
+        shot(
+            "b_dance",
+            "smear elongate",
+            &robot,
+            "Dance",
+            &["b/dance.usdc", "b/dance.pc2"],
+        ),
+        shot(
+            "c_punch",
+            "smear elongate",
+            &robot,
+            "Punch",
+            &["c/punch.abc", "c/punch.pc2"],
+        ),
+        shot(
+            "d_dance",
+            "convert",
+            &robot,
+            "Dance",
+            &["d/dance.abc", "d/dance.usdc"],
+        ),
+    ];
+    let m = manifest(dir.path(), &shots);
+    let out = dir.path().join("out");
+    // One shot at a time; kill the batch as soon as the first shot is stamped.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_toonkit"))
+        .args(["batch", s(&m), "-o", s(&out), "--jobs", "1"])
+        .spawn()
+        .unwrap();
+    let t = Instant::now();
+    while stamps(&out).is_empty() && t.elapsed() < Duration::from_secs(120) {
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    let before = stamps(&out);
+    assert!(!before.is_empty(), "no shot finished before the kill");
+    assert!(
+        before.len() < 4,
+        "every shot finished before the kill: {before:?}"
+    );
+    let kept: Vec<(PathBuf, SystemTime)> = ["a/punch.pc2", "a/punch.abc"]
+        .iter()
+        .map(|o| (out.join(o), mtime(&out.join(o))))
+        .collect();
+
+    let summary = common::json(&["batch", s(&m), "-o", s(&out), "--jobs", "2"]);
+    let status: Vec<(&str, &str)> = summary["shots"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| (r["name"].as_str().unwrap(), r["status"].as_str().unwrap()))
+        .collect();
+    for (name, st) in &status {
+        let was_done = before.iter().any(|(n, _)| n == name);
+        let want = if was_done { "skipped" } else { "done" };
+        assert_eq!(*st, want, "shot {name}: {summary}");
+    }
+    assert_eq!(summary["failed"], 0);
+    // Completed shots were not redone: stamps and outputs untouched.
+    let after = stamps(&out);
+    for (name, time) in &before {
+        assert!(
+            after.contains(&(name.clone(), *time)),
+            "stamp of {name} rewritten"
+        );
+    }
+    for (p, time) in &kept {
+        assert_eq!(mtime(p), *time, "{} rewritten", p.display());
+    }
+    for o in [
+        "a/punch.pc2",
+        "a/punch.abc",
+        "b/dance.usdc",
+        "b/dance.pc2",
+        "c/punch.abc",
+        "c/punch.pc2",
+        "d/dance.abc",
+        "d/dance.usdc",
+    ] {
+        assert_valid(&out.join(o));
+    }
+    assert_eq!(after.len(), 4);
+    // No temporary file of the killed writer is left behind.
+    for sub in ["a", "b", "c", "d"] {
+        for e in std::fs::read_dir(out.join(sub)).unwrap().flatten() {
+            let n = e.file_name().to_string_lossy().into_owned();
+            assert!(!n.ends_with(".tmp"), "left behind: {n}");
+        }
+    }
+    // A third run does nothing; changing a shot's options redoes that shot only.
+    let again = common::json(&["batch", s(&m), "-o", s(&out)]);
+    assert_eq!(again["skipped"], 4, "{again}");
+    let mut changed = shots.clone();
+    changed[3] = changed[3].replace("clip = \"Dance\"", "clip = \"Punch\"");
+    let m = manifest(dir.path(), &changed);
+    let third = common::json(&["batch", s(&m), "-o", s(&out)]);
+    assert_eq!(
+        (third["skipped"].as_u64(), third["done"].as_u64()),
+        (Some(3), Some(1)),
+        "{third}"
+    );
+}
+
+#[test]
+fn a_failing_shot_is_reported_and_the_others_are_made() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = data("characters/RobotExpressive.glb");
+    let shots = vec![
+        shot("good", "convert", &robot, "Punch", &["good.abc"]),
+        shot("bad_clip", "convert", &robot, "NoSuchClip", &["bad.abc"]),
+        shot(
+            "missing",
+            "convert",
+            &dir.path().join("absent.glb"),
+            "Punch",
+            &["m.abc"],
+        ),
+        shot("good2", "convert", &robot, "Wave", &["good2.usdc"]),
+    ];
+    let m = manifest(dir.path(), &shots);
+    let out = dir.path().join("out");
+    let run = toonkit(&["--json", "batch", s(&m), "-o", s(&out), "--jobs", "2"]);
+    assert_eq!(run.status.code(), Some(2), "exit code = failed shots");
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        stderr.contains("2 of 4 shots failed") && !stderr.contains("panicked"),
+        "{stderr}"
+    );
+    let summary: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    assert_eq!(
+        (summary["done"].as_u64(), summary["failed"].as_u64()),
+        (Some(2), Some(2))
+    );
+    for r in summary["shots"].as_array().unwrap() {
+        let name = r["name"].as_str().unwrap();
+        if name.starts_with("good") {
+            assert_eq!(r["status"], "done", "{r}");
+        } else {
+            assert_eq!(r["status"], "failed", "{r}");
+            let e = r["error"].as_str().unwrap();
+            assert!(
+                e.contains(&format!("shot '{name}'")) && !e.contains('\n'),
+                "{e}"
+            );
+        }
+    }
+    assert!(summary["shots"][1]["error"]
+        .as_str()
+        .unwrap()
+        .contains("NoSuchClip"));
+    assert!(summary["shots"][2]["error"]
+        .as_str()
+        .unwrap()
+        .contains("absent.glb"));
+    assert_valid(&out.join("good.abc"));
+    assert_valid(&out.join("good2.usdc"));
+    assert!(!out.join("bad.abc").exists() && !out.join("m.abc").exists());
+    // One shot only, by name.
+    let one = common::json(&["batch", s(&m), "-o", s(&out), "--shot", "good"]);
+    assert_eq!(
+        (
+            one["skipped"].as_u64(),
+            one["shots"].as_array().unwrap().len()
+        ),
+        (Some(1), 1)
+    );
+    // A bad manifest is one line, exit 2.
+    std::fs::write(&m, "[[shot]]\nname = \"x\"\n").unwrap();
+    common::assert_bad_input(&["batch", s(&m)], "shots.toml");
+}
+
+#[test]
+fn openjd_template_has_one_step_per_tool_and_one_task_per_shot() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = data("characters/RobotExpressive.glb");
+    let shots = vec![
+        shot("p1", "convert", &robot, "Punch", &["p1.abc"]),
+        shot("p2", "smear elongate", &robot, "Punch", &["p2.abc"]),
+        shot("p3", "convert", &robot, "Wave", &["p3.usdc"]),
+    ];
+    let m = manifest(dir.path(), &shots);
+    let job = dir.path().join("job.yaml");
+    common::ok(&[
+        "batch",
+        s(&m),
+        "-o",
+        s(&dir.path().join("out")),
+        "--openjd",
+        s(&job),
+    ]);
+    let text = std::fs::read_to_string(&job).unwrap();
+    assert!(
+        text.contains("specificationVersion: \"jobtemplate-2023-09\""),
+        "{text}"
+    );
+    // Steps in order of first use, each listing its shots as the task parameter's range.
+    let at = |needle: &str| {
+        text.find(needle)
+            .unwrap_or_else(|| panic!("{needle}:\n{text}"))
+    };
+    let order = [
+        at("- name: \"convert\""),
+        at("- \"p1\""),
+        at("- \"p3\""),
+        at("- name: \"smear\""),
+        at("- \"p2\""),
+    ];
+    assert!(order.windows(2).all(|w| w[0] < w[1]), "{text}");
+    assert_eq!(text.matches("name: \"Shot\"").count(), 2, "{text}");
+    for p in [
+        "ManifestFile",
+        "OutputDir",
+        "Toonkit",
+        "{{Task.Param.Shot}}",
+    ] {
+        assert!(text.contains(p), "{p} missing:\n{text}");
+    }
+    assert!(!out_exists(dir.path()), "--openjd runs nothing");
+}
+
+fn out_exists(dir: &Path) -> bool {
+    dir.join("out").exists()
+}

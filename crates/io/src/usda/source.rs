@@ -1,0 +1,337 @@
+//! The checked view of a [`UsdStage`] that every scene-cache writer reads (`.usda` text,
+//! `.usdc` binary, `.abc` Alembic): per frame, the points, faces, colours and presence of each
+//! mesh prim, so all three formats hold the same prims and samples.
+
+use anim::glam::Vec3;
+use anim::Mesh;
+
+use super::stage::{UsdGeometry, UsdMesh, UsdStage};
+use crate::{IoError, Result};
+
+/// Checks a stage (frame rate, units, frame counts, colour lengths, face indices) and returns
+/// one [`Source`] per mesh prim, in order.
+///
+/// # Errors
+/// A non-positive or non-finite frame rate or unit scale, point caches whose frame counts
+/// differ from the stage's, colour arrays of the wrong length, faces indexing missing vertices.
+pub(crate) fn check<'a>(stage: &'a UsdStage<'a>) -> Result<Vec<Source<'a>>> {
+    if !(stage.fps.is_finite() && stage.fps > 0.0) {
+        return Err(IoError::unsupported(format!(
+            "USD export needs a positive frame rate, got {}",
+            stage.fps
+        )));
+    }
+    let units_ok = stage.meters_per_unit.is_finite() && stage.meters_per_unit > 0.0;
+    if !(stage.start_time_code.is_finite() && units_ok) {
+        return Err(IoError::unsupported(format!(
+            "USD export needs a finite start time code and a positive metersPerUnit, got {} and {}",
+            stage.start_time_code, stage.meters_per_unit
+        )));
+    }
+    let frames = stage.frame_count();
+    stage
+        .meshes
+        .iter()
+        .map(|m| Source::new(m, frames))
+        .collect()
+}
+
+/// The bounding box `(min, max)` of the points as written (non-finite coordinates count as
+/// 0); the zero box for no point.
+pub(crate) fn extent(points: &[Vec3]) -> (Vec3, Vec3) {
+    let clean = |v: f32| if v.is_finite() { v } else { 0.0 };
+    let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    for p in points {
+        let q = Vec3::new(clean(p.x), clean(p.y), clean(p.z));
+        lo = lo.min(q);
+        hi = hi.max(q);
+    }
+    if points.is_empty() {
+        (lo, hi) = (Vec3::ZERO, Vec3::ZERO);
+    }
+    (lo, hi)
+}
+
+/// A coordinate as written: NaN and ±∞ become 0.
+pub(crate) fn finite(v: f32) -> f32 {
+    if v.is_finite() {
+        v
+    } else {
+        0.0
+    }
+}
+
+/// Bitwise equality of two point sets (so that NaN frames compare equal to themselves).
+pub(crate) fn same_bits(a: &[Vec3], b: &[Vec3]) -> bool {
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(p, q)| p.to_array().map(f32::to_bits) == q.to_array().map(f32::to_bits))
+}
+
+/// Colour of present frames that carry no vertex colour while others do (white, opaque,
+/// as glTF renders a primitive without `COLOR_0`).
+pub(crate) const NO_COLOR: [f32; 4] = [1.0, 1.0, 1.0, 1.0];
+
+/// The faces of a frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Faces<'a> {
+    /// Triangles of a mesh without polygons.
+    Triangles(&'a [[u32; 3]]),
+    /// The mesh's own polygons.
+    Polygons(&'a [Vec<u32>]),
+}
+
+impl Faces<'_> {
+    /// Number of vertices of every face, in order.
+    pub(crate) fn counts(&self) -> Vec<i32> {
+        match self {
+            Faces::Triangles(t) => vec![3; t.len()],
+            Faces::Polygons(p) => p.iter().map(|f| f.len() as i32).collect(),
+        }
+    }
+
+    /// Vertex indices of every face, concatenated.
+    pub(crate) fn indices(&self) -> Vec<i32> {
+        match self {
+            Faces::Triangles(t) => t.iter().flatten().map(|&i| i as i32).collect(),
+            Faces::Polygons(p) => p.iter().flatten().map(|&i| i as i32).collect(),
+        }
+    }
+
+    /// Faces of a mesh: its polygons when it has usable ones (≥ 3 sides each), else triangles.
+    pub(crate) fn of(mesh: &Mesh) -> Faces<'_> {
+        match &mesh.polygons {
+            Some(p) if !p.is_empty() && p.iter().all(|f| f.len() >= 3) => Faces::Polygons(p),
+            _ => Faces::Triangles(&mesh.triangles),
+        }
+    }
+
+    pub(crate) fn check(&self, vertices: usize, what: &str) -> Result<()> {
+        let bad = |i: u32| {
+            Err(IoError::unsupported(format!(
+                "{what}: a face uses vertex {i} but the mesh has {vertices} vertices"
+            )))
+        };
+        match self {
+            Faces::Triangles(t) => match t.iter().flatten().find(|&&i| i as usize >= vertices) {
+                Some(&i) => bad(i),
+                None => Ok(()),
+            },
+            Faces::Polygons(p) => match p.iter().flatten().find(|&&i| i as usize >= vertices) {
+                Some(&i) => bad(i),
+                None => Ok(()),
+            },
+        }
+    }
+}
+
+/// One mesh prim's frames, checked.
+pub(crate) struct Source<'a> {
+    /// The prim's geometry.
+    pub(crate) geometry: &'a UsdGeometry<'a>,
+    /// Frames of the stage.
+    pub(crate) frames: usize,
+}
+
+impl<'a> Source<'a> {
+    /// Checks one mesh prim against the stage's frame count.
+    pub(crate) fn new(mesh: &'a UsdMesh<'a>, frames: usize) -> Result<Source<'a>> {
+        let what = format!("USD mesh '{}'", mesh.name);
+        match &mesh.geometry {
+            UsdGeometry::Animation { animation, colors } => {
+                if animation.frame_count() != frames {
+                    return Err(IoError::unsupported(format!(
+                        "{what} has {} frames, expected {frames} like the other meshes",
+                        animation.frame_count()
+                    )));
+                }
+                let n = animation.vertex_count();
+                if let Some(c) = colors {
+                    if c.len() != n * frames {
+                        return Err(IoError::unsupported(format!(
+                            "{what}: expected {} vertex colours (frames × vertices), got {}",
+                            n * frames,
+                            c.len()
+                        )));
+                    }
+                }
+                Faces::of(&animation.mesh).check(n, &what)?;
+            }
+            UsdGeometry::Frames(meshes) => {
+                for (f, m) in meshes.iter().enumerate() {
+                    let what = format!("{what} frame {}", f + 1);
+                    Faces::of(m).check(m.vertex_count(), &what)?;
+                    if let Some(c) = m.colors.as_ref().filter(|c| c.len() != m.vertex_count()) {
+                        return Err(IoError::unsupported(format!(
+                            "{what}: {} vertex colours for {} vertices",
+                            c.len(),
+                            m.vertex_count()
+                        )));
+                    }
+                }
+            }
+        }
+        Ok(Source {
+            geometry: &mesh.geometry,
+            frames,
+        })
+    }
+
+    /// The mesh of frame `f` when the geometry is per-frame and the frame has a drawable one.
+    pub(crate) fn frame_mesh(&self, f: usize) -> Option<&'a Mesh> {
+        match self.geometry {
+            UsdGeometry::Frames(m) => m
+                .get(f)
+                .copied()
+                .filter(|m| m.vertex_count() > 0 && !m.triangles.is_empty()),
+            UsdGeometry::Animation { .. } => None,
+        }
+    }
+
+    /// Points of frame `f` (empty when absent).
+    pub(crate) fn points(&self, f: usize) -> &'a [Vec3] {
+        match self.geometry {
+            UsdGeometry::Animation { animation, .. } => match animation.vertex_count() {
+                0 => &[],
+                _ => animation.frame(f),
+            },
+            UsdGeometry::Frames(_) => self.frame_mesh(f).map_or(&[], |m| &m.positions),
+        }
+    }
+
+    /// Faces of frame `f` (none when absent).
+    pub(crate) fn faces(&self, f: usize) -> Faces<'a> {
+        match self.geometry {
+            UsdGeometry::Animation { animation, .. } => Faces::of(&animation.mesh),
+            UsdGeometry::Frames(_) => self
+                .frame_mesh(f)
+                .map_or(Faces::Triangles(&[]), |m| Faces::of(m)),
+        }
+    }
+
+    /// Colours of frame `f`, `None` when the prim has no colour at all.
+    pub(crate) fn colors(&self, f: usize) -> Option<ColorsOf<'a>> {
+        match self.geometry {
+            UsdGeometry::Animation { animation, colors } => {
+                let n = animation.vertex_count();
+                colors.map(|c| ColorsOf::Given(&c[f * n..(f + 1) * n]))
+            }
+            UsdGeometry::Frames(meshes) => {
+                if !meshes.iter().any(|m| m.colors.is_some()) {
+                    return None;
+                }
+                Some(match self.frame_mesh(f) {
+                    Some(m) => match &m.colors {
+                        Some(c) => ColorsOf::Given(c),
+                        None => ColorsOf::Default(m.vertex_count()),
+                    },
+                    None => ColorsOf::Given(&[]),
+                })
+            }
+        }
+    }
+
+    /// Whether frame `f` shows anything: some face, and (with colours) some non-zero alpha.
+    pub(crate) fn present(&self, f: usize) -> bool {
+        match self.geometry {
+            UsdGeometry::Animation { animation, colors } => {
+                let n = animation.vertex_count();
+                let has_faces = match Faces::of(&animation.mesh) {
+                    Faces::Triangles(t) => !t.is_empty(),
+                    Faces::Polygons(p) => !p.is_empty(),
+                };
+                n > 0
+                    && has_faces
+                    && colors.is_none_or(|c| c[f * n..(f + 1) * n].iter().any(|c| c[3] > 0.0))
+            }
+            UsdGeometry::Frames(_) => self.frame_mesh(f).is_some(),
+        }
+    }
+
+    /// True when `eq(f)` holds for every frame after the first.
+    fn all_frames(&self, eq: impl Fn(usize) -> bool) -> bool {
+        (1..self.frames).all(eq)
+    }
+
+    /// Whether every frame has the faces of frame 0.
+    pub(crate) fn topology_static(&self) -> bool {
+        let first = self.faces(0);
+        self.all_frames(|f| self.faces(f) == first)
+    }
+
+    /// Whether every frame has the points of frame 0 (bitwise).
+    pub(crate) fn points_static(&self) -> bool {
+        let first = self.points(0);
+        self.all_frames(|f| same_bits(self.points(f), first))
+    }
+
+    /// Whether the colours (when there are any) are the same on every frame.
+    pub(crate) fn colors_static(&self) -> bool {
+        let Some(first) = self.colors(0) else {
+            return true;
+        };
+        self.topology_static()
+            && self.all_frames(|f| self.colors(f).is_some_and(|c| c.same(&first)))
+    }
+
+    /// Whether some frame is absent (nothing to draw).
+    pub(crate) fn any_absent(&self) -> bool {
+        (0..self.frames).any(|f| !self.present(f))
+    }
+
+    /// Whether every frame is present, or every frame absent.
+    pub(crate) fn presence_static(&self) -> bool {
+        let first = self.present(0);
+        self.all_frames(|f| self.present(f) == first)
+    }
+
+    /// Texture coordinates of a point cache (one per vertex, toonkit's v-down convention).
+    pub(crate) fn uvs(&self) -> Option<&'a [[f32; 2]]> {
+        match self.geometry {
+            UsdGeometry::Animation { animation, .. } => {
+                let n = animation.vertex_count();
+                animation
+                    .mesh
+                    .uvs
+                    .as_deref()
+                    .filter(|u| u.len() == n && n > 0)
+            }
+            UsdGeometry::Frames(_) => None,
+        }
+    }
+}
+
+/// Colours of one frame: given, or `n` times [`NO_COLOR`].
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum ColorsOf<'a> {
+    /// One colour per vertex.
+    Given(&'a [[f32; 4]]),
+    /// `n` vertices without colour.
+    Default(usize),
+}
+
+impl ColorsOf<'_> {
+    /// Colour of vertex `i`.
+    pub(crate) fn get(&self, i: usize) -> [f32; 4] {
+        match self {
+            ColorsOf::Given(c) => c[i],
+            ColorsOf::Default(_) => NO_COLOR,
+        }
+    }
+
+    /// Number of vertices.
+    pub(crate) fn len(&self) -> usize {
+        match self {
+            ColorsOf::Given(c) => c.len(),
+            ColorsOf::Default(n) => *n,
+        }
+    }
+
+    /// Bitwise equality.
+    pub(crate) fn same(&self, other: &ColorsOf) -> bool {
+        self.len() == other.len()
+            && (0..self.len())
+                .all(|i| self.get(i).map(f32::to_bits) == other.get(i).map(f32::to_bits))
+    }
+}
