@@ -1,0 +1,83 @@
+"""Type stubs of the compiled core (import ``toonkit`` instead)."""
+
+import os
+from typing import Any, Callable, Mapping, Optional, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+class ToonkitError(Exception):
+    """A toonkit file or computation failed; the message is the CLI's one-line error."""
+
+class Scene:
+    """A clip sampled at a fixed frame rate (objects merged in order)."""
+
+    @staticmethod
+    def from_arrays(
+        positions: npt.ArrayLike,
+        triangles: npt.ArrayLike,
+        fps: float = 24.0,
+        skin: Optional[Mapping[str, Any]] = None,
+    ) -> Scene: ...
+    @property
+    def positions(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def triangles(self) -> npt.NDArray[np.int32]: ...
+    @property
+    def fps(self) -> float: ...
+    @property
+    def frame_count(self) -> int: ...
+    @property
+    def vertex_count(self) -> int: ...
+    @property
+    def joint_names(self) -> list[str]: ...
+    @property
+    def cameras(self) -> list[str]: ...
+    @property
+    def objects(self) -> list[tuple[str, range]]: ...
+    @property
+    def skin(self) -> Optional[dict[str, Any]]: ...
+
+def load(
+    path: Union[str, os.PathLike[str]],
+    clip: Optional[Union[str, int]] = None,
+    fps: float = 24.0,
+) -> Scene: ...
+def smear_offsets(
+    scene: Scene,
+    smooth: int = 2,
+    whole_body: bool = False,
+    prune: Sequence[str] = ...,
+    camera: Optional[Union[str, int]] = None,
+    progress: Optional[Callable[[str, float], Any]] = None,
+) -> npt.NDArray[np.float32]: ...
+
+class Line:
+    """An animated line of action: one chain of joints per frame."""
+
+    @property
+    def points(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def angles(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def lengths(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def frames(self) -> list[int]: ...
+    @property
+    def keystroke_frames(self) -> list[int]: ...
+    @property
+    def fps(self) -> float: ...
+    def to_json(self) -> str: ...
+    def save(self, path: Union[str, os.PathLike[str]]) -> os.PathLike[str]: ...
+
+def loa_line(
+    keystrokes_json: str,
+    mode: str = "physics",
+    fps: Optional[float] = None,
+    elements: int = 10,
+    substeps: int = 8,
+    simulated_frames: Optional[Union[int, str]] = None,
+    progress: Optional[Callable[[str, float], Any]] = None,
+) -> Line: ...

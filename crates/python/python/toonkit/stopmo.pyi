@@ -1,0 +1,1 @@
+"""Replacement libraries for 3D-printed stop-motion (type stubs)."""
