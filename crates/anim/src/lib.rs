@@ -21,6 +21,7 @@
 mod camera;
 mod clip;
 mod error;
+mod flipbook;
 mod mesh;
 mod mesh_animation;
 mod rng;
@@ -33,6 +34,7 @@ mod transform;
 pub use camera::{Camera, Projection};
 pub use clip::{frame_count, Channel, Clip, Interpolation, Property, MAX_FRAMES};
 pub use error::{AnimError, Result};
+pub use flipbook::{Flipbook, FlipbookPart};
 pub use mesh::{triangulate_polygon, vertex_normals, Aabb, Mesh};
 pub use mesh_animation::{MeshAnimation, DEFAULT_FPS};
 pub use rng::{mix, SplitMix64};

@@ -82,8 +82,15 @@ pub fn merged(path: &Path, sampled: &SampledScene) -> Result<MeshAnimation> {
     if sampled.objects.is_empty() {
         anyhow::bail!("{}: the file has no mesh", path.display());
     }
-    let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh");
     sampled
-        .merged(name)
+        .merged(&merged_name(path))
         .with_context(|| path.display().to_string())
+}
+
+/// Name of the merged point cache of an input: its file stem (`mesh` when it has none).
+pub fn merged_name(path: &Path) -> String {
+    path.file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("mesh")
+        .to_string()
 }

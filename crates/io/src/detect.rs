@@ -145,7 +145,9 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Loaded> {
 
 fn load_as(path: &Path, bytes: &[u8], format: Format, options: &LoadOptions) -> Result<Loaded> {
     match format {
-        Format::Glb | Format::Gltf => crate::gltf::read(path).map(|s| Loaded::Scene(Box::new(s))),
+        Format::Glb | Format::Gltf => {
+            crate::gltf_read::read_bytes_at(bytes, path).map(|s| Loaded::Scene(Box::new(s)))
+        }
         Format::Bvh => crate::bvh::read(bytes).map(|s| Loaded::Scene(Box::new(s))),
         #[cfg(feature = "obj")]
         Format::Obj => {

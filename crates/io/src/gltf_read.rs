@@ -35,6 +35,12 @@ pub fn read_bytes(bytes: &[u8]) -> Result<Scene> {
     read_with_base(bytes, None)
 }
 
+/// Reads a glTF document already read from `path` (external buffers are found beside it):
+/// what [`load`](crate::load) calls, so the file is read once.
+pub(crate) fn read_bytes_at(bytes: &[u8], path: &Path) -> Result<Scene> {
+    read_with_base(bytes, path.parent())
+}
+
 fn read_with_base(bytes: &[u8], base: Option<&Path>) -> Result<Scene> {
     precheck(bytes)?;
     // gltf-json's validation indexes some arrays unchecked; `precheck` covers the known

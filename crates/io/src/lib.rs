@@ -26,6 +26,7 @@ pub use error::{FilePath, IoError, Result};
 pub use save::{save, Layout, Output};
 
 mod detect;
+mod flipbook;
 mod gltf_accessors;
 mod gltf_attributes;
 mod gltf_flipbook;

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anim::{Mesh, MeshAnimation};
+use anim::{Flipbook, Mesh, MeshAnimation};
 
 use crate::{write_atomic, Format, IoError, Result};
 
@@ -34,12 +34,25 @@ pub enum Output<'a> {
         colors: Option<&'a [[f32; 4]]>,
     },
     /// Several point caches with the same frames, as one multi-node glTF (one node or node
-    /// group per part).
+    /// group per part) or one USD layer (one Mesh prim per part, `.usda`).
     Parts {
         /// `(animation, per-frame colours)` per part.
         parts: &'a [(&'a MeshAnimation, Option<&'a [[f32; 4]]>)],
         /// Flipbook or morph targets.
         layout: Layout,
+    },
+    /// Parts with the same frames, some with a topology that changes per frame (a
+    /// stylization result): `.glb` (one root node per part, one child per frame with
+    /// geometry, visibility keyed) or `.usda` (one Mesh prim per part).
+    Flipbook(&'a Flipbook),
+    /// A body and its motion lines (one mesh per frame, possibly empty): `.glb` (the body's
+    /// and the lines' frames as visibility-keyed nodes) or `.usda` (the body's point cache and
+    /// one `motion_lines` Mesh prim with per-frame topology).
+    MotionLines {
+        /// The body's point cache.
+        body: &'a MeshAnimation,
+        /// The lines of every frame.
+        lines: &'a [Mesh],
     },
     /// A scalar per frame and vertex (`.npy`, float32, `frames × vertices`).
     Field {
@@ -81,7 +94,10 @@ pub fn save(path: &Path, output: &Output<'_>) -> Result<Vec<PathBuf>> {
             values,
         } => {
             expect_extension(path, Format::Npy, "a per-frame scalar field", ".npy")?;
-            put(path, &crate::npy::write_f32(&[frames, vertices], values).map_err(|e| e.at(path))?)?
+            put(
+                path,
+                &crate::npy::write_f32(&[frames, vertices], values).map_err(|e| e.at(path))?,
+            )?
         }
         Output::Mesh(mesh) => match output_format(path)? {
             #[cfg(feature = "obj")]
@@ -89,8 +105,9 @@ pub fn save(path: &Path, output: &Output<'_>) -> Result<Vec<PathBuf>> {
             #[cfg(feature = "stl")]
             Format::Stl => put(path, &crate::stl::write_binary(mesh))?,
             _ => {
-                let anim = MeshAnimation::new(mesh.clone(), anim::DEFAULT_FPS, mesh.positions.clone())
-                    .map_err(|e| IoError::from(e).at(path))?;
+                let anim =
+                    MeshAnimation::new(mesh.clone(), anim::DEFAULT_FPS, mesh.positions.clone())
+                        .map_err(|e| IoError::from(e).at(path))?;
                 return save(
                     path,
                     &Output::Animation {
@@ -102,9 +119,27 @@ pub fn save(path: &Path, output: &Output<'_>) -> Result<Vec<PathBuf>> {
             }
         },
         Output::Parts { parts, layout } => {
-            expect_extension(path, Format::Glb, "several parts", ".glb")?;
-            let bytes = crate::gltf::write_animations(parts, gltf_layout(layout))
-                .map_err(|e| e.at(path))?;
+            let bytes = match scene_format(path, "several parts")? {
+                Format::Usda => crate::usda::write_parts(parts).map(String::into_bytes),
+                _ => crate::gltf::write_animations(parts, gltf_layout(layout)),
+            }
+            .map_err(|e| e.at(path))?;
+            put(path, &bytes)?;
+        }
+        Output::Flipbook(book) => {
+            let bytes = match scene_format(path, "a flipbook")? {
+                Format::Usda => crate::flipbook::flipbook_usda(book).map(String::into_bytes),
+                _ => crate::gltf::write_glb(&crate::flipbook::flipbook_scene(book)),
+            }
+            .map_err(|e| e.at(path))?;
+            put(path, &bytes)?;
+        }
+        Output::MotionLines { body, lines } => {
+            let bytes = match scene_format(path, "motion lines")? {
+                Format::Usda => crate::flipbook::lines_usda(body, lines).map(String::into_bytes),
+                _ => crate::gltf::write_glb(&crate::flipbook::lines_scene(body, lines)),
+            }
+            .map_err(|e| e.at(path))?;
             put(path, &bytes)?;
         }
         Output::Animation {
@@ -133,6 +168,14 @@ fn expect_extension(path: &Path, want: Format, what: &str, ext: &str) -> Result<
     Ok(())
 }
 
+/// `.glb` or `.usda` for outputs with several parts, else an error naming both.
+fn scene_format(path: &Path, what: &str) -> Result<Format> {
+    match output_format(path)? {
+        f @ (Format::Glb | Format::Usda) => Ok(f),
+        _ => Err(IoError::unsupported(format!("{what} is written as .glb or .usda")).at(path)),
+    }
+}
+
 fn gltf_layout(layout: Layout) -> crate::gltf::AnimationLayout {
     match layout {
         Layout::Morph => crate::gltf::AnimationLayout::Morph,
@@ -153,10 +196,9 @@ fn write_animation(
                 .map_err(|e| e.at(path))?;
             put(path, &bytes)
         }
-        Format::Gltf => Err(IoError::unsupported(
-            "toonkit writes binary glTF: name the output .glb",
-        )
-        .at(path)),
+        Format::Gltf => {
+            Err(IoError::unsupported("toonkit writes binary glTF: name the output .glb").at(path))
+        }
         format @ (Format::Pc2 | Format::Mdd) => {
             let bytes = if format == Format::Pc2 {
                 crate::pc2::write(anim)
@@ -182,7 +224,10 @@ fn write_animation(
         Format::Npy => {
             let flat: Vec<f32> = anim.positions().iter().flat_map(|p| p.to_array()).collect();
             let shape = [anim.frame_count(), anim.vertex_count(), 3];
-            put(path, &crate::npy::write_f32(&shape, &flat).map_err(|e| e.at(path))?)
+            put(
+                path,
+                &crate::npy::write_f32(&shape, &flat).map_err(|e| e.at(path))?,
+            )
         }
         Format::Bvh => Err(IoError::unsupported("BVH output holds skeletons, not meshes").at(path)),
         Format::Usda => {
@@ -201,7 +246,10 @@ fn rest_mesh(
     anim: &MeshAnimation,
     put: &mut dyn FnMut(&Path, &[u8]) -> Result<()>,
 ) -> Result<()> {
-    put(&path.with_extension("obj"), crate::obj::write(&anim.mesh).as_bytes())
+    put(
+        &path.with_extension("obj"),
+        crate::obj::write(&anim.mesh).as_bytes(),
+    )
 }
 
 #[cfg(not(feature = "obj"))]

@@ -10,11 +10,7 @@ use proptest::prelude::*;
 use tkio::{bvh, mdd, npy, obj, pc2, stl};
 
 fn asset(rel: &str) -> Vec<u8> {
-    let p = PathBuf::from(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../assets/"
-    ))
-    .join(rel);
+    let p = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/")).join(rel);
     std::fs::read(&p).unwrap_or_else(|e| panic!("test asset missing: {}: {e}", p.display()))
 }
 

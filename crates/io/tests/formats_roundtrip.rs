@@ -9,11 +9,7 @@ use anim::{sample, Mesh, MeshAnimation, SampleOptions, Scene};
 use tkio::{bvh, mdd, npy, obj, pc2, stl};
 
 fn asset(rel: &str) -> PathBuf {
-    let p = PathBuf::from(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../assets/"
-    ))
-    .join(rel);
+    let p = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/")).join(rel);
     assert!(p.is_file(), "test asset missing: {}", p.display());
     p
 }

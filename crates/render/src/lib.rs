@@ -41,10 +41,12 @@ mod colormap;
 mod draw;
 mod encode;
 mod error;
+mod flipbook;
 mod follow;
 mod font;
 mod image;
 mod lines;
+mod offsets;
 mod preview;
 mod raster;
 mod renderer;
@@ -66,10 +68,12 @@ pub use draw::{
 };
 pub use encode::{decode_png, encode_gif, encode_png, DEFAULT_GIF_SAMPLE_FACTOR};
 pub use error::{RenderError, Result};
+pub use flipbook::flipbook_gif;
 pub use follow::{follow_views, DEFAULT_FOLLOW_SMOOTHING};
 pub use font::{draw_text, text_size, GLYPH_HEIGHT, GLYPH_WIDTH};
 pub use image::{Image, ImageDiff, MAX_IMAGE_SIZE};
 pub use lines::DEFAULT_LINE_DEPTH_BIAS;
+pub use offsets::{offset_colors, offset_rgba};
 pub use preview::{preview_scene, OutputFormat, PreviewOptions, ViewSpec, DEFAULT_PREVIEW_SIZE};
 pub use renderer::{
     Ghost, RenderOptions, Renderer, DEFAULT_AMBIENT, DEFAULT_BACKGROUND, DEFAULT_LIGHT,

@@ -8,10 +8,7 @@ use render::{
     Renderer, View, ViewDirection,
 };
 
-const SPOT: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../assets/meshes/spot.obj"
-);
+const SPOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/meshes/spot.obj");
 
 #[test]
 fn spot_three_quarter_preview() {

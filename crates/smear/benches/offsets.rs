@@ -1,4 +1,4 @@
-//! Motion offsets of a 15,000-vertex tube skinned to 10 bones, 40 frames (Eqs. 1–9).
+//! Motion offsets of a 15,000-vertex tube skinned to 10 bones, 40 frames (SMEAR Eqs. 1–9).
 //!
 //! Run: `cargo bench -p toonkit-smear --bench offsets`; divide the reported time by 40 for
 //! the time per frame.

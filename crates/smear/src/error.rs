@@ -2,6 +2,8 @@
 
 use thiserror::Error;
 
+use crate::StyleError;
+
 /// Any error of the `smear` crate.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum SmearError {
@@ -90,6 +92,9 @@ pub enum SmearError {
     /// `anim::sample`, which always produces consistent scenes.
     #[error("inconsistent scene: {0}")]
     InvalidScene(String),
+    /// A style's function or parameter is invalid (see [`StyleError`] for how to fix it).
+    #[error(transparent)]
+    Style(#[from] StyleError),
 }
 
 /// Result alias of the smear crate.

@@ -12,13 +12,13 @@ use crate::velocity::{track_velocity, CameraSpace};
 /// The offset field of one group of vertices (one simple object or one skinned character).
 #[derive(Debug, Clone)]
 pub(crate) enum Field {
-    /// Eq. 1, one plane per frame.
+    /// SMEAR Eq. 1, one plane per frame.
     Plane(Vec<PlaneFrame>),
-    /// Eqs. 3–9, one ribbon per bone and frame.
+    /// SMEAR Eqs. 3–9, one ribbon per bone and frame.
     Ribbons(Box<RibbonField>),
 }
 
-/// Ribbons and neighbourhood maxima of Eq. 9 for every bone and frame.
+/// Ribbons and neighbourhood maxima of SMEAR Eq. 9 for every bone and frame.
 #[derive(Debug, Clone)]
 pub(crate) struct RibbonField {
     pub(crate) rig: Rig,
@@ -38,7 +38,7 @@ pub(crate) struct Tolerances {
 }
 
 impl Field {
-    /// The Eq. 1 field of a frame-major buffer, and the (unsmoothed) offsets of its vertices.
+    /// The SMEAR Eq. 1 field of a frame-major buffer, and the (unsmoothed) offsets of its vertices.
     ///
     /// # Performance
     /// Parallel over frames, allocation-free per vertex (see [`plane_frames`]).
@@ -57,7 +57,7 @@ impl Field {
         (Field::Plane(planes), raw)
     }
 
-    /// The Eqs. 3–9 field of a skinned group, and the (unsmoothed) offsets of its vertices.
+    /// The SMEAR Eqs. 3–9 field of a skinned group, and the (unsmoothed) offsets of its vertices.
     ///
     /// # Arguments
     /// * `bones` — bones of the whole skeleton, frame-major `frames × joints`.
@@ -71,8 +71,8 @@ impl Field {
     /// run by run from the frame's position columns (or gathered into per-worker columns
     /// when fragmented, see [`Hood::runs`]) and evaluated once by the vectorized
     /// [`Ribbon::eval_batch`]:
-    /// the maxima of Eq. 9 come out of that pass, then only the bone's skinned entries are
-    /// normalized and accumulated into Eq. 7's sum in a per-worker buffer, and each output
+    /// the maxima of SMEAR Eq. 9 come out of that pass, then only the bone's skinned entries are
+    /// normalized and accumulated into SMEAR Eq. 7's sum in a per-worker buffer, and each output
     /// frame is written once (no read of fresh zeroed pages). No allocation per frame or
     /// vertex.
     pub(crate) fn ribbons(
@@ -163,7 +163,7 @@ struct Scratch {
     raw: Vec<f32>,
     u: Vec<f32>,
     coll: Vec<f32>,
-    /// Σ_k w_k·δ_k of Eq. 7 per vertex.
+    /// Σ_k w_k·δ_k of SMEAR Eq. 7 per vertex.
     acc: Vec<f32>,
     /// Σ_k w_k over the non-skipped bones per vertex.
     wsum: Vec<f32>,
@@ -208,8 +208,8 @@ impl Scratch {
         }
     }
 
-    /// Evaluates one bone's ribbon over its neighbourhood (batched, Eqs. 3–6), accumulates
-    /// the normalized offsets of its skinned vertices (Eqs. 7–9) into `acc`/`wsum`.
+    /// Evaluates one bone's ribbon over its neighbourhood (batched, SMEAR Eqs. 3–6), accumulates
+    /// the normalized offsets of its skinned vertices (SMEAR Eqs. 7–9) into `acc`/`wsum`.
     ///
     /// # Returns
     /// The maxima of |δ̃| over V_k,r and V_k,t.
@@ -292,7 +292,7 @@ fn masked_maxima(raw: &[f32], in_root: &[f32], in_tip: &[f32]) -> [f32; 2] {
     [fold(mr), fold(mt)]
 }
 
-/// Eq. 8 with Eq. 9's normalizer M = (1 − u)·max_{V_k,r} + u·max_{V_k,t} (SPEC.md's
+/// SMEAR Eq. 8 with SMEAR Eq. 9's normalizer M = (1 − u)·max_{V_k,r} + u·max_{V_k,t} (SPEC.md's
 /// orientation, continuous across joints): w_coll(u)·δ̃ / M, or 0 when M vanishes.
 #[inline]
 fn normalized(s: RibbonSample, max_root: f32, max_tip: f32, collinear: bool) -> f32 {
@@ -306,8 +306,8 @@ fn normalized(s: RibbonSample, max_root: f32, max_tip: f32, collinear: bool) -> 
 }
 
 impl RibbonField {
-    /// Eqs. 7–9 at one point: Σ_k w_k · w_coll(u_k) · δ̃_k / M_k with
-    /// M_k = (1 − u_k)·max_{V_k,r} + u_k·max_{V_k,t} (SPEC.md's orientation of Eq. 9).
+    /// SMEAR Eqs. 7–9 at one point: Σ_k w_k · w_coll(u_k) · δ̃_k / M_k with
+    /// M_k = (1 − u_k)·max_{V_k,r} + u_k·max_{V_k,t} (SPEC.md's orientation of SMEAR Eq. 9).
     /// Zero-length bones are skipped and the remaining weights renormalized.
     #[inline]
     fn eval(&self, f: usize, p: Vec3, joints: &[u32], weights: &[f32]) -> f32 {

@@ -1,18 +1,66 @@
 //! Smear frames from motion offsets — Basset, Bénard, Barla, "Smear: Stylized Motion Effects
-//! for 3D Animation", SIGGRAPH 2024, Section 3.
+//! for 3D Animation", SIGGRAPH 2024 (`SMEAR` below).
 //!
 //! Motion offsets δ_i(f) ∈ [−1, 1] say which parts of a moving object lead (δ > 0) and which
 //! trail (δ < 0); elongated in-betweens, multiple in-betweens and motion lines are driven by
-//! them (Section 4).
+//! them (SMEAR Section 4).
 //!
-//! * Simple objects (Eq. 1): signed distance to the plane through the area-weighted surface
-//!   centroid ([`surface_centroid`]) with the direction of motion as normal, normalized by the
-//!   largest |δ̃|.
-//! * Temporal smoothing (Eq. 2): [`smoothing_weights`], [`smooth_in_time`].
-//! * Articulated figures (Eqs. 3–9): per-bone ribbons orthogonal to the bone and as aligned as
-//!   possible with the slerped joint motion, collinear weights, skin-weighted sum, and the
-//!   joint-continuous normalization of Eq. 9 (orientation fixed in SPEC.md); optional
-//!   skeleton pruning and whole-body mode.
+//! # The whole job
+//! [`prepare`] takes a sampled scene and does everything that does not depend on the style,
+//! once: the offset solve per object group (merged inside the crate when asked), the camera,
+//! painted weights, velocities. [`stylize`] then applies a [`Style`] (the TOML format of
+//! `examples/smear/`) and returns a [`Stylized`] flipbook plus a report; calling it again with
+//! another style never solves offsets again (see [`offset_solves`]), which is what makes live
+//! tuning possible. [`offsets`] alone is the `toonkit smear offsets` job. Options are serde
+//! structs, so the same options come from CLI flags, TOML, Python keyword arguments or a web
+//! form.
+//!
+//! ```
+//! use anim::{Mesh, MeshAnimation, SampledScene};
+//! use glam::Vec3;
+//! use smear::{prepare, stylize, PrepareOptions, Style};
+//!
+//! // A unit tetrahedron translating along +X, one unit per frame.
+//! let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+//! let mesh = Mesh::new("tet", p.clone(), vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]);
+//! let frames: Vec<Vec3> = (0..6).flat_map(|f| p.iter().map(move |q| *q + Vec3::X * f as f32)).collect();
+//! let scene = SampledScene::from_animation(MeshAnimation::new(mesh, 24.0, frames)?);
+//!
+//! let prepared = prepare(scene, &PrepareOptions::default())?;
+//! let solves = smear::offset_solves();
+//! let stretch = Style::from_toml_str("[elongate]\nfunction = { stages = [{ op = \"scale\", by = 2 }] }")?;
+//! let copies = Style::from_toml_str("[multiples]\npast = 2\nfuture = 0")?;
+//! let a = stylize(&prepared, &stretch)?; // the body, elongated
+//! let b = stylize(&prepared, &copies)?; // the body and two past copies
+//! assert_eq!((a.flipbook.parts.len(), b.flipbook.parts.len()), (1, 3));
+//! assert_eq!(smear::offset_solves(), solves); // restyling reused the offsets
+//! assert!(a.report.objects[0].elongation_max.unwrap() > 1.0);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! # Paper map
+//! | SMEAR | item |
+//! |---|---|
+//! | SMEAR Eq. 1 (separation plane, simple objects) | [`surface_centroid`], [`mesh_offsets`], [`OffsetMode::Simple`] |
+//! | SMEAR Eq. 2 (temporal smoothing) | [`smoothing_weights`], [`smooth_in_time`], [`MotionOffsets::smoothed`] |
+//! | SMEAR Eqs. 3–5 (bone ribbons, slerped joint motion) | [`OffsetSolver`] with [`OffsetMode::Articulated`], [`smoothstep`] |
+//! | SMEAR Eqs. 6–8 (collinear weight, skin-weighted sum) | [`OffsetOptions::collinear_weight`], [`OffsetSolver::surface_offsets`] |
+//! | SMEAR Eq. 9 (joint-continuous normalization) | [`OffsetSolver::new`] (orientation fixed in SPEC.md) |
+//! | SMEAR Eq. 10 (elongated in-betweens) | [`elongate`], [`elongate_frame`], [`ElongateStyle`] |
+//! | SMEAR Eq. 11 (multiple in-betweens) | [`multiples`], [`multiples_frame`], [`MultiplesStyle`] |
+//! | SMEAR Eq. 12 (multiples opacity) | [`multiple_opacity`], [`eq12_opacity`], [`overlap_spacing`] |
+//! | SMEAR Eq. 13 (motion lines) | [`motion_lines`], [`motion_lines_frame`], [`LinesStyle`] |
+//! | Section 5 (stylization functions) | [`FunctionSpec`], [`Stage`], [`Expression`], [`warp_offset`], [`voronoi_f1`] |
+//!
+//! # Building blocks
+//! * Simple objects (SMEAR Eq. 1): signed distance to the plane through the area-weighted
+//!   surface centroid ([`surface_centroid`]) with the direction of motion as normal,
+//!   normalized by the largest |δ̃|.
+//! * Temporal smoothing (SMEAR Eq. 2): [`smoothing_weights`], [`smooth_in_time`].
+//! * Articulated figures (SMEAR Eqs. 3–9): per-bone ribbons orthogonal to the bone and as
+//!   aligned as possible with the slerped joint motion, collinear weights, skin-weighted sum,
+//!   and the joint-continuous normalization of SMEAR Eq. 9 (orientation fixed in SPEC.md);
+//!   optional skeleton pruning and whole-body mode.
 //! * Camera space, several objects per scene, offsets at surface points ([`OffsetSolver`]).
 //! * Velocities by central differences ([`vertex_velocities`]), used for speed.
 //!
@@ -34,9 +82,12 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+#![warn(missing_docs, unreachable_pub)]
+
 mod effects;
 mod error;
 mod field;
+mod job;
 mod offsets;
 mod options;
 mod plane;
@@ -56,6 +107,10 @@ pub use effects::{
     DEFAULT_SEED, DEFAULT_SPACING,
 };
 pub use error::{Result, SmearError};
+pub use job::{
+    offsets, prepare, stylize, CopyReport, ObjectOffsets, ObjectParts, ObjectReport,
+    PrepareOptions, PrepareReport, Prepared, SceneOffsets, StylizeReport, StylizeTimings, Stylized,
+};
 pub use offsets::MotionOffsets;
 pub use options::{
     CameraSelect, OffsetOptions, DEFAULT_LERP_ANGLE, DEFAULT_SMOOTH, DEFAULT_STILL_TOLERANCE,
@@ -64,12 +119,14 @@ pub use options::{
 pub use plane::surface_centroid;
 pub use ribbon::smoothstep;
 pub use smooth::{smooth_in_time, smoothing_weights};
-pub use solver::{mesh_offsets, scene_offsets, OffsetMode, OffsetSolver, SurfacePoint};
+pub use solver::{
+    mesh_offsets, offset_solves, scene_offsets, OffsetMode, OffsetSolver, SurfacePoint,
+};
 pub use stylize::{
     apply_stages, hise_curve, voronoi_f1, warp_offset, CompiledEffects, CompiledLines,
     ElongateStyle, Expression, FunctionSpec, LinesStyle, MultiplesStyle, ObjectEffects,
     ObjectStyle, Param, Stage, Style, StyleError, StyleFunction, StyleOps, WeightAttribute,
-    WeightGroup, WeightSource, DEFAULT_LINE_COUNT, DEFAULT_LINE_THICKNESS, EXPRESSION_INPUTS,
-    MAX_EXPRESSION_VARIABLES,
+    WeightGroup, WeightSource, DEFAULT_LINE_COUNT, DEFAULT_LINE_THICKNESS, DEFAULT_MULTIPLE_COLOR,
+    EXPRESSION_INPUTS, MAX_EXPRESSION_VARIABLES,
 };
 pub use velocity::{camera_vertex_velocities, speeds, vertex_velocities};

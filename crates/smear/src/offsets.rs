@@ -5,8 +5,8 @@ use crate::{smooth_in_time, Result, SmearError};
 /// Motion offsets δ_i(f) of one object: `frames × vertices` values, frame-major and
 /// contiguous (frame `f` is `values[f * vertices..(f + 1) * vertices]`).
 ///
-/// Values lie in [−1, 1] for simple objects (Eq. 1) and may slightly exceed it at joints of
-/// articulated figures (paper Section 3.2, after Eq. 9).
+/// Values lie in [−1, 1] for simple objects (SMEAR Eq. 1) and may slightly exceed it at joints of
+/// articulated figures (paper Section 3.2, after SMEAR Eq. 9).
 #[derive(Debug, Clone, PartialEq)]
 pub struct MotionOffsets {
     frames: usize,
@@ -92,7 +92,7 @@ impl MotionOffsets {
             })
     }
 
-    /// Temporal smoothing of Eq. 2 with half-window `n` (0 returns a copy).
+    /// Temporal smoothing of SMEAR Eq. 2 with half-window `n` (0 returns a copy).
     pub fn smoothed(&self, n: usize) -> MotionOffsets {
         MotionOffsets {
             frames: self.frames,

@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Default temporal smoothing half-window `N` of Eq. 2 (the paper's "N = 2 in practice").
+/// Default temporal smoothing half-window `N` of SMEAR Eq. 2 (the paper's "N = 2 in practice").
 pub const DEFAULT_SMOOTH: usize = 2;
 
 /// A velocity shorter than this fraction of the bounding-box diagonal counts as "still"
@@ -15,7 +15,7 @@ pub const DEFAULT_STILL_TOLERANCE: f32 = 1e-9;
 /// the camera moves by rounding noise only, which must not pick a random separation plane.
 pub const STILL_ROUNDING_FACTOR: f32 = 16.0 * f32::EPSILON;
 
-/// Below this angle (radians) between root and tip directions, Eq. 4's slerp falls back to a
+/// Below this angle (radians) between root and tip directions, SMEAR Eq. 4's slerp falls back to a
 /// renormalized linear interpolation (paper Section 3.2).
 pub const DEFAULT_LERP_ANGLE: f32 = 0.1;
 
@@ -35,7 +35,7 @@ pub enum CameraSelect {
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct OffsetOptions {
-    /// Temporal smoothing half-window `N` of Eq. 2; 0 turns smoothing off.
+    /// Temporal smoothing half-window `N` of SMEAR Eq. 2; 0 turns smoothing off.
     pub smooth: usize,
     /// Treat every skinned character (its skinned meshes and the rigid props parented to its
     /// joints) as one simple object with a single separation plane (paper Fig. 14).
@@ -44,7 +44,7 @@ pub struct OffsetOptions {
     pub prune: Vec<String>,
     /// Compute offsets relative to this (possibly moving) camera instead of the world.
     pub camera: Option<CameraSelect>,
-    /// Apply the collinear weight w_coll of Eqs. 6/8 (paper Fig. 7); turning it off shows the
+    /// Apply the collinear weight w_coll of SMEAR Eqs. 6/8 (paper Fig. 7); turning it off shows the
     /// shearing it prevents.
     pub collinear_weight: bool,
 }

@@ -1,4 +1,4 @@
-//! Simple objects: the separation plane of paper Eq. 1.
+//! Simple objects: the separation plane of paper SMEAR Eq. 1.
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -46,7 +46,7 @@ pub fn surface_centroid(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec3 {
     (sum / positions.len() as f64).as_vec3()
 }
 
-/// One frame's separation plane of Eq. 1, pre-scaled: δ_i = (p_i − c) · `normal`, where
+/// One frame's separation plane of SMEAR Eq. 1, pre-scaled: δ_i = (p_i − c) · `normal`, where
 /// `normal` = v̂ / max_j |δ̃_j|, or zero for a still frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct PlaneFrame {
@@ -55,7 +55,7 @@ pub(crate) struct PlaneFrame {
 }
 
 impl PlaneFrame {
-    /// Eq. 1 at point `p`.
+    /// SMEAR Eq. 1 at point `p`.
     #[inline]
     pub(crate) fn eval(&self, p: Vec3) -> f32 {
         (p - self.centroid).dot(self.normal)
@@ -68,10 +68,10 @@ impl PlaneFrame {
 /// # Arguments
 /// * `still` — velocities at most this long give a still frame (offsets 0).
 /// * `space` — measure the centroid's velocity relative to this camera.
-/// * `raw` — receives the frame-major `frames × vertices` offsets δ_i(f) of Eq. 1.
+/// * `raw` — receives the frame-major `frames × vertices` offsets δ_i(f) of SMEAR Eq. 1.
 ///
 /// # Performance
-/// Two parallel passes over frames: centroids, then per frame the maximum of Eq. 1 and the
+/// Two parallel passes over frames: centroids, then per frame the maximum of SMEAR Eq. 1 and the
 /// offsets back to back (the frame is still in cache for the second read). No allocation
 /// per vertex; every `raw` element is written, never read. (Computing each frame's plane
 /// right after the next frame's centroid, to read every frame from memory once, measured no

@@ -1,4 +1,4 @@
-//! One bone's ribbon separation surface (paper Eqs. 3–6), precomputed per bone and frame.
+//! One bone's ribbon separation surface (paper SMEAR Eqs. 3–6), precomputed per bone and frame.
 
 use glam::Vec3;
 
@@ -15,7 +15,7 @@ fn lanes_mut(c: &mut [f32], s: usize) -> &mut [f32; BATCH_LANES] {
         .expect("BATCH_LANES entries")
 }
 
-/// Smoothstep S(x) = 3x² − 2x³ on x clamped to [0, 1] (Eq. 3).
+/// Smoothstep S(x) = 3x² − 2x³ on x clamped to [0, 1] (SMEAR Eq. 3).
 #[inline]
 pub fn smoothstep(x: f32) -> f32 {
     let x = x.clamp(0.0, 1.0);
@@ -23,7 +23,7 @@ pub fn smoothstep(x: f32) -> f32 {
 }
 
 /// `(sin x, cos x)` for x ∈ [0, π] by Taylor polynomials around π/2 (|error| < 2e-7, a few
-/// times faster than `f32::sin_cos`, which dominates Eq. 4 otherwise).
+/// times faster than `f32::sin_cos`, which dominates SMEAR Eq. 4 otherwise).
 #[inline]
 pub(crate) fn sin_cos_0_pi(x: f32) -> (f32, f32) {
     let y = x - std::f32::consts::FRAC_PI_2;
@@ -44,8 +44,8 @@ pub(crate) fn sin_cos_0_pi(x: f32) -> (f32, f32) {
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Interp {
-    /// Eq. 4: v̂(u) = cos(uω)·P + sin(uω)·Q with P = v̂_r and Q the unit vector orthogonal to
-    /// v̂_r in the plane of v̂_r, v̂_t (equal to Eq. 4's slerp).
+    /// SMEAR Eq. 4: v̂(u) = cos(uω)·P + sin(uω)·Q with P = v̂_r and Q the unit vector orthogonal to
+    /// v̂_r in the plane of v̂_r, v̂_t (equal to SMEAR Eq. 4's slerp).
     Slerp,
     /// Renormalized lerp (1 − u)·P + u·Q, P = v̂_r, Q = v̂_t, when ω < 0.1 rad.
     Lerp,
@@ -53,10 +53,10 @@ pub(crate) enum Interp {
     Still,
 }
 
-/// A bone's ribbon at one frame: everything of Eqs. 3–6 that does not depend on the vertex.
+/// A bone's ribbon at one frame: everything of SMEAR Eqs. 3–6 that does not depend on the vertex.
 ///
 /// The interpolated direction is written v(u) = α(u)·P + β(u)·Q, so that the ribbon normal
-/// n(u) = v − (v·b̂)b̂ (Eq. 5), the offset δ̃ = (p − c_r)·n̂ (Eq. 6) and the collinear weight
+/// n(u) = v − (v·b̂)b̂ (SMEAR Eq. 5), the offset δ̃ = (p − c_r)·n̂ (SMEAR Eq. 6) and the collinear weight
 /// w_coll = 1 − (v̂·b̂)² reduce to a few dot products per vertex.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Ribbon {
@@ -73,14 +73,14 @@ pub(crate) struct Ribbon {
     omega: f32,
     interp: Interp,
     /// Ribbon normal n̂ and w_coll at u = 0 and u = 1, for points beyond the bone's ends
-    /// (where the smoothstep clamps and Eq. 6 reduces to a dot product).
+    /// (where the smoothstep clamps and SMEAR Eq. 6 reduces to a dot product).
     n0: Vec3,
     coll0: f32,
     n1: Vec3,
     coll1: f32,
 }
 
-/// n̂ and w_coll of Eq. 5–6 for a direction `v` (any length): zero where v ∥ axis.
+/// n̂ and w_coll of SMEAR Eq. 5–6 for a direction `v` (any length): zero where v ∥ axis.
 fn end_normal(v: Vec3, axis: Vec3) -> (Vec3, f32) {
     let vv = v.dot(v);
     let vb = v.dot(axis);
@@ -92,12 +92,12 @@ fn end_normal(v: Vec3, axis: Vec3) -> (Vec3, f32) {
     }
 }
 
-/// Eqs. 3–6 at one point.
+/// SMEAR Eqs. 3–6 at one point.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct RibbonSample {
-    /// Parameter u along the bone (Eq. 3).
+    /// Parameter u along the bone (SMEAR Eq. 3).
     pub(crate) u: f32,
-    /// Unnormalized offset δ̃ = (p − c_r)·n̂(u) (Eq. 6/8).
+    /// Unnormalized offset δ̃ = (p − c_r)·n̂(u) (SMEAR Eq. 6/8).
     pub(crate) raw: f32,
     /// Collinear weight w_coll(u) = 1 − (v̂(u)·b̂)².
     pub(crate) coll: f32,
@@ -182,7 +182,7 @@ impl Ribbon {
         })
     }
 
-    /// Eqs. 3–6 at point `x`.
+    /// SMEAR Eqs. 3–6 at point `x`.
     ///
     /// # Performance
     /// About 40 flops, a polynomial `sin_cos` for slerped bones, one square root and two
@@ -196,7 +196,7 @@ impl Ribbon {
         }
     }
 
-    /// Eq. 3: offset from the root, its projection on the axis, and the unclamped ratio.
+    /// SMEAR Eq. 3: offset from the root, its projection on the axis, and the unclamped ratio.
     #[inline(always)]
     fn project(&self, x: Vec3) -> (Vec3, f32, f32) {
         let d = x - self.root;
@@ -307,7 +307,7 @@ impl Ribbon {
 
     /// The loop of [`Ribbon::eval_batch`] for v(u) = a·P + b·Q, `dir(u) = (a, b, |v|²)`, by
     /// blocks of [`BATCH_LANES`] points: a block entirely beyond the bone's ends (most of the
-    /// neighbours of a bone, spatially coherent in vertex order) only needs Eq. 6's dot
+    /// neighbours of a bone, spatially coherent in vertex order) only needs SMEAR Eq. 6's dot
     /// product with the end normals; other blocks run [`Ribbon::beyond_ends`] and
     /// [`Ribbon::finish`] written as selects. Both give the same bits.
     #[inline(always)]
@@ -390,7 +390,7 @@ impl Ribbon {
         }
     }
 
-    /// Eqs. 5–6 from v(u) = a·P + b·Q with |v|² = `vv`.
+    /// SMEAR Eqs. 5–6 from v(u) = a·P + b·Q with |v|² = `vv`.
     #[inline(always)]
     fn finish(&self, d: Vec3, db: f32, u: f32, a: f32, b: f32, vv: f32) -> RibbonSample {
         let vb = a * self.pb + b * self.qb;
@@ -417,7 +417,7 @@ impl Ribbon {
 mod tests {
     use super::*;
 
-    /// Direct transcription of Eqs. 3–6 (slerp with sines, explicit projection) as an oracle.
+    /// Direct transcription of SMEAR Eqs. 3–6 (slerp with sines, explicit projection) as an oracle.
     fn reference(root: Vec3, tip: Vec3, vr: Vec3, vt: Vec3, x: Vec3) -> (f32, f32, f32) {
         let b = tip - root;
         let bh = b.normalize();

@@ -1,4 +1,4 @@
-//! Skin weights over kept bones and the joint neighbourhoods of Eq. 9, after pruning.
+//! Skin weights over kept bones and the joint neighbourhoods of SMEAR Eq. 9, after pruning.
 
 use anim::{Skeleton, Skin};
 

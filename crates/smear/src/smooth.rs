@@ -1,8 +1,8 @@
-//! Temporal smoothing of motion offsets (paper Eq. 2).
+//! Temporal smoothing of motion offsets (paper SMEAR Eq. 2).
 
 use rayon::prelude::*;
 
-/// The normalized weights w_n, n = −N..=N, of Eq. 2: w_n = (1 − (n/(N+1))²)² / Σ w.
+/// The normalized weights w_n, n = −N..=N, of SMEAR Eq. 2: w_n = (1 − (n/(N+1))²)² / Σ w.
 ///
 /// # Arguments
 /// * `n` — half-window N; 0 gives `[1.0]` (no smoothing).
@@ -21,7 +21,7 @@ pub fn smoothing_weights(n: usize) -> Vec<f32> {
     raw.iter().map(|w| (w / sum) as f32).collect()
 }
 
-/// Smooths a frame-major `frames × vertices` buffer in time with Eq. 2; frames outside the
+/// Smooths a frame-major `frames × vertices` buffer in time with SMEAR Eq. 2; frames outside the
 /// animation are clamped to the first/last frame (SPEC.md).
 ///
 /// # Performance
@@ -30,7 +30,7 @@ pub fn smooth_in_time(values: &[f32], frames: usize, vertices: usize, n: usize) 
     smooth_columns(values, frames, vertices, 0..vertices, n)
 }
 
-/// Eq. 2 on the columns `cols` of a frame-major `frames × stride` buffer (one object's
+/// SMEAR Eq. 2 on the columns `cols` of a frame-major `frames × stride` buffer (one object's
 /// vertices inside a group), into a new frame-major `frames × cols.len()` buffer.
 ///
 /// # Panics

@@ -1,10 +1,11 @@
 //! Motion offsets of whole scenes: grouping objects, camera space, pruning, surface points.
 
-use std::borrow::Cow;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use anim::{Aabb, Camera, MeshAnimation, SampledScene, Skin};
 use glam::Vec3;
 use rayon::prelude::*;
+use serde::Serialize;
 
 use crate::field::{Field, Tolerances};
 use crate::rig::{Pruned, Rig};
@@ -14,14 +15,25 @@ use crate::{
     DEFAULT_ZERO_LENGTH, STILL_ROUNDING_FACTOR,
 };
 
+/// Offset solves run by this process (see [`offset_solves`]).
+static SOLVES: AtomicUsize = AtomicUsize::new(0);
+
+/// Number of motion-offset solves (SMEAR Eqs. 1–9 over a scene or point cache) this process
+/// has run so far: lets tests and front ends check that restyling a
+/// [`Prepared`](crate::Prepared) scene reuses its offsets instead of solving them again.
+pub fn offset_solves() -> usize {
+    SOLVES.load(Ordering::Relaxed)
+}
+
 /// How an object's offsets are computed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum OffsetMode {
-    /// A simple object on its own: separation plane of Eq. 1.
+    /// A simple object on its own: separation plane of SMEAR Eq. 1.
     Simple,
     /// Part of a skinned character treated as one simple object (whole-body mode, Fig. 14).
     WholeBody,
-    /// A skinned mesh: ribbons of Eqs. 3–9.
+    /// A skinned mesh: ribbons of SMEAR Eqs. 3–9.
     Articulated,
 }
 
@@ -62,16 +74,27 @@ impl SurfacePoint {
     }
 }
 
-#[derive(Debug)]
-struct Slot<'a> {
-    anim: &'a MeshAnimation,
+/// Where an object's vertices sit in its group.
+#[derive(Debug, Clone)]
+struct Slot {
     group: usize,
     base: usize,
+    vertices: usize,
+}
+
+/// The positions a group's field was computed on: one object's own cache (not copied), or
+/// several objects side by side.
+#[derive(Debug, Clone)]
+enum GroupPositions {
+    /// The cache of this object (index into the solver's objects).
+    Object(usize),
+    /// Frame-major positions of several objects merged.
+    Merged(Vec<Vec3>),
 }
 
 #[derive(Debug)]
-struct Group<'a> {
-    positions: Cow<'a, [Vec3]>,
+struct Group {
+    positions: GroupPositions,
     vertices: usize,
     mode: OffsetMode,
     field: Field,
@@ -79,20 +102,29 @@ struct Group<'a> {
     raw: Vec<f32>,
 }
 
+/// The solved offset fields of a scene, owning everything but the objects' caches: what
+/// [`OffsetSolver`] and [`Prepared`](crate::Prepared) evaluate at vertices and surface points.
+#[derive(Debug)]
+pub(crate) struct SolvedField {
+    frames: usize,
+    smooth: usize,
+    slots: Vec<Slot>,
+    groups: Vec<Group>,
+}
+
 /// Motion offsets of every object of a sampled scene (or of one bare point cache), computed
 /// once and evaluated at vertices or arbitrary surface points.
 ///
 /// Objects are grouped so that a character stays continuous across its meshes: all meshes
-/// skinned to one skeleton tree form one articulated group (Eqs. 3–9, neighbourhood maxima of
-/// Eq. 9 taken over all of them); in whole-body mode they form one simple object together
-/// with the rigid props parented to its joints. Other objects, including props parented to a
-/// joint outside whole-body mode, are simple objects moving with whatever carries them.
+/// skinned to one skeleton tree form one articulated group (SMEAR Eqs. 3–9, neighbourhood
+/// maxima of SMEAR Eq. 9 taken over all of them); in whole-body mode they form one simple
+/// object together with the rigid props parented to its joints. Other objects, including
+/// props parented to a joint outside whole-body mode, are simple objects moving with whatever
+/// carries them.
 #[derive(Debug)]
 pub struct OffsetSolver<'a> {
-    frames: usize,
-    smooth: usize,
-    slots: Vec<Slot<'a>>,
-    groups: Vec<Group<'a>>,
+    objects: Vec<&'a MeshAnimation>,
+    field: SolvedField,
 }
 
 impl OffsetOptions {
@@ -165,10 +197,11 @@ fn tolerances(
     }
 }
 
-/// Frame-major positions of several caches side by side (borrowed when there is one).
-fn merged_positions<'a>(parts: &[&'a MeshAnimation], frames: usize) -> Cow<'a, [Vec3]> {
-    if let [one] = parts {
-        return Cow::Borrowed(one.positions());
+/// Frame-major positions of several caches side by side (`None` when there is one: its own
+/// cache is used as is).
+fn merged_positions(parts: &[&MeshAnimation], frames: usize) -> Option<Vec<Vec3>> {
+    if parts.len() == 1 {
+        return None;
     }
     let n: usize = parts.iter().map(|a| a.vertex_count()).sum();
     let mut out = Vec::with_capacity(n * frames);
@@ -177,7 +210,7 @@ fn merged_positions<'a>(parts: &[&'a MeshAnimation], frames: usize) -> Cow<'a, [
             out.extend_from_slice(a.frame(f));
         }
     }
-    Cow::Owned(out)
+    Some(out)
 }
 
 fn merged_triangles(parts: &[&MeshAnimation]) -> Vec<[u32; 3]> {
@@ -190,77 +223,84 @@ fn merged_triangles(parts: &[&MeshAnimation]) -> Vec<[u32; 3]> {
     out
 }
 
-impl<'a> OffsetSolver<'a> {
-    /// Prepares the offsets of every object of `scene`.
-    ///
-    /// # Errors
-    /// Unknown pruned joint or camera, a pruned root with skinned vertices, or an inconsistent
-    /// scene (see [`SmearError`]).
-    ///
-    /// # Performance
-    /// Computes the per-frame planes, ribbons, Eq. 9 maxima and unsmoothed vertex offsets
-    /// (parallel over frames); [`OffsetSolver::all`] then only smooths (Eq. 2) and splits.
-    pub fn new(scene: &'a SampledScene, options: &OffsetOptions) -> Result<OffsetSolver<'a>> {
-        let frames = scene.frame_count;
-        let joints = scene.skeleton.len();
-        if joints > 0 && scene.bones.len() != frames * joints {
+/// Checks that the scene's buffers agree (bones per frame, frames per object, skin slots).
+fn check_scene(scene: &SampledScene) -> Result<()> {
+    let frames = scene.frame_count;
+    let joints = scene.skeleton.len();
+    if joints > 0 && scene.bones.len() != frames * joints {
+        return Err(SmearError::InvalidScene(format!(
+            "{} bones for {frames} frames × {joints} joints",
+            scene.bones.len()
+        )));
+    }
+    for o in &scene.objects {
+        if o.animation.frame_count() != frames {
             return Err(SmearError::InvalidScene(format!(
-                "{} bones for {frames} frames × {joints} joints",
-                scene.bones.len()
+                "object '{}' has {} frames, the scene {frames}",
+                o.name,
+                o.animation.frame_count()
             )));
         }
-        for o in &scene.objects {
-            if o.animation.frame_count() != frames {
-                return Err(SmearError::InvalidScene(format!(
-                    "object '{}' has {} frames, the scene {frames}",
-                    o.name,
-                    o.animation.frame_count()
-                )));
-            }
-            if let Some(s) = &o.skin {
-                s.validate(o.animation.vertex_count(), joints)
-                    .map_err(|e| SmearError::InvalidScene(format!("object '{}': {e}", o.name)))?;
-            }
+        if let Some(s) = &o.skin {
+            s.validate(o.animation.vertex_count(), joints)
+                .map_err(|e| SmearError::InvalidScene(format!("object '{}': {e}", o.name)))?;
         }
+    }
+    Ok(())
+}
+
+/// Objects grouped for the solve: `Some(root joint)` for characters, `None` for a standalone
+/// simple object, with the members of each group in scene order.
+fn group_keys(scene: &SampledScene, whole_body: bool) -> Vec<(Option<usize>, Vec<usize>)> {
+    let joints = scene.skeleton.len();
+    let root_of = |mut j: usize| {
+        while let Some(p) = scene.skeleton.joints[j].parent {
+            j = p;
+        }
+        j
+    };
+    let mut keys: Vec<(Option<usize>, Vec<usize>)> = Vec::new();
+    for (i, o) in scene.objects.iter().enumerate() {
+        let skin_root = o
+            .skin
+            .as_ref()
+            .and_then(|s| s.joints.first())
+            .map(|&j| root_of(j));
+        let key = match (skin_root, o.parent_joint) {
+            (Some(r), _) => Some(r),
+            (None, Some(j)) if whole_body && j < joints => Some(root_of(j)),
+            _ => None,
+        };
+        match keys.iter_mut().find(|(k, _)| key.is_some() && *k == key) {
+            Some((_, members)) => members.push(i),
+            None => keys.push((key, vec![i])),
+        }
+    }
+    keys
+}
+
+impl SolvedField {
+    /// Solves the offsets of every object of `scene` (see [`OffsetSolver::new`]).
+    pub(crate) fn new(scene: &SampledScene, options: &OffsetOptions) -> Result<SolvedField> {
+        SOLVES.fetch_add(1, Ordering::Relaxed);
+        check_scene(scene)?;
+        let frames = scene.frame_count;
         let pruned = Pruned::new(&scene.skeleton, &options.prune)?;
         let camera = resolve_camera(&scene.cameras, &options.camera)?;
         let space = camera.map(|c| CameraSpace::new(c, frames));
 
-        let root_of = |mut j: usize| {
-            while let Some(p) = scene.skeleton.joints[j].parent {
-                j = p;
-            }
-            j
-        };
-        // Group key: Some(root joint) for characters, None for a standalone simple object.
-        let mut keys: Vec<(Option<usize>, Vec<usize>)> = Vec::new();
-        for (i, o) in scene.objects.iter().enumerate() {
-            let skin_root = o
-                .skin
-                .as_ref()
-                .and_then(|s| s.joints.first())
-                .map(|&j| root_of(j));
-            let key = match (skin_root, o.parent_joint) {
-                (Some(r), _) => Some(r),
-                (None, Some(j)) if options.whole_body && j < joints => Some(root_of(j)),
-                _ => None,
-            };
-            match keys.iter_mut().find(|(k, _)| key.is_some() && *k == key) {
-                Some((_, members)) => members.push(i),
-                None => keys.push((key, vec![i])),
-            }
-        }
-
-        let mut slots: Vec<Option<Slot<'a>>> = (0..scene.objects.len()).map(|_| None).collect();
+        let mut slots: Vec<Option<Slot>> = (0..scene.objects.len()).map(|_| None).collect();
+        let keys = group_keys(scene, options.whole_body);
         let mut groups = Vec::with_capacity(keys.len());
         for (key, members) in keys {
             let parts: Vec<&MeshAnimation> = members
                 .iter()
                 .map(|&i| &scene.objects[i].animation)
                 .collect();
-            let positions = merged_positions(&parts, frames);
+            let merged = merged_positions(&parts, frames);
+            let positions: &[Vec3] = merged.as_deref().unwrap_or_else(|| parts[0].positions());
             let vertices: usize = parts.iter().map(|a| a.vertex_count()).sum();
-            let tol = tolerances(&positions, frames, vertices, space.as_ref());
+            let tol = tolerances(positions, frames, vertices, space.as_ref());
             let mode = match key {
                 None => OffsetMode::Simple,
                 Some(_) if options.whole_body => OffsetMode::WholeBody,
@@ -274,7 +314,7 @@ impl<'a> OffsetSolver<'a> {
                 let rig = Rig::new(&scene.skeleton, &pruned, &skins)?;
                 Field::ribbons(
                     rig,
-                    &positions,
+                    positions,
                     frames,
                     &scene.bones,
                     tol,
@@ -283,49 +323,43 @@ impl<'a> OffsetSolver<'a> {
                 )
             } else {
                 let tris = merged_triangles(&parts);
-                Field::plane(&positions, frames, vertices, &tris, tol, space.as_ref())
+                Field::plane(positions, frames, vertices, &tris, tol, space.as_ref())
             };
             let mut base = 0;
             for (&i, a) in members.iter().zip(&parts) {
                 slots[i] = Some(Slot {
-                    anim: a,
                     group: groups.len(),
                     base,
+                    vertices: a.vertex_count(),
                 });
                 base += a.vertex_count();
             }
             groups.push(Group {
-                positions,
+                positions: match merged {
+                    Some(m) => GroupPositions::Merged(m),
+                    None => GroupPositions::Object(members[0]),
+                },
                 vertices,
                 mode,
                 field,
                 raw,
             });
         }
-        Ok(OffsetSolver {
+        Ok(SolvedField {
             frames,
             smooth: options.smooth,
-            slots: slots
-                .into_iter()
-                .map(|s| s.expect("every object is grouped"))
-                .collect(),
+            slots: slots.into_iter().flatten().collect(),
             groups,
         })
     }
 
-    /// Prepares the offsets of a bare point cache, a simple object (Eq. 1).
-    ///
-    /// # Arguments
-    /// * `cameras` — cameras that `options.camera` may select from (may be empty).
-    ///
-    /// # Errors
-    /// [`SmearError::UnknownCamera`] when the selected camera is not in `cameras`;
-    /// [`SmearError::UnknownJoint`] when `options.prune` names a joint (there is no skeleton).
-    pub fn from_animation(
-        anim: &'a MeshAnimation,
+    /// Solves a bare point cache as a simple object (see [`OffsetSolver::from_animation`]).
+    fn from_animation(
+        anim: &MeshAnimation,
         options: &OffsetOptions,
         cameras: &[Camera],
-    ) -> Result<OffsetSolver<'a>> {
+    ) -> Result<SolvedField> {
+        SOLVES.fetch_add(1, Ordering::Relaxed);
         if let Some(name) = options.prune.first() {
             return Err(SmearError::UnknownJoint {
                 name: name.clone(),
@@ -335,26 +369,30 @@ impl<'a> OffsetSolver<'a> {
         let camera = resolve_camera(cameras, &options.camera)?;
         let frames = anim.frame_count();
         let space = camera.map(|c| CameraSpace::new(c, frames));
-        let positions = Cow::Borrowed(anim.positions());
-        let tol = tolerances(&positions, frames, anim.vertex_count(), space.as_ref());
+        let tol = tolerances(
+            anim.positions(),
+            frames,
+            anim.vertex_count(),
+            space.as_ref(),
+        );
         let (field, raw) = Field::plane(
-            &positions,
+            anim.positions(),
             frames,
             anim.vertex_count(),
             &anim.mesh.triangles,
             tol,
             space.as_ref(),
         );
-        Ok(OffsetSolver {
+        Ok(SolvedField {
             frames,
             smooth: options.smooth,
             slots: vec![Slot {
-                anim,
                 group: 0,
                 base: 0,
+                vertices: anim.vertex_count(),
             }],
             groups: vec![Group {
-                positions,
+                positions: GroupPositions::Object(0),
                 vertices: anim.vertex_count(),
                 mode: OffsetMode::Simple,
                 field,
@@ -363,73 +401,61 @@ impl<'a> OffsetSolver<'a> {
         })
     }
 
-    /// Number of frames.
-    pub fn frame_count(&self) -> usize {
-        self.frames
-    }
-
     /// Number of objects (scene order).
-    pub fn object_count(&self) -> usize {
+    pub(crate) fn object_count(&self) -> usize {
         self.slots.len()
     }
 
     /// How object `i`'s offsets are computed (`None` when out of range).
-    pub fn mode(&self, i: usize) -> Option<OffsetMode> {
+    pub(crate) fn mode(&self, i: usize) -> Option<OffsetMode> {
         self.slots.get(i).map(|s| self.groups[s.group].mode)
     }
 
-    fn slot(&self, i: usize) -> Result<&Slot<'a>> {
+    fn slot(&self, i: usize) -> Result<&Slot> {
         self.slots.get(i).ok_or(SmearError::UnknownObject {
             index: i,
             count: self.slots.len(),
         })
     }
 
-    /// Smoothed (Eq. 2) offsets of one object, straight from its group's raw offsets.
-    fn slot_offsets(&self, slot: &Slot<'_>) -> MotionOffsets {
+    /// Smoothed (SMEAR Eq. 2) offsets of one object, straight from its group's raw offsets.
+    fn slot_offsets(&self, slot: &Slot) -> MotionOffsets {
         let grp = &self.groups[slot.group];
-        let nv = slot.anim.vertex_count();
         let values = crate::smooth::smooth_columns(
             &grp.raw,
             self.frames,
             grp.vertices,
-            slot.base..slot.base + nv,
+            slot.base..slot.base + slot.vertices,
             self.smooth,
         );
-        MotionOffsets::new(self.frames, nv, values).expect("frames × vertices")
+        MotionOffsets::new(self.frames, slot.vertices, values).expect("frames × vertices")
     }
 
-    /// Smoothed (Eq. 2) offsets of every vertex of object `i`.
-    ///
-    /// # Errors
-    /// [`SmearError::UnknownObject`] when `i` is out of range.
-    ///
-    /// # Performance
-    /// Smooths only the object's own vertices (its group's neighbourhood maxima were taken
-    /// when the solver was built).
-    pub fn vertex_offsets(&self, i: usize) -> Result<MotionOffsets> {
+    /// Smoothed offsets of object `i`'s vertices.
+    pub(crate) fn vertex_offsets(&self, i: usize) -> Result<MotionOffsets> {
         Ok(self.slot_offsets(self.slot(i)?))
     }
 
     /// Smoothed offsets of every object, in object order.
-    pub fn all(&self) -> Vec<MotionOffsets> {
+    pub(crate) fn all(&self) -> Vec<MotionOffsets> {
         self.slots.iter().map(|s| self.slot_offsets(s)).collect()
     }
 
-    /// Smoothed offsets at surface points of object `i` (Section 4.3: Eq. 8 evaluated at the
-    /// points' own positions, skin weights interpolated barycentrically, the neighbourhood
-    /// maxima of the mesh).
-    ///
-    /// # Returns
-    /// `frames × points` offsets.
-    ///
-    /// # Errors
-    /// [`SmearError::UnknownObject`], or [`SmearError::InvalidSurfacePoint`] for a triangle out
-    /// of range or unusable barycentric coordinates.
-    pub fn surface_offsets(&self, i: usize, points: &[SurfacePoint]) -> Result<MotionOffsets> {
+    /// Smoothed offsets at surface points of object `i`; `objects` are the caches the field
+    /// was solved on (scene order).
+    pub(crate) fn surface_offsets(
+        &self,
+        objects: &[&MeshAnimation],
+        i: usize,
+        points: &[SurfacePoint],
+    ) -> Result<MotionOffsets> {
         let slot = self.slot(i)?;
         let grp = &self.groups[slot.group];
-        let tris = &slot.anim.mesh.triangles;
+        let tris = &objects[i].mesh.triangles;
+        let positions: &[Vec3] = match &grp.positions {
+            GroupPositions::Object(k) => objects[*k].positions(),
+            GroupPositions::Merged(p) => p,
+        };
         // Per point: three group vertices and weights, then merged influences (CSR).
         let mut corners = Vec::with_capacity(points.len());
         let (mut start, mut joints, mut weights) = (vec![0u32], Vec::new(), Vec::new());
@@ -457,7 +483,7 @@ impl<'a> OffsetSolver<'a> {
         let mut raw = vec![0.0f32; self.frames * np];
         if np > 0 {
             raw.par_chunks_mut(np).enumerate().for_each(|(f, dst)| {
-                let pos = &grp.positions[f * grp.vertices..(f + 1) * grp.vertices];
+                let pos = &positions[f * grp.vertices..(f + 1) * grp.vertices];
                 for (k, d) in dst.iter_mut().enumerate() {
                     let p: Vec3 = corners[k].iter().map(|&(v, w)| w * pos[v]).sum();
                     let (a, b) = (start[k] as usize, start[k + 1] as usize);
@@ -470,6 +496,90 @@ impl<'a> OffsetSolver<'a> {
     }
 }
 
+impl<'a> OffsetSolver<'a> {
+    /// Prepares the offsets of every object of `scene`.
+    ///
+    /// # Errors
+    /// Unknown pruned joint or camera, a pruned root with skinned vertices, or an inconsistent
+    /// scene (see [`SmearError`]).
+    ///
+    /// # Performance
+    /// Computes the per-frame planes, ribbons, SMEAR Eq. 9 maxima and unsmoothed vertex
+    /// offsets (parallel over frames); [`OffsetSolver::all`] then only smooths (SMEAR Eq. 2)
+    /// and splits.
+    pub fn new(scene: &'a SampledScene, options: &OffsetOptions) -> Result<OffsetSolver<'a>> {
+        Ok(OffsetSolver {
+            field: SolvedField::new(scene, options)?,
+            objects: scene.objects.iter().map(|o| &o.animation).collect(),
+        })
+    }
+
+    /// Prepares the offsets of a bare point cache, a simple object (SMEAR Eq. 1).
+    ///
+    /// # Arguments
+    /// * `cameras` — cameras that `options.camera` may select from (may be empty).
+    ///
+    /// # Errors
+    /// [`SmearError::UnknownCamera`] when the selected camera is not in `cameras`;
+    /// [`SmearError::UnknownJoint`] when `options.prune` names a joint (there is no skeleton).
+    pub fn from_animation(
+        anim: &'a MeshAnimation,
+        options: &OffsetOptions,
+        cameras: &[Camera],
+    ) -> Result<OffsetSolver<'a>> {
+        Ok(OffsetSolver {
+            field: SolvedField::from_animation(anim, options, cameras)?,
+            objects: vec![anim],
+        })
+    }
+
+    /// Number of frames.
+    pub fn frame_count(&self) -> usize {
+        self.field.frames
+    }
+
+    /// Number of objects (scene order).
+    pub fn object_count(&self) -> usize {
+        self.field.object_count()
+    }
+
+    /// How object `i`'s offsets are computed (`None` when out of range).
+    pub fn mode(&self, i: usize) -> Option<OffsetMode> {
+        self.field.mode(i)
+    }
+
+    /// Smoothed (SMEAR Eq. 2) offsets of every vertex of object `i`.
+    ///
+    /// # Errors
+    /// [`SmearError::UnknownObject`] when `i` is out of range.
+    ///
+    /// # Performance
+    /// Smooths only the object's own vertices (its group's neighbourhood maxima were taken
+    /// when the solver was built).
+    pub fn vertex_offsets(&self, i: usize) -> Result<MotionOffsets> {
+        self.field.vertex_offsets(i)
+    }
+
+    /// Smoothed offsets of every object, in object order.
+    pub fn all(&self) -> Vec<MotionOffsets> {
+        self.field.all()
+    }
+
+    /// Smoothed offsets at surface points of object `i` (SMEAR Section 4.3: SMEAR Eq. 8
+    /// evaluated at the points' own positions, skin weights interpolated barycentrically, the
+    /// neighbourhood maxima of the mesh).
+    ///
+    /// # Returns
+    /// `frames × points` offsets.
+    ///
+    /// # Errors
+    /// [`SmearError::UnknownObject`], or [`SmearError::InvalidSurfacePoint`] for a triangle out
+    /// of range or unusable barycentric coordinates.
+    pub fn surface_offsets(&self, i: usize, points: &[SurfacePoint]) -> Result<MotionOffsets> {
+        self.field.surface_offsets(&self.objects, i, points)
+    }
+}
+
 /// Motion offsets of every object of a sampled scene (see [`OffsetSolver`]).
 ///
 /// # Errors
@@ -478,7 +588,7 @@ pub fn scene_offsets(scene: &SampledScene, options: &OffsetOptions) -> Result<Ve
     Ok(OffsetSolver::new(scene, options)?.all())
 }
 
-/// Motion offsets of a bare point cache treated as a simple object (Eqs. 1–2).
+/// Motion offsets of a bare point cache treated as a simple object (SMEAR Eqs. 1–2).
 ///
 /// # Errors
 /// As [`OffsetSolver::from_animation`] with no camera.

@@ -1,5 +1,5 @@
 //! Real characters read with the glTF reader: every clip gives finite offsets within
-//! [−1.5, 1.5] (Eq. 9 may slightly exceed [−1, 1] at joints, paper Section 3.2).
+//! [−1.5, 1.5] (SMEAR Eq. 9 may slightly exceed [−1, 1] at joints, paper Section 3.2).
 
 use std::path::PathBuf;
 

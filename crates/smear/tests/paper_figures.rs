@@ -162,7 +162,7 @@ fn thin_thick_capsule(
     skinned_scene(mesh, skel, w, frames, move |f| locals(f, &l0))
 }
 
-/// Eq. 9 with SPEC.md's orientation is continuous across a joint: the two copies of the
+/// SMEAR Eq. 9 with SPEC.md's orientation is continuous across a joint: the two copies of the
 /// joint ring (one on each bone) get the same offsets although the bones' parts have very
 /// different thickness. The printed orientation would normalize each side by its own part.
 #[test]
@@ -196,11 +196,11 @@ fn eq9_continuity_across_joint() {
     assert!(jump < 1e-5, "jump across the joint {jump}");
     assert!(
         printed_jump > 0.5,
-        "printed Eq. 9 would jump by {printed_jump}"
+        "printed SMEAR Eq. 9 would jump by {printed_jump}"
     );
 }
 
-/// Direct transcription of Eqs. 3–9 for a two-bone chain, as an oracle.
+/// Direct transcription of SMEAR Eqs. 3–9 for a two-bone chain, as an oracle.
 fn oracle_two_bones(scene: &anim::SampledScene, f: usize) -> Vec<f32> {
     let frames = scene.frame_count;
     let (a, b, s) = match f {
@@ -273,7 +273,7 @@ fn oracle_two_bones(scene: &anim::SampledScene, f: usize) -> Vec<f32> {
         .collect()
 }
 
-/// Fig. 5 / Eqs. 3–9 on a bending, translating two-bone capsule with blended weights: the
+/// Fig. 5 / SMEAR Eqs. 3–9 on a bending, translating two-bone capsule with blended weights: the
 /// crate's factored evaluation matches a literal transcription of the equations.
 #[test]
 fn fig5_bending_capsule_matches_the_equations() {
@@ -300,7 +300,7 @@ fn fig5_bending_capsule_matches_the_equations() {
             worst = worst.max((a - b).abs());
         }
     }
-    assert!(worst < 2e-3, "max deviation from Eqs. 3–9: {worst}");
+    assert!(worst < 2e-3, "max deviation from SMEAR Eqs. 3–9: {worst}");
     assert!(
         d.max_abs() > 0.5 && d.max_abs() < 1.5,
         "range {:?}",

@@ -501,7 +501,7 @@ fn shuffled(mut scene: SampledScene) -> (SampledScene, Vec<usize>) {
 
 /// The optimized vertex pass (batched ribbons over neighbourhoods read by runs of
 /// consecutive vertices, or gathered when the vertex order is scattered) equals the
-/// straightforward pointwise evaluation of Eqs. 3–9 (surface points at the vertices) at
+/// straightforward pointwise evaluation of SMEAR Eqs. 3–9 (surface points at the vertices) at
 /// every vertex and frame, and both vertex orders give the same offsets.
 #[test]
 fn vertex_pass_matches_pointwise_evaluation() {
@@ -576,7 +576,7 @@ fn camera_following_the_ball_sees_no_speed() {
     let speed_preset = smear::FunctionSpec::speed(2.0).compile().unwrap();
     let options = smear::ElongateOptions::default();
     let moved = |inputs: &smear::EffectInputs<'_>| {
-        let e = smear::elongate(&ball, inputs, &speed_preset, &options).unwrap();
+        let e = smear::elongate(inputs, &speed_preset, &options).unwrap();
         e.positions()
             .iter()
             .zip(ball.positions())

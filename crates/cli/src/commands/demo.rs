@@ -68,11 +68,7 @@ pub fn run(ctx: &Context, args: DemoArgs) -> Result<()> {
     // smear: motion offsets as colours (red leading, blue trailing) and a preview.
     let parts = smear::scene_offsets(&sampled, &smear::OffsetOptions::default())?;
     let offsets = smear::MotionOffsets::concat(&parts)?;
-    let colors: Vec<[f32; 4]> = offsets
-        .values()
-        .iter()
-        .map(|&d| super::smear::color(d))
-        .collect();
+    let colors = render::offset_colors(offsets.values());
     written.extend(output::write_animation(
         &out("robot_offsets.glb"),
         &robot,
@@ -105,10 +101,17 @@ pub fn run(ctx: &Context, args: DemoArgs) -> Result<()> {
 
     // smear: the bundled style (elongation, multiples, motion lines) as a GIF.
     let style = smear::Style::from_toml_str(SAMPLE_STYLE).context("bundled smear style")?;
-    let styled = super::smear_style::apply(&sampled, &style)?;
+    let prepared = smear::prepare(
+        sampled.clone(),
+        &smear::PrepareOptions {
+            offsets: style.offsets.clone(),
+            ..smear::PrepareOptions::default()
+        },
+    )?;
+    let styled = smear::stylize(&prepared, &style)?;
     put(
         &out("robot_smear.gif"),
-        &styled.render_gif(320, 320)?,
+        &render::flipbook_gif(&styled.flipbook, 320, 320)?,
         &mut written,
     )?;
 

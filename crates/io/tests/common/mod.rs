@@ -5,11 +5,7 @@ use std::path::PathBuf;
 
 /// Path of a shared test asset; panics (fails loudly) if it is missing.
 pub fn data(rel: &str) -> PathBuf {
-    let p = PathBuf::from(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../assets/"
-    ))
-    .join(rel);
+    let p = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/")).join(rel);
     assert!(p.exists(), "missing test asset {}", p.display());
     p
 }

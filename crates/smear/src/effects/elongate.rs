@@ -1,4 +1,4 @@
-//! Elongated in-betweens (Section 4.1, Eq. 10): every vertex slides along its own trajectory
+//! Elongated in-betweens (Section 4.1, SMEAR Eq. 10): every vertex slides along its own trajectory
 //! by β_i(f) = S_E(δ_i(f); args) frames.
 
 use anim::MeshAnimation;
@@ -47,7 +47,7 @@ fn fill(
 
 /// The elongated in-between of one frame, written into a caller buffer (for interactive
 /// scrubbing): `p′_i(f) = Q_{i, f+⌊β_i⌋}(β_i − ⌊β_i⌋)` with `β_i(f) = step · S_E(x_i(f))`
-/// (Eq. 10), `f` replaced by its held frame when `step > 1`.
+/// (SMEAR Eq. 10), `f` replaced by its held frame when `step > 1`.
 ///
 /// # Arguments
 /// * `style` — S_E; the paper's linear example is `|x: &StyleInput| x.delta * beta_max`.
@@ -110,20 +110,23 @@ pub fn elongate_frame(
 /// Elongated in-betweens of the whole clip (Section 4.1): the input animation with every
 /// frame replaced by its elongated in-between; same mesh, frame rate and topology.
 ///
+/// The mesh, frame rate and start time are those of the animation `inputs` were built from
+/// ([`EffectInputs::new`]).
+///
 /// # Errors
-/// [`SmearError::InvalidParameter`] when `step` is 0 or `inputs` were not built from `anim`
-/// (different frame or vertex counts).
+/// [`SmearError::InvalidParameter`] when `step` is 0 or `inputs` are surface points (built
+/// with [`EffectInputs::at_surface_points`]: there is no mesh to elongate).
 ///
 /// # Performance
 /// Parallel over frames; allocates only the output.
 pub fn elongate(
-    anim: &MeshAnimation,
     inputs: &EffectInputs<'_>,
     style: &dyn Stylize,
     options: &ElongateOptions,
 ) -> Result<MeshAnimation> {
     let step = check_step(options.step)?;
-    let (frames, n) = inputs.check_animation(anim)?;
+    let anim = inputs.animation()?;
+    let (frames, n) = (inputs.frame_count(), inputs.point_count());
     let mut positions = vec![Vec3::ZERO; frames * n];
     if n > 0 {
         positions
@@ -151,7 +154,7 @@ mod tests {
         let delta = mesh_offsets(&anim, &OffsetOptions::default()).unwrap();
         let inputs = EffectInputs::new(&anim, &delta).unwrap();
         let linear = |x: &StyleInput| x.delta;
-        let out = elongate(&anim, &inputs, &linear, &ElongateOptions::default()).unwrap();
+        let out = elongate(&inputs, &linear, &ElongateOptions::default()).unwrap();
         let f = 4;
         let got = Aabb::from_points(out.frame(f));
         let cover =
@@ -169,7 +172,7 @@ mod tests {
         assert!((got.max.y - got.min.y - 2.0).abs() < 1e-3);
         // β_max = 2 reaches two frames away.
         let two = |x: &StyleInput| 2.0 * x.delta;
-        let out2 = elongate(&anim, &inputs, &two, &ElongateOptions::default()).unwrap();
+        let out2 = elongate(&inputs, &two, &ElongateOptions::default()).unwrap();
         let got2 = Aabb::from_points(out2.frame(f));
         assert!((got2.max.x - got.max.x - 0.8).abs() < 1e-3);
         // The single-frame entry point agrees with the clip.
@@ -185,12 +188,12 @@ mod tests {
         let inputs = EffectInputs::new(&anim, &delta).unwrap();
         let linear = |x: &StyleInput| x.delta;
         let twos = ElongateOptions { step: 2 };
-        let out = elongate(&anim, &inputs, &linear, &twos).unwrap();
+        let out = elongate(&inputs, &linear, &twos).unwrap();
         assert_eq!(out.frame(2), out.frame(3));
         let bb = Aabb::from_points(out.frame(2));
         // Held frame 2 displaced by ±2 frames: covers frames 0..4 → 2 + 4 × 0.5.
         assert!((bb.max.x - bb.min.x - 4.0).abs() < 1e-3, "{bb:?}");
-        assert!(elongate(&anim, &inputs, &linear, &ElongateOptions { step: 0 }).is_err());
+        assert!(elongate(&inputs, &linear, &ElongateOptions { step: 0 }).is_err());
     }
 
     #[test]
@@ -200,13 +203,13 @@ mod tests {
         let delta = mesh_offsets(&still, &OffsetOptions::default()).unwrap();
         let inputs = EffectInputs::new(&still, &delta).unwrap();
         let nan = |_: &StyleInput| f32::NAN;
-        let out = elongate(&still, &inputs, &nan, &ElongateOptions::default()).unwrap();
+        let out = elongate(&inputs, &nan, &ElongateOptions::default()).unwrap();
         assert_eq!(out.positions(), still.positions());
         let one = MeshAnimation::still(ball(1.0, 4, 6));
         let z = MotionOffsets::zeros(1, one.vertex_count());
         let inputs = EffectInputs::new(&one, &z).unwrap();
         let big = |_: &StyleInput| 5.0;
-        let out = elongate(&one, &inputs, &big, &ElongateOptions::default()).unwrap();
+        let out = elongate(&inputs, &big, &ElongateOptions::default()).unwrap();
         assert_eq!(out.positions(), one.positions());
         let mut short = vec![Vec3::ZERO; 3];
         assert!(elongate_frame(&inputs, &big, 0, &ElongateOptions::default(), &mut short).is_err());

@@ -25,8 +25,10 @@ pub struct EffectInputs<'a> {
     frames: usize,
     points: usize,
     offsets: Cow<'a, MotionOffsets>,
-    velocities: Vec<Vec3>,
+    velocities: Cow<'a, [Vec3]>,
     weights: Option<Vec<f32>>,
+    /// The point cache the points are the vertices of (`None` for surface points).
+    source: Option<&'a MeshAnimation>,
 }
 
 fn mismatch(name: &'static str, expected: usize, found: usize) -> SmearError {
@@ -37,24 +39,36 @@ fn mismatch(name: &'static str, expected: usize, found: usize) -> SmearError {
 }
 
 impl<'a> EffectInputs<'a> {
-    /// Checks that these inputs were built for `anim` (same frame and point counts) and
-    /// returns `(frames, points)`.
+    /// The point cache these inputs were built from with [`EffectInputs::new`] (its mesh,
+    /// frame rate and start time go to the outputs of the effects that rebuild it).
     ///
     /// # Errors
-    /// [`SmearError::InvalidParameter`] naming both shapes otherwise.
-    pub(crate) fn check_animation(&self, anim: &anim::MeshAnimation) -> Result<(usize, usize)> {
-        let (frames, n) = (self.frame_count(), self.point_count());
-        if anim.frame_count() != frames || anim.vertex_count() != n {
-            return Err(SmearError::InvalidParameter {
-                name: "inputs",
-                reason: format!(
-                    "built for {frames} frames × {n} points, the animation has {} × {}",
-                    anim.frame_count(),
-                    anim.vertex_count()
-                ),
-            });
+    /// [`SmearError::InvalidParameter`] for inputs at surface points, which have no mesh.
+    pub(crate) fn animation(&self) -> Result<&'a MeshAnimation> {
+        self.source.ok_or_else(|| SmearError::InvalidParameter {
+            name: "inputs",
+            reason: "built at surface points, not from a mesh's vertices".into(),
+        })
+    }
+
+    /// Inputs from parts computed beforehand (by [`prepare`](crate::prepare)), borrowed:
+    /// the vertices of `anim` with their offsets and velocities (frame-major, already in
+    /// the right space). The caller guarantees the shapes agree.
+    pub(crate) fn from_prepared(
+        anim: &'a MeshAnimation,
+        offsets: &'a MotionOffsets,
+        velocities: &'a [Vec3],
+        weights: Option<Vec<f32>>,
+    ) -> EffectInputs<'a> {
+        EffectInputs {
+            positions: Cow::Borrowed(anim.positions()),
+            frames: anim.frame_count(),
+            points: anim.vertex_count(),
+            offsets: Cow::Borrowed(offsets),
+            velocities: Cow::Borrowed(velocities),
+            weights,
+            source: Some(anim),
         }
-        Ok((frames, n))
     }
 
     /// The vertices of a point cache with their motion offsets.
@@ -66,12 +80,14 @@ impl<'a> EffectInputs<'a> {
     /// # Performance
     /// Computes the velocities (central differences, parallel over frames).
     pub fn new(anim: &'a MeshAnimation, offsets: &'a MotionOffsets) -> Result<EffectInputs<'a>> {
-        Self::build(
+        let mut inputs = Self::build(
             Cow::Borrowed(anim.positions()),
             anim.frame_count(),
             anim.vertex_count(),
             Cow::Borrowed(offsets),
-        )
+        )?;
+        inputs.source = Some(anim);
+        Ok(inputs)
     }
 
     /// Surface points of a point cache (e.g. motion-line seeds, Section 4.3) with their
@@ -128,8 +144,9 @@ impl<'a> EffectInputs<'a> {
             frames,
             points,
             offsets,
-            velocities,
+            velocities: Cow::Owned(velocities),
             weights: None,
+            source: None,
         })
     }
 
@@ -158,7 +175,7 @@ impl<'a> EffectInputs<'a> {
                 velocities.len(),
             ));
         }
-        self.velocities = velocities;
+        self.velocities = Cow::Owned(velocities);
         Ok(self)
     }
 
@@ -175,12 +192,12 @@ impl<'a> EffectInputs<'a> {
             return self;
         };
         let space = crate::velocity::CameraSpace::new(camera, self.frames);
-        self.velocities = crate::velocity::camera_buffer_velocities(
+        self.velocities = Cow::Owned(crate::velocity::camera_buffer_velocities(
             &self.positions,
             self.frames,
             self.points,
             &space,
-        );
+        ));
         self
     }
 

@@ -1,4 +1,4 @@
-//! Motion lines (Section 4.3, Eq. 13): tubes traced along the trajectories of surface seeds.
+//! Motion lines (Section 4.3, SMEAR Eq. 13): tubes traced along the trajectories of surface seeds.
 
 use anim::Mesh;
 use rayon::prelude::*;
@@ -17,7 +17,7 @@ pub const DEFAULT_LINE_SAMPLES: usize = 16;
 /// the position along the line (0 at the surface end) — `t` is 0 for `length`.
 #[derive(Clone, Copy)]
 pub struct LineStyle<'s> {
-    /// τ = S_L(x) (Eq. 13): signed length in frames along the trajectory, like β in
+    /// τ = S_L(x) (SMEAR Eq. 13): signed length in frames along the trajectory, like β in
     /// Section 4.1 (τ < 0 traces the past, τ > 0 the future; the paper's example
     /// S_L(δ; τ_max) = δ·τ_max makes trailing seeds trail). τ = 0 draws nothing.
     pub length: &'s dyn Stylize,
@@ -224,7 +224,7 @@ fn trace(
 }
 
 /// The motion lines of one frame (Section 4.3): seed ℓ's line runs along its trajectory from
-/// time `f + gap·sign(τ)` to `f + τ`, with `τ_ℓ(f) = step · S_L(x_ℓ(f))` (Eq. 13), sampled at
+/// time `f + gap·sign(τ)` to `f + τ`, with `τ_ℓ(f) = step · S_L(x_ℓ(f))` (SMEAR Eq. 13), sampled at
 /// `samples` rings whose radius and opacity are `style.thickness` / `style.opacity` at
 /// `t = j / (samples − 1)`. Seeds slower than `min_speed`, τ = 0 or non-finite, and still
 /// trajectories draw nothing.

@@ -1,4 +1,4 @@
-//! Multiple in-betweens (Section 4.2, Eqs. 11–12): displaced copies of the whole mesh in the
+//! Multiple in-betweens (Section 4.2, SMEAR Eqs. 11–12): displaced copies of the whole mesh in the
 //! past and future, each vertex with its own opacity.
 
 use anim::MeshAnimation;
@@ -13,7 +13,7 @@ use crate::{smoothstep, Param, Result, SmearError};
 pub const DEFAULT_SPACING: f32 = 0.5;
 
 /// Most copies on either side (a guard against a typo asking for millions of meshes).
-pub const MAX_MULTIPLES: usize = 64;
+pub(crate) const MAX_MULTIPLES: usize = 64;
 
 /// How far apart the copies are in time.
 #[derive(Debug, Clone, PartialEq)]
@@ -159,7 +159,7 @@ pub fn overlap_spacing(past: usize, future: usize, overlap: usize) -> Result<f32
     Ok(1.0 / (total + 1 - overlap) as f32)
 }
 
-/// Eq. 12: `S_M(δ, m; m_max) = H(δm) · S((|δ| − δ_m) / (1 − δ_m))`, `δ_m = (|m| − 1) / m_max`,
+/// SMEAR Eq. 12: `S_M(δ, m; m_max) = H(δm) · S((|δ| − δ_m) / (1 − δ_m))`, `δ_m = (|m| − 1) / m_max`,
 /// with H the Heaviside step (H(0) = 0) and S the smoothstep. Past copies (m < 0) show only
 /// trailing vertices (δ < 0), future copies only leading ones.
 ///
@@ -178,7 +178,7 @@ pub fn multiple_opacity(delta: f32, m: f32, m_max: f32) -> f32 {
     smoothstep((a - dm) / (1.0 - dm))
 }
 
-/// Eq. 12 as a stylization function S_M(δ, m; m_max).
+/// SMEAR Eq. 12 as a stylization function S_M(δ, m; m_max).
 pub fn eq12_opacity(m_max: f32) -> impl Stylize + Copy {
     move |x: &StyleInput| multiple_opacity(x.delta, x.m, m_max)
 }
@@ -193,7 +193,7 @@ pub struct MultipleCopy {
     pub beta: f32,
     /// The copy at every frame (same mesh and topology as the input).
     pub animation: MeshAnimation,
-    /// Opacity α_{i,m}(f) ∈ [0, 1] per frame and vertex (frame-major), Eq. 11.
+    /// Opacity α_{i,m}(f) ∈ [0, 1] per frame and vertex (frame-major), SMEAR Eq. 11.
     pub alpha: Vec<f32>,
 }
 
@@ -242,7 +242,7 @@ fn fill(
 /// opacities to `alpha[k·n..(k+1)·n]`, with `n` the point count.
 ///
 /// Every vertex of copy m moves by the same β_m(f) = step · m·Δf (Section 4.2); its opacity is
-/// `α_{i,m}(f) = S_M(x_i(f))` (Eq. 11) with `x.m = m`, clamped to [0, 1] (non-finite → 0).
+/// `α_{i,m}(f) = S_M(x_i(f))` (SMEAR Eq. 11) with `x.m = m`, clamped to [0, 1] (non-finite → 0).
 ///
 /// # Errors
 /// [`SmearError::InvalidParameter`] for a bad spacing, step, frame or buffer length.
@@ -295,18 +295,18 @@ pub fn multiples_frame(
 /// the original as alpha-blended flipbooks.
 ///
 /// # Errors
-/// As [`multiples_frame`], or when `inputs` were not built from `anim`.
+/// As [`multiples_frame`], or when `inputs` are surface points (no mesh to copy).
 ///
 /// # Performance
 /// Parallel over frames; allocates only the outputs (copies × frames × vertices).
 pub fn multiples(
-    anim: &MeshAnimation,
     inputs: &EffectInputs<'_>,
     style: &dyn Stylize,
     options: &MultiplesOptions,
 ) -> Result<Vec<MultipleCopy>> {
     let step = check_step(options.step)?;
-    let (frames, n) = inputs.check_animation(anim)?;
+    let anim = inputs.animation()?;
+    let (frames, n) = (inputs.frame_count(), inputs.point_count());
     // Δf and copy counts of every held drawing, checked once.
     let spacing = (0..frames)
         .map(|f| options.spacing_at(held_frame(f, step) as f32))
@@ -407,7 +407,7 @@ mod tests {
             spacing: Spacing::Overlap(2.0.into()),
             step: 1,
         };
-        let copies = multiples(&anim, &inputs, &eq12_opacity(1.0), &opts).unwrap();
+        let copies = multiples(&inputs, &eq12_opacity(1.0), &opts).unwrap();
         assert_eq!(copies.iter().map(|c| c.m).collect::<Vec<_>>(), [-1, 1]);
         let names: Vec<&str> = copies
             .iter()
@@ -469,7 +469,7 @@ mod tests {
         assert_eq!(opts.spacing_at(0.0).unwrap(), 0.0);
         assert_eq!(opts.spacing_at(2.0).unwrap(), 1.0);
         assert_eq!(opts.spacing_at(5.0).unwrap(), 0.5);
-        let copies = multiples(&anim, &inputs, &eq12_opacity(2.0), &opts).unwrap();
+        let copies = multiples(&inputs, &eq12_opacity(2.0), &opts).unwrap();
         let n = anim.vertex_count();
         let shown =
             |c: &MultipleCopy, f: usize| c.alpha[f * n..(f + 1) * n].iter().any(|a| *a > 0.0);

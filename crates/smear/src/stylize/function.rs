@@ -62,7 +62,7 @@ impl FunctionSpec {
         }
     }
 
-    /// S_E(δ; β_max) = β_max·δ (Eq. 10; also S_L(δ; τ_max) = τ_max·δ, Eq. 13).
+    /// S_E(δ; β_max) = β_max·δ (SMEAR Eq. 10; also S_L(δ; τ_max) = τ_max·δ, SMEAR Eq. 13).
     pub fn linear(beta_max: impl Into<Param>) -> Self {
         Self::stages(vec![Stage::Scale {
             by: beta_max.into(),
@@ -94,7 +94,7 @@ impl FunctionSpec {
         ])
     }
 
-    /// S_M(δ, m; m_max) of Eq. 12.
+    /// S_M(δ, m; m_max) of SMEAR Eq. 12.
     pub fn multiples(m_max: impl Into<Param>) -> Self {
         Self::stages(vec![Stage::Multiples {
             m_max: m_max.into(),
@@ -204,7 +204,7 @@ mod tests {
             Stage::Multiples { m_max: 2.0.into() },
         ]);
         let x = "min(10 * speed * weight * delta, 0)";
-        // Eq. 12 written out with δ_m = (|m| − 1)/2; H(0) = 0.
+        // SMEAR Eq. 12 written out with δ_m = (|m| − 1)/2; H(0) = 0.
         let sm = format!(
             "step(m * {x}) * step(abs({x}) - 0.000001) \
              * smoothstep((abs({x}) - (abs(m) - 1) / 2) / (1 - (abs(m) - 1) / 2))"

@@ -1,9 +1,9 @@
-//! Stylization functions (paper G3; S_E, S_M, S_L of Eqs. 10–13 and the variants of Section 5)
+//! Stylization functions (paper G3; S_E, S_M, S_L of SMEAR Eqs. 10–13 and the variants of Section 5)
 //! and styles: which effects to apply with which functions and parameters.
 //!
 //! * [`Stage`] chains compose the paper's presets: linear (`scale`), speed-weighted, Voronoi
 //!   noise, past-/future-only offsets, Hise-warped offsets, painted weights, speed threshold,
-//!   the multiples opacity of Eq. 12, line fading.
+//!   the multiples opacity of SMEAR Eq. 12, line fading.
 //! * [`Expression`]: user expressions (exmex) over `delta, speed, weight, noise, frame, m, t,
 //!   vx, vy, vz, x, y, z` and declared parameters.
 //! * [`Param`]: every numeric parameter is a constant or a keyframed curve.
@@ -28,7 +28,7 @@ pub use param::Param;
 pub use stage::{apply_stages, Stage};
 pub use style::{
     CompiledEffects, CompiledLines, ElongateStyle, LinesStyle, MultiplesStyle, ObjectEffects,
-    ObjectStyle, Style, DEFAULT_LINE_COUNT, DEFAULT_LINE_THICKNESS,
+    ObjectStyle, Style, DEFAULT_LINE_COUNT, DEFAULT_LINE_THICKNESS, DEFAULT_MULTIPLE_COLOR,
 };
 pub use voronoi::voronoi_f1;
 pub use warp::{hise_curve, warp_offset};

@@ -1,4 +1,4 @@
-//! Composable preset stages: the paper's stylization functions S_E, S_M, S_L (Eqs. 10–13) and
+//! Composable preset stages: the paper's stylization functions S_E, S_M, S_L (SMEAR Eqs. 10–13) and
 //! their Section 5 variants as a chain of small operations on one value.
 
 use serde::{Deserialize, Serialize};
@@ -29,7 +29,7 @@ pub enum Stage {
     Past,
     /// x ← max(x, 0): future-only offsets δ+.
     Future,
-    /// x ← k·x: β_max of S_E (Eq. 10), τ_max of S_L (Eq. 13), or any gain.
+    /// x ← k·x: β_max of S_E (SMEAR Eq. 10), τ_max of S_L (SMEAR Eq. 13), or any gain.
     Scale {
         /// The factor k.
         by: Param,
@@ -51,11 +51,11 @@ pub enum Stage {
         /// Speed v_min in units per frame.
         min_speed: Param,
     },
-    /// x ← S_M(x, m; m_max) = H(x·m)·S((|x| − δ_m)/(1 − δ_m)), δ_m = (|m| − 1)/m_max (Eq. 12,
+    /// x ← S_M(x, m; m_max) = H(x·m)·S((|x| − δ_m)/(1 − δ_m)), δ_m = (|m| − 1)/m_max (SMEAR Eq. 12,
     /// [`multiple_opacity`](crate::multiple_opacity)): past copies (m < 0) show trailing
     /// vertices only, future copies leading ones.
     Multiples {
-        /// m_max of Eq. 12 (> 0).
+        /// m_max of SMEAR Eq. 12 (> 0).
         m_max: Param,
     },
     /// x ← (1 − t)·x: fades along a motion line from its start to its end (Fig. 15e).

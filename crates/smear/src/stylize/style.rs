@@ -21,6 +21,13 @@ pub const DEFAULT_LINE_COUNT: usize = 40;
 /// Default motion-line radius as a fraction of the object's bounding-box diagonal.
 pub const DEFAULT_LINE_THICKNESS: f32 = 0.002;
 
+/// Default colour of the multiple in-betweens (linear RGB, light grey; alpha is S_M).
+pub const DEFAULT_MULTIPLE_COLOR: [f32; 3] = [0.8, 0.8, 0.8];
+
+fn is_default_multiple_color(c: &[f32; 3]) -> bool {
+    *c == DEFAULT_MULTIPLE_COLOR
+}
+
 fn yes() -> bool {
     true
 }
@@ -37,7 +44,7 @@ pub struct ElongateStyle {
     pub enabled: bool,
     /// Frame step: 2 = "on twos" (Section 5.2).
     pub step: usize,
-    /// S_E of Eq. 10: β in frames along the trajectory.
+    /// S_E of SMEAR Eq. 10: β in frames along the trajectory.
     pub function: FunctionSpec,
 }
 
@@ -70,9 +77,13 @@ pub struct MultiplesStyle {
     pub overlap: Option<Param>,
     /// Frame step: 2 = "on twos".
     pub step: usize,
-    /// S_M of Eq. 11: opacity per vertex and copy (default Eq. 12 with m_max = max(m_p, m_n)).
+    /// S_M of SMEAR Eq. 11: opacity per vertex and copy (default SMEAR Eq. 12 with
+    /// m_max = max(m_p, m_n)).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub opacity: Option<FunctionSpec>,
+    /// Linear RGB colour of the copies in [0, 1] (default [`DEFAULT_MULTIPLE_COLOR`]).
+    #[serde(skip_serializing_if = "is_default_multiple_color")]
+    pub color: [f32; 3],
 }
 
 impl Default for MultiplesStyle {
@@ -85,6 +96,7 @@ impl Default for MultiplesStyle {
             overlap: None,
             step: one(),
             opacity: None,
+            color: DEFAULT_MULTIPLE_COLOR,
         }
     }
 }
@@ -129,7 +141,7 @@ impl MultiplesStyle {
         Ok(options)
     }
 
-    /// The opacity function (Eq. 12 with m_max = max(m_p, m_n, 1) when none is given).
+    /// The opacity function (SMEAR Eq. 12 with m_max = max(m_p, m_n, 1) when none is given).
     pub fn opacity_spec(&self) -> FunctionSpec {
         self.opacity.clone().unwrap_or_else(|| {
             let largest = self.past.max_value().max(self.future.max_value()).round();
@@ -164,7 +176,7 @@ pub struct LinesStyle {
     /// Linear RGB colour in [0, 1]; each component keyframeable, e.g.
     /// `color = [[[0, 0.0], [12, 1.0]], 0.1, 0.1]` turns the lines red.
     pub color: [Param; 3],
-    /// S_L of Eq. 13: signed length τ in frames (default S_L(δ; 1) = δ).
+    /// S_L of SMEAR Eq. 13: signed length τ in frames (default S_L(δ; 1) = δ).
     pub length: FunctionSpec,
     /// Tube radius in scene units along the line (default [`DEFAULT_LINE_THICKNESS`] × the
     /// bounding-box diagonal).
@@ -350,6 +362,12 @@ impl Style {
                 m.options().map_err(at)?;
                 m.opacity_spec().compile().map_err(at)?;
                 check_step("multiples.step", m.step).map_err(at)?;
+                if !m.color.iter().all(|c| (0.0..=1.0).contains(c)) {
+                    return Err(at(StyleError::Parameter {
+                        name: "multiples.color".into(),
+                        problem: format!("components must be in [0, 1], got {:?}", m.color),
+                    }));
+                }
             }
             if let Some(l) = &s.lines {
                 l.length.compile().map_err(at)?;

@@ -202,15 +202,15 @@ pub fn chain_weights(mesh: &Mesh, bones: usize, len: f32, blend: f32) -> VertexW
     }))
 }
 
-/// The benchmark scene (SPEC target): a 15,002-vertex wavy tube skinned to a 10-bone chain
-/// that translates, bends and twists over `frames` frames.
-pub fn benchmark_tube(frames: usize) -> SampledScene {
+/// The benchmark tube's parts: a 15,002-vertex wavy tube, a 10-bone chain, skin weights and
+/// the chain's local joint matrices at frame f (it translates, bends and twists).
+pub fn benchmark_tube_parts() -> (Mesh, Skeleton, VertexWeights, impl Fn(usize) -> Vec<Mat4>) {
     let ys: Vec<f32> = (0..300).map(|i| i as f32 * 10.0 / 299.0).collect();
     let mesh = tube(&ys, 50, |y| 0.3 + 0.1 * (2.0 * y).sin());
     let w = chain_weights(&mesh, 10, 1.0, 0.25);
     let skel = chain(10, 1.0, Quat::IDENTITY);
     let l0 = bind_locals(&skel);
-    skinned_scene(mesh, skel, w, frames, move |f| {
+    let locals = move |f: usize| {
         let t = f as f32;
         let mut l = l0.clone();
         l[0] =
@@ -221,5 +221,23 @@ pub fn benchmark_tube(frames: usize) -> SampledScene {
                 * Mat4::from_rotation_x(0.1 * (0.3 * t).cos());
         }
         l
-    })
+    };
+    (mesh, skel, w, locals)
+}
+
+/// The benchmark scene (SPEC target): a 15,002-vertex wavy tube skinned to a 10-bone chain
+/// that translates, bends and twists over `frames` frames.
+pub fn benchmark_tube(frames: usize) -> SampledScene {
+    let (mesh, skel, w, locals) = benchmark_tube_parts();
+    skinned_scene(mesh, skel, w, frames, locals)
+}
+
+/// Path of a bundled asset (`assets/…` at the workspace root, same relative names as the
+/// shared data folder); panics if it is missing.
+pub fn asset(rel: &str) -> std::path::PathBuf {
+    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../assets")
+        .join(rel);
+    assert!(p.exists(), "missing test asset {}", p.display());
+    p
 }

@@ -1,17 +1,19 @@
-//! `toonkit smear elongate | multiples | lines`: the smear effects of Basset et al. 2024,
-//! Section 4, driven by motion offsets computed with the same options as `smear offsets`.
+//! `toonkit smear elongate | multiples | lines`: the smear effects of SMEAR Section 4, driven
+//! by motion offsets computed with the same options as `smear offsets`, on all objects merged
+//! into one.
 //!
 //! * `elongate IN -o OUT [--preset linear|speed|noise] [--beta-max X] [--kappa K]
-//!   [--expr "..."]`: every frame replaced by its elongated in-between (Eq. 10); `.glb`
+//!   [--expr "..."]`: every frame replaced by its elongated in-between (SMEAR Eq. 10); `.glb`
 //!   (flipbook or `--layout morph`), `.usda`, `.pc2`/`.mdd` + rest `.obj`, or an `.obj`
 //!   sequence (`--layout sequence`), on the input topology.
 //! * `multiples IN -o OUT.glb|OUT.usda --past M --future M [--spacing DF | --overlap N]
 //!   [--m-max X] [--opacity-expr "..."]`: the original plus displaced copies with per-vertex
-//!   opacity (Eqs. 11–12), each an alpha-blended flipbook node (a Mesh prim in `.usda`).
+//!   opacity (SMEAR Eqs. 11–12), each an alpha-blended flipbook node (a Mesh prim in `.usda`).
 //! * `lines IN -o OUT.glb|OUT.usda --count K --length-max T [--seed S]
 //!   [--length-expr "..."]`: the original as a flipbook plus one motion-line tube mesh per
-//!   frame (Eq. 13); in `.usda`, one Mesh prim whose topology changes per frame.
+//!   frame (SMEAR Eq. 13); in `.usda`, one Mesh prim whose topology changes per frame.
 //!
+//! Each command turns its flags into a [`smear::Style`] and calls [`smear::stylize`].
 //! Expressions are those of `smear::Expression` (inputs `delta`, `speed`, `weight`, `noise`,
 //! `frame`, `m`, `t`, …) with the command's maximum bound as a parameter (`beta_max`,
 //! `m_max`, `tau_max`).
@@ -19,25 +21,23 @@
 use std::path::Path;
 use std::time::Instant;
 
-use anim::glam::Vec3;
-use anim::{Channel, Clip, MeshAnimation, Node, Scene, SceneMesh};
-use anyhow::{bail, Result};
+use anim::{FlipbookPart, MeshAnimation};
+use anyhow::{anyhow, bail, Result};
 use clap::{Args, ValueEnum};
 use serde_json::json;
 use smear::{
-    ElongateOptions, FunctionSpec, LineFrame, LineOptions, LineStyle, MultiplesOptions, Param,
-    Spacing, StyleFunction, StyleInput,
+    ElongateStyle, FunctionSpec, LinesStyle, MultiplesOptions, MultiplesStyle, Param, Prepared,
+    Spacing, Stage, Style, Stylized,
 };
-use tkio::Format;
+use tkio::{Format, Output};
 
-use super::smear_prepare::{prepare, EffectArgs, EffectIo};
-use super::Context;
+use super::{at_input, prepare, Context, EffectArgs, EffectIo};
 use crate::output::{self, Layout};
 
-/// Presets of S_E (Section 5.2).
+/// Presets of S_E (SMEAR Section 5.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum ElongatePreset {
-    /// S_E(δ; β_max) = β_max·δ (Eq. 10 example, Fig. 9b, 11b).
+    /// S_E(δ; β_max) = β_max·δ (SMEAR Eq. 10 example, Fig. 9b, 11b).
     Linear,
     /// S_E(δ; v, β_max) = β_max‖v‖δ (Fig. 11c).
     Speed,
@@ -89,10 +89,10 @@ pub struct MultiplesArgs {
     /// keyframeable.
     #[arg(long)]
     pub overlap: Option<Param>,
-    /// m_max of Eq. 12 (default: max(m_p, m_n); keyframeable).
+    /// m_max of SMEAR Eq. 12 (default: max(m_p, m_n); keyframeable).
     #[arg(long)]
     pub m_max: Option<Param>,
-    /// User expression for the opacity (replaces Eq. 12), e.g. "step(delta * m)".
+    /// User expression for the opacity (replaces SMEAR Eq. 12), e.g. "step(delta * m)".
     #[arg(long)]
     pub opacity_expr: Option<String>,
 }
@@ -108,7 +108,7 @@ pub struct LinesArgs {
     /// sample as many seeds as the largest key and draw a fixed random subset per frame.
     #[arg(long, default_value_t = Param::Constant(smear::DEFAULT_LINE_COUNT as f32))]
     pub count: Param,
-    /// Maximum length τ_max in frames: S_L(δ; τ_max) = τ_max·δ (Eq. 13); keyframeable.
+    /// Maximum length τ_max in frames: S_L(δ; τ_max) = τ_max·δ (SMEAR Eq. 13); keyframeable.
     #[arg(long, default_value = "1")]
     pub length_max: Param,
     /// Seed of the random seed placement.
@@ -147,8 +147,11 @@ pub struct LinesArgs {
     pub samples: usize,
 }
 
-fn compile(spec: FunctionSpec, what: &str) -> Result<StyleFunction> {
-    spec.compile().map_err(|e| anyhow::anyhow!("{what}: {e}"))
+/// Checks that a user function compiles, naming the flag that gave it.
+fn check(spec: &FunctionSpec, flag: &str) -> Result<()> {
+    spec.compile()
+        .map(|_| ())
+        .map_err(|e| anyhow!("{flag}: {e}"))
 }
 
 fn require_scene_output(path: &Path, what: &str) -> Result<()> {
@@ -161,9 +164,23 @@ fn require_scene_output(path: &Path, what: &str) -> Result<()> {
     Ok(())
 }
 
-/// True when `path` names a USD layer (`.usda`).
-fn is_usda(path: &Path) -> bool {
-    Format::from_extension(path) == Some(Format::Usda)
+/// A style with only the offsets `p` was prepared with (effects are added by the caller).
+fn base_style(p: &Prepared) -> Style {
+    Style {
+        offsets: p.options().offsets.clone(),
+        ..Style::default()
+    }
+}
+
+/// Runs the style on the prepared input, naming the input in errors.
+fn run_style(io: &EffectIo, p: &Prepared, style: &Style) -> Result<Stylized> {
+    smear::stylize(p, style).map_err(|e| at_input(&io.input)(e))
+}
+
+/// The point cache of part `i` of a result (the body is part 0, copies follow).
+fn part(out: &Stylized, i: usize) -> Result<&MeshAnimation> {
+    out.animation(i)
+        .ok_or_else(|| anyhow!("internal: part {i} of the result is not a point cache"))
 }
 
 /// Runs `toonkit smear elongate`.
@@ -183,41 +200,38 @@ pub fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
             ElongatePreset::Noise => FunctionSpec::noise(args.kappa.clone(), args.beta_max.clone()),
         }),
     };
-    let style = compile(spec, "--expr")?;
+    check(&spec, "--expr")?;
     let spinner = crate::progress::spinner("elongating", ctx.json);
-    let p = prepare(&args.io, &args.offsets, None)?;
-    let t = Instant::now();
-    let inputs = p.vertex_inputs()?;
-    let options = ElongateOptions {
-        step: args.offsets.step,
+    let p = prepare(&args.io, &args.offsets)?;
+    let style = Style {
+        elongate: Some(ElongateStyle {
+            enabled: true,
+            step: args.offsets.step,
+            function: spec,
+        }),
+        ..base_style(&p)
     };
-    let out = smear::elongate(&p.merged, &inputs, &style, &options)?;
-    let effect_seconds = t.elapsed().as_secs_f64();
+    let out = run_style(&args.io, &p, &style)?;
     let t = Instant::now();
-    let written = output::write_animation(&args.io.output, &out, args.layout, None)?;
+    let body = part(&out, 0)?;
+    let written = output::write_animation(&args.io.output, body, args.layout, None)?;
     spinner.finish_and_clear();
-    let (mut max_d, mut sum_d) = (0.0f32, 0.0f64);
-    for (a, b) in out.positions().iter().zip(p.merged.positions()) {
-        let d = a.distance(*b);
-        max_d = max_d.max(d);
-        sum_d += d as f64;
-    }
-    let mean_d = sum_d / out.positions().len().max(1) as f64;
+    let stats = &out.report.objects[0];
     let summary = json!({
         "input": args.io.input, "output": args.io.output, "files": written,
-        "frames": out.frame_count(), "vertices": out.vertex_count(),
-        "objects": p.sampled.objects.len(), "step": options.step,
-        "weighted": p.weights.is_some(), "camera_speed": p.camera.is_some(),
-        "max_displacement": max_d, "mean_displacement": mean_d,
-        "seconds": {"offsets": p.seconds, "effect": effect_seconds,
+        "frames": body.frame_count(), "vertices": body.vertex_count(),
+        "objects": p.scene().objects.len(), "step": args.offsets.step,
+        "weighted": p.weights(0).is_some(), "camera_speed": p.camera().is_some(),
+        "max_displacement": stats.elongation_max, "mean_displacement": stats.elongation_mean,
+        "seconds": {"offsets": p.report().seconds, "effect": out.report.seconds.total,
                     "write": t.elapsed().as_secs_f64(), "total": start.elapsed().as_secs_f64()},
     });
     ctx.report(&summary, || {
         format!(
             "wrote {} ({} frames × {} vertices, elongated in-betweens)",
             args.io.output.display(),
-            out.frame_count(),
-            out.vertex_count()
+            body.frame_count(),
+            body.vertex_count()
         )
     });
     Ok(())
@@ -250,105 +264,66 @@ pub fn multiples(ctx: &Context, args: MultiplesArgs) -> Result<()> {
             .offsets
             .weighted(FunctionSpec::multiples(m_max.clone())),
     };
-    let style = compile(spec, "--opacity-expr")?;
+    check(&spec, "--opacity-expr")?;
     let spinner = crate::progress::spinner("drawing multiple in-betweens", ctx.json);
-    let p = prepare(&args.io, &args.offsets, None)?;
+    let p = prepare(&args.io, &args.offsets)?;
+    let style = Style {
+        multiples: Some(MultiplesStyle {
+            enabled: true,
+            past: args.past.clone(),
+            future: args.future.clone(),
+            spacing: args.spacing.clone(),
+            overlap: args.overlap.clone(),
+            step: args.offsets.step,
+            opacity: Some(spec),
+            color: [1.0; 3],
+        }),
+        ..base_style(&p)
+    };
+    let out = run_style(&args.io, &p, &style)?;
     let t = Instant::now();
-    let inputs = p.vertex_inputs()?;
-    let copies = smear::multiples(&p.merged, &inputs, &style, &options)?;
-    let effect_seconds = t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    let colors: Vec<Vec<[f32; 4]>> = copies
+    let parts: Vec<(&MeshAnimation, Option<&[[f32; 4]]>)> = out
+        .flipbook
+        .parts
         .iter()
-        .map(|c| c.alpha.iter().map(|&a| [1.0, 1.0, 1.0, a]).collect())
+        .filter_map(|part| match part {
+            FlipbookPart::Animation { animation, colors } => Some((animation, colors.as_deref())),
+            FlipbookPart::Frames { .. } => None,
+        })
         .collect();
-    let mut parts: Vec<(&MeshAnimation, Option<&[[f32; 4]]>)> = vec![(&p.merged, None)];
-    parts.extend(
-        copies
-            .iter()
-            .zip(&colors)
-            .map(|(c, col)| (&c.animation, Some(col.as_slice()))),
-    );
-    let bytes = if is_usda(&args.io.output) {
-        tkio::usda::write_parts(&parts).map(String::into_bytes)
-    } else {
-        tkio::gltf::write_animations(&parts, tkio::gltf::AnimationLayout::Flipbook)
-    }
-    .map_err(|e| e.at(&args.io.output))?;
-    tkio::write_atomic(&args.io.output, &bytes)?;
+    tkio::save(
+        &args.io.output,
+        &Output::Parts {
+            parts: &parts,
+            layout: tkio::Layout::Flipbook,
+        },
+    )?;
     spinner.finish_and_clear();
-    let copies_json: Vec<_> = copies
+    let body = part(&out, 0)?;
+    let copies_json: Vec<_> = out.report.objects[0]
+        .copies
         .iter()
         .map(|c| {
-            let visible = c.alpha.iter().filter(|a| **a > 0.0).count();
-            json!({"m": c.m, "beta": c.beta, "visible_fraction": visible as f64 / c.alpha.len().max(1) as f64})
+            json!({"m": c.m, "beta": c.beta, "visible_fraction": c.visible as f64 / c.total.max(1) as f64})
         })
         .collect();
     let summary = json!({
         "input": args.io.input, "output": args.io.output,
-        "frames": p.merged.frame_count(), "vertices": p.merged.vertex_count(),
+        "frames": body.frame_count(), "vertices": body.vertex_count(),
         "spacing": df, "spacing_keyframed": matches!(&options.spacing, Spacing::Frames(Param::Curve(_))),
         "m_max": m_max, "step": options.step, "copies": copies_json,
-        "seconds": {"offsets": p.seconds, "effect": effect_seconds,
+        "seconds": {"offsets": p.report().seconds, "effect": out.report.seconds.total,
                     "write": t.elapsed().as_secs_f64(), "total": start.elapsed().as_secs_f64()},
     });
     ctx.report(&summary, || {
         format!(
             "wrote {} ({} frames, {} copies spaced {df:.3} frames)",
             args.io.output.display(),
-            p.merged.frame_count(),
-            copies.len()
+            body.frame_count(),
+            copies_json.len()
         )
     });
     Ok(())
-}
-
-/// A flipbook scene: the body (one node per frame) and the lines (one node per frame, none
-/// when the frame has no line), visibility keyed with STEP scale.
-fn lines_scene(body: &MeshAnimation, lines: &[LineFrame]) -> Scene {
-    let frames = body.frame_count();
-    let times: Vec<f32> = (0..frames).map(|f| f as f32 / body.fps).collect();
-    let mut scene = Scene::default();
-    let mut channels = Vec::new();
-    let mut group =
-        |scene: &mut Scene, name: &str, mesh_of: &dyn Fn(usize) -> Option<anim::Mesh>| {
-            let root = scene.nodes.len();
-            scene.nodes.push(Node {
-                name: name.to_string(),
-                ..Default::default()
-            });
-            for f in 0..frames {
-                let id = scene.nodes.len();
-                let mesh = mesh_of(f).filter(|m| m.vertex_count() > 0).map(|m| {
-                    scene.meshes.push(SceneMesh {
-                        mesh: m,
-                        ..Default::default()
-                    });
-                    scene.meshes.len() - 1
-                });
-                let mut node = Node {
-                    name: format!("{name}_f{:04}", f + 1),
-                    parent: Some(root),
-                    mesh,
-                    ..Default::default()
-                };
-                if f != 0 {
-                    node.transform.scale = Vec3::ZERO;
-                }
-                scene.nodes.push(node);
-                scene.nodes[root].children.push(id);
-                channels.extend(Channel::flipbook_visibility(id, f, &times));
-            }
-        };
-    group(&mut scene, &body.mesh.name, &|f| Some(body.mesh_at(f)));
-    group(&mut scene, "motion_lines", &|f| Some(lines[f].mesh.clone()));
-    if !channels.is_empty() {
-        scene.clips.push(Clip {
-            name: format!("{}_lines", body.mesh.name),
-            channels,
-        });
-    }
-    scene
 }
 
 /// Runs `toonkit smear lines`.
@@ -362,17 +337,18 @@ pub fn lines(ctx: &Context, args: LinesArgs) -> Result<()> {
             bail!("--thickness must be positive numbers, got {t:?}");
         }
     }
-    let length_spec = match &args.length_expr {
+    let length = match &args.length_expr {
         Some(e) => FunctionSpec::expr(e, &[("tau_max", args.length_max.clone())]),
         None => args
             .offsets
             .weighted(FunctionSpec::linear(args.length_max.clone())),
     };
-    let length = compile(length_spec, "--length-expr")?;
+    check(&length, "--length-expr")?;
     let opacity = match &args.opacity_expr {
-        Some(e) => Some(compile(FunctionSpec::expr(e, &[]), "--opacity-expr")?),
-        None => None,
+        Some(e) => FunctionSpec::expr(e, &[]),
+        None => FunctionSpec::stages(vec![Stage::Set { value: 1.0.into() }]),
     };
+    check(&opacity, "--opacity-expr")?;
     let spinner = crate::progress::spinner("tracing motion lines", ctx.json);
     if args
         .count
@@ -384,81 +360,80 @@ pub fn lines(ctx: &Context, args: LinesArgs) -> Result<()> {
             args.count
         );
     }
-    let seed_count = args.count.max_value().round() as usize;
-    let mut p = prepare(&args.io, &args.offsets, Some((seed_count, args.seed)))?;
-    let t = Instant::now();
-    let (seeds, seed_total) = p
-        .seed_inputs()
-        .map_err(|e| anyhow::anyhow!("{}: {e:#}", args.io.input.display()))?;
+    let color = match args.color.as_slice() {
+        [] => smear::LineOptions::default().color,
+        &[r, g, b] => [r, g, b].map(Param::Constant),
+        c => bail!(
+            "--color takes R,G,B (3 numbers in [0, 1]), got {} numbers",
+            c.len()
+        ),
+    };
+    let p = prepare(&args.io, &args.offsets)?;
     let radius = args.thickness.clone().unwrap_or(Param::Constant(
-        smear::DEFAULT_LINE_THICKNESS * p.merged.bbox().diagonal(),
+        smear::DEFAULT_LINE_THICKNESS * p.animation(0).bbox().diagonal(),
     ));
     let thickness = match &args.thickness_expr {
-        Some(e) => compile(FunctionSpec::expr(e, &[]), "--thickness-expr")?,
-        None => compile(
-            FunctionSpec::stages(vec![smear::Stage::Set {
-                value: radius.clone(),
-            }]),
-            "--thickness",
-        )?,
+        Some(e) => FunctionSpec::expr(e, &[]),
+        None => FunctionSpec::stages(vec![Stage::Set {
+            value: radius.clone(),
+        }]),
     };
-    let opaque = |_: &StyleInput| 1.0;
-    let style = LineStyle {
-        length: &length,
-        thickness: &thickness,
-        opacity: match &opacity {
-            Some(o) => o,
-            None => &opaque,
-        },
-    };
-    let line_options = LineOptions {
-        sides: args.sides,
-        samples: args.samples,
-        gap: args.gap.clone(),
-        min_speed: args.min_speed.clone(),
-        count: args.count.is_keyframed().then(|| args.count.clone()),
-        color: match args.color.as_slice() {
-            [] => LineOptions::default().color,
-            &[r, g, b] => [r, g, b].map(Param::Constant),
-            c => bail!(
-                "--color takes R,G,B (3 numbers in [0, 1]), got {} numbers",
-                c.len()
-            ),
-        },
-        past_only: args.past_only,
-        step: args.offsets.step,
-    };
-    let frames = smear::motion_lines(&seeds, &style, &line_options)?;
-    let effect_seconds = t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    let bytes = if is_usda(&args.io.output) {
-        use tkio::usda::{UsdMesh, UsdStage};
-        let lines = UsdMesh::frames("motion_lines", frames.iter().map(|f| &f.mesh).collect());
-        let stage = UsdStage::new(
-            p.merged.fps,
-            vec![UsdMesh::animation(&p.merged, None), lines],
-        );
-        tkio::usda::write(&stage).map(String::into_bytes)
+    let flag = if args.thickness_expr.is_some() {
+        "--thickness-expr"
     } else {
-        tkio::gltf::write_glb(&lines_scene(&p.merged, &frames))
-    }
-    .map_err(|e| e.at(&args.io.output))?;
-    tkio::write_atomic(&args.io.output, &bytes)?;
+        "--thickness"
+    };
+    check(&thickness, flag)?;
+    let style = Style {
+        lines: Some(LinesStyle {
+            enabled: true,
+            count: args.count.clone(),
+            seed: args.seed,
+            gap: args.gap.clone(),
+            min_speed: args.min_speed.clone(),
+            past_only: args.past_only,
+            sides: args.sides,
+            samples: args.samples,
+            step: args.offsets.step,
+            color,
+            length,
+            thickness: Some(thickness),
+            opacity,
+        }),
+        ..base_style(&p)
+    };
+    let out = run_style(&args.io, &p, &style)?;
+    let t = Instant::now();
+    let body = part(&out, 0)?;
+    let Some(FlipbookPart::Frames { meshes, .. }) =
+        out.objects[0].lines.and_then(|i| out.flipbook.parts.get(i))
+    else {
+        bail!("internal: the result has no motion lines");
+    };
+    tkio::save(
+        &args.io.output,
+        &Output::MotionLines {
+            body,
+            lines: meshes,
+        },
+    )?;
     spinner.finish_and_clear();
-    let per_frame: Vec<usize> = frames.iter().map(|f| f.lines).collect();
+    let stats = &out.report.objects[0];
+    let per_frame = stats.lines_per_frame.clone().unwrap_or_default();
+    let seed_total = stats.seeds.unwrap_or(0);
     let summary = json!({
         "input": args.io.input, "output": args.io.output,
-        "frames": p.merged.frame_count(), "vertices": p.merged.vertex_count(),
-        "seeds": seed_total, "radius": radius, "weighted": p.weights.is_some(), "step": line_options.step,
+        "frames": body.frame_count(), "vertices": body.vertex_count(),
+        "seeds": seed_total, "radius": radius, "weighted": p.weights(0).is_some(), "step": args.offsets.step,
         "lines_per_frame": per_frame,
-        "seconds": {"offsets": p.seconds, "effect": effect_seconds,
+        "seconds": {"offsets": p.report().seconds, "effect": out.report.seconds.total,
                     "write": t.elapsed().as_secs_f64(), "total": start.elapsed().as_secs_f64()},
     });
     ctx.report(&summary, || {
         format!(
             "wrote {} ({} frames, {} seeds, up to {} lines per frame)",
             args.io.output.display(),
-            frames.len(),
+            meshes.len(),
             seed_total,
             per_frame.iter().max().unwrap_or(&0)
         )

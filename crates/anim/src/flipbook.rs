@@ -1,0 +1,47 @@
+//! Flipbooks: several animated parts with the same frames, some with a topology that changes
+//! per frame (e.g. motion lines) — what stylization results are, and what `tkio::save`
+//! writes and `render` previews.
+
+use crate::{Mesh, MeshAnimation};
+
+/// One part of a [`Flipbook`].
+#[derive(Debug, Clone)]
+pub enum FlipbookPart {
+    /// A fixed-topology animation with optional per-frame RGBA vertex colours (frame-major,
+    /// `frames × vertices`, linear RGB and alpha).
+    Animation {
+        /// The point cache.
+        animation: MeshAnimation,
+        /// Per-frame vertex colours.
+        colors: Option<Vec<[f32; 4]>>,
+    },
+    /// One mesh per frame, whose topology may change from frame to frame; an empty mesh
+    /// (no triangles) shows nothing at that frame.
+    Frames {
+        /// Name of the part.
+        name: String,
+        /// One mesh per frame.
+        meshes: Vec<Mesh>,
+    },
+}
+
+impl FlipbookPart {
+    /// The part's name (the animation's mesh name, or the frames' name).
+    pub fn name(&self) -> &str {
+        match self {
+            FlipbookPart::Animation { animation, .. } => &animation.mesh.name,
+            FlipbookPart::Frames { name, .. } => name,
+        }
+    }
+}
+
+/// Parts that play together: `frames` frames at `fps`.
+#[derive(Debug, Clone, Default)]
+pub struct Flipbook {
+    /// Frames per second.
+    pub fps: f32,
+    /// Number of frames.
+    pub frames: usize,
+    /// The parts, in drawing order.
+    pub parts: Vec<FlipbookPart>,
+}

@@ -1,0 +1,13 @@
+//! The whole smear job on in-memory data: [`prepare`] once (offsets, camera, weights,
+//! velocities), then [`stylize`] with any number of styles; [`offsets`] alone for
+//! `toonkit smear offsets`.
+
+mod prepare;
+mod stylize;
+
+pub use prepare::{
+    offsets, prepare, ObjectOffsets, PrepareOptions, PrepareReport, Prepared, SceneOffsets,
+};
+pub use stylize::{
+    stylize, CopyReport, ObjectParts, ObjectReport, StylizeReport, StylizeTimings, Stylized,
+};

@@ -1,0 +1,402 @@
+//! `prepare`: everything of a smear job that does not depend on the style — the offset solve
+//! (SMEAR Eqs. 1–9) per object group, merged inside the crate, the camera, painted weights and
+//! the velocities the stylization functions read.
+
+use std::time::Instant;
+
+use anim::{Camera, MeshAnimation, SampledScene};
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::solver::SolvedField;
+use crate::velocity::{buffer_velocities, camera_buffer_velocities, CameraSpace};
+use crate::{
+    EffectInputs, MotionOffsets, OffsetMode, OffsetOptions, Result, SmearError, SurfacePoint,
+    WeightSource,
+};
+
+/// What [`prepare`] computes once for any number of [`stylize`](crate::stylize) calls.
+///
+/// Deserializes from TOML/JSON with every field optional (the defaults of
+/// [`OffsetOptions`], no painted weights, objects kept apart).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PrepareOptions {
+    /// Motion-offset options (SMEAR Section 3).
+    pub offsets: OffsetOptions,
+    /// Painted weights ω of every vertex (SMEAR Fig. 15b), resolved once; a style's own
+    /// `weights` replace them in [`stylize`](crate::stylize).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub weights: Option<WeightSource>,
+    /// Merge every object into one point cache of this name (vertex order of
+    /// `anim::SampledScene::merged`, the order every per-vertex output uses); `None` keeps the
+    /// objects apart, so a style can override its effects per object.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub merge: Option<String>,
+}
+
+/// How one object's offsets came out.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ObjectOffsets {
+    /// Object name.
+    pub name: String,
+    /// Number of vertices.
+    pub vertices: usize,
+    /// How its offsets were computed.
+    pub mode: OffsetMode,
+    /// Smallest offset.
+    pub min: f32,
+    /// Largest offset.
+    pub max: f32,
+}
+
+/// What [`prepare`] did.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PrepareReport {
+    /// Number of frames.
+    pub frames: usize,
+    /// Frames per second.
+    pub fps: f32,
+    /// Vertices over all objects.
+    pub vertices: usize,
+    /// Every object of the scene, in scene order.
+    pub objects: Vec<ObjectOffsets>,
+    /// Smallest and largest offset over all objects.
+    pub range: (f32, f32),
+    /// Seconds spent solving the offsets.
+    pub solve_seconds: f64,
+    /// Seconds spent in total.
+    pub seconds: f64,
+}
+
+/// One object the effects apply to (a scene object, or all of them merged).
+#[derive(Debug)]
+struct Target {
+    name: String,
+    offsets: MotionOffsets,
+    velocities: Vec<Vec3>,
+    weights: Option<Vec<f32>>,
+}
+
+/// A scene with its motion offsets solved, ready to be stylized any number of times
+/// ([`stylize`](crate::stylize) only reads it).
+#[derive(Debug)]
+pub struct Prepared {
+    scene: SampledScene,
+    options: PrepareOptions,
+    field: SolvedField,
+    camera: Option<Camera>,
+    merged: Option<MeshAnimation>,
+    targets: Vec<Target>,
+    report: PrepareReport,
+}
+
+/// Per-object offset reports.
+fn object_reports(
+    scene: &SampledScene,
+    field: &SolvedField,
+    per_object: &[MotionOffsets],
+) -> Vec<ObjectOffsets> {
+    scene
+        .objects
+        .iter()
+        .zip(per_object)
+        .enumerate()
+        .map(|(i, (o, d))| {
+            let (min, max) = d.range();
+            ObjectOffsets {
+                name: o.name.clone(),
+                vertices: d.vertex_count(),
+                mode: field.mode(i).unwrap_or(OffsetMode::Simple),
+                min,
+                max,
+            }
+        })
+        .collect()
+}
+
+/// Smallest and largest offset over all objects, `(0, 0)` when there are none.
+fn overall_range(objects: &[ObjectOffsets]) -> (f32, f32) {
+    if objects.is_empty() {
+        return (0.0, 0.0);
+    }
+    objects
+        .iter()
+        .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), o| {
+            (lo.min(o.min), hi.max(o.max))
+        })
+}
+
+/// Motion offsets of a whole scene, merged in object order, with a report.
+#[derive(Debug, Clone)]
+pub struct SceneOffsets {
+    /// Offsets of every vertex of every object (vertex order of
+    /// `anim::SampledScene::merged`).
+    pub offsets: MotionOffsets,
+    /// Per-object modes and ranges, timings.
+    pub report: PrepareReport,
+}
+
+/// Solves the motion offsets of every object of `scene` (SMEAR Eqs. 1–9, smoothed by SMEAR
+/// SMEAR Eq. 2) and merges them in object order — the whole `toonkit smear offsets` job.
+///
+/// # Errors
+/// As [`prepare`].
+///
+/// # Performance
+/// One solve, parallel over frames; the only copy is the merge of several objects.
+pub fn offsets(scene: &SampledScene, options: &OffsetOptions) -> Result<SceneOffsets> {
+    let start = Instant::now();
+    let field = SolvedField::new(scene, options)?;
+    let per_object = field.all();
+    let solve_seconds = start.elapsed().as_secs_f64();
+    let objects = object_reports(scene, &field, &per_object);
+    let offsets = if per_object.len() == 1 {
+        per_object.into_iter().next().expect("one object")
+    } else {
+        MotionOffsets::concat(&per_object)?
+    };
+    Ok(SceneOffsets {
+        offsets,
+        report: PrepareReport {
+            frames: scene.frame_count,
+            fps: scene.fps,
+            vertices: scene.vertex_count(),
+            range: overall_range(&objects),
+            objects,
+            solve_seconds,
+            seconds: start.elapsed().as_secs_f64(),
+        },
+    })
+}
+
+/// Prepares `scene` for stylization: solves the motion offsets of every object (SMEAR
+/// SMEAR Eqs. 1–9, smoothed by SMEAR Eq. 2), merges them when asked, resolves the camera and the
+/// painted weights, and measures the velocities (camera-relative when a camera is selected).
+///
+/// # Errors
+/// Unknown pruned joint, camera, weight joint or attribute; an inconsistent scene; merging a
+/// scene without objects.
+///
+/// # Performance
+/// The offset solve dominates (parallel over frames); velocities are one pass over the
+/// positions.
+pub fn prepare(scene: SampledScene, options: &PrepareOptions) -> Result<Prepared> {
+    let start = Instant::now();
+    let camera = options.offsets.selected_camera(&scene.cameras)?.cloned();
+    let field = SolvedField::new(&scene, &options.offsets)?;
+    let per_object = field.all();
+    let solve_seconds = start.elapsed().as_secs_f64();
+    let objects = object_reports(&scene, &field, &per_object);
+    let velocities = |anim: &MeshAnimation| {
+        let (p, f, n) = (anim.positions(), anim.frame_count(), anim.vertex_count());
+        match &camera {
+            Some(c) => camera_buffer_velocities(p, f, n, &CameraSpace::new(c, f)),
+            None => buffer_velocities(p, f, n),
+        }
+    };
+    let resolve = |w: &WeightSource, i: usize| w.vertex_weights(&scene, i);
+    let (merged, targets) = match &options.merge {
+        Some(name) => {
+            if scene.objects.is_empty() {
+                return Err(SmearError::InvalidScene("the scene has no mesh".into()));
+            }
+            let anim = scene
+                .merged(name)
+                .map_err(|e| SmearError::InvalidScene(e.to_string()))?;
+            let weights = match &options.weights {
+                Some(w) => {
+                    let mut all = Vec::with_capacity(anim.vertex_count());
+                    for i in 0..scene.objects.len() {
+                        all.extend(resolve(w, i)?);
+                    }
+                    Some(all)
+                }
+                None => None,
+            };
+            let offsets = if per_object.len() == 1 {
+                per_object.into_iter().next().expect("one object")
+            } else {
+                MotionOffsets::concat(&per_object)?
+            };
+            let target = Target {
+                name: name.clone(),
+                offsets,
+                velocities: velocities(&anim),
+                weights,
+            };
+            (Some(anim), vec![target])
+        }
+        None => {
+            let mut targets = Vec::with_capacity(scene.objects.len());
+            for (i, (o, offsets)) in scene.objects.iter().zip(per_object).enumerate() {
+                targets.push(Target {
+                    name: o.name.clone(),
+                    offsets,
+                    velocities: velocities(&o.animation),
+                    weights: match &options.weights {
+                        Some(w) => Some(resolve(w, i)?),
+                        None => None,
+                    },
+                });
+            }
+            (None, targets)
+        }
+    };
+    let report = PrepareReport {
+        frames: scene.frame_count,
+        fps: scene.fps,
+        vertices: scene.vertex_count(),
+        range: overall_range(&objects),
+        objects,
+        solve_seconds,
+        seconds: start.elapsed().as_secs_f64(),
+    };
+    Ok(Prepared {
+        scene,
+        options: options.clone(),
+        field,
+        camera,
+        merged,
+        targets,
+        report,
+    })
+}
+
+impl Prepared {
+    /// The scene as sampled.
+    pub fn scene(&self) -> &SampledScene {
+        &self.scene
+    }
+
+    /// The options it was prepared with.
+    pub fn options(&self) -> &PrepareOptions {
+        &self.options
+    }
+
+    /// What preparing did (per-object offset modes and ranges, timings).
+    pub fn report(&self) -> &PrepareReport {
+        &self.report
+    }
+
+    /// The camera offsets and speeds are measured against (`None`: world space).
+    pub fn camera(&self) -> Option<&Camera> {
+        self.camera.as_ref()
+    }
+
+    /// Number of objects the effects apply to: the scene's objects, or 1 when merged.
+    pub fn object_count(&self) -> usize {
+        self.targets.len()
+    }
+
+    /// Name of object `i` (the merged name when merged).
+    ///
+    /// # Panics
+    /// If `i >= object_count()`.
+    pub fn name(&self, i: usize) -> &str {
+        &self.targets[i].name
+    }
+
+    /// Point cache of object `i` (all objects merged when merged).
+    ///
+    /// # Panics
+    /// If `i >= object_count()`.
+    pub fn animation(&self, i: usize) -> &MeshAnimation {
+        match &self.merged {
+            Some(m) => m,
+            None => &self.scene.objects[i].animation,
+        }
+    }
+
+    /// Motion offsets of object `i`'s vertices.
+    ///
+    /// # Panics
+    /// If `i >= object_count()`.
+    pub fn offsets(&self, i: usize) -> &MotionOffsets {
+        &self.targets[i].offsets
+    }
+
+    /// Painted weights of object `i`'s vertices (from [`PrepareOptions::weights`]).
+    ///
+    /// # Panics
+    /// If `i >= object_count()`.
+    pub fn weights(&self, i: usize) -> Option<&[f32]> {
+        self.targets[i].weights.as_deref()
+    }
+
+    /// Painted weights of object `i` from another source (a style's `weights`).
+    ///
+    /// # Errors
+    /// Unknown joint or attribute, or a function that does not compile.
+    pub fn resolve_weights(&self, source: &WeightSource, i: usize) -> Result<Vec<f32>> {
+        if self.merged.is_none() {
+            return source.vertex_weights(&self.scene, i);
+        }
+        let mut all = Vec::with_capacity(self.animation(0).vertex_count());
+        for k in 0..self.scene.objects.len() {
+            all.extend(source.vertex_weights(&self.scene, k)?);
+        }
+        Ok(all)
+    }
+
+    /// The effect inputs of object `i`'s vertices — positions, offsets, velocities borrowed
+    /// from the prepared data — with painted `weights` (one per vertex) if given.
+    ///
+    /// # Errors
+    /// [`SmearError::UnknownObject`], or weights of the wrong length.
+    pub fn inputs(&self, i: usize, weights: Option<Vec<f32>>) -> Result<EffectInputs<'_>> {
+        let t = self.targets.get(i).ok_or(SmearError::UnknownObject {
+            index: i,
+            count: self.targets.len(),
+        })?;
+        let inputs =
+            EffectInputs::from_prepared(self.animation(i), &t.offsets, &t.velocities, None);
+        match weights {
+            Some(w) => inputs.with_weights(w),
+            None => Ok(inputs),
+        }
+    }
+
+    /// Offsets at surface points of object `i` (SMEAR Section 4.3: SMEAR Eq. 8 evaluated at
+    /// the points' own positions with the prepared field; no solve). On a merged object the
+    /// points must be sorted by triangle (they are split by source object).
+    ///
+    /// # Errors
+    /// [`SmearError::UnknownObject`], or [`SmearError::InvalidSurfacePoint`].
+    pub fn surface_offsets(&self, i: usize, points: &[SurfacePoint]) -> Result<MotionOffsets> {
+        let objects: Vec<&MeshAnimation> =
+            self.scene.objects.iter().map(|o| &o.animation).collect();
+        if self.merged.is_none() {
+            return self.field.surface_offsets(&objects, i, points);
+        }
+        if i != 0 {
+            return Err(SmearError::UnknownObject { index: i, count: 1 });
+        }
+        let mut parts = Vec::with_capacity(objects.len());
+        let (mut base, mut k) = (0u32, 0usize);
+        for (o, anim) in objects.iter().enumerate() {
+            let end = base + anim.mesh.triangles.len() as u32;
+            let local: Vec<SurfacePoint> = points[k..]
+                .iter()
+                .take_while(|s| s.triangle < end)
+                .map(|s| SurfacePoint {
+                    triangle: s.triangle - base,
+                    ..*s
+                })
+                .collect();
+            k += local.len();
+            parts.push(self.field.surface_offsets(&objects, o, &local)?);
+            base = end;
+        }
+        if k < points.len() {
+            return Err(SmearError::InvalidSurfacePoint {
+                index: k,
+                reason: format!(
+                    "triangle {} is out of order or does not exist (sort the points by triangle)",
+                    points[k].triangle
+                ),
+            });
+        }
+        MotionOffsets::concat(&parts)
+    }
+}
