@@ -17,6 +17,7 @@ mod from_arrays;
 mod loa_py;
 mod progress;
 mod scene;
+mod smear_job;
 mod smear_py;
 
 use pyo3::prelude::*;
@@ -30,6 +31,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::Scene>()?;
     m.add_function(wrap_pyfunction!(scene::load, m)?)?;
     m.add_function(wrap_pyfunction!(smear_py::offsets, m)?)?;
+    m.add_class::<smear_job::Prepared>()?;
+    m.add_class::<smear_job::Stylized>()?;
+    m.add_function(wrap_pyfunction!(smear_job::prepare, m)?)?;
+    m.add_function(wrap_pyfunction!(smear_job::stylize, m)?)?;
     m.add_class::<loa_py::Line>()?;
     m.add_function(wrap_pyfunction!(loa_py::line, m)?)?;
     Ok(())

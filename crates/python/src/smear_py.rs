@@ -3,7 +3,7 @@
 
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
-use smear::{CameraSelect, MotionOffsets, OffsetOptions, OffsetSolver};
+use smear::{CameraSelect, OffsetOptions};
 
 use crate::arrays::output;
 use crate::errors::smear_error;
@@ -67,11 +67,9 @@ pub(crate) fn offsets<'py>(
     report(py, progress.as_ref(), "offsets", 0.0)?;
     let sampled = scene.sampled.clone();
     let merged = py
-        .detach(move || {
-            let solver = OffsetSolver::new(&sampled, &options)?;
-            MotionOffsets::concat(&solver.all())
-        })
-        .map_err(|e| smear_error(&scene.source, e))?;
+        .detach(move || smear::offsets(&sampled, &options))
+        .map_err(|e| smear_error(&scene.source, e))?
+        .offsets;
     report(py, progress.as_ref(), "offsets", 1.0)?;
     let shape = [merged.frame_count(), merged.vertex_count()];
     output(py, &shape, merged.into_values())

@@ -81,3 +81,42 @@ def loa_line(
     simulated_frames: Optional[Union[int, str]] = None,
     progress: Optional[Callable[[str, float], Any]] = None,
 ) -> Line: ...
+
+class Prepared:
+    """Motion offsets solved once for any number of stylize calls."""
+
+    @property
+    def offsets(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def report(self) -> dict[str, Any]: ...
+    def report_json(self) -> str: ...
+
+class Stylized:
+    """A style's result: elongated positions, multiple in-betweens, motion lines."""
+
+    @property
+    def elongated(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def multiples(self) -> list[dict[str, Any]]: ...
+    @property
+    def lines(self) -> list[dict[str, Any]]: ...
+    @property
+    def report(self) -> dict[str, Any]: ...
+    def report_json(self) -> str: ...
+    def save(self, path: Union[str, os.PathLike[str]]) -> os.PathLike[str]: ...
+
+def smear_prepare(
+    scene: Scene,
+    smooth: int = 2,
+    whole_body: bool = False,
+    prune: Sequence[str] = ...,
+    camera: Optional[Union[str, int]] = None,
+    options_json: Optional[str] = None,
+    progress: Optional[Callable[[str, float], Any]] = None,
+) -> Prepared: ...
+def smear_stylize(
+    prepared: Prepared,
+    style_json: Optional[str] = None,
+    style_path: Optional[str] = None,
+    progress: Optional[Callable[[str, float], Any]] = None,
+) -> Stylized: ...
