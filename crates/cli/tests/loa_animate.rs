@@ -120,3 +120,118 @@ fn bad_inputs_exit_2_with_one_line() {
         "Tail",
     );
 }
+
+#[test]
+fn settle_wobble_and_reversed_strokes_from_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("whip.json");
+    let report = json(&[
+        "loa",
+        "line",
+        &examples("whip.json"),
+        "-o",
+        out.to_str().unwrap(),
+        "--settle",
+        "24",
+        "--wobble",
+        "20:1:0,-800",
+    ]);
+    // 41 frames of keystrokes (0..=40) + 24 settle frames (the wobble's tail may add more).
+    let frames = report["frames"].as_u64().unwrap();
+    println!("whip --settle 24 --wobble: {frames} frames");
+    assert!(frames >= 65, "{frames}");
+    let keyed = json(&[
+        "loa",
+        "line",
+        &examples("whip.json"),
+        "-o",
+        out.to_str().unwrap(),
+        "--settle",
+        "key",
+    ]);
+    assert_eq!(keyed["frames"].as_u64().unwrap(), 41 + 20);
+    assert_bad_input(
+        &[
+            "loa",
+            "line",
+            &examples("whip.json"),
+            "-o",
+            out.to_str().unwrap(),
+            "--wobble",
+            "20:2:0,1",
+        ],
+        "wobble",
+    );
+    // A keystroke drawn backwards is reversed, with a warning on stderr.
+    let text = std::fs::read_to_string(examples("whip.json")).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let pts = v["keystrokes"][1]["points"].as_array_mut().unwrap();
+    pts.reverse();
+    let flipped = dir.path().join("flipped.json");
+    std::fs::write(&flipped, v.to_string()).unwrap();
+    let out = common::toonkit(&[
+        "loa",
+        "line",
+        flipped.to_str().unwrap(),
+        "-o",
+        dir.path().join("f.json").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("warning") && err.contains("frame 20"), "{err}");
+}
+
+#[test]
+fn perspective_camera_node_and_following_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut scene = tkio::gltf::read(&data("characters/RobotExpressive.glb")).unwrap();
+    // A perspective camera 12 units in front of the robot, 2 units up, looking at it.
+    scene.cameras.push(anim::SceneCamera {
+        name: "Cam".into(),
+        projection: anim::Projection::Perspective {
+            yfov: 0.6,
+            aspect: None,
+            znear: 0.1,
+            zfar: Some(100.0),
+        },
+    });
+    scene.nodes.push(anim::Node {
+        name: "Cam".into(),
+        transform: anim::Transform::from_translation(anim::glam::Vec3::new(0.0, 2.0, 12.0)),
+        camera: Some(scene.cameras.len() - 1),
+        ..Default::default()
+    });
+    let with_camera = dir.path().join("robot_cam.glb");
+    std::fs::write(&with_camera, tkio::gltf::write_glb(&scene).unwrap()).unwrap();
+    let out = dir.path().join("jump.glb");
+    let png = dir.path().join("jump.png");
+    let report = json(&[
+        "loa",
+        "animate",
+        with_camera.to_str().unwrap(),
+        &examples("jump.json"),
+        "-o",
+        out.to_str().unwrap(),
+        "--camera",
+        "Cam",
+        "--render",
+        png.to_str().unwrap(),
+    ]);
+    let dist = report["line_distance_mean_percent"].as_f64().unwrap();
+    println!("perspective camera: line distance {dist:.2} %");
+    assert!(dist < 8.0);
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+    assert_bad_input(
+        &[
+            "loa",
+            "animate",
+            with_camera.to_str().unwrap(),
+            &examples("jump.json"),
+            "-o",
+            out.to_str().unwrap(),
+            "--camera",
+            "Nope",
+        ],
+        "Cam",
+    );
+}

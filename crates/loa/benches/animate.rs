@@ -5,7 +5,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use loa::animate::{animate, AnimateOptions, BoneSetKey, Character};
-use loa::{line_of_action, Keystrokes, LineOptions};
+use loa::{Keystrokes, LineOptions};
 
 fn stroke(bow: f64, lean: f64) -> String {
     let pts: Vec<String> = (0..=20)
@@ -50,7 +50,7 @@ fn bench(c: &mut Criterion) {
     c.bench_function("animate_robot_5keys_120frames", |b| {
         b.iter(|| {
             let character = Character::rest(&skeleton).unwrap();
-            let line = line_of_action(&keys, &LineOptions::default()).unwrap();
+            let line = loa::line(&keys, &LineOptions::default()).unwrap();
             let motion = animate(
                 &character,
                 &line.animation,

@@ -20,7 +20,8 @@ pub struct Animation {
     pub fps: f64,
     /// Frames of the keystrokes.
     pub keystroke_frames: Vec<i64>,
-    /// Consecutive frames, first keystroke to last (inclusive).
+    /// Consecutive frames from the first keystroke to the last (inclusive), plus any settle
+    /// or wobble frames after it.
     pub frames: Vec<AnimationFrame>,
 }
 

@@ -272,7 +272,7 @@ impl Chain {
 pub(crate) mod hierarchy {
     /// Joint an element rotates about (its inboard end).
     #[inline]
-    pub fn pivot(r: usize, element: usize) -> usize {
+    pub(crate) fn pivot(r: usize, element: usize) -> usize {
         if element >= r {
             element
         } else {
@@ -282,7 +282,7 @@ pub(crate) mod hierarchy {
 
     /// Whether rotating element `a` moves element `e` (a is `e` or one of its ancestors).
     #[inline]
-    pub fn moves(r: usize, a: usize, e: usize) -> bool {
+    pub(crate) fn moves(r: usize, a: usize, e: usize) -> bool {
         if a == r {
             true
         } else if a > r {

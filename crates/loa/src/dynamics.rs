@@ -33,7 +33,7 @@ use glam::DVec2;
 
 use crate::chain::{hierarchy, perp, Chain};
 use crate::keystroke::check_non_negative;
-use crate::linalg::{cholesky, forward, symmetric_eigen};
+use crate::linalg::{backward, cholesky, forward, symmetric_eigen};
 use crate::LoaError;
 
 /// A forward-simulated elastic chain with a fixed target shape.
@@ -67,11 +67,8 @@ impl ElasticChain {
         check_non_negative("damping", damping)?;
         let n = pose.elements();
         let mass = mass_matrix(pose);
-        let mut l = mass.clone();
-        if !cholesky(&mut l, n) {
-            // Unreachable after regularization; fall back to the identity inertia.
-            l = identity(n);
-        }
+        // Unreachable after regularization; fall back to the identity inertia.
+        let l = cholesky(&mass, n).unwrap_or_else(|| identity(n));
         let k = stiffness_diagonal(&mass, n, stiffness);
         // A = L⁻¹ K L⁻ᵀ = B Bᵀ with B = L⁻¹ diag(√K).
         let mut b = vec![0.0; n * n];
@@ -118,7 +115,7 @@ impl ElasticChain {
             for i in 0..n {
                 col[i] = q[i * n + j];
             }
-            crate::linalg::backward(&l, n, &mut col);
+            backward(&l, n, &mut col);
             for i in 0..n {
                 to_angles[i * n + j] = col[i];
             }
@@ -259,7 +256,7 @@ impl ElasticChain {
             .collect();
         // Δγ̇ = M⁻¹ g = L⁻ᵀ L⁻¹ g, then Δż = T Δγ̇.
         forward(&self.mass_factor, n, &mut g);
-        crate::linalg::backward(&self.mass_factor, n, &mut g);
+        backward(&self.mass_factor, n, &mut g);
         let mut y = vec![0.0; n];
         apply(&self.to_modal, n, &g, &mut y);
         for (v, dv) in self.zdot.iter_mut().zip(&y) {
@@ -424,8 +421,8 @@ mod tests {
                 - 0.25 * h * h * k[i] * v[i]
                 - h * k[i] * e[i];
         }
-        assert!(cholesky(&mut lhs, 10));
-        crate::linalg::cholesky_solve(&lhs, 10, &mut rhs);
+        let l = cholesky(&lhs, 10).unwrap();
+        crate::linalg::cholesky_solve(&l, 10, &mut rhs);
         for (a, b) in chain.velocities().iter().zip(&rhs) {
             assert!((a - b).abs() < 1e-9, "{a} vs {b}");
         }

@@ -101,4 +101,7 @@ pub enum LoaError {
         /// What is wrong.
         message: String,
     },
+    /// A wobble is not written `FRAME:S:DX,DY` (e.g. `20:1:0,-800`), with `S` in `[0, 1]`.
+    #[error("wobble '{0}': expected FRAME:S:DX,DY with S in [0, 1] (e.g. 20:1:0,-800)")]
+    Wobble(String),
 }

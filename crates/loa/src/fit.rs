@@ -1,4 +1,4 @@
-//! Fitting a chain of equal rigid elements to a stroke (Section 3.1, Eq. 1).
+//! Fitting a chain of equal rigid elements to a stroke (Section 3.1, LoA Eq. 1).
 
 use glam::DVec2;
 
@@ -13,10 +13,10 @@ pub const DEFAULT_ELEMENTS: usize = 10;
 /// Maximum Levenberg–Marquardt iterations of the angle fit.
 const MAX_ITERATIONS: usize = 100;
 
-/// How well a chain matches its stroke: the value of Eq. 1 and friendlier summaries.
+/// How well a chain matches its stroke: the value of LoA Eq. 1 and friendlier summaries.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct FitResidual {
-    /// `Σ_j ‖x_stroke(l·j) − x_loa(s_j)‖²`, the minimized objective of Eq. 1 (squared screen
+    /// `Σ_j ‖x_stroke(l·j) − x_loa(s_j)‖²`, the minimized objective of LoA Eq. 1 (squared screen
     /// units).
     pub sum_squares: f64,
     /// Root-mean-square joint distance over the `N` non-root joints (screen units).
@@ -34,11 +34,11 @@ pub struct FitResidual {
 pub struct ChainFit {
     /// The fitted chain: root at `x_stroke(0.5)`, `N` elements of length `l = L / N`.
     pub chain: Chain,
-    /// The fit residual of Eq. 1.
+    /// The fit residual of LoA Eq. 1.
     pub residual: FitResidual,
 }
 
-/// Fits `elements` rigid elements of equal length to `stroke` (Eq. 1).
+/// Fits `elements` rigid elements of equal length to `stroke` (LoA Eq. 1).
 ///
 /// The stroke is parametrized by arc length, each element gets `l = L / N`, the root is placed
 /// at `x_stroke(0.5)` and the local angles minimize `Σ_j ‖x_stroke(l·j) − x_loa(s_j)‖²` with
@@ -100,11 +100,11 @@ pub fn fit_chain(stroke: &Stroke, elements: usize) -> Result<ChainFit, LoaError>
                 a[k * n + k] += lambda * (jtj[k * n + k] + 1e-12 * scale * scale);
             }
             let mut step: Vec<f64> = jtr.iter().map(|g| -g).collect();
-            if !cholesky(&mut a, n) {
+            let Some(l) = cholesky(&a, n) else {
                 lambda *= 10.0;
                 continue;
-            }
-            cholesky_solve(&a, n, &mut step);
+            };
+            cholesky_solve(&l, n, &mut step);
             let mut trial = chain.clone();
             for (g, d) in trial.angles_mut().iter_mut().zip(&step) {
                 *g += d;

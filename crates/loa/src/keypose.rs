@@ -1,4 +1,4 @@
-//! Key poses: keystrokes fitted with chains (Eq. 1), angles unwrapped across keys.
+//! Key poses: keystrokes fitted with chains (LoA Eq. 1), angles unwrapped across keys.
 
 use std::f64::consts::PI;
 
@@ -18,11 +18,11 @@ pub struct KeyPose {
     pub stiffness: f64,
     /// Damping ratio `ζ` of the interval starting here.
     pub damping: f64,
-    /// Residual of the chain fit (Eq. 1).
+    /// Residual of the chain fit (LoA Eq. 1).
     pub residual: FitResidual,
 }
 
-/// Fits every keystroke with `elements` rigid elements (Eq. 1) and unwraps the angles so that
+/// Fits every keystroke with `elements` rigid elements (LoA Eq. 1) and unwraps the angles so that
 /// consecutive keys differ by at most π per angle.
 pub fn fit_keystrokes(keys: &Keystrokes, elements: usize) -> Result<Vec<KeyPose>, LoaError> {
     let mut out: Vec<KeyPose> = Vec::with_capacity(keys.keys().len());

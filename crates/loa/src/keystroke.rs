@@ -156,11 +156,6 @@ impl Keystrokes {
         Self::new(keys, file.fps)
     }
 
-    /// Parses keystrokes from SVG; see [`crate::svg`] for the accepted elements.
-    pub fn from_svg_str(text: &str) -> Result<Self, LoaError> {
-        crate::svg::parse_keystrokes(text)
-    }
-
     /// The keystrokes in frame order.
     pub fn keys(&self) -> &[Keystroke] {
         &self.keys

@@ -1,36 +1,115 @@
 //! Dynamic lines of action from sketched keystrokes — Guay, Ronfard, Gleicher, Cani,
-//! "Adding dynamics to sketch-based character animations", SBIM 2015, Section 3.
+//! "Adding dynamics to sketch-based character animations", SBIM 2015 (LoA).
 //!
-//! * [`Stroke`] / [`Keystrokes`]: screen-space strokes with a frame each, read from JSON
-//!   ([`Keystrokes::from_json_str`]) or SVG ([`Keystrokes::from_svg_str`]).
-//! * [`fit_chain`] (Eq. 1): a chain of `N` equal rigid elements, root at the arc-length
-//!   midpoint, two chains outward, angles by least squares.
-//! * [`interpolate_hermite`]: geometric interpolation of angles, lengths and root with Hermite
-//!   cubics, then forward kinematics.
-//! * [`interpolate_physics`] (Section 3.2, Eq. 2): the line as an elastic articulated chain
-//!   ([`ElasticChain`]) shooting for the next keystroke, re-targeted to land on it exactly.
-//! * [`wobble()`]: an impulse on a point of the line, left to settle.
+//! Two whole jobs, each one call on in-memory data with a serde options struct:
+//!
+//! * [`line()`] — keystrokes ([`Keystrokes`], from JSON or SVG text) → the dynamic line
+//!   ([`Line`]: one chain per frame, fitted keys, re-targeting report). Options:
+//!   [`LineOptions`].
+//! * [`animate()`] — a [`Character`](animate::Character) (skeleton + initial pose, e.g.
+//!   [`Character::from_scene`](animate::Character::from_scene)) and a [`Line`] → the 3D motion
+//!   ([`Motion`](animate::Motion), with its [`AnimateReport`](animate::AnimateReport)).
+//!   Options: [`AnimateOptions`](animate::AnimateOptions). [`Motion::to_scene`]
+//!   (animate::Motion::to_scene) puts the motion back into the character's scene for writing.
 //!
 //! The crate is pure computation: it never touches files.
 //!
+//! # Paper map
+//!
+//! | paper | item |
+//! |---|---|
+//! | §3.1, LoA Eq. 1 (chain fit) | [`fit_chain`], [`fit_keystrokes`], [`FitResidual`] |
+//! | §3.1 end (geometric in-betweens) | [`interpolate_hermite`], [`HermiteLine`] |
+//! | §3.2 elastic chain | [`ElasticChain`], [`simulate`] |
+//! | §3.2, LoA Eq. 2 (closest simulated frame `t*`) | [`closest_frame`], [`Retarget`], [`interpolate_physics`] |
+//! | §5 drag-to-wobble | [`wobble()`], [`Wobble`] |
+//! | §4, LoA Eq. 3 (E_ẋ smoothness) + E_x, E_∂ (shape matching) | [`animate::animate`], [`animate::Weights`] |
+//! | §4 dynamic bone sets Ω(t) = Ω(t_k) ∩ Ω(t_k+1) | [`animate::BoneSetKey`], [`animate::BoneSet`] |
+//! | §4 motion reduction (2N − 1 Hermite nodes) | [`animate::Reduction`] |
+//! | §4.1 E_twist, E_⊥ (contacts) | [`animate::TwistKey`], [`animate::ContactKey`] |
+//!
+//! # Parameters (measured on `examples/loa/whip.json`, 24 fps)
+//!
+//! The keystrokes stay at the frames the animator put them on; the parameters shape the
+//! motion between them (see `timing` below):
+//!
+//! * **stiffness** `k` (1/s², per keystroke, documented range 5–1000): how quickly the line
+//!   heads for the next pose and how fast it wobbles. RANGE_STIFFNESS
+//! * **damping** `ζ` (per keystroke, documented range 0.05–2): how far the line overshoots
+//!   the next pose; ≥ 1 arrives without swinging past it. RANGE_DAMPING
+//! * **settle** ([`PhysicsOptions::settle`]): follow-through frames after the last keystroke,
+//!   ending on it at rest. A keystroke repeated at a later frame is a moving hold.
+//! * No setting in those ranges moves any chain point more than 15 % of the line's length in
+//!   one frame (the approach is slowed down as needed, [`MAX_FRAME_MOTION`]). RANGE_JUMP
+//!
+//! # SPEC decisions (where toonkit departs from or adds to the paper)
+//!
+//! * **Timing** (LoA §3.2, Eq. 2): the paper re-times the simulated frames `0..=t*` onto the
+//!   whole keyframe interval, which makes the interval's speed independent of the stiffness.
+//!   toonkit keeps Eq. 2's `t*` and correction but plays the approach at the simulation's own
+//!   speed (arriving `t*` frames after the keystroke, later only when the per-frame motion cap
+//!   needs it, sped up only when `t*` is past the next keystroke), then lets the line
+//!   overshoot and wobble around the next pose for the rest of the interval with a second
+//!   blended correction that lands it exactly on the keystroke ([`Retarget::arrival`]).
+//! * **Settle and holds**: frames after the last keystroke continue the simulation with the
+//!   springs faded out by a smoothstep window (ending at rest on the last keystroke); a
+//!   repeated keystroke is simulated like any other interval, so the line swings through it.
+//! * **Strokes** (LoA §3.1, "spatially smooth stroke"): smoothed with a Gaussian along the arc
+//!   (σ = 2 % of the stroke's length by default, [`Stroke::smoothed`]); each keystroke is
+//!   oriented like the previous one and a reversed one is reported ([`Line::warnings`]).
+//! * **Screen map** (LoA §4): one scale for all keystrokes (least squares over the keystrokes'
+//!   lengths against their bone sets' lengths), not the first keystroke's alone.
+//! * **Planar stage** (LoA §4): the pelvis and chest (turn joints carrying a sideways branch)
+//!   are solved by continuation — first held at their initial orientation, then freed from
+//!   that solution — so they turn and the root translates without the side flip a cold start
+//!   takes. The solver iterates until an accepted step gains less than
+//!   [`animate::DEFAULT_TOLERANCE`] (cap [`animate::DEFAULT_MAX_ITERATIONS`]).
+//! * **Contacts** (LoA §4.1, E_⊥): eased in before the first key and out after the last over
+//!   [`animate::DEFAULT_CONTACT_RELEASE`] frames (the target slides between the planar pose
+//!   and the contact), so a released foot does not snap.
+//! * **Cameras**: a scene camera may be perspective ([`animate::ActionCamera::from_scene`]);
+//!   E_∂ then uses the projection's derivative at each segment's midpoint.
+//!
+//! # Example
+//!
 //! ```
-//! use loa::{line_of_action, Keystrokes, LineOptions, Mode};
+//! use loa::animate::{AnimateOptions, Character};
+//! use loa::{Keystrokes, LineOptions, Mode};
 //!
 //! let keys = Keystrokes::from_json_str(r#"{"keystrokes": [
 //!     {"frame": 0,  "points": [[0, 0], [50, -30], [100, 0]]},
 //!     {"frame": 24, "points": [[0, 0], [50, 30], [100, 0]], "damping": 0.2}
 //! ]}"#)?;
-//! let line = line_of_action(&keys, &LineOptions::default())?;
+//! let line = loa::line(&keys, &LineOptions::default())?;
 //! assert_eq!(line.animation.frames.len(), 25);
 //! // The line lands on the second keystroke exactly.
 //! let last = line.animation.chain_at(24).unwrap().joints();
 //! let key = line.keys[1].chain.joints();
 //! assert!(last.iter().zip(&key).all(|(a, b)| (*a - *b).length() < 1e-9));
 //!
-//! let hermite = line_of_action(&keys, &LineOptions { mode: Mode::Hermite, ..Default::default() })?;
+//! let hermite = loa::line(&keys, &LineOptions { mode: Mode::Hermite, ..Default::default() })?;
 //! assert!(hermite.retargets.is_empty());
-//! # Ok::<(), loa::LoaError>(())
+//!
+//! // A 4-joint spine standing up along +Y follows the line (options as a JSON file would
+//! // give them).
+//! let joint = |name: &str, parent, y| anim::Joint {
+//!     name: name.into(),
+//!     parent,
+//!     bind_local: anim::Transform::from_translation(glam::Vec3::new(0.0, y, 0.0)),
+//! };
+//! let skeleton = anim::Skeleton { joints: vec![
+//!     joint("hips", None, 0.0), joint("spine", Some(0), 1.0),
+//!     joint("chest", Some(1), 1.0), joint("head", Some(2), 1.0),
+//! ] };
+//! let character = Character::rest(&skeleton)?;
+//! let options: AnimateOptions =
+//!     serde_json::from_str(r#"{"bone_sets": [{"frame": 0, "set": "hips,head"}]}"#)?;
+//! let motion = loa::animate(&character, &hermite, &options)?;
+//! assert_eq!(motion.frames(), 25);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+
+#![warn(missing_docs, unreachable_pub)]
 
 pub mod animate;
 mod animation;
@@ -42,11 +121,13 @@ mod hermite;
 mod keypose;
 mod keystroke;
 mod linalg;
+mod line;
 mod onion;
 mod physics;
 mod retarget;
 mod stroke;
 pub mod svg;
+mod timing;
 mod wobble;
 
 pub use animation::{Animation, AnimationFrame};
@@ -62,74 +143,26 @@ pub use keystroke::{
 };
 pub use onion::{to_svg_string, DEFAULT_SVG_WIDTH};
 pub use physics::{
-    interpolate_physics, simulate, PhysicsAnimation, PhysicsOptions, Retarget, SimulatedFrames,
-    Simulation, DEFAULT_SIMULATED_FRAMES, DEFAULT_SUBSTEPS, MAX_SIMULATED_STEPS,
+    simulate, PhysicsAnimation, PhysicsOptions, Retarget, SimulatedFrames, Simulation,
+    DEFAULT_SIMULATED_FRAMES, DEFAULT_SUBSTEPS, MAX_SIMULATED_STEPS,
 };
 pub use retarget::{closest_frame, Blend};
-pub use stroke::Stroke;
+pub use stroke::{Stroke, DEFAULT_STROKE_SMOOTHING, SMOOTHING_SAMPLES};
+pub use timing::{interpolate_physics, MAX_FRAME_MOTION};
 pub use wobble::{wobble, Wobble, MAX_SETTLE_SECONDS, SETTLE_TOLERANCE};
 
-/// Which interpolation between keystrokes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Mode {
-    /// Physically-based interpolation (Section 3.2).
-    #[default]
-    Physics,
-    /// Geometric Hermite interpolation (end of Section 3.1).
-    Hermite,
-}
+pub use line::{line, Line, LineOptions, Mode};
 
-/// Options of [`line_of_action`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LineOptions {
-    /// Interpolation mode.
-    pub mode: Mode,
-    /// Rigid elements per chain (even, ≥ 2).
-    pub elements: usize,
-    /// Physics options; `physics.fps` is also the output's fps in Hermite mode.
-    pub physics: PhysicsOptions,
-}
-
-impl Default for LineOptions {
-    fn default() -> Self {
-        Self {
-            mode: Mode::default(),
-            elements: DEFAULT_ELEMENTS,
-            physics: PhysicsOptions::default(),
-        }
-    }
-}
-
-/// A computed dynamic line of action.
-#[derive(Debug, Clone, PartialEq)]
-pub struct LineOfAction {
-    /// The animated line, one chain per frame.
-    pub animation: Animation,
-    /// The fitted keystrokes (with their Eq. 1 residuals).
-    pub keys: Vec<KeyPose>,
-    /// Re-targeting per interval (physics mode only; empty for Hermite).
-    pub retargets: Vec<Retarget>,
-}
-
-/// Fits the keystrokes (Eq. 1) and interpolates them with the chosen mode.
-pub fn line_of_action(keys: &Keystrokes, options: &LineOptions) -> Result<LineOfAction, LoaError> {
-    let poses = fit_keystrokes(keys, options.elements)?;
-    match options.mode {
-        Mode::Hermite => {
-            keystroke::check_positive("fps", options.physics.fps)?;
-            Ok(LineOfAction {
-                animation: interpolate_hermite(&poses, options.physics.fps),
-                keys: poses,
-                retargets: Vec::new(),
-            })
-        }
-        Mode::Physics => {
-            let result = interpolate_physics(&poses, &options.physics)?;
-            Ok(LineOfAction {
-                animation: result.animation,
-                keys: poses,
-                retargets: result.retargets,
-            })
-        }
-    }
+/// Synthesizes the 3D character motion that follows `line` (LoA Section 4 and 4.1): the
+/// whole job of `loa animate`, with the bone sets, contacts and twists in `options`. See
+/// [`animate::animate`] for the details.
+///
+/// # Errors
+/// Unknown joints or presets, keys outside the line's frames, a zero plane normal.
+pub fn animate(
+    character: &animate::Character,
+    line: &Line,
+    options: &animate::AnimateOptions,
+) -> Result<animate::Motion, animate::AnimateError> {
+    animate::animate(character, &line.animation, &[], &[], &[], options)
 }

@@ -1,54 +1,54 @@
-//! Tiny dense linear algebra for `N × N` systems (N ≈ 10): row-major `Vec<f64>` matrices.
-//! Kept in-crate because the matrices are far too small for a BLAS-style library to pay off.
+//! Small dense linear algebra for `N × N` systems (N ≈ 10) on faer: Cholesky factorization,
+//! triangular solves and the symmetric eigendecomposition, on row-major `Vec<f64>` matrices
+//! (the layout the chain code builds them in).
 
-/// In-place Cholesky factorization `A = L Lᵀ` of a symmetric positive-definite matrix; the
-/// lower triangle receives `L` (the upper triangle is zeroed). Returns `false` when `A` is not
-/// numerically positive definite (the contents are then unspecified).
-pub(crate) fn cholesky(a: &mut [f64], n: usize) -> bool {
-    for j in 0..n {
-        let mut d = a[j * n + j];
-        for k in 0..j {
-            d -= a[j * n + k] * a[j * n + k];
-        }
-        if !(d > 0.0 && d.is_finite()) {
-            return false;
-        }
-        let d = d.sqrt();
-        a[j * n + j] = d;
-        for i in j + 1..n {
-            let mut s = a[i * n + j];
-            for k in 0..j {
-                s -= a[i * n + k] * a[j * n + k];
-            }
-            a[i * n + j] = s / d;
-        }
-        for i in 0..j {
-            a[i * n + j] = 0.0;
+use faer::linalg::triangular_solve::{
+    solve_lower_triangular_in_place, solve_upper_triangular_in_place,
+};
+use faer::{Mat, Par, Side};
+
+/// A row-major `n × n` slice as a faer matrix.
+fn to_mat(a: &[f64], n: usize) -> Mat<f64> {
+    Mat::from_fn(n, n, |i, j| a[i * n + j])
+}
+
+/// A column vector holding `b`.
+fn to_col(b: &[f64], n: usize) -> Mat<f64> {
+    Mat::from_fn(n, 1, |i, _| b[i])
+}
+
+fn copy_back(x: &Mat<f64>, b: &mut [f64]) {
+    for (i, v) in b.iter_mut().enumerate().take(x.nrows()) {
+        *v = x[(i, 0)];
+    }
+}
+
+/// Cholesky factor `L` (`A = L Lᵀ`, row-major, upper triangle zero) of a symmetric
+/// positive-definite matrix; `None` when `A` is not numerically positive definite.
+pub(crate) fn cholesky(a: &[f64], n: usize) -> Option<Vec<f64>> {
+    let llt = to_mat(a, n).llt(Side::Lower).ok()?;
+    let l = llt.L();
+    let mut out = vec![0.0; n * n];
+    for i in 0..n {
+        for j in 0..=i {
+            out[i * n + j] = l[(i, j)];
         }
     }
-    true
+    out.iter().all(|v| v.is_finite()).then_some(out)
 }
 
 /// Solves `L y = b` in place (forward substitution).
 pub(crate) fn forward(l: &[f64], n: usize, b: &mut [f64]) {
-    for i in 0..n {
-        let mut s = b[i];
-        for k in 0..i {
-            s -= l[i * n + k] * b[k];
-        }
-        b[i] = s / l[i * n + i];
-    }
+    let mut x = to_col(b, n);
+    solve_lower_triangular_in_place(to_mat(l, n).as_ref(), x.as_mut(), Par::Seq);
+    copy_back(&x, b);
 }
 
 /// Solves `Lᵀ x = y` in place (back substitution).
 pub(crate) fn backward(l: &[f64], n: usize, b: &mut [f64]) {
-    for i in (0..n).rev() {
-        let mut s = b[i];
-        for k in i + 1..n {
-            s -= l[k * n + i] * b[k];
-        }
-        b[i] = s / l[i * n + i];
-    }
+    let mut x = to_col(b, n);
+    solve_upper_triangular_in_place(to_mat(l, n).transpose(), x.as_mut(), Par::Seq);
+    copy_back(&x, b);
 }
 
 /// Solves `L Lᵀ x = b` in place given the Cholesky factor `L`.
@@ -57,189 +57,24 @@ pub(crate) fn cholesky_solve(l: &[f64], n: usize, b: &mut [f64]) {
     backward(l, n, b);
 }
 
-/// `y = A x`.
-#[cfg(test)]
-pub(crate) fn mat_vec(a: &[f64], n: usize, x: &[f64], y: &mut [f64]) {
-    for i in 0..n {
-        y[i] = a[i * n..(i + 1) * n]
-            .iter()
-            .zip(x)
-            .map(|(p, q)| p * q)
-            .sum();
-    }
-}
-
-/// Eigen-decomposition of a symmetric matrix: Householder tridiagonalization followed by the
-/// implicit QL algorithm (the EISPACK `tred2`/`tql2` pair, as in JAMA). Returns the
-/// eigenvalues and the eigenvectors as the *columns* of a row-major matrix.
+/// Eigen-decomposition of a symmetric matrix (faer's self-adjoint solver): the eigenvalues
+/// (ascending) and the eigenvectors as the *columns* of a row-major matrix. A matrix the
+/// solver rejects (non-finite entries) gives NaN values instead of an error.
 pub(crate) fn symmetric_eigen(a: &[f64], n: usize) -> (Vec<f64>, Vec<f64>) {
-    let mut v = a[..n * n].to_vec();
-    let mut d = vec![0.0; n];
-    let mut e = vec![0.0; n];
-    if n == 0 {
-        return (d, v);
-    }
-    tred2(&mut v, &mut d, &mut e, n);
-    tql2(&mut v, &mut d, &mut e, n);
-    (d, v)
-}
-
-fn tred2(v: &mut [f64], d: &mut [f64], e: &mut [f64], n: usize) {
-    let at = |i: usize, j: usize| i * n + j;
-    for j in 0..n {
-        d[j] = v[at(n - 1, j)];
-    }
-    for i in (1..n).rev() {
-        let scale: f64 = d[..i].iter().map(|x| x.abs()).sum();
-        let mut h = 0.0;
-        if scale == 0.0 {
-            e[i] = d[i - 1];
-            for j in 0..i {
-                d[j] = v[at(i - 1, j)];
-                v[at(i, j)] = 0.0;
-                v[at(j, i)] = 0.0;
-            }
-        } else {
-            for k in 0..i {
-                d[k] /= scale;
-                h += d[k] * d[k];
-            }
-            let mut f = d[i - 1];
-            let mut g = h.sqrt();
-            if f > 0.0 {
-                g = -g;
-            }
-            e[i] = scale * g;
-            h -= f * g;
-            d[i - 1] = f - g;
-            for ej in e[..i].iter_mut() {
-                *ej = 0.0;
-            }
-            for j in 0..i {
-                f = d[j];
-                v[at(j, i)] = f;
-                g = e[j] + v[at(j, j)] * f;
-                for k in j + 1..i {
-                    g += v[at(k, j)] * d[k];
-                    e[k] += v[at(k, j)] * f;
+    match to_mat(a, n).self_adjoint_eigen(Side::Lower) {
+        Ok(evd) => {
+            let s = evd.S().column_vector();
+            let u = evd.U();
+            let values = (0..n).map(|i| s[i]).collect();
+            let mut vectors = vec![0.0; n * n];
+            for i in 0..n {
+                for j in 0..n {
+                    vectors[i * n + j] = u[(i, j)];
                 }
-                e[j] = g;
             }
-            f = 0.0;
-            for j in 0..i {
-                e[j] /= h;
-                f += e[j] * d[j];
-            }
-            let hh = f / (h + h);
-            for j in 0..i {
-                e[j] -= hh * d[j];
-            }
-            for j in 0..i {
-                f = d[j];
-                g = e[j];
-                for k in j..i {
-                    v[at(k, j)] -= f * e[k] + g * d[k];
-                }
-                d[j] = v[at(i - 1, j)];
-                v[at(i, j)] = 0.0;
-            }
+            (values, vectors)
         }
-        d[i] = h;
-    }
-    // Accumulate the transformations.
-    for i in 0..n - 1 {
-        v[at(n - 1, i)] = v[at(i, i)];
-        v[at(i, i)] = 1.0;
-        let h = d[i + 1];
-        if h != 0.0 {
-            for k in 0..=i {
-                d[k] = v[at(k, i + 1)] / h;
-            }
-            for j in 0..=i {
-                let mut g = 0.0;
-                for k in 0..=i {
-                    g += v[at(k, i + 1)] * v[at(k, j)];
-                }
-                for k in 0..=i {
-                    v[at(k, j)] -= g * d[k];
-                }
-            }
-        }
-        for k in 0..=i {
-            v[at(k, i + 1)] = 0.0;
-        }
-    }
-    for j in 0..n {
-        d[j] = v[at(n - 1, j)];
-        v[at(n - 1, j)] = 0.0;
-    }
-    v[at(n - 1, n - 1)] = 1.0;
-    e[0] = 0.0;
-}
-
-fn tql2(v: &mut [f64], d: &mut [f64], e: &mut [f64], n: usize) {
-    let at = |i: usize, j: usize| i * n + j;
-    for i in 1..n {
-        e[i - 1] = e[i];
-    }
-    e[n - 1] = 0.0;
-    let mut f = 0.0;
-    let mut tst1: f64 = 0.0;
-    let eps = f64::EPSILON;
-    for l in 0..n {
-        tst1 = tst1.max(d[l].abs() + e[l].abs());
-        let mut m = l;
-        while m < n - 1 && e[m].abs() > eps * tst1 {
-            m += 1;
-        }
-        if m > l {
-            for _iteration in 0..64 {
-                let mut g = d[l];
-                let mut p = (d[l + 1] - g) / (2.0 * e[l]);
-                let mut r = p.hypot(1.0);
-                if p < 0.0 {
-                    r = -r;
-                }
-                d[l] = e[l] / (p + r);
-                d[l + 1] = e[l] * (p + r);
-                let dl1 = d[l + 1];
-                let mut h = g - d[l];
-                for di in d[l + 2..n].iter_mut() {
-                    *di -= h;
-                }
-                f += h;
-                p = d[m];
-                let (mut c, mut c2, mut c3) = (1.0, 1.0, 1.0);
-                let el1 = e[l + 1];
-                let (mut s, mut s2) = (0.0, 0.0);
-                for i in (l..m).rev() {
-                    c3 = c2;
-                    c2 = c;
-                    s2 = s;
-                    g = c * e[i];
-                    h = c * p;
-                    r = p.hypot(e[i]);
-                    e[i + 1] = s * r;
-                    s = e[i] / r;
-                    c = p / r;
-                    p = c * d[i] - s * g;
-                    d[i + 1] = h + s * (c * g + s * d[i]);
-                    for k in 0..n {
-                        h = v[at(k, i + 1)];
-                        v[at(k, i + 1)] = s * v[at(k, i)] + c * h;
-                        v[at(k, i)] = c * v[at(k, i)] - s * h;
-                    }
-                }
-                p = -s * s2 * c3 * el1 * e[l] / dl1;
-                e[l] = s * p;
-                d[l] = c * p;
-                if e[l].is_nan() || e[l].abs() <= eps * tst1 {
-                    break;
-                }
-            }
-        }
-        d[l] += f;
-        e[l] = 0.0;
+        Err(_) => (vec![f64::NAN; n], vec![f64::NAN; n * n]),
     }
 }
 
@@ -251,15 +86,14 @@ mod tests {
     fn cholesky_solves_spd_system() {
         let n = 3;
         let a = vec![4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 2.0];
-        let mut l = a.clone();
-        assert!(cholesky(&mut l, n));
+        let l = cholesky(&a, n).unwrap();
         let mut x = vec![1.0, 2.0, 3.0];
         cholesky_solve(&l, n, &mut x);
-        let mut y = vec![0.0; 3];
-        mat_vec(&a, n, &x, &mut y);
-        for (yi, bi) in y.iter().zip([1.0, 2.0, 3.0]) {
-            assert!((yi - bi).abs() < 1e-12);
+        for i in 0..n {
+            let y: f64 = (0..n).map(|j| a[i * n + j] * x[j]).sum();
+            assert!((y - [1.0, 2.0, 3.0][i]).abs() < 1e-12);
         }
+        assert!(cholesky(&[1.0, 2.0, 2.0, 1.0], 2).is_none(), "indefinite");
     }
 
     #[test]
@@ -281,7 +115,7 @@ mod tests {
                 }
             }
         }
-        // Non-finite input terminates with a defined (NaN) result instead of looping.
+        // Non-finite input gives a defined (NaN) result instead of an error or a loop.
         let (w, _) = symmetric_eigen(&[f64::NAN, 1.0, 1.0, 2.0], 2);
         assert_eq!(w.len(), 2);
     }

@@ -1,34 +1,29 @@
-//! Physically-based stroke interpolation (Section 3.2).
+//! The elastic simulation of physically-based stroke interpolation (Section 3.2).
 //!
 //! From each keystroke the elastic chain ([`ElasticChain`]) is simulated for `M` frames with
 //! its springs pulling toward the next keystroke's angles, starting with the angular velocity
-//! the line arrived with. Eq. 2 picks the simulated frame `t*` closest to the next keystroke;
-//! the simulated frames `0..=t*` are retimed onto the keyframe interval and the correction
-//! `Δγ = γ(t_k+1) − γ(t*)` is blended in ([`Blend`]) so that the line lands exactly on the next
-//! keystroke. The root position and the element lengths are Hermite-interpolated.
+//! the line arrived with ([`simulate`]). LoA Eq. 2 then picks the simulated frame `t*`
+//! closest to the next keystroke and a correction `Δγ = γ(t_k+1) − γ(t*)` is blended in
+//! ([`Blend`]); how the result is laid onto the keystrokes' frames (approach,
+//! follow-through, settle) is [`interpolate_physics`](crate::interpolate_physics)'s job.
+//! The root position and the element lengths are Hermite-interpolated.
 //!
-//! How the parameters shape the motion:
-//! * **stiffness `k`** (per keystroke, 1/s²): speed. The line turning rigidly about its root
-//!   oscillates at `√k` rad/s and its bending modes scale with `√k`; stiffer springs reach the
-//!   next pose sooner (smaller `t*`) and wobble faster.
+//! * **stiffness `k`** (per keystroke, 1/s²): the line turning rigidly about its root
+//!   oscillates at `√k` rad/s and its bending modes scale with `√k`.
 //! * **damping `ζ`** (per keystroke): `ζ ≥ 1` approaches the target without overshoot (every
 //!   mode is at least critically damped); `ζ < 1` lets the slow modes overshoot by about
-//!   `exp(−πζ/√(1−ζ²))` and wobble (follow-through). Because the inertia couples joints, outboard joints lag and
-//!   joints whose own target barely changes first swing the opposite way (anticipation), more
-//!   visibly at low damping.
-//! * **simulated frames `M`**: the time window searched by Eq. 2; with `M` larger than the
-//!   frame gap the physics is sped up to fit the interval, with `M` smaller it is slowed down.
-//! * **fps**: frame duration `1/fps` s of the simulated frames, so higher fps means slower
-//!   motion per frame for the same stiffness.
+//!   `exp(−πζ/√(1−ζ²))` and wobble. Because the inertia couples joints, outboard joints lag
+//!   and joints whose own target barely changes first swing the opposite way (anticipation).
+//! * **simulated frames `M`**: the time window searched by LoA Eq. 2.
+//! * **fps**: frame duration `1/fps` s of the simulated frames.
 //! * **substeps**: accuracy only (the integrator is stable for any sub-step).
 
-use crate::animation::{Animation, AnimationFrame};
+use crate::animation::Animation;
 use crate::dynamics::ElasticChain;
-use crate::hermite::HermiteLine;
 use crate::keypose::KeyPose;
 use crate::keystroke::{check_positive, DEFAULT_FPS};
-use crate::retarget::{closest_frame, Blend};
-use crate::{Chain, LoaError};
+use crate::retarget::Blend;
+use crate::LoaError;
 
 /// Simulated frames per interval used by the paper (`M = 40`).
 pub const DEFAULT_SIMULATED_FRAMES: u32 = 40;
@@ -39,7 +34,8 @@ pub const DEFAULT_SUBSTEPS: u32 = 8;
 pub const MAX_SIMULATED_STEPS: u64 = 2_000_000;
 
 /// How many frames are simulated from each keystroke.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum SimulatedFrames {
     /// A fixed count `M` (the paper uses 40), retimed onto each interval.
     Fixed(u32),
@@ -54,7 +50,8 @@ impl Default for SimulatedFrames {
 }
 
 /// Options of the physically-based interpolation.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct PhysicsOptions {
     /// Frames per second (simulated frame duration `1/fps` s).
     pub fps: f64,
@@ -64,6 +61,9 @@ pub struct PhysicsOptions {
     pub simulated_frames: SimulatedFrames,
     /// Blend of the re-targeting correction.
     pub blend: Blend,
+    /// Frames of follow-through added after the last keystroke (0 = end on it); they end on
+    /// the last keystroke, at rest.
+    pub settle: u32,
 }
 
 impl Default for PhysicsOptions {
@@ -73,12 +73,13 @@ impl Default for PhysicsOptions {
             substeps: DEFAULT_SUBSTEPS,
             simulated_frames: SimulatedFrames::default(),
             blend: Blend::default(),
+            settle: 0,
         }
     }
 }
 
 impl PhysicsOptions {
-    fn validate(&self) -> Result<(), LoaError> {
+    pub(crate) fn validate(&self) -> Result<(), LoaError> {
         check_positive("fps", self.fps)?;
         if self.substeps == 0 {
             return Err(LoaError::InvalidParameter {
@@ -247,10 +248,15 @@ pub struct Retarget {
     pub to_frame: i64,
     /// Simulated frames `M`.
     pub simulated_frames: u32,
-    /// The closest simulated frame `t*` of Eq. 2.
+    /// The closest simulated frame `t*` of LoA Eq. 2.
     pub t_star: usize,
     /// Euclidean norm of the correction `Δγ` (radians).
     pub correction: f64,
+    /// Output frames after `from_frame` at which the line reaches the next pose: `t*` at the
+    /// simulation's own speed, later when the per-frame motion cap slowed the approach, and
+    /// the whole interval when `t*` lies beyond it (then the simulation is sped up, as in
+    /// the paper). The rest of the interval is follow-through.
+    pub arrival: f64,
 }
 
 /// The physically interpolated line and what the re-targeting did per interval.
@@ -260,80 +266,4 @@ pub struct PhysicsAnimation {
     pub animation: Animation,
     /// One entry per keyframe interval.
     pub retargets: Vec<Retarget>,
-}
-
-/// Physically-based interpolation of the key poses (Section 3.2). The result passes exactly
-/// through every key pose at its frame.
-pub fn interpolate_physics(
-    keys: &[KeyPose],
-    options: &PhysicsOptions,
-) -> Result<PhysicsAnimation, LoaError> {
-    options.validate()?;
-    let Some(first) = keys.first() else {
-        return Err(LoaError::NoKeystrokes);
-    };
-    let n = first.chain.elements();
-    let line = HermiteLine::new(keys);
-    let mut frames = vec![AnimationFrame {
-        frame: first.frame,
-        chain: first.chain.clone(),
-    }];
-    let mut retargets = Vec::with_capacity(keys.len().saturating_sub(1));
-    let mut velocity = vec![0.0; n];
-    let frame_time = 1.0 / options.fps;
-    for pair in keys.windows(2) {
-        let (from, to) = (&pair[0], &pair[1]);
-        let gap = (to.frame - from.frame) as f64;
-        let m = match options.simulated_frames {
-            SimulatedFrames::Fixed(m) => m,
-            SimulatedFrames::FrameGap => u32::try_from(to.frame - from.frame).unwrap_or(u32::MAX),
-        };
-        let sim = simulate(from, to.chain.angles(), &velocity, m, options)?;
-        let whole: Vec<Vec<f64>> = (0..=sim.frames()).map(|i| sim.frame(i)).collect();
-        let t_star = closest_frame(&whole, to.chain.angles());
-        let correction: Vec<f64> = to
-            .chain
-            .angles()
-            .iter()
-            .zip(&sim.frame(t_star))
-            .map(|(a, b)| a - b)
-            .collect();
-        let speed = t_star as f64 / gap;
-        for f in from.frame + 1..=to.frame {
-            let chain = if f == to.frame {
-                to.chain.clone()
-            } else {
-                let tau = (f - from.frame) as f64 * speed;
-                let w = options.blend.weight(tau / t_star as f64);
-                let angles = sim
-                    .angles_at(tau)
-                    .iter()
-                    .zip(&correction)
-                    .map(|(a, d)| a + w * d)
-                    .collect();
-                let t = f as f64;
-                Chain::new(line.root_at(t), angles, line.lengths_at(t))?
-            };
-            frames.push(AnimationFrame { frame: f, chain });
-        }
-        // Velocity the line arrives with, in seconds of output time.
-        let slope = options.blend.slope(1.0);
-        velocity = sim
-            .state_velocity(t_star * options.substeps as usize)
-            .iter()
-            .zip(&correction)
-            .map(|(v, d)| v * speed + d * slope / (gap * frame_time))
-            .collect();
-        retargets.push(Retarget {
-            from_frame: from.frame,
-            to_frame: to.frame,
-            simulated_frames: m,
-            t_star,
-            correction: correction.iter().map(|d| d * d).sum::<f64>().sqrt(),
-        });
-    }
-    Ok(PhysicsAnimation {
-        animation: Animation::new(options.fps, keys.iter().map(|k| k.frame).collect(), frames),
-        retargets,
-    })
 }

@@ -1,7 +1,8 @@
-//! Re-targeting a forward simulation onto the next keystroke (Section 3.2, Eq. 2).
+//! Re-targeting a forward simulation onto the next keystroke (Section 3.2, LoA Eq. 2).
 
 /// How the correction `Δγ = γ(t_k+1) − γ(t*)` is blended in over the frames before `t*`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Blend {
     /// Weight `u = t_i / t*`, as printed in the paper: lands exactly, but adds a constant
     /// angular velocity `Δγ / t*`, so the line's velocity jumps at the keystrokes.
@@ -32,7 +33,7 @@ impl Blend {
     }
 }
 
-/// Eq. 2: the simulated frame `t*_i = argmin_{t_i} Σ_j (γ_j(t_i) − γ_j(t_k+1))²`, searched over
+/// LoA Eq. 2: the simulated frame `t*_i = argmin_{t_i} Σ_j (γ_j(t_i) − γ_j(t_k+1))²`, searched over
 /// frames `1..frames.len()` (frame 0 is the start keystroke itself). Ties go to the earliest
 /// frame; NaN distances never win. Returns 1 when there is no frame after the start.
 pub fn closest_frame(frames: &[Vec<f64>], target: &[f64]) -> usize {

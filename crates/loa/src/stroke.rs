@@ -7,6 +7,13 @@ use crate::error::StrokeError;
 /// Relative tolerance under which a stroke's extent counts as a single point.
 const COLLAPSE_TOLERANCE: f64 = 1e-9;
 
+/// Samples of a smoothed stroke ([`Stroke::smoothed`]).
+pub const SMOOTHING_SAMPLES: usize = 101;
+
+/// Default smoothing of keystrokes before fitting: a Gaussian of σ = 2 % of the stroke's
+/// length along the arc ([`Stroke::smoothed`]).
+pub const DEFAULT_STROKE_SMOOTHING: f64 = 0.02;
+
 /// A polyline of screen-space samples, parametrized by arc length (Section 3.1).
 ///
 /// Consecutive duplicate samples are dropped on construction, so every segment has a
@@ -97,6 +104,46 @@ impl Stroke {
             .collect()
     }
 
+    /// The stroke drawn the other way round.
+    pub fn reversed(&self) -> Stroke {
+        let total = self.length();
+        Stroke {
+            points: self.points.iter().rev().copied().collect(),
+            cumulative: self.cumulative.iter().rev().map(|c| total - c).collect(),
+        }
+    }
+
+    /// The "spatially smooth stroke" the paper fits (LoA Section 3.1): the stroke resampled at
+    /// [`SMOOTHING_SAMPLES`] points equally spaced in arc length, each averaged with a
+    /// Gaussian of standard deviation `sigma × length` along the arc (window ±3σ, shrinking
+    /// symmetrically near the ends so that both end points stay exactly where they were
+    /// drawn). Jitter shorter than σ is removed; a stroke that is already smooth at that scale
+    /// moves by much less than σ (a circular arc of angle θ shrinks by about σ²θ²/2 of its
+    /// length). `sigma ≤ 0` returns the stroke unchanged.
+    pub fn smoothed(&self, sigma: f64) -> Stroke {
+        if !(sigma > 0.0 && sigma.is_finite()) {
+            return self.clone();
+        }
+        let count = SMOOTHING_SAMPLES;
+        let samples = self.resample(count - 1);
+        let step = 1.0 / (count - 1) as f64;
+        let radius = ((3.0 * sigma / step).ceil() as usize).max(1);
+        let smooth: Vec<DVec2> = (0..count)
+            .map(|i| {
+                let k = radius.min(i).min(count - 1 - i);
+                let (mut sum, mut weight) = (DVec2::ZERO, 0.0);
+                for j in i - k..=i + k {
+                    let d = (j as f64 - i as f64) * step / sigma;
+                    let w = (-0.5 * d * d).exp();
+                    sum += w * samples[j];
+                    weight += w;
+                }
+                sum / weight
+            })
+            .collect();
+        Stroke::new(smooth).unwrap_or_else(|_| self.clone())
+    }
+
     /// Axis-aligned bounds `(min, max)` of the samples.
     pub fn bounds(&self) -> (DVec2, DVec2) {
         self.points.iter().fold(
@@ -119,6 +166,26 @@ mod tests {
         assert!((r[1] - DVec2::new(1.0, 0.0)).length() < 1e-12);
         assert!((r[2] - DVec2::new(1.0, 1.0)).length() < 1e-12);
         assert!((s.point_at(1.0) - DVec2::new(1.0, 3.0)).length() < 1e-12);
+    }
+
+    #[test]
+    fn smoothing_removes_jitter_and_keeps_the_ends() {
+        // A straight stroke with ±1 % zig-zag jitter every sample.
+        let raw: Vec<DVec2> = (0..=200)
+            .map(|i| DVec2::new(i as f64, if i % 2 == 0 { 2.0 } else { -2.0 }))
+            .collect();
+        let s = Stroke::new(raw).unwrap();
+        let smooth = s.smoothed(DEFAULT_STROKE_SMOOTHING);
+        assert_eq!(smooth.points()[0], s.points()[0]);
+        assert_eq!(smooth.points().last(), s.points().last());
+        let interior = &smooth.points()[10..smooth.points().len() - 10];
+        let worst = interior.iter().map(|p| p.y.abs()).fold(0.0, f64::max);
+        assert!(worst < 0.2, "jitter left: {worst}");
+        // Reversal swaps the ends and keeps the length.
+        let r = s.reversed();
+        assert_eq!(r.points()[0], *s.points().last().unwrap());
+        assert!((r.length() - s.length()).abs() < 1e-9);
+        assert!((r.point_at(0.25) - s.point_at(0.75)).length() < 1e-9);
     }
 
     #[test]

@@ -16,7 +16,25 @@ use crate::stroke::Stroke;
 /// Number of line segments a Bézier curve segment is flattened into.
 pub const CURVE_SEGMENTS: usize = 16;
 
-pub(crate) fn parse_keystrokes(text: &str) -> Result<Keystrokes, LoaError> {
+impl Keystrokes {
+    /// Parses keystrokes from SVG; see the [module documentation](crate::svg) for the
+    /// accepted elements and attributes.
+    pub fn from_svg_str(text: &str) -> Result<Self, LoaError> {
+        parse_keystrokes(text)
+    }
+
+    /// Parses keystrokes from either layout: SVG when the text starts with `<` (after
+    /// whitespace), else JSON ([`Keystrokes::from_json_str`]).
+    pub fn parse(text: &str) -> Result<Self, LoaError> {
+        if text.trim_start().starts_with('<') {
+            Self::from_svg_str(text)
+        } else {
+            Self::from_json_str(text)
+        }
+    }
+}
+
+fn parse_keystrokes(text: &str) -> Result<Keystrokes, LoaError> {
     let doc = roxmltree::Document::parse(text).map_err(|e| LoaError::Xml(e.to_string()))?;
     let root = doc.root_element();
     let fps = attr_f64(root, "data-fps").map_err(|m| LoaError::Xml(format!("<svg>: {m}")))?;

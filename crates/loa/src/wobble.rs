@@ -21,7 +21,7 @@ pub const MAX_SETTLE_SECONDS: f64 = 10.0;
 pub const SETTLE_TOLERANCE: f64 = 1e-4;
 
 /// An impulse applied to the line.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Wobble {
     /// Frame at which the line is hit.
     pub frame: i64,
@@ -46,6 +46,29 @@ impl Wobble {
             stiffness: DEFAULT_STIFFNESS,
             damping: DEFAULT_DAMPING,
         }
+    }
+}
+
+impl std::str::FromStr for Wobble {
+    type Err = LoaError;
+    /// `FRAME:S:DX,DY`: hit frame, arc-length position `S ∈ [0, 1]` along the line, and the
+    /// impulse in screen units per second (default stiffness and damping).
+    fn from_str(text: &str) -> Result<Self, Self::Err> {
+        let bad = || LoaError::Wobble(text.to_string());
+        let parts: Vec<&str> = text.split(':').collect();
+        let [frame, at, impulse] = parts[..] else {
+            return Err(bad());
+        };
+        let number = |x: &str| x.trim().parse::<f64>().ok().filter(|v| v.is_finite());
+        let frame = number(frame)
+            .filter(|f| f.fract() == 0.0 && f.abs() < 1e15)
+            .ok_or_else(bad)? as i64;
+        let at = number(at)
+            .filter(|u| (0.0..=1.0).contains(u))
+            .ok_or_else(bad)?;
+        let (dx, dy) = impulse.split_once(',').ok_or_else(bad)?;
+        let impulse = DVec2::new(number(dx).ok_or_else(bad)?, number(dy).ok_or_else(bad)?);
+        Ok(Wobble::new(frame, at, impulse))
     }
 }
 

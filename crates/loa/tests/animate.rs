@@ -5,14 +5,10 @@ use std::path::PathBuf;
 
 use anim::Skeleton;
 use loa::animate::{animate, AnimateOptions, BoneSetKey, Character, ContactKey, Motion, TwistKey};
-use loa::{line_of_action, Keystrokes, LineOptions, Mode};
+use loa::{Keystrokes, LineOptions, Mode};
 
 fn data(rel: &str) -> PathBuf {
-    let p = PathBuf::from(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../assets/"
-    ))
-    .join(rel);
+    let p = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/")).join(rel);
     assert!(p.exists(), "missing test asset {}", p.display());
     p
 }
@@ -52,7 +48,7 @@ fn line(keys: &[(i64, f64, f64)]) -> loa::Animation {
         mode: Mode::Hermite,
         ..Default::default()
     };
-    line_of_action(&keys, &options).unwrap().animation
+    loa::line(&keys, &options).unwrap().animation
 }
 
 fn sets(s: &[(&str, i64)]) -> Vec<BoneSetKey> {

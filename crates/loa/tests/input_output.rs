@@ -83,7 +83,7 @@ fn keystroke_input_errors_are_clear() {
         ..Default::default()
     };
     assert!(matches!(
-        line_of_action(&keys, &odd),
+        loa::line(&keys, &odd),
         Err(LoaError::InvalidParameter {
             name: "elements",
             ..
@@ -96,7 +96,7 @@ fn keystroke_input_errors_are_clear() {
         },
         ..Default::default()
     };
-    assert!(line_of_action(&keys, &bad_fps).is_err());
+    assert!(loa::line(&keys, &bad_fps).is_err());
 }
 
 #[test]
@@ -118,9 +118,9 @@ fn svg_whip_matches_json_whip() {
 #[test]
 fn json_output_follows_the_spec_layout_and_is_deterministic() {
     let keys = Keystrokes::from_json_str(JUMP).unwrap();
-    let line = line_of_action(&keys, &LineOptions::default()).unwrap();
+    let line = loa::line(&keys, &LineOptions::default()).unwrap();
     let text = line.animation.to_json_string();
-    let again = line_of_action(&keys, &LineOptions::default())
+    let again = loa::line(&keys, &LineOptions::default())
         .unwrap()
         .animation
         .to_json_string();
@@ -197,7 +197,7 @@ fn extreme_parameters_give_errors_or_defined_results() {
     )
     .unwrap();
     for mode in [Mode::Physics, Mode::Hermite] {
-        let line = line_of_action(
+        let line = loa::line(
             &one,
             &LineOptions {
                 mode,

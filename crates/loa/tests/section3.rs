@@ -44,7 +44,7 @@ fn fig3_physics_line_lands_on_every_keystroke() {
                 },
                 ..Default::default()
             };
-            let line = line_of_action(&keys, &options).unwrap();
+            let line = loa::line(&keys, &options).unwrap();
             let a = &line.animation;
             assert_eq!(a.keystroke_frames, keys.frames());
             let span = keys.frames().last().unwrap() - keys.frames()[0] + 1;
@@ -373,7 +373,7 @@ fn eq1_fit_residual_is_small_for_smooth_strokes() {
 #[test]
 fn drag_to_wobble_settles_back_to_the_line() {
     let keys = Keystrokes::from_json_str(WHIP).unwrap();
-    let line = line_of_action(
+    let line = loa::line(
         &keys,
         &LineOptions {
             mode: Mode::Hermite,

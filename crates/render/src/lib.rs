@@ -15,7 +15,9 @@
 //!   [`Renderer::render_animation`] renders all frames in parallel; [`contact_sheet`] lays
 //!   frames out on a grid with frame numbers.
 //! * [`encode_png`] and [`encode_gif`] return bytes; this crate never touches files.
-//! * [`preview_scene`] does all of it for a sampled scene (what `toonkit render` calls).
+//! * [`preview_scene`] does all of it for a sampled scene (what `toonkit render` calls);
+//!   [`line_preview`] and [`rig_preview`] draw a line of action alone or over a character
+//!   (what `toonkit loa` calls).
 //!
 //! Colours are linear RGBA ([`Color`]); images are sRGB RGBA8 ([`Image`]).
 //!
@@ -45,11 +47,13 @@ mod flipbook;
 mod follow;
 mod font;
 mod image;
+mod line_preview;
 mod lines;
 mod offsets;
 mod preview;
 mod raster;
 mod renderer;
+mod rig_preview;
 mod sheet;
 mod view;
 
@@ -72,6 +76,7 @@ pub use flipbook::flipbook_gif;
 pub use follow::{follow_views, DEFAULT_FOLLOW_SMOOTHING};
 pub use font::{draw_text, text_size, GLYPH_HEIGHT, GLYPH_WIDTH};
 pub use image::{Image, ImageDiff, MAX_IMAGE_SIZE};
+pub use line_preview::{line_preview, DEFAULT_LINE_PREVIEW_SIZE};
 pub use lines::DEFAULT_LINE_DEPTH_BIAS;
 pub use offsets::{offset_colors, offset_rgba};
 pub use preview::{preview_scene, OutputFormat, PreviewOptions, ViewSpec, DEFAULT_PREVIEW_SIZE};
@@ -79,5 +84,6 @@ pub use renderer::{
     Ghost, RenderOptions, Renderer, DEFAULT_AMBIENT, DEFAULT_BACKGROUND, DEFAULT_LIGHT,
     DEFAULT_SUPERSAMPLE, MAX_SUPERSAMPLE,
 };
+pub use rig_preview::{rig_preview, RigPreview, RigView, ViewAxes, DEFAULT_RIG_PREVIEW_SIZE};
 pub use sheet::{contact_sheet, SheetOptions, DEFAULT_SHEET_GAP};
 pub use view::{animation_bbox, View, ViewDirection, DEFAULT_FIT_MARGIN};

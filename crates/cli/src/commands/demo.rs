@@ -117,7 +117,7 @@ pub fn run(ctx: &Context, args: DemoArgs) -> Result<()> {
 
     // loa: the jump keystrokes as a dynamic line of action.
     let keys = loa::Keystrokes::from_json_str(SAMPLE_KEYS).context("bundled keystrokes")?;
-    let line = loa::line_of_action(&keys, &loa::LineOptions::default())?;
+    let line = loa::line(&keys, &loa::LineOptions::default())?;
     put(
         &out("jump_line.json"),
         line.animation.to_json_string().as_bytes(),
@@ -130,7 +130,7 @@ pub fn run(ctx: &Context, args: DemoArgs) -> Result<()> {
     )?;
     put(
         &out("jump_line.gif"),
-        &super::loa_render::render_line(&line.animation, &keys, true)?,
+        &super::loa::render_line(&line.animation, &keys, true)?,
         &mut written,
     )?;
     spinner.finish_and_clear();

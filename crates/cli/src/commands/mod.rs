@@ -4,8 +4,6 @@ pub mod convert;
 pub mod demo;
 pub mod info;
 pub mod loa;
-mod loa_animate;
-mod loa_render;
 pub mod render;
 pub mod smear;
 pub mod stopmo;

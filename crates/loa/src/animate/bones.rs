@@ -78,7 +78,8 @@ impl FromStr for Preset {
 }
 
 /// What a bone set is made of.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(into = "String", try_from = "String")]
 pub enum BoneSet {
     /// A named humanoid preset.
     Preset(Preset),
@@ -114,6 +115,19 @@ impl fmt::Display for BoneSet {
     }
 }
 
+impl From<BoneSet> for String {
+    fn from(set: BoneSet) -> String {
+        set.to_string()
+    }
+}
+
+impl TryFrom<String> for BoneSet {
+    type Error = AnimateError;
+    fn try_from(s: String) -> Result<Self, Self::Error> {
+        s.parse()
+    }
+}
+
 /// A bone set resolved on a rig: the chain's joints (kinematic path) and whether the last
 /// point is the last joint's bone tip.
 #[derive(Debug, Clone, PartialEq)]
@@ -132,7 +146,7 @@ pub(crate) enum ChainPoint {
 }
 
 impl Chain3 {
-    pub fn points(&self) -> Vec<ChainPoint> {
+    pub(super) fn points(&self) -> Vec<ChainPoint> {
         let mut v: Vec<ChainPoint> = self.joints.iter().map(|&j| ChainPoint::Joint(j)).collect();
         if self.tip {
             if let Some(&l) = self.joints.last() {

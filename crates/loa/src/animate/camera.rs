@@ -1,10 +1,12 @@
 //! The camera `P` the line is drawn through, the action plane, and the map from the
 //! keystrokes' screen coordinates onto the camera's image plane.
 //!
-//! The camera is orthographic (the paper's figures; perspective is not supported yet): a 3D
-//! point `x` projects to image coordinates `P x = ((x − c)·r, (x − c)·u)` in world units, with
-//! `r`/`u` the camera's right/up axes. The default is the glTF front view (looking down −Z,
-//! +Y up) fitted to the character.
+//! Orthographic (the paper's figures): a 3D point `x` projects to image coordinates
+//! `P x = ((x − c)·r, (x − c)·u)` in world units, with `r`/`u` the camera's right/up axes.
+//! Perspective (a scene camera, [`ActionCamera::from_scene_camera`]): the eye sits `D` behind
+//! the focal plane through `c`, and `P x = D/z · ((x − c)·r, (x − c)·u)` with the depth
+//! `z = D + (x − c)·f`, so image units are world units on the focal plane. The default is the
+//! glTF front view (looking down −Z, +Y up) fitted to the character.
 
 use glam::{DVec2, DVec3};
 
@@ -14,7 +16,7 @@ use super::error::AnimateError;
 pub const DEFAULT_CAMERA_MARGIN: f64 = 0.15;
 
 /// An orthographic camera.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ActionCamera {
     /// Point the camera looks at (image origin).
     pub center: DVec3,
@@ -26,6 +28,9 @@ pub struct ActionCamera {
     pub up: DVec3,
     /// Half height of the view volume (world units); the width follows the image aspect.
     pub half_height: f64,
+    /// Perspective: distance `D` from the eye to the focal plane through `center` (`None` =
+    /// orthographic).
+    pub eye_distance: Option<f64>,
 }
 
 impl ActionCamera {
@@ -58,6 +63,73 @@ impl ActionCamera {
             right,
             up,
             half_height: (extent * (1.0 + DEFAULT_CAMERA_MARGIN)).max(1e-9),
+            eye_distance: None,
+        }
+    }
+
+    /// A scene camera (e.g. a glTF camera node) at its world matrix `world` (camera looks
+    /// down its local −Z, +Y up), with its focal plane through the point of the view axis
+    /// nearest `target` (the character's centre). Perspective cameras keep their
+    /// perspective; orthographic ones their half height.
+    pub fn from_scene_camera(
+        projection: &anim::Projection,
+        world: &glam::Mat4,
+        target: DVec3,
+    ) -> ActionCamera {
+        let m = world.as_dmat4();
+        let eye = m.w_axis.truncate();
+        let forward = (-m.z_axis.truncate())
+            .try_normalize()
+            .unwrap_or(DVec3::NEG_Z);
+        let right = forward
+            .cross(m.y_axis.truncate())
+            .try_normalize()
+            .unwrap_or_else(|| forward.any_orthonormal_vector());
+        let up = right.cross(forward);
+        let depth = (target - eye).dot(forward).max(1e-6);
+        let center = eye + forward * depth;
+        match *projection {
+            anim::Projection::Perspective { yfov, .. } => ActionCamera {
+                center,
+                forward,
+                right,
+                up,
+                half_height: depth * (0.5 * yfov as f64).tan(),
+                eye_distance: Some(depth),
+            },
+            anim::Projection::Orthographic { ymag, .. } => ActionCamera {
+                center,
+                forward,
+                right,
+                up,
+                half_height: (ymag as f64).abs().max(1e-9),
+                eye_distance: None,
+            },
+        }
+    }
+
+    /// `D / z` at `x`: image units per world unit across the view (1 for orthographic).
+    #[inline]
+    fn magnification(&self, x: DVec3) -> f64 {
+        match self.eye_distance {
+            None => 1.0,
+            Some(d) => d / (d + (x - self.center).dot(self.forward)).max(1e-9 * d),
+        }
+    }
+
+    /// The derivative of [`ActionCamera::project`] at `x` applied to a world-space direction
+    /// `v` (for orthographic cameras simply `(v·r, v·u)`).
+    #[inline]
+    pub fn project_direction(&self, x: DVec3, v: DVec3) -> DVec2 {
+        let flat = DVec2::new(v.dot(self.right), v.dot(self.up));
+        match self.eye_distance {
+            None => flat,
+            Some(d) => {
+                // p = s (a, b) with s = D / z: dp = s (v·r, v·u) − p (v·f) / z.
+                let s = self.magnification(x);
+                let z = d / s;
+                s * flat - self.project(x) * (v.dot(self.forward) / z)
+            }
         }
     }
 
@@ -65,7 +137,7 @@ impl ActionCamera {
     #[inline]
     pub fn project(&self, x: DVec3) -> DVec2 {
         let d = x - self.center;
-        DVec2::new(d.dot(self.right), d.dot(self.up))
+        self.magnification(x) * DVec2::new(d.dot(self.right), d.dot(self.up))
     }
 
     /// The world point on the plane through `center` facing the camera with image
@@ -77,7 +149,7 @@ impl ActionCamera {
 }
 
 /// The plane the motion happens in: bones turn about its normal, the root moves in it.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ActionPlane {
     /// Unit normal `n`.
     pub normal: DVec3,
@@ -104,7 +176,7 @@ impl ActionPlane {
 
 /// Maps the keystrokes' screen coordinates (x right, y down, any units) onto the camera's
 /// image plane: `image = origin + scale · (x − anchor.x, anchor.y − y)`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ScreenMap {
     /// Screen point mapped onto `origin`.
     pub anchor: DVec2,

@@ -67,6 +67,29 @@ pub enum AnimateError {
     /// The line of action has no frame. Provide keystrokes.
     #[error("the line of action has no frames")]
     EmptyLine,
+    /// The initial pose is not `rest` or `CLIP@FRAME` of an existing clip and frame.
+    #[error("initial pose '{pose}': expected {expected}")]
+    BadPose {
+        /// The pose as given.
+        pose: String,
+        /// What would be accepted.
+        expected: String,
+    },
+    /// No camera of that name; the message lists the scene's cameras.
+    #[error("no camera named '{name}' (cameras: {cameras})")]
+    UnknownCamera {
+        /// The requested name.
+        name: String,
+        /// The scene's camera names.
+        cameras: String,
+    },
+    /// The character's scene could not be sampled or turned into a skeletal animation.
+    #[error("the character's scene: {source}")]
+    Scene {
+        /// The data-model error.
+        #[source]
+        source: anim::AnimError,
+    },
     /// A numeric option is out of range.
     #[error("invalid {name} = {value}: {expected}")]
     InvalidParameter {

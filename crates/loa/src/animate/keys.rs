@@ -8,7 +8,7 @@ use super::bones::BoneSet;
 use super::error::AnimateError;
 
 /// Ω(t_k): the bone set constrained at keystroke frame `frame`.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct BoneSetKey {
     /// A keystroke frame.
     pub frame: i64,
@@ -38,7 +38,7 @@ impl FromStr for BoneSetKey {
 /// where the planar stage put it at that frame, and later keys hold the previous key's target
 /// (so two keys plant the joint for the whole range). The orientation target is the planar
 /// stage's orientation at the joint's first key.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ContactKey {
     /// Joint name.
     pub joint: String,
@@ -112,7 +112,7 @@ impl ContactKey {
 /// A twist key (Section 4.1, E_twist): joint `joint` turned by `angle` radians about its own
 /// bone axis relative to the planar solution. Angles interpolate linearly between a joint's
 /// keys and hold before the first and after the last.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TwistKey {
     /// Joint name.
     pub joint: String,

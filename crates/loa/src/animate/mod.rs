@@ -4,12 +4,13 @@
 //! * [`ActionCamera`] / [`ActionPlane`] / [`ScreenMap`]: the view `P` the line is drawn
 //!   through (default: orthographic front view fitted to the character), the plane the motion
 //!   happens in (default normal: the view direction), and where the keystrokes' screen
-//!   coordinates land on the image plane (default: the first keystroke's length is the first
-//!   bone set's length, arc-length midpoints aligned).
+//!   coordinates land on the image plane (default: one scale fitted so that every keystroke's
+//!   length matches its bone set's length, the first keystroke's arc-length midpoint on its
+//!   chain's midpoint).
 //! * [`BoneSet`] / [`Preset`]: at each keystroke, an ordered chain of bones mapped onto the
 //!   line by arc length; between keystrokes the common subset Ω(t) = Ω(t_k) ∩ Ω(t_k+1) is
 //!   constrained (its arc-length positions blend linearly), the rest follows smoothly.
-//! * [`animate`]: space-time matching over the whole clip — E_ẋ (Eq. 3) + w_x E_x + w_∂ E_∂ —
+//! * [`animate`]: space-time matching over the whole clip — E_ẋ (LoA Eq. 3) + w_x E_x + w_∂ E_∂ —
 //!   with per-bone angles about the plane normal and the root moving in the plane, on
 //!   Hermite-reduced degrees of freedom (2N − 1 nodes), by Levenberg–Marquardt with analytic
 //!   Jacobians; then, when twists or contacts are given, a second stage with full 3D bone
@@ -21,7 +22,7 @@
 //! use anim::{Joint, Skeleton, Transform};
 //! use glam::Vec3;
 //! use loa::animate::{animate, AnimateOptions, BoneSetKey, Character};
-//! use loa::{line_of_action, Keystrokes, LineOptions, Mode};
+//! use loa::{Keystrokes, LineOptions, Mode};
 //!
 //! // A 4-joint "spine" standing up along +Y.
 //! let joint = |name: &str, parent, y| Joint {
@@ -38,7 +39,7 @@
 //! let keys = Keystrokes::from_json_str(r#"{"keystrokes": [
 //!     {"frame": 0, "points": [[0, 0], [30, -40], [40, -90], [30, -140]]},
 //!     {"frame": 12, "points": [[0, 0], [30, -40], [40, -90], [30, -140]]}]}"#)?;
-//! let line = line_of_action(&keys, &LineOptions { mode: Mode::Hermite, ..Default::default() })?;
+//! let line = loa::line(&keys, &LineOptions { mode: Mode::Hermite, ..Default::default() })?;
 //! let sets = [BoneSetKey { frame: 0, set: "hips,head".parse()? }];
 //! let motion = animate(&character, &line.animation, &sets, &[], &[], &AnimateOptions::default())?;
 //! assert_eq!(motion.frames(), 13);
@@ -52,6 +53,7 @@ mod error;
 mod keys;
 mod reduction;
 mod rig;
+mod scene;
 mod solver;
 mod synthesis;
 mod targets;
@@ -63,6 +65,7 @@ pub use error::AnimateError;
 pub use keys::{BoneSetKey, ContactKey, TwistKey};
 pub use reduction::Reduction;
 pub use rig::ATTACH_TOLERANCE;
+pub use scene::{InitialPose, CLIP_NAME};
 pub use solver::{StageReport, DEFAULT_INITIAL_DAMPING, DEFAULT_TOLERANCE};
 
 use anim::{Skeleton, Transform};
@@ -76,12 +79,12 @@ use rig::Rig;
 pub const DEFAULT_POSITION_WEIGHT: f64 = 1.0;
 /// Default weight of E_∂ (projected bone directions along the line's tangent).
 pub const DEFAULT_TANGENT_WEIGHT: f64 = 0.5;
-/// Default weight of Eq. 3's rotation term for constrained bones (radians per frame).
+/// Default weight of LoA Eq. 3's rotation term for constrained bones (radians per frame).
 pub const DEFAULT_SMOOTHNESS_WEIGHT: f64 = 1.0;
 /// Fraction of the smoothness weight applied to unconstrained degrees of freedom, so that
 /// bones leaving Ω(t) keep moving smoothly instead of being free.
 pub const DEFAULT_FREE_SMOOTHNESS: f64 = 0.2;
-/// Default weight of Eq. 3's root velocity term (relative to the longest bone set's length).
+/// Default weight of LoA Eq. 3's root velocity term (relative to the longest bone set's length).
 pub const DEFAULT_ROOT_VELOCITY_WEIGHT: f64 = 0.2;
 /// Default weight of contact positions (relative to body height).
 pub const DEFAULT_CONTACT_POSITION_WEIGHT: f64 = 1e4;
@@ -92,21 +95,27 @@ pub const DEFAULT_TWIST_WEIGHT: f64 = 1.0;
 /// Default weight pulling the accumulated increments toward the initial pose (keeps
 /// redundant joints well-posed).
 pub const DEFAULT_REGULARIZATION: f64 = 1e-2;
-/// Default cap on accepted Levenberg–Marquardt iterations per stage.
-pub const DEFAULT_MAX_ITERATIONS: usize = 30;
+/// Default cap on accepted Levenberg–Marquardt iterations per stage: a safety net; the
+/// solver stops earlier, when an accepted step lowers the energy by less than
+/// [`DEFAULT_TOLERANCE`].
+pub const DEFAULT_MAX_ITERATIONS: usize = 200;
+/// Frames over which a contact eases in before its first key and out after its last: the
+/// target slides between the planar pose and the contact along a smoothstep.
+pub const DEFAULT_CONTACT_RELEASE: usize = 6;
 
 /// Weights of the energy terms.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Weights {
     /// `w_x` of E_x.
     pub position: f64,
     /// `w_∂` of E_∂.
     pub tangent: f64,
-    /// Eq. 3 rotation term, constrained bones.
+    /// LoA Eq. 3 rotation term, constrained bones.
     pub smoothness: f64,
     /// Factor on `smoothness` for unconstrained degrees of freedom.
     pub free_smoothness: f64,
-    /// Eq. 3 root velocity term.
+    /// LoA Eq. 3 root velocity term.
     pub root_velocity: f64,
     /// `w_x` of E_⊥ (contact positions).
     pub contact_position: f64,
@@ -134,9 +143,19 @@ impl Default for Weights {
     }
 }
 
-/// Options of [`animate`].
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+/// Options of [`crate::animate`] (and [`animate()`]): keyed inputs, view and solver settings.
+/// Serde-ready, so the same options come from CLI flags, a TOML/JSON file or Python keyword
+/// arguments; bone sets are written as on the command line (`"arms"`, `"FootR,Head"`).
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct AnimateOptions {
+    /// Ω(t_k) per keystroke frame; a keystroke without one keeps the previous keystroke's
+    /// set; the first defaults to [`Preset::RightLegSpineHead`].
+    pub bone_sets: Vec<BoneSetKey>,
+    /// Contact keys (Section 4.1, E_⊥); any contact or twist adds the 3D stage.
+    pub contacts: Vec<ContactKey>,
+    /// Twist keys (Section 4.1, E_twist).
+    pub twists: Vec<TwistKey>,
     /// Camera; default [`ActionCamera::front_fitted`] to the initial pose.
     pub camera: Option<ActionCamera>,
     /// Action-plane normal; default the camera's viewing direction.
@@ -189,6 +208,11 @@ impl Character {
     /// Joint names.
     pub fn joint_names(&self) -> &[String] {
         &self.rig.names
+    }
+
+    /// Skeleton parent of every joint.
+    pub fn parents(&self) -> &[Option<usize>] {
+        &self.rig.skeleton_parent
     }
 
     /// Joints re-parented for solving: `(joint, leaf it is attached to)`.
@@ -324,12 +348,11 @@ impl Motion {
 ///
 /// # Arguments
 /// * `character` – skeleton and initial pose (every frame starts from it).
-/// * `line` – the dynamic line of action (e.g. [`crate::line_of_action`]); one frame per
+/// * `line` – the dynamic line of action (e.g. [`crate::line()`]'s animation); one frame per
 ///   output frame, keystrokes at `line.keystroke_frames`.
-/// * `bone_sets` – Ω(t_k) per keystroke frame; a keystroke without one keeps the previous
-///   keystroke's set; the first defaults to [`Preset::RightLegSpineHead`].
-/// * `contacts`, `twists` – keyed 3D targets (see [`ContactKey`], [`TwistKey`]); when any is
-///   given a second, 3D stage runs.
+/// * `bone_sets`, `contacts`, `twists` – keyed inputs in addition to those in `options` (see
+///   [`AnimateOptions::bone_sets`], [`ContactKey`], [`TwistKey`]); when any contact or twist
+///   is given a second, 3D stage runs.
 ///
 /// # Errors
 /// Unknown joints or presets, keys outside the line's frames, a zero plane normal.
@@ -345,5 +368,8 @@ pub fn animate(
     twists: &[TwistKey],
     options: &AnimateOptions,
 ) -> Result<Motion, AnimateError> {
-    synthesis::run(character, line, bone_sets, contacts, twists, options)
+    let bone_sets = [options.bone_sets.as_slice(), bone_sets].concat();
+    let contacts = [options.contacts.as_slice(), contacts].concat();
+    let twists = [options.twists.as_slice(), twists].concat();
+    synthesis::run(character, line, &bone_sets, &contacts, &twists, options)
 }

@@ -57,7 +57,7 @@ pub(crate) struct WorldPose {
 
 impl WorldPose {
     /// Tip of a leaf joint's bone, or the joint position for joints without a tip.
-    pub fn tip(&self, rig: &Rig, j: usize) -> DVec3 {
+    pub(super) fn tip(&self, rig: &Rig, j: usize) -> DVec3 {
         match rig.leaf_tip[j] {
             Some(t) => self.position[j] + self.rotation[j] * (self.scale[j] * t),
             None => self.position[j],
@@ -72,7 +72,7 @@ fn dquat(q: glam::Quat) -> DQuat {
 impl Rig {
     /// Builds the rig from a skeleton and the local transforms of the initial pose (one per
     /// joint, relative to the skeleton parent).
-    pub fn new(skeleton: &Skeleton, pose: &[Transform]) -> Result<Rig, AnimateError> {
+    pub(super) fn new(skeleton: &Skeleton, pose: &[Transform]) -> Result<Rig, AnimateError> {
         let n = skeleton.len();
         if n == 0 {
             return Err(AnimateError::EmptySkeleton);
@@ -113,7 +113,7 @@ impl Rig {
     }
 
     /// Number of joints.
-    pub fn len(&self) -> usize {
+    pub(super) fn len(&self) -> usize {
         self.names.len()
     }
 
@@ -224,7 +224,7 @@ impl Rig {
     }
 
     /// Whether `a` is `b` or an ancestor of `b` in the kinematic tree.
-    pub fn is_ancestor(&self, a: usize, b: usize) -> bool {
+    pub(super) fn is_ancestor(&self, a: usize, b: usize) -> bool {
         let mut k = Some(b);
         while let Some(x) = k {
             if x == a {
@@ -236,7 +236,7 @@ impl Rig {
     }
 
     /// Path in the kinematic tree from `a` to `b` (both included).
-    pub fn path(&self, a: usize, b: usize) -> Vec<usize> {
+    pub(super) fn path(&self, a: usize, b: usize) -> Vec<usize> {
         let up = |mut k: usize| {
             let mut v = vec![k];
             while let Some(p) = self.parent[k] {
@@ -258,14 +258,14 @@ impl Rig {
 
     /// Forward kinematics of local `rotations` (one per joint) with `offset` added to every
     /// root's translation.
-    pub fn world(&self, rotations: &[DQuat], offset: DVec3) -> WorldPose {
+    pub(super) fn world(&self, rotations: &[DQuat], offset: DVec3) -> WorldPose {
         let mut w = WorldPose::default();
         self.world_into(rotations, offset, &mut w);
         w
     }
 
     /// [`Rig::world`] into reusable buffers.
-    pub fn world_into(&self, rotations: &[DQuat], offset: DVec3, w: &mut WorldPose) {
+    pub(super) fn world_into(&self, rotations: &[DQuat], offset: DVec3, w: &mut WorldPose) {
         let n = self.len();
         w.position.resize(n, DVec3::ZERO);
         w.rotation.resize(n, DQuat::IDENTITY);
@@ -288,7 +288,7 @@ impl Rig {
     }
 
     /// Rotation of the kinematic parent (identity for roots).
-    pub fn parent_rotation(&self, w: &WorldPose, k: usize) -> DQuat {
+    pub(super) fn parent_rotation(&self, w: &WorldPose, k: usize) -> DQuat {
         self.parent[k].map_or(DQuat::IDENTITY, |p| w.rotation[p])
     }
 }

@@ -4,7 +4,7 @@
 //! (rayon), folds them into small per-frame normal-equation blocks `JᵀJ`, maps the blocks onto
 //! the `(2N − 1) × columns` node unknowns through the reduction's basis weights (each frame
 //! touches at most four nodes, so the system is banded in node order), adds the pair terms of
-//! Eq. 3 between consecutive frames, and solves the damped system with a dense Cholesky
+//! LoA Eq. 3 between consecutive frames, and solves the damped system with a dense Cholesky
 //! factorization (faer; a few hundred unknowns). Accepted steps are folded into the pose
 //! (`q ← q'`, increments back to 0), as in the paper.
 
@@ -29,7 +29,7 @@ pub const DEFAULT_INITIAL_DAMPING: f64 = 1e-3;
 pub const DEFAULT_TOLERANCE: f64 = 1e-7;
 
 /// Largest rotation (radians) of any node in one step.
-pub const MAX_STEP_ANGLE: f64 = 0.35;
+pub(super) const MAX_STEP_ANGLE: f64 = 0.35;
 
 /// Pose of every frame: local rotations (frames × joints) and the root offset per frame.
 #[derive(Debug, Clone)]
@@ -40,15 +40,15 @@ pub(crate) struct Poses {
 }
 
 impl Poses {
-    pub fn frames(&self) -> usize {
+    pub(super) fn frames(&self) -> usize {
         self.offsets.len()
     }
 
-    pub fn frame(&self, f: usize) -> &[DQuat] {
+    pub(super) fn frame(&self, f: usize) -> &[DQuat] {
         &self.rotations[f * self.joints..(f + 1) * self.joints]
     }
 
-    pub fn worlds(&self, rig: &Rig) -> Vec<WorldPose> {
+    pub(super) fn worlds(&self, rig: &Rig) -> Vec<WorldPose> {
         (0..self.frames())
             .into_par_iter()
             .map(|f| rig.world(self.frame(f), self.offsets[f]))
@@ -57,7 +57,7 @@ impl Poses {
 }
 
 /// What one stage did.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
 pub struct StageReport {
     /// Unknowns (nodes × degrees of freedom per frame).
     pub unknowns: usize,
@@ -96,24 +96,27 @@ impl Stage<'_> {
         let (rig, cam, cols) = (self.rig, self.camera, &self.cols);
         let sx = self.weights.position.sqrt() / self.ref_length;
         for p in &t.points {
-            let r = cam.project(point_position(rig, w, p.point)) - p.target;
+            let x = point_position(rig, w, p.point);
+            let r = cam.project(x) - p.target;
             if jac {
                 s.j3.clear();
                 point_jacobian(rig, cols, w, p.point, 1.0, &mut s.j3);
-                project_jacobian(cam, &s.j3, &mut s.j2);
+                project_jacobian(cam, x, &s.j3, &mut s.j2);
             }
             add(b, &s.j2, r, sx, jac);
         }
         let st = self.weights.tangent.sqrt();
         for g in &t.segments {
-            let d = point_position(rig, w, g.b) - point_position(rig, w, g.a);
-            let pd = glam::DVec2::new(d.dot(cam.right), d.dot(cam.up));
-            let r = pd * g.inv_length - g.tangent;
+            let (pa, pb) = (point_position(rig, w, g.a), point_position(rig, w, g.b));
+            // The segment's direction projected at its midpoint (exact for orthographic
+            // cameras; the local perspective scale otherwise).
+            let mid = 0.5 * (pa + pb);
+            let r = cam.project_direction(mid, pb - pa) * g.inv_length - g.tangent;
             if jac {
                 s.j3.clear();
                 point_jacobian(rig, cols, w, g.b, g.inv_length, &mut s.j3);
                 point_jacobian(rig, cols, w, g.a, -g.inv_length, &mut s.j3);
-                project_jacobian(cam, &s.j3, &mut s.j2);
+                project_jacobian(cam, mid, &s.j3, &mut s.j2);
             }
             add(b, &s.j2, r, st, jac);
         }
@@ -137,7 +140,7 @@ impl Stage<'_> {
         }
     }
 
-    /// Eq. 3 between frames `i` and `i + 1`, plus a weak smoothness of the unconstrained
+    /// LoA Eq. 3 between frames `i` and `i + 1`, plus a weak smoothness of the unconstrained
     /// degrees of freedom; adds to the global system when `h` is given. Returns the energy.
     fn pair_terms(
         &self,
@@ -299,7 +302,7 @@ impl Stage<'_> {
     }
 
     /// Runs Levenberg–Marquardt from `poses` for at most `max_iterations` accepted steps.
-    pub fn solve(&self, poses: &mut Poses, max_iterations: usize) -> StageReport {
+    pub(super) fn solve(&self, poses: &mut Poses, max_iterations: usize) -> StageReport {
         let nc = self.cols.len();
         let nodes = self.reduction.nodes();
         let n = nodes * nc;

@@ -10,13 +10,17 @@ use super::error::AnimateError;
 use super::keys::{BoneSetKey, ContactKey, TwistKey};
 use super::reduction::Reduction;
 use super::rig::{Rig, WorldPose};
-use super::solver::{Poses, Stage};
+use super::solver::{Poses, Stage, StageReport};
 use super::targets::{
     image_lines, line_targets, twist_target, ContactTarget, FrameTargets, ImageLine, KeyChain,
     OrientTarget,
 };
 use super::terms::{log, point_position, Columns};
-use super::{AnimateOptions, AnimateReport, Character, Motion, DEFAULT_MAX_ITERATIONS};
+use super::{
+    AnimateOptions, AnimateReport, Character, Motion, DEFAULT_CONTACT_RELEASE,
+    DEFAULT_MAX_ITERATIONS,
+};
+use crate::retarget::Blend;
 use crate::Animation;
 
 fn joint_index(rig: &Rig, name: &str) -> Result<usize, AnimateError> {
@@ -58,15 +62,27 @@ fn key_sets(line: &Animation, sets: &[BoneSetKey]) -> Result<Vec<BoneSet>, Anima
         .collect())
 }
 
-/// Default screen map: the first keystroke's line length equals the first chain's length and
-/// their arc-length midpoints coincide.
-fn fit_screen(line: &Animation, key0: usize, chain: &KeyChain, image: &[DVec2]) -> ScreenMap {
-    let screen = ImageLine::new(line.frames[key0].chain.joints());
-    let scale = if screen.length() > 0.0 && chain.length > 0.0 {
-        chain.length / screen.length()
-    } else {
-        1.0
-    };
+/// Default screen map: one scale for all keystrokes, fitted by least squares so that every
+/// keystroke's line length matches its bone set's length (`s = Σ C_k S_k / Σ S_k²` over the
+/// keystrokes' screen lengths `S_k` and chain lengths `C_k`); the first keystroke's arc-length
+/// midpoint lands on its chain's midpoint.
+fn fit_screen(
+    line: &Animation,
+    key_offsets: &[usize],
+    keys: &[KeyChain],
+    image: &[DVec2],
+) -> ScreenMap {
+    let (mut cs, mut ss) = (0.0, 0.0);
+    for (&k, chain) in key_offsets.iter().zip(keys) {
+        let screen = ImageLine::new(line.frames[k].chain.joints()).length();
+        if screen > 0.0 && chain.length > 0.0 {
+            cs += chain.length * screen;
+            ss += screen * screen;
+        }
+    }
+    let scale = if ss > 0.0 { cs / ss } else { 1.0 };
+    let chain = &keys[0];
+    let screen = ImageLine::new(line.frames[key_offsets[0]].chain.joints());
     // The chain's midpoint by 3D arc length.
     let k = chain
         .u
@@ -153,7 +169,7 @@ pub(crate) fn run(
             .iter()
             .map(|&p| camera.project(point_position(rig, &initial, p)))
             .collect();
-        fit_screen(line, key_offsets[0], &keys[0], &image)
+        fit_screen(line, &key_offsets, &keys, &image)
     });
     let lines = image_lines(line, &screen);
     let mut targets: Vec<FrameTargets> = vec![FrameTargets::default(); frames];
@@ -171,15 +187,17 @@ pub(crate) fn run(
     }
     // The turn joint of a chain (pelvis, chest) carries a sideways branch connector: turning
     // it, or any of its ancestors, swaps the connector's side — a discrete flip the solver
-    // would otherwise take mid-clip, the children counter-rotating. The turn joint and its
-    // ancestors therefore keep their initial orientation; the limbs and the spine hanging
-    // from it turn, and the root translates.
+    // takes mid-clip (the children counter-rotating) when it starts from the initial pose.
+    // Continuation: solve first with the turn joints and their ancestors at their initial
+    // orientation (limbs and spine turn, the root translates), then free them, starting from
+    // that solution, so the pelvis turns and translates too without flipping.
+    let mut held = dof.clone();
     for k in &keys {
         for (i, c) in k.connector.iter().enumerate() {
             if let (true, Some(&ChainPoint::Joint(turn))) = (*c, k.points.get(i + 1)) {
                 let mut a = Some(turn);
                 while let Some(x) = a {
-                    dof[x] = false;
+                    held[x] = false;
                     a = rig.parent[x];
                 }
             }
@@ -192,21 +210,31 @@ pub(crate) fn run(
             .collect(),
         offsets: vec![DVec3::ZERO; frames],
     };
-    let stage = Stage {
+    let planar_stage = |dof: &[bool]| Stage {
         rig,
         camera: &camera,
-        cols: Columns::new(rig, &dof, &[plane.normal], &[plane.u, plane.v]),
+        cols: Columns::new(rig, dof, &[plane.normal], &[plane.u, plane.v]),
         targets: &targets,
         reduction: &reduction,
         weights,
         ref_length,
         height,
     };
-    let planar = stage.solve(&mut poses, max_iterations);
+    let mut planar = planar_stage(&held).solve(&mut poses, max_iterations);
+    if held != dof {
+        let free = planar_stage(&dof).solve(&mut poses, max_iterations);
+        planar = StageReport {
+            unknowns: free.unknowns,
+            iterations: planar.iterations + free.iterations,
+            initial_energy: planar.initial_energy,
+            final_energy: free.final_energy,
+        };
+    }
 
     // 3D stage (Section 4.1).
     let mut spatial = None;
     let mut contact_targets: Vec<Vec<ContactTarget>> = vec![Vec::new(); frames];
+    let mut easing: Vec<Vec<ContactTarget>> = vec![Vec::new(); frames];
     if !contacts.is_empty() || !twists.is_empty() {
         let worlds = poses.worlds(rig);
         let frame_index = |what: &'static str, f: i64| -> Result<usize, AnimateError> {
@@ -257,6 +285,31 @@ pub(crate) fn run(
                     });
                 }
             }
+            // Ease in and out over DEFAULT_CONTACT_RELEASE frames: the target slides from the
+            // planar stage's pose onto the contact before its first key and back after its
+            // last, so the limb does not snap free.
+            let (first_key, last_key) = (resolved[0], resolved[resolved.len() - 1]);
+            for i in 1..=DEFAULT_CONTACT_RELEASE {
+                let w =
+                    1.0 - Blend::Smoothstep.weight(i as f64 / (DEFAULT_CONTACT_RELEASE + 1) as f64);
+                for (f, held) in [
+                    (first_key.0.checked_sub(i), first_key.1),
+                    (Some(last_key.0 + i), last_key.1),
+                ] {
+                    let Some(f) = f.filter(|&f| f < frames) else {
+                        continue;
+                    };
+                    if contact_targets[f].iter().any(|c| c.joint == j) {
+                        continue;
+                    }
+                    let free = &worlds[f];
+                    easing[f].push(ContactTarget {
+                        joint: j,
+                        position: free.position[j].lerp(held, w),
+                        rotation: free.rotation[j].slerp(rotation, w),
+                    });
+                }
+            }
         }
         let mut twist_by_joint: BTreeMap<usize, Vec<(usize, f64)>> = BTreeMap::new();
         for t in twists {
@@ -269,6 +322,7 @@ pub(crate) fn run(
         let mut targets3 = targets.clone();
         for (f, t) in targets3.iter_mut().enumerate() {
             t.contacts = contact_targets[f].clone();
+            t.contacts.extend_from_slice(&easing[f]);
             for (&j, ks) in &twist_by_joint {
                 let angle = piecewise_linear(ks, f);
                 t.twists.push(OrientTarget {

@@ -48,7 +48,7 @@ pub(crate) struct ContactTarget {
 pub(crate) struct FrameTargets {
     pub points: Vec<PointTarget>,
     pub segments: Vec<SegmentTarget>,
-    /// Bones in Ω(t) (the joint rotating each constrained segment), for Eq. 3.
+    /// Bones in Ω(t) (the joint rotating each constrained segment), for LoA Eq. 3.
     pub bones: Vec<usize>,
     pub twists: Vec<OrientTarget>,
     pub contacts: Vec<ContactTarget>,
@@ -64,7 +64,7 @@ pub(crate) struct ImageLine {
 }
 
 impl ImageLine {
-    pub fn new(points: Vec<DVec2>) -> ImageLine {
+    pub(super) fn new(points: Vec<DVec2>) -> ImageLine {
         let mut cumulative = Vec::with_capacity(points.len());
         let mut s = 0.0;
         for (i, p) in points.iter().enumerate() {
@@ -76,12 +76,12 @@ impl ImageLine {
         ImageLine { points, cumulative }
     }
 
-    pub fn length(&self) -> f64 {
+    pub(super) fn length(&self) -> f64 {
         self.cumulative.last().copied().unwrap_or(0.0)
     }
 
     /// The point at normalized arc length `u ∈ [0, 1]`.
-    pub fn at(&self, u: f64) -> DVec2 {
+    pub(super) fn at(&self, u: f64) -> DVec2 {
         let total = self.length();
         if self.points.is_empty() {
             return DVec2::ZERO;
@@ -124,7 +124,7 @@ pub(crate) struct KeyChain {
 }
 
 impl KeyChain {
-    pub fn new(rig: &Rig, w: &WorldPose, chain: &Chain3) -> KeyChain {
+    pub(super) fn new(rig: &Rig, w: &WorldPose, chain: &Chain3) -> KeyChain {
         let points = chain.points();
         let pos: Vec<DVec3> = points.iter().map(|&p| point_position(rig, w, p)).collect();
         let seg_length: Vec<f64> = pos.windows(2).map(|s| (s[1] - s[0]).length()).collect();

@@ -1,5 +1,5 @@
 //! Residuals and analytic Jacobians of the energy terms, per frame (E_x, E_∂, E_twist, E_⊥)
-//! and per pair of consecutive frames (E_ẋ, Eq. 3).
+//! and per pair of consecutive frames (E_ẋ, LoA Eq. 3).
 //!
 //! Degrees of freedom are *increments* on the current pose (the paper's scheme: solve, then
 //! set `q_j ← q'_j` and the angles back to 0): a rotation column `(a, w)` turns joint `a`'s
@@ -38,7 +38,12 @@ pub(crate) struct Columns {
 }
 
 impl Columns {
-    pub fn new(rig: &Rig, dof_joints: &[bool], axes: &[DVec3], translations: &[DVec3]) -> Self {
+    pub(super) fn new(
+        rig: &Rig,
+        dof_joints: &[bool],
+        axes: &[DVec3],
+        translations: &[DVec3],
+    ) -> Self {
         let mut dofs = Vec::new();
         let mut joint_cols = vec![(0, 0); rig.len()];
         for j in 0..rig.len() {
@@ -51,7 +56,7 @@ impl Columns {
         Columns { dofs, joint_cols }
     }
 
-    pub fn len(&self) -> usize {
+    pub(super) fn len(&self) -> usize {
         self.dofs.len()
     }
 }
@@ -106,7 +111,7 @@ pub(crate) struct Block {
 }
 
 impl Block {
-    pub fn new(n: usize) -> Block {
+    pub(super) fn new(n: usize) -> Block {
         Block {
             n,
             h: vec![0.0; n * n],
@@ -115,7 +120,7 @@ impl Block {
         }
     }
 
-    pub fn clear(&mut self) {
+    pub(super) fn clear(&mut self) {
         self.h.iter_mut().for_each(|x| *x = 0.0);
         self.g.iter_mut().for_each(|x| *x = 0.0);
         self.cost = 0.0;
@@ -130,12 +135,12 @@ pub(crate) struct SparseJ<V> {
 }
 
 impl<V: Copy + std::ops::AddAssign> SparseJ<V> {
-    pub fn clear(&mut self) {
+    pub(super) fn clear(&mut self) {
         self.cols.clear();
         self.d.clear();
     }
 
-    pub fn add(&mut self, col: usize, d: V) {
+    pub(super) fn add(&mut self, col: usize, d: V) {
         if let Some(i) = self.cols.iter().position(|&c| c == col) {
             self.d[i] += d;
         } else {
@@ -218,18 +223,17 @@ pub(crate) fn point_jacobian(
     }
 }
 
-/// Projects world-space derivatives through the camera.
+/// Projects world-space derivatives at the world point `at` through the camera.
 pub(crate) fn project_jacobian(
     camera: &ActionCamera,
+    at: DVec3,
     j: &SparseJ<DVec3>,
     out: &mut SparseJ<DVec2>,
 ) {
     out.clear();
     out.cols.extend_from_slice(&j.cols);
-    out.d.extend(
-        j.d.iter()
-            .map(|d| DVec2::new(d.dot(camera.right), d.dot(camera.up))),
-    );
+    out.d
+        .extend(j.d.iter().map(|d| camera.project_direction(at, *d)));
 }
 
 /// Residual `log(Q_j⁻¹ target)` of a world orientation target, and its Jacobian.

@@ -1,0 +1,282 @@
+//! `toonkit loa animate CHARACTER KEYS.json -o OUT.glb|OUT.bvh [--bones SET@FRAME]...
+//! [--plane-normal x,y,z] [--contact JOINT@FRAME[:x,y,z]|JOINT@A..B]...
+//! [--twist JOINT@FRAME:DEGREES]... [--pose rest|CLIP@FRAME] [--bvh OUT.bvh]
+//! [--render OUT.gif|OUT.png]`.
+//!
+//! The output format follows `-o`'s extension: `.glb` writes the character (skinned meshes,
+//! skeleton) with the synthesized clip `loa` as its only animation; `.bvh` writes the
+//! skeleton and motion as BVH. `--bvh` writes a BVH in addition to a `.glb`.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anim::glam::{DVec3, Vec3};
+use anyhow::{bail, Context as _, Result};
+use clap::Args;
+use loa::animate::{ActionCamera, AnimateOptions, Character, ContactKey, InitialPose, Motion};
+use serde_json::json;
+
+use super::{extension, read_keystrokes, warn, Context, LineFlags};
+
+/// Arguments of `toonkit loa animate`.
+#[derive(Debug, Args)]
+pub struct AnimateArgs {
+    /// The character: a skinned glTF/GLB or a BVH skeleton.
+    pub character: PathBuf,
+    /// Keystrokes (JSON or SVG, as for `loa line`), drawn in the front view from the bone
+    /// set's first bone (feet for leg presets) to its last.
+    pub keys: PathBuf,
+    /// Output: `.glb` (character + clip `loa`) or `.bvh`.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Also write a BVH of the motion.
+    #[arg(long)]
+    pub bvh: Option<PathBuf>,
+    /// Bone set at a keystroke frame: a preset (right-leg-spine-head, left-leg-spine-head,
+    /// arm-spine, left-arm-spine, arms, legs, full-body) or comma-separated joint names, then
+    /// `@FRAME`. Repeat for changing sets.
+    #[arg(long = "bones")]
+    pub bones: Vec<String>,
+    /// Action-plane normal `x,y,z` (default: the view direction).
+    #[arg(long, allow_hyphen_values = true)]
+    pub plane_normal: Option<String>,
+    /// Contact: `JOINT@FRAME` (hold where it is), `JOINT@FRAME:x,y,z`, or `JOINT@A..B`.
+    #[arg(long = "contact")]
+    pub contacts: Vec<String>,
+    /// Twist: `JOINT@FRAME:DEGREES` about the bone's own axis.
+    #[arg(long = "twist", allow_hyphen_values = true)]
+    pub twists: Vec<String>,
+    /// Initial pose: `rest`, or `CLIP@FRAME` (a frame of one of the file's clips).
+    #[arg(long, default_value = "rest")]
+    pub pose: String,
+    /// Cap on solver iterations per stage.
+    #[arg(long, default_value_t = loa::animate::DEFAULT_MAX_ITERATIONS)]
+    pub iterations: usize,
+    /// The camera the keystrokes are drawn through: a camera node of the character's file
+    /// (perspective allowed; default an orthographic front view fitted to the character).
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// Preview: `.gif` (every frame) or `.png` (first frame), the character with the line, in
+    /// a view that follows the character (or through `--camera`).
+    #[arg(long)]
+    pub render: Option<PathBuf>,
+    #[command(flatten)]
+    pub line: LineFlags,
+}
+
+fn parse_vec3(s: &str) -> Result<DVec3> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("--plane-normal {s}: expected x,y,z"))?;
+    if v.len() != 3 {
+        bail!("--plane-normal {s}: expected three numbers x,y,z");
+    }
+    Ok(DVec3::new(v[0], v[1], v[2]))
+}
+
+/// Checks the output paths' extensions before any work.
+fn check_outputs(args: &AnimateArgs) -> Result<()> {
+    let known = |p: &Path, exts: &[&str], what: &str| -> Result<()> {
+        if exts.contains(&extension(p).as_str()) {
+            return Ok(());
+        }
+        bail!(
+            "{}: unknown {what} extension (use {})",
+            p.display(),
+            exts.join(" or ")
+        )
+    };
+    known(&args.output, &["glb", "bvh"], "output")?;
+    if let Some(b) = &args.bvh {
+        known(b, &["bvh"], "--bvh")?;
+    }
+    if let Some(r) = &args.render {
+        known(r, &["gif", "png"], "render")?;
+    }
+    Ok(())
+}
+
+/// The library options from the flags.
+fn options(args: &AnimateArgs) -> Result<AnimateOptions> {
+    let bone_sets = args
+        .bones
+        .iter()
+        .map(|b| b.parse().with_context(|| format!("--bones {b}")))
+        .collect::<Result<_>>()?;
+    let mut contacts = Vec::new();
+    for c in &args.contacts {
+        contacts.extend(ContactKey::parse_all(c).with_context(|| format!("--contact {c}"))?);
+    }
+    let twists = args
+        .twists
+        .iter()
+        .map(|t| t.parse().with_context(|| format!("--twist {t}")))
+        .collect::<Result<_>>()?;
+    Ok(AnimateOptions {
+        bone_sets,
+        contacts,
+        twists,
+        plane_normal: args.plane_normal.as_deref().map(parse_vec3).transpose()?,
+        max_iterations: args.iterations,
+        ..Default::default()
+    })
+}
+
+/// Runs `toonkit loa animate`.
+pub fn run(ctx: &Context, args: AnimateArgs) -> Result<()> {
+    let start = Instant::now();
+    check_outputs(&args)?;
+    let mut options = options(&args)?;
+    let pose: InitialPose = args
+        .pose
+        .parse()
+        .with_context(|| format!("--pose {}", args.pose))?;
+    let keys = read_keystrokes(&args.keys)?;
+    let line_options = args.line.options(&keys)?;
+    let fps = line_options.physics.fps;
+
+    let spinner = crate::progress::spinner("synthesizing motion", ctx.json);
+    let cpath = args.character.display().to_string();
+    let load = tkio::LoadOptions {
+        fps: fps as f32,
+        rest: None,
+    };
+    let tkio::Loaded::Scene(scene) =
+        tkio::load(&args.character, &load).with_context(|| cpath.clone())?
+    else {
+        bail!("{cpath}: not a character (use a skinned glTF/GLB or a BVH file)");
+    };
+    let character = Character::from_scene(&scene, &pose, fps).with_context(|| cpath.clone())?;
+    let scene_camera = match &args.camera {
+        Some(name) => {
+            let (action, camera) = ActionCamera::from_scene(&scene, name, &character, fps)
+                .with_context(|| format!("{cpath}: --camera {name}"))?;
+            options.camera = Some(action);
+            Some(camera)
+        }
+        None => None,
+    };
+    let line = loa::line(&keys, &line_options).with_context(|| args.keys.display().to_string())?;
+    warn(&line, &args.keys);
+    let solve_start = Instant::now();
+    let motion = loa::animate(&character, &line, &options)
+        .with_context(|| format!("{cpath} with {}", args.keys.display()))?;
+    let solve_seconds = solve_start.elapsed().as_secs_f64();
+
+    let out_scene = motion.to_scene(&scene);
+    let (skeleton, _) = scene.skeleton();
+    let bvh = || -> Result<String> {
+        let skeletal = motion
+            .skeletal_animation(&skeleton)
+            .with_context(|| cpath.clone())?;
+        Ok(tkio::bvh::write(&skeleton, &skeletal)?)
+    };
+    if extension(&args.output) == "bvh" {
+        tkio::save(&args.output, &tkio::Output::Text(&bvh()?))?;
+    } else {
+        let bytes =
+            tkio::gltf::write_glb(&out_scene).with_context(|| args.output.display().to_string())?;
+        tkio::save(&args.output, &tkio::Output::Bytes(&bytes))?;
+    }
+    if let Some(b) = &args.bvh {
+        tkio::save(b, &tkio::Output::Text(&bvh()?))?;
+    }
+    if let Some(r) = &args.render {
+        let gif = extension(r) == "gif";
+        let bytes = render_motion(&out_scene, &motion, &skeleton, scene_camera.as_ref(), gif)
+            .with_context(|| r.display().to_string())?;
+        tkio::save(r, &tkio::Output::Bytes(&bytes))?;
+    }
+    spinner.finish_and_clear();
+
+    let rep = &motion.report;
+    let seconds = start.elapsed().as_secs_f64();
+    let names = character.joint_names();
+    let summary = json!({
+        "output": args.output.display().to_string(),
+        "frames": motion.frames(),
+        "fps": fps,
+        "joints": motion.joints,
+        "keystroke_frames": line.animation.keystroke_frames,
+        "warnings": line.warnings,
+        "attachments": character.attachments().iter()
+            .map(|&(j, p)| format!("{}->{}", names[j], names[p])).collect::<Vec<_>>(),
+        "planar": rep.planar,
+        "spatial": rep.spatial,
+        "line_distance_mean_percent": 100.0 * rep.line_distance_mean,
+        "line_distance_max_percent": 100.0 * rep.line_distance_max,
+        "max_rotation_step_degrees": rep.max_rotation_step.to_degrees(),
+        "contact_error_max_percent": 100.0 * rep.contact_error_max,
+        "solve_seconds": solve_seconds,
+        "seconds": seconds,
+    });
+    ctx.report(&summary, || {
+        format!(
+            "{}: {} frames, {} joints; line distance {:.2} % (max {:.2} %), max joint step {:.1}°{} \
+             in {:.0} ms (solve {:.0} ms)",
+            args.output.display(),
+            motion.frames(),
+            motion.joints,
+            100.0 * rep.line_distance_mean,
+            100.0 * rep.line_distance_max,
+            rep.max_rotation_step.to_degrees(),
+            if options.contacts.is_empty() {
+                String::new()
+            } else {
+                format!(", contact error {:.2} % of height", 100.0 * rep.contact_error_max)
+            },
+            seconds * 1e3,
+            solve_seconds * 1e3
+        )
+    });
+    Ok(())
+}
+
+/// The preview: the character's meshes sampled from the written clip, its bones, the line
+/// and the constrained joints, through a view that follows the character.
+fn render_motion(
+    scene: &anim::Scene,
+    motion: &Motion,
+    skeleton: &anim::Skeleton,
+    camera: Option<&anim::Camera>,
+    gif: bool,
+) -> Result<Vec<u8>> {
+    let sampled = anim::sample(
+        scene,
+        &anim::SampleOptions {
+            fps: motion.fps as f32,
+            clip: Some(0),
+            meshes: Vec::new(),
+        },
+    )?;
+    let meshes: Vec<&anim::MeshAnimation> = sampled.objects.iter().map(|o| &o.animation).collect();
+    let positions: Vec<Vec3> = motion.positions.iter().map(|p| p.as_vec3()).collect();
+    let bones: Vec<(usize, usize)> = skeleton
+        .joints
+        .iter()
+        .enumerate()
+        .filter_map(|(k, j)| j.parent.map(|p| (p, k)))
+        .collect();
+    let lines: Vec<Vec<Vec3>> = (0..motion.frames())
+        .map(|f| motion.line_world(f).iter().map(|p| p.as_vec3()).collect())
+        .collect();
+    let cam = &motion.camera;
+    let preview = render::RigPreview {
+        meshes: &meshes,
+        joints: motion.joints,
+        positions: &positions,
+        bones: &bones,
+        lines: &lines,
+        marked: &motion.constrained,
+        fps: motion.fps as f32,
+    };
+    let axes = render::ViewAxes {
+        right: cam.right.as_vec3(),
+        up: cam.up.as_vec3(),
+        forward: cam.forward.as_vec3(),
+    };
+    let view = camera.map_or(render::RigView::Follow(axes), render::RigView::Camera);
+    Ok(render::rig_preview(&preview, view, gif)?)
+}

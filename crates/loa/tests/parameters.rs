@@ -1,0 +1,284 @@
+//! Issue 20 acceptance, the line: parameters that do what an animator expects (timing stays
+//! the animator's, stiffness = speed toward the next pose + wobble frequency, damping =
+//! overshoot, never strobing), settles and moving holds — measured on `examples/loa/`.
+
+mod common;
+
+use common::{example, with_params};
+use glam::DVec2;
+use loa::{Animation, Keystrokes, LineOptions, PhysicsOptions};
+
+/// Documented ranges (crate docs, "Parameters").
+const STIFFNESS_RANGE: [f64; 2] = [5.0, 1000.0];
+const DAMPING_RANGE: [f64; 2] = [0.05, 2.0];
+
+fn physics_line(keys: &Keystrokes, settle: u32) -> loa::Line {
+    let options = LineOptions {
+        physics: PhysicsOptions {
+            settle,
+            fps: keys.fps().unwrap_or(24.0),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    loa::line(keys, &options).unwrap()
+}
+
+fn points(a: &Animation, frame: i64) -> Vec<DVec2> {
+    a.chain_at(frame).unwrap().joints()
+}
+
+/// Progress of the line from keystroke `k0` toward `k1` at `frame`, projected on the
+/// key-to-key displacement of every chain point: −1 on `k0`, 0 on `k1`, > 0 past `k1`.
+fn progress(a: &Animation, k0: i64, k1: i64, frame: i64) -> f64 {
+    let (p0, p1, p) = (points(a, k0), points(a, k1), points(a, frame));
+    let (mut num, mut den) = (0.0, 0.0);
+    for ((a0, a1), x) in p0.iter().zip(&p1).zip(&p) {
+        let d = *a1 - *a0;
+        num += (*x - *a1).dot(d);
+        den += d.length_squared();
+    }
+    num / den
+}
+
+/// Largest overshoot past the next keystroke over every interval.
+fn overshoot(a: &Animation) -> f64 {
+    let k = &a.keystroke_frames;
+    k.windows(2)
+        .flat_map(|w| (w[0] + 1..w[1]).map(move |f| (w[0], w[1], f)))
+        .map(|(k0, k1, f)| progress(a, k0, k1, f))
+        .fold(0.0, f64::max)
+}
+
+/// Fractional frames after the first keystroke until the line has covered 90 % of the way
+/// to the second.
+fn arrival(a: &Animation) -> f64 {
+    let (k0, k1) = (a.keystroke_frames[0], a.keystroke_frames[1]);
+    let mut prev = -1.0;
+    for f in k0 + 1..=k1 {
+        let s = progress(a, k0, k1, f);
+        if s >= -0.1 {
+            return (f - 1 - k0) as f64 + (-0.1 - prev) / (s - prev);
+        }
+        prev = s;
+    }
+    (k1 - k0) as f64
+}
+
+/// Wobble frequency (Hz) in the settle tail: zero crossings of the root element's direction
+/// relative to the last keystroke.
+fn settle_frequency(a: &Animation) -> f64 {
+    let last = *a.keystroke_frames.last().unwrap();
+    let r = a.frames[0].chain.root_index();
+    let key = a.chain_at(last).unwrap().directions()[r];
+    let e: Vec<f64> = a
+        .frames
+        .iter()
+        .filter(|f| f.frame >= last)
+        .map(|f| f.chain.directions()[r] - key)
+        .collect();
+    let crossings: Vec<f64> = e
+        .windows(2)
+        .enumerate()
+        .skip(1)
+        .filter(|(_, w)| w[0] * w[1] < 0.0)
+        .map(|(i, w)| i as f64 + w[0] / (w[0] - w[1]))
+        .collect();
+    assert!(crossings.len() >= 2, "no wobble to measure: {crossings:?}");
+    let span = crossings[crossings.len() - 1] - crossings[0];
+    (crossings.len() - 1) as f64 / (2.0 * span) * a.fps
+}
+
+/// Largest per-frame motion of any chain point over the line's length.
+fn max_jump(a: &Animation) -> f64 {
+    a.frames
+        .windows(2)
+        .map(|w| {
+            let length = w[0].chain.total_length().max(w[1].chain.total_length());
+            let (p, q) = (w[0].chain.joints(), w[1].chain.joints());
+            p.iter()
+                .zip(&q)
+                .map(|(a, b)| (*a - *b).length())
+                .fold(0.0, f64::max)
+                / length
+        })
+        .fold(0.0, f64::max)
+}
+
+fn strictly_increasing(v: &[f64]) -> bool {
+    v.windows(2).all(|w| w[1] > w[0])
+}
+
+#[test]
+fn keystrokes_stay_at_their_frames_for_every_setting() {
+    let whip = example("whip.json");
+    for k in [5.0, 60.0, 1000.0] {
+        for z in [0.05, 0.35, 2.0] {
+            let line = physics_line(&with_params(&whip, Some(k), Some(z)), 0);
+            for key in &line.keys {
+                let c = line.animation.chain_at(key.frame).unwrap();
+                for (a, b) in c.joints().iter().zip(key.chain.joints()) {
+                    assert!((*a - b).length() < 1e-6, "k={k} ζ={z} frame {}", key.frame);
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn damping_sets_the_overshoot_monotonically() {
+    let whip = example("whip.json");
+    let values: Vec<f64> = [0.1, 0.25, 0.5, 1.0]
+        .iter()
+        .map(|&z| overshoot(&physics_line(&with_params(&whip, Some(120.0), Some(z)), 0).animation))
+        .collect();
+    println!(
+        "whip overshoot (fraction of the key-to-key motion) at ζ = 0.1, 0.25, 0.5, 1: {values:.3?}"
+    );
+    assert!(values.windows(2).all(|w| w[1] < w[0]), "{values:?}");
+    assert!(
+        values[0] > 0.05,
+        "low damping overshoots visibly: {values:?}"
+    );
+}
+
+#[test]
+fn stiffness_sets_arrival_and_wobble_frequency_monotonically() {
+    let whip = example("whip.json");
+    let ks = [15.0, 30.0, 60.0, 120.0];
+    let mut arrivals = Vec::new();
+    let mut frequencies = Vec::new();
+    for k in ks {
+        let line = physics_line(&with_params(&whip, Some(k), Some(0.15)), 96);
+        arrivals.push(arrival(&line.animation));
+        frequencies.push(settle_frequency(&line.animation));
+    }
+    println!(
+        "whip k = {ks:?}: arrival (frames) {arrivals:.2?}, settle frequency (Hz) {frequencies:.3?}"
+    );
+    let earlier: Vec<f64> = arrivals.iter().map(|a| -a).collect();
+    assert!(strictly_increasing(&earlier), "{arrivals:?}");
+    assert!(strictly_increasing(&frequencies), "{frequencies:?}");
+}
+
+#[test]
+fn no_setting_in_the_documented_ranges_strobes() {
+    let mut worst: (f64, &str, f64, f64) = (0.0, "", 0.0, 0.0);
+    for name in ["whip.json", "jump.json"] {
+        let keys = example(name);
+        for i in 0..=6 {
+            let k =
+                STIFFNESS_RANGE[0] * (STIFFNESS_RANGE[1] / STIFFNESS_RANGE[0]).powf(i as f64 / 6.0);
+            for z in [DAMPING_RANGE[0], 0.15, 0.35, 0.7, 1.0, DAMPING_RANGE[1]] {
+                let line = physics_line(&with_params(&keys, Some(k), Some(z)), 24);
+                let j = max_jump(&line.animation);
+                if j > worst.0 {
+                    worst = (j, name, k, z);
+                }
+            }
+        }
+    }
+    println!(
+        "largest per-frame motion: {:.1} % of the line length ({} k={:.0} ζ={})",
+        100.0 * worst.0,
+        worst.1,
+        worst.2,
+        worst.3
+    );
+    assert!(worst.0 <= 0.15, "{worst:?}");
+}
+
+#[test]
+fn a_repeated_keystroke_is_a_moving_hold_and_settle_ends_at_rest() {
+    // jump.json's first two strokes; the second repeated at frame 34 (a hold from 10 to 34).
+    let jump = example("jump.json");
+    let k = jump.keys();
+    let mut hold = k[1].clone();
+    hold.frame = 34;
+    let keys = Keystrokes::new(vec![k[0].clone(), k[1].clone(), hold], jump.fps()).unwrap();
+    let line = physics_line(&keys, 24);
+    let a = &line.animation;
+    let key = points(a, 10);
+    let length = a.chain_at(10).unwrap().total_length();
+    let deviation = |f: i64| {
+        points(a, f)
+            .iter()
+            .zip(&key)
+            .map(|(p, q)| (*p - *q).length())
+            .fold(0.0, f64::max)
+            / length
+    };
+    let swing = (11..34).map(deviation).fold(0.0, f64::max);
+    let before_end = deviation(33);
+    println!(
+        "hold 10..34: overshoot {:.1} % of the line length, deviation at frame 33 {:.3} %",
+        100.0 * swing,
+        100.0 * before_end
+    );
+    assert!(swing > 0.0);
+    assert!(before_end < 0.01);
+    // --settle 24: 24 more frames that end on the last keystroke, at rest.
+    assert_eq!(a.frames.len(), 35 + 24);
+    let last = a.frames.len() - 1;
+    let step = |i: usize| {
+        let (p, q) = (a.frames[i - 1].chain.joints(), a.frames[i].chain.joints());
+        p.iter()
+            .zip(&q)
+            .map(|(x, y)| (*x - *y).length())
+            .fold(0.0, f64::max)
+            / length
+    };
+    let end = a.frames[last].chain.joints();
+    assert!(end.iter().zip(&key).all(|(p, q)| (*p - *q).length() < 1e-9));
+    println!("settle: last step {:.2e} of the line length", step(last));
+    assert!(step(last) < 1e-3);
+    let settle_swing = (35..=last)
+        .map(|i| deviation(a.frames[i].frame))
+        .fold(0.0, f64::max);
+    println!(
+        "settle: swing {:.2} % of the line length",
+        100.0 * settle_swing
+    );
+}
+
+#[test]
+fn a_reversed_stroke_is_oriented_with_a_warning() {
+    let jump = example("jump.json");
+    let mut ks = jump.keys().to_vec();
+    ks[2].stroke = ks[2].stroke.reversed();
+    let flipped = Keystrokes::new(ks, jump.fps()).unwrap();
+    let a = physics_line(&jump, 0);
+    let b = physics_line(&flipped, 0);
+    assert_eq!(b.reversed, vec![22]);
+    assert_eq!(b.warnings.len(), 1);
+    assert!(b.warnings[0].contains("frame 22"), "{:?}", b.warnings);
+    assert!(a.warnings.is_empty());
+    // The same motion as the correctly drawn strokes.
+    for (x, y) in a.animation.frames.iter().zip(&b.animation.frames) {
+        for (p, q) in x.chain.joints().iter().zip(y.chain.joints()) {
+            assert!((*p - q).length() < 1e-6);
+        }
+    }
+}
+
+#[test]
+fn wobble_option_hits_the_line() {
+    let whip = example("whip.json");
+    let plain = physics_line(&whip, 0);
+    let options = LineOptions {
+        wobbles: vec!["20:1:0,-800".parse().unwrap()],
+        ..Default::default()
+    };
+    let wobbled = loa::line(&whip, &options).unwrap();
+    let d = (21..=40)
+        .map(|f| {
+            let (p, q) = (points(&plain.animation, f), points(&wobbled.animation, f));
+            p.iter()
+                .zip(&q)
+                .map(|(a, b)| (*a - *b).length())
+                .fold(0.0, f64::max)
+        })
+        .fold(0.0, f64::max);
+    assert!(d > 5.0, "{d}");
+    assert!("20:1.5:0,1".parse::<loa::Wobble>().is_err());
+}
