@@ -14,6 +14,7 @@
 mod arrays;
 mod errors;
 mod from_arrays;
+mod loa_animate;
 mod loa_py;
 mod progress;
 mod scene;
@@ -37,5 +38,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(smear_job::stylize, m)?)?;
     m.add_class::<loa_py::Line>()?;
     m.add_function(wrap_pyfunction!(loa_py::line, m)?)?;
+    m.add_class::<loa_animate::Motion>()?;
+    m.add_function(wrap_pyfunction!(loa_animate::animate, m)?)?;
     Ok(())
 }

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use loa::{Keystrokes, LineOfAction, LineOptions, Mode, PhysicsOptions, SimulatedFrames};
+use loa::{Keystrokes, LineOptions};
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
 
@@ -22,7 +22,7 @@ const SOURCE: &str = "<keystrokes>";
 #[pyclass(module = "toonkit.loa", name = "Line", frozen)]
 pub(crate) struct Line {
     /// The computed line.
-    pub(crate) line: LineOfAction,
+    pub(crate) line: loa::Line,
     /// The keystrokes it was computed from.
     pub(crate) keys: Keystrokes,
 }
@@ -100,6 +100,12 @@ impl Line {
         Ok(path)
     }
 
+    /// Warnings of the line (e.g. keystrokes drawn the other way round and reversed).
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.line.warnings.clone()
+    }
+
     fn __repr__(&self) -> String {
         let a = &self.line.animation;
         format!(
@@ -124,60 +130,23 @@ impl Line {
     }
 }
 
-/// Simulated frames per interval: a count, or `"gap"`.
-#[derive(FromPyObject)]
-pub(crate) enum SimulatedArg {
-    Count(u32),
-    Name(String),
-}
-
-/// The native half of `toonkit.loa.line`: keystrokes in the CLI's JSON layout.
+/// The native half of `toonkit.loa.line`: keystrokes in the CLI's JSON layout and
+/// `loa::LineOptions` as JSON (the keyword arguments).
 #[pyfunction(name = "loa_line")]
-#[pyo3(signature = (keystrokes_json, mode="physics", fps=None, elements=loa::DEFAULT_ELEMENTS, substeps=loa::DEFAULT_SUBSTEPS, simulated_frames=None, progress=None))]
+#[pyo3(signature = (keystrokes_json, options_json, progress=None))]
 pub(crate) fn line(
     py: Python<'_>,
     keystrokes_json: &str,
-    mode: &str,
-    fps: Option<f64>,
-    elements: usize,
-    substeps: u32,
-    simulated_frames: Option<SimulatedArg>,
+    options_json: &str,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Line> {
-    let mode = match mode {
-        "physics" => Mode::Physics,
-        "hermite" => Mode::Hermite,
-        m => {
-            return Err(value_error(format!(
-                "mode must be \"physics\" or \"hermite\", got {m:?}"
-            )))
-        }
-    };
-    let simulated_frames = match simulated_frames {
-        None => SimulatedFrames::default(),
-        Some(SimulatedArg::Count(m)) => SimulatedFrames::Fixed(m),
-        Some(SimulatedArg::Name(n)) if n == "gap" => SimulatedFrames::FrameGap,
-        Some(SimulatedArg::Name(n)) => {
-            return Err(value_error(format!(
-                "simulated_frames {n:?}: expected a frame count or \"gap\""
-            )))
-        }
-    };
+    let options: LineOptions = serde_json::from_str(options_json)
+        .map_err(|e| value_error(format!("line options: {e}")))?;
     let keys =
         Keystrokes::from_json_str(keystrokes_json).map_err(|e| value_error(at(SOURCE, e)))?;
-    let options = LineOptions {
-        mode,
-        elements,
-        physics: PhysicsOptions {
-            fps: fps.or(keys.fps()).unwrap_or(loa::DEFAULT_FPS),
-            substeps,
-            simulated_frames,
-            ..Default::default()
-        },
-    };
     report(py, progress.as_ref(), "line", 0.0)?;
     let (line, keys) = py
-        .detach(move || loa::line_of_action(&keys, &options).map(|l| (l, keys)))
+        .detach(move || loa::line(&keys, &options).map(|l| (l, keys)))
         .map_err(|e| value_error(at(SOURCE, e)))?;
     report(py, progress.as_ref(), "line", 1.0)?;
     Ok(Line { line, keys })

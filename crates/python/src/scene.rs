@@ -30,13 +30,21 @@ pub(crate) struct Scene {
     pub(crate) sampled: Arc<SampledScene>,
     /// The file path, or `<arrays>`, for one-line error messages.
     pub(crate) source: String,
+    /// The scene as read (hierarchy, skins, clips) when it came from a glTF/BVH file: what
+    /// `toonkit.loa.animate` poses.
+    pub(crate) file_scene: Option<Arc<anim::Scene>>,
     positions: Py<PyArrayDyn<f32>>,
     triangles: Py<PyArrayDyn<i32>>,
 }
 
 impl Scene {
     /// Wraps a sampled scene (merging its objects once for the array views).
-    pub(crate) fn new(py: Python<'_>, sampled: SampledScene, source: String) -> PyResult<Scene> {
+    pub(crate) fn new(
+        py: Python<'_>,
+        sampled: SampledScene,
+        source: String,
+        file_scene: Option<Arc<anim::Scene>>,
+    ) -> PyResult<Scene> {
         let (frames, vertices) = (sampled.frame_count, sampled.vertex_count());
         let mut positions = Vec::with_capacity(frames * vertices * 3);
         for f in 0..frames {
@@ -58,6 +66,7 @@ impl Scene {
             triangles: frozen(py, &[nt, 3], triangles)?.unbind(),
             sampled: Arc::new(sampled),
             source,
+            file_scene,
         })
     }
 
@@ -74,7 +83,11 @@ impl Scene {
 }
 
 /// Reads and samples a file as the CLI does (`tkio::load`, then the clip at `fps`).
-fn load_sampled(path: &Path, clip: Option<&str>, fps: f32) -> Result<SampledScene, PyErrLater> {
+fn load_sampled(
+    path: &Path,
+    clip: Option<&str>,
+    fps: f32,
+) -> Result<(SampledScene, Option<Arc<anim::Scene>>), PyErrLater> {
     let loaded = tkio::load(path, &LoadOptions { fps, rest: None }).map_err(PyErrLater::Io)?;
     let at = |e| PyErrLater::Anim(path.display().to_string(), e);
     match loaded {
@@ -88,10 +101,14 @@ fn load_sampled(path: &Path, clip: Option<&str>, fps: f32) -> Result<SampledScen
                 clip,
                 meshes: Vec::new(),
             };
-            anim::sample(&scene, &options).map_err(at)
+            let sampled = anim::sample(&scene, &options).map_err(at)?;
+            Ok((sampled, Some(Arc::from(scene))))
         }
-        Loaded::Cache(cache) => Ok(SampledScene::from_animation(cache)),
-        Loaded::Mesh(mesh) => Ok(SampledScene::from_animation(MeshAnimation::still(mesh))),
+        Loaded::Cache(cache) => Ok((SampledScene::from_animation(cache), None)),
+        Loaded::Mesh(mesh) => Ok((
+            SampledScene::from_animation(MeshAnimation::still(mesh)),
+            None,
+        )),
     }
 }
 
@@ -145,8 +162,8 @@ pub(crate) fn load(
         ClipArg::Name(n) => n,
     });
     let p = path.clone();
-    let sampled = py.detach(move || load_sampled(&p, clip.as_deref(), fps))?;
-    Scene::new(py, sampled, path.display().to_string())
+    let (sampled, file_scene) = py.detach(move || load_sampled(&p, clip.as_deref(), fps))?;
+    Scene::new(py, sampled, path.display().to_string(), file_scene)
 }
 
 #[pymethods]
@@ -175,7 +192,7 @@ impl Scene {
         skin: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Scene> {
         let sampled = crate::from_arrays::sampled(&positions, &triangles, fps, skin)?;
-        Scene::new(py, sampled, "<arrays>".to_string())
+        Scene::new(py, sampled, "<arrays>".to_string(), None)
     }
 
     /// float32 ``(frames, vertices, 3)``: world-space positions, objects merged in order.

@@ -53,3 +53,42 @@ def test_bad_keystrokes_raise():
                              {"frame": 4, "points": [[0, 0], [1, 2]]}])
     with pytest.raises(ValueError, match=r"\.json or \.svg"):
         line.save("line.png")
+
+
+JUMP_FLAGS = ["--bones", "right-leg-spine-head@0", "--bones", "left-leg-spine-head@22",
+              "--contact", "FootL@0..3", "--twist", "Torso_1@22:20"]
+
+
+def test_animate_equals_cli_bvh(robot, tmp_path):
+    from conftest import ROBOT, asset
+
+    out = tmp_path / "cli.bvh"
+    run_cli("loa", "animate", asset(ROBOT), example("loa/jump.json"), "-o", out, *JUMP_FLAGS)
+    keys, fps = keystrokes("jump.json")
+    line = toonkit.loa.line(keys, fps=fps)
+    motion = toonkit.loa.animate(
+        asset(ROBOT), line,
+        bones=["right-leg-spine-head@0", "left-leg-spine-head@22"],
+        contacts="FootL@0..3", twists=["Torso_1@22:20"],
+    )
+    frames = len(line.frames)
+    assert motion.rotations.shape == (frames, len(motion.joint_names), 4)
+    np.testing.assert_allclose(np.linalg.norm(motion.rotations, axis=2), 1.0, atol=1e-6)
+    assert motion.report["line_distance_mean"] < 0.5
+    saved = motion.save(tmp_path / "py.bvh")
+    assert saved.read_text() == out.read_text()
+    # A loaded scene works as the character too.
+    again = toonkit.loa.animate(toonkit.load(asset(ROBOT)), line,
+                                bones=["right-leg-spine-head@0", "left-leg-spine-head@22"],
+                                contacts="FootL@0..3", twists=["Torso_1@22:20"])
+    np.testing.assert_array_equal(again.rotations, motion.rotations)
+
+
+def test_animate_bad_input(robot):
+    keys, fps = keystrokes("jump.json")
+    line = toonkit.loa.line(keys, fps=fps)
+    with pytest.raises(ValueError, match="bones"):
+        toonkit.loa.animate(robot, line, bones=["no-such-preset@0"])
+    arrays = toonkit.Scene.from_arrays(robot.positions, robot.triangles)
+    with pytest.raises(ValueError, match="not a character"):
+        toonkit.loa.animate(arrays, line)

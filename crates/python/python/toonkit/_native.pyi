@@ -69,16 +69,14 @@ class Line:
     def keystroke_frames(self) -> list[int]: ...
     @property
     def fps(self) -> float: ...
+    @property
+    def warnings(self) -> list[str]: ...
     def to_json(self) -> str: ...
     def save(self, path: Union[str, os.PathLike[str]]) -> os.PathLike[str]: ...
 
 def loa_line(
     keystrokes_json: str,
-    mode: str = "physics",
-    fps: Optional[float] = None,
-    elements: int = 10,
-    substeps: int = 8,
-    simulated_frames: Optional[Union[int, str]] = None,
+    options_json: str,
     progress: Optional[Callable[[str, float], Any]] = None,
 ) -> Line: ...
 
@@ -120,3 +118,31 @@ def smear_stylize(
     style_path: Optional[str] = None,
     progress: Optional[Callable[[str, float], Any]] = None,
 ) -> Stylized: ...
+
+class Motion:
+    """Joint motion synthesized from a line of action."""
+
+    @property
+    def rotations(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def positions(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def joint_names(self) -> list[str]: ...
+    @property
+    def fps(self) -> float: ...
+    @property
+    def first_frame(self) -> int: ...
+    @property
+    def report(self) -> dict[str, float]: ...
+    def save(self, path: Union[str, os.PathLike[str]]) -> os.PathLike[str]: ...
+
+def loa_animate(
+    character: Union[Scene, str],
+    line: Line,
+    bones: Sequence[str],
+    contacts: Sequence[str],
+    twists: Sequence[str],
+    pose: str,
+    options_json: str,
+    progress: Optional[Callable[[str, float], Any]] = None,
+) -> Motion: ...

@@ -17,10 +17,12 @@ from typing import Any, Callable, Iterable, Mapping, Optional, Union
 
 import numpy as np
 
-from . import _native
-from ._native import Line
+import os
 
-__all__ = ["Line", "line"]
+from . import _native
+from ._native import Line, Motion
+
+__all__ = ["Line", "Motion", "animate", "line"]
 
 
 def _keystrokes_json(keystrokes: Iterable[Mapping[str, Any]], fps: Optional[float]) -> str:
@@ -47,36 +49,88 @@ def _keystrokes_json(keystrokes: Iterable[Mapping[str, Any]], fps: Optional[floa
     return json.dumps(doc, allow_nan=True)
 
 
+_PHYSICS = {"fps", "substeps", "simulated_frames", "blend", "settle"}
+
+
 def line(
     keystrokes: Iterable[Mapping[str, Any]],
     mode: str = "physics",
     fps: float = 24.0,
-    elements: int = 10,
-    substeps: int = 8,
-    simulated_frames: Union[int, str] = 40,
     progress: Optional[Callable[[str, float], None]] = None,
+    **options: Any,
 ) -> "Line":
     """A dynamic line of action through sketched keystrokes (LoA Eqs. 1-2).
 
     ``keystrokes`` is a list of ``{"frame": f, "points": (n, 2) array}`` dicts (optionally
     ``"stiffness"`` and ``"damping"`` per keystroke), frames strictly increasing. ``mode`` is
     ``"physics"`` (elastic chain re-targeted onto every keystroke) or ``"hermite"``.
-    ``elements`` rigid elements per chain, ``substeps`` integration steps per frame,
-    ``simulated_frames`` frames simulated per interval (or ``"gap"``) -- the CLI's
-    ``toonkit loa line`` options. Returns a :class:`Line` with ``.points``
+    ``options`` are the fields of the loa crate's ``LineOptions`` (``elements``,
+    ``smoothing``, ``orient``, ``wobbles``) and of its ``physics`` options (``substeps``,
+    ``simulated_frames`` -- a count or ``"gap"`` --, ``settle``, ``blend``), as the CLI's
+    ``toonkit loa line`` flags set them. Returns a :class:`Line` with ``.points``
     ``(frames, joints, 2)``, ``.angles``, ``.lengths`` and ``.save(path)``.
 
     >>> l = toonkit.loa.line([{"frame": 0, "points": [[0, 0], [1, 2]]},
     ...                       {"frame": 12, "points": [[0, 0], [-1, 2]]}])
-    >>> l.points.shape[0]
-    13
+    >>> l.points.shape[2]
+    2
     """
-    return _native.loa_line(
-        _keystrokes_json(keystrokes, None),
-        mode,
-        float(fps),
-        int(elements),
-        int(substeps),
-        simulated_frames,
+    physics = {"fps": float(fps)}
+    rest = {}
+    for k, v in options.items():
+        if k in _PHYSICS:
+            if k == "simulated_frames":
+                v = {"fixed": int(v)} if isinstance(v, int) else ("frame_gap" if v == "gap" else v)
+            physics[k] = v
+        else:
+            rest[k] = v
+    opts = {"mode": mode, "physics": physics, **rest}
+    return _native.loa_line(_keystrokes_json(keystrokes, None), json.dumps(opts), progress)
+
+
+def _strings(x: Union[str, Iterable[str], None]) -> list:
+    if x is None:
+        return []
+    if isinstance(x, str):
+        return [x]
+    return [str(v) for v in x]
+
+
+def animate(
+    character: Union["_native.Scene", str, "os.PathLike[str]"],
+    line: Line,
+    bones: Union[str, Iterable[str], None] = None,
+    contacts: Union[str, Iterable[str], None] = None,
+    twists: Union[str, Iterable[str], None] = None,
+    pose: str = "rest",
+    progress: Optional[Callable[[str, float], None]] = None,
+    **options: Any,
+) -> Motion:
+    """3D character motion that follows a line of action (LoA Section 4 and 4.1).
+
+    ``character`` is a skinned glTF/GLB or BVH file (path, or a :class:`toonkit.Scene` loaded
+    from one). ``bones``, ``contacts`` and ``twists`` are written as the CLI's ``--bones``,
+    ``--contact`` and ``--twist`` values (``"right-leg-spine-head@0"``, ``"FootL@0..3"``,
+    ``"Torso_1@22:20"``); ``pose`` is ``"rest"`` or ``"CLIP@FRAME"``. Other ``options`` are
+    fields of the loa crate's ``AnimateOptions`` (``plane_normal``, ``weights``,
+    ``max_iterations``). Returns a :class:`Motion` with per-frame joint ``.rotations``
+    ``(frames, joints, 4)``, ``.positions``, ``.report`` and ``.save(path)`` (``.glb``/``.bvh``).
+
+    >>> line = toonkit.loa.line(keys)
+    >>> motion = toonkit.loa.animate("assets/characters/RobotExpressive.glb", line,
+    ...                              bones=["right-leg-spine-head@0"])
+    >>> motion.rotations.shape[2]
+    4
+    """
+    if not isinstance(character, _native.Scene):
+        character = os.fspath(character)
+    return _native.loa_animate(
+        character,
+        line,
+        _strings(bones),
+        _strings(contacts),
+        _strings(twists),
+        str(pose),
+        json.dumps(options),
         progress,
     )
