@@ -38,6 +38,7 @@
 //! ```
 
 mod animation;
+pub mod chart;
 mod color;
 mod colormap;
 mod draw;

@@ -1,4 +1,4 @@
-//! Seam homogenization (Eqs. 4–9) of all 1,800 frames of the ICT face asset, two parts
+//! Seam homogenization (StopShop Eqs. 4–9) of all 1,800 frames of the ICT face asset, two parts
 //! (forehead / chin seeds). Target: ≤ 2 s on 2 cores.
 //!
 //! Run: `cargo bench -p toonkit-stopmo --bench homogenize` (prints the best and median of

@@ -122,7 +122,7 @@ fn face_fig19_stopshop_kmeans_uniform() {
     // Fig. 19a: both optimized libraries beat uniform sampling on position.
     assert!(ours.errors_mm.position_mean < uni.errors_mm.position_mean);
     assert!(km.errors_mm.position_mean < uni.errors_mm.position_mean);
-    // Eq. 10 (same λ for all): ours is lowest.
+    // StopShop Eq. 10 (same λ for all): ours is lowest.
     assert!(ours.energy < km.energy && ours.energy < uni.energy);
     // Every printable piece of the lower part is a closed, oriented 2-manifold.
     let k = ours.parts[1].solution.pieces.len();

@@ -142,7 +142,7 @@ fn fig19_stopshop_beats_kmeans_and_uniform_on_velocity() {
     // Uniform sampling holds each piece for 50 frames: a small mean velocity error (the input
     // velocity) but a large pop at every switch.
     assert!(ours.errors_mm.velocity_max < 0.5 * uni.errors_mm.velocity_max);
-    // All three energies are Eq. 10 at the same λ: ours is the lowest.
+    // All three energies are StopShop Eq. 10 at the same λ: ours is the lowest.
     assert!(ours.energy < km.energy && ours.energy < uni.energy);
 }
 

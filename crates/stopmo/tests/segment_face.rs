@@ -267,7 +267,7 @@ fn mouth_and_eye_heights(f: &Face) -> (f32, f32) {
 
 #[test]
 fn fig4_large_gamma_cut_stays_between_mouth_and_eyes() {
-    // The seed-independent cut of Fig. 4 (γ = 1,000 with Eq. 3 averaged over frames) is still
+    // The seed-independent cut of Fig. 4 (γ = 1,000 with StopShop Eq. 3 averaged over frames) is still
     // the paper's face split; far beyond (γ = 10,000) the graph cut's shrinking bias wins and
     // the cut collapses around a seed — reported, so the useful γ range is documented.
     let f = face();

@@ -1,6 +1,6 @@
 //! Boykov–Kolmogorov max-flow and the Potts solvers against brute force on small graphs.
 
-use stopmo::segment::{minimize_potts, MaxFlow, PottsProblem};
+use stopmo::segment::solver::{minimize_potts, MaxFlow, PottsProblem};
 
 /// Deterministic xorshift generator.
 struct Rng(u64);

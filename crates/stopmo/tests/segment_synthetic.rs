@@ -208,7 +208,7 @@ fn fig18_three_and_six_parts() {
             counts[p as usize] += 1;
         }
         // The tube has two motion regions, so extra parts may be confined to their seed
-        // patch by Eq. 1; every part must still exist and own its seeds.
+        // patch by StopShop Eq. 1; every part must still exist and own its seeds.
         assert!(
             counts.iter().all(|&c| c > 0),
             "{n} parts: empty part in {counts:?}"
@@ -242,7 +242,7 @@ fn fig18_three_and_six_parts() {
 fn still_animation_has_defined_results() {
     let mesh = segment_support::tube(16, 10);
     let one = anim::MeshAnimation::still(mesh);
-    // Without motion Eq. 3 is the cut length; a moderate γ cuts across the tube.
+    // Without motion StopShop Eq. 3 is the cut length; a moderate γ cuts across the tube.
     let opts = SegmentOptions {
         gamma: 10.0,
         ..SegmentOptions::default()

@@ -7,9 +7,6 @@ pub mod loa;
 pub mod render;
 pub mod smear;
 pub mod stopmo;
-mod stopmo_curve;
-mod stopmo_library;
-mod stopmo_run;
 
 /// Options every command sees.
 #[derive(Debug, Clone, Copy)]

@@ -29,10 +29,10 @@ pub enum LibrarySize {
 }
 
 /// Which algorithm picks the pieces (Fig. 19 compares all three).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Method {
-    /// Eq. 10 with the velocity term (λ from the options).
+    /// StopShop Eq. 10 with the velocity term (λ from the options).
     StopShop,
     /// λ = 0: k-means (Lloyd), the paper's "velocity independent" variant.
     KMeans,
@@ -102,7 +102,7 @@ pub struct Library {
     pub method: Method,
     /// λ the energies are evaluated with.
     pub lambda: f64,
-    /// Total Eq. 10 energy over parts (model units²).
+    /// Total StopShop Eq. 10 energy over parts (model units²).
     pub energy: f64,
     /// Millimetres per model unit.
     pub mm_per_unit: f64,

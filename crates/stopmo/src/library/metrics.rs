@@ -1,4 +1,4 @@
-//! Exact energy (Eq. 10) and per-frame position/velocity errors (Fig. 19).
+//! Exact energy (StopShop Eq. 10) and per-frame position/velocity errors (Fig. 19).
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -76,7 +76,7 @@ impl ErrorSummary {
     }
 }
 
-/// Exact energy of Eq. 10 (saliency-weighted, model units²) and the per-frame errors.
+/// Exact energy of StopShop Eq. 10 (saliency-weighted, model units²) and the per-frame errors.
 ///
 /// # Performance
 /// One parallel pass over the frames, f64 accumulation.
@@ -132,7 +132,7 @@ pub(crate) fn evaluate(
 }
 
 impl PartProblem<'_> {
-    /// Exact Eq. 10 energy and per-frame errors of any library and labeling of this part.
+    /// Exact StopShop Eq. 10 energy and per-frame errors of any library and labeling of this part.
     ///
     /// `pieces` must have the part's vertex count and `labels` one entry per frame with values
     /// below `pieces.len()`; otherwise `None`.

@@ -1,10 +1,10 @@
 //! Replacement library optimization and fabrication (StopShop Sections 3.3–3.4, 5).
 //!
 //! Given one animation per part, [`build_library`] finds for every part a small library of
-//! pieces `R` and a piece label per frame `ℓ` minimizing Eq. 10,
+//! pieces `R` and a piece label per frame `ℓ` minimizing StopShop Eq. 10,
 //! `‖X − R S(ℓ)‖²_W + (λ/2)‖X G − R S(ℓ) G‖²_W` (positions plus velocities), by block
-//! coordinate descent: the library step solves the normal equations of Eq. 10 (derived in
-//! the `update` module; the printed Eq. 13 has typos) and the label step is solved *exactly*
+//! coordinate descent: the library step solves the normal equations of StopShop Eq. 10 (derived in
+//! the `update` module; the printed StopShop Eq. 13 has typos) and the label step is solved *exactly*
 //! by dynamic programming along the frame chain (cuts split it), never worse than the paper's
 //! α-expansion. k-means++ seeding, random restarts in parallel, fixed or partially fixed
 //! libraries, saliency weights, empty-piece repair. Library sizes are given per part, found

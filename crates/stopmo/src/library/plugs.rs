@@ -51,7 +51,8 @@ pub const DEFAULT_PLUG_SEGMENTS: usize = 24;
 const FLATNESS_STEP_MM: f32 = 0.1;
 
 /// Plug dimensions (millimetres at print scale, like the printable pieces).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
+#[serde(default)]
 pub struct PlugOptions {
     /// Pin radius `r`.
     pub radius_mm: f64,

@@ -17,7 +17,7 @@ pub struct PartSetup {
     /// Pre-defined pieces (a fully or partially fixed library), model units, one position per
     /// vertex. They take labels `0..fixed.len()`; free pieces follow.
     pub fixed: Vec<Vec<Vec3>>,
-    /// Frames that start a new, unrelated clip (the cut vector `c` of Eq. 12); 0 is implied.
+    /// Frames that start a new, unrelated clip (the cut vector `c` of StopShop Eq. 12); 0 is implied.
     pub cuts: Vec<usize>,
 }
 

@@ -12,7 +12,7 @@ use super::solver::{PartSolution, SolveOptions};
 pub struct CurvePoint {
     /// Library size (fixed pieces included).
     pub pieces: usize,
-    /// Eq. 10 energy.
+    /// StopShop Eq. 10 energy.
     pub energy: f64,
     /// Largest per-frame mean position error.
     pub worst_frame_error: f64,
@@ -127,7 +127,7 @@ pub(crate) fn max_error_search(
 }
 
 /// Distributes a total budget of pieces over parts by greedy marginal allocation: every part
-/// starts at max(fixed, 1) pieces; each further piece goes to the part whose Eq. 10 energy
+/// starts at max(fixed, 1) pieces; each further piece goes to the part whose StopShop Eq. 10 energy
 /// drops the most by it.
 ///
 /// # Returns

@@ -1,4 +1,4 @@
-//! Block coordinate descent on Eq. 10 with k-means++ seeding and parallel restarts.
+//! Block coordinate descent on StopShop Eq. 10 with k-means++ seeding and parallel restarts.
 
 use faer::linalg::matmul::matmul;
 use faer::{Accum, MatMut, MatRef, Par};
@@ -8,11 +8,11 @@ use rayon::prelude::*;
 use super::error::{LibraryError, Result};
 use super::metrics::evaluate;
 use super::problem::PartProblem;
-use anim::SplitMix64;
 use super::update::{right_hand_side, solve_pieces, system_matrix, Dense, Positions};
 use super::viterbi::{label_step, LabelInputs, ViterbiWork};
+use anim::SplitMix64;
 
-/// Velocity weight λ of Eq. 10 (the paper's results use 2).
+/// Velocity weight λ of StopShop Eq. 10 (the paper's results use 2).
 pub const DEFAULT_LAMBDA: f64 = 2.0;
 /// Random restarts; the best energy is kept.
 pub const DEFAULT_RESTARTS: usize = 8;
@@ -24,7 +24,8 @@ pub const DEFAULT_TOLERANCE: f64 = 1e-5;
 pub const DEFAULT_SEED: u64 = 0x5709_5409;
 
 /// Parameters of one optimization.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
 pub struct SolveOptions {
     /// Velocity weight λ ≥ 0 (0 = k-means / Lloyd).
     pub lambda: f64,
@@ -79,7 +80,7 @@ pub struct PartSolution {
     pub pieces: Vec<Vec<Vec3>>,
     /// Piece of each frame.
     pub labels: Vec<u32>,
-    /// Eq. 10 evaluated exactly in full space (model units², saliency-weighted).
+    /// StopShop Eq. 10 evaluated exactly in full space (model units², saliency-weighted).
     pub energy: f64,
     /// Library steps of the best restart.
     pub iterations: usize,
@@ -325,7 +326,7 @@ fn finish(
 }
 
 impl PartProblem<'_> {
-    /// Optimizes a library of `pieces` pieces (fixed ones included) and the labels (Eqs. 10–16).
+    /// Optimizes a library of `pieces` pieces (fixed ones included) and the labels (StopShop Eqs. 10–16).
     ///
     /// Block coordinate descent in the reduced coordinates: k-means++ seeding, exact label
     /// steps (Viterbi, see [`label_step`](super::viterbi)), library steps from the normal

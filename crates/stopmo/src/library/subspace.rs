@@ -1,8 +1,8 @@
 //! Exact or sketched reduction of a part's frames to low-dimensional coordinates.
 //!
-//! Every quantity of the block coordinate descent (Eqs. 10–16) is built from inner products
+//! Every quantity of the block coordinate descent (StopShop Eqs. 10–16) is built from inner products
 //! between frames and pieces, and every optimal piece is a linear combination of frames (the
-//! normal equations below Eq. 10 give `R = A⁻¹ S L X`). So the optimization can run on
+//! normal equations below StopShop Eq. 10 give `R = A⁻¹ S L X`). So the optimization can run on
 //! coordinates `Y` with `Y Yᵀ = Z Zᵀ`, where `Z` stacks the (centred, saliency-scaled) frames
 //! and the fixed pieces: the energy restricted to that span is unchanged. When `Z` has more
 //! rows and columns than [`SubspaceOptions::max_rank`], a randomized range finder (Halko,

@@ -1,9 +1,9 @@
-//! Library step: the optimal pieces for fixed labels (normal equations of Eq. 10).
+//! Library step: the optimal pieces for fixed labels (normal equations of StopShop Eq. 10).
 //!
 //! # Derivation
 //! Write one vertex coordinate across all frames as a row `x ∈ ℝ¹ˣⁿ` of `X` with saliency
 //! weight `w`, and the same coordinate of the pieces as `r ∈ ℝ¹ˣᵈ`. With the finite-difference
-//! matrix `G` of Eq. 12 (columns of cut edges are zero), Eq. 10 restricted to that row is
+//! matrix `G` of StopShop Eq. 12 (columns of cut edges are zero), StopShop Eq. 10 restricted to that row is
 //!
 //! `E = w (x − rS)(x − rS)ᵀ + (λ/2) w (x − rS) G Gᵀ (x − rS)ᵀ = w (x − rS) L (x − rS)ᵀ`,
 //! with `L = I + (λ/2) G Gᵀ` (identity plus λ/2 times the chain Laplacian of the clips).
@@ -12,7 +12,7 @@
 //!
 //! `A Rᵀ = B`, with `A = S Sᵀ + (λ/2) S G Gᵀ Sᵀ` (`d × d`) and `B = S L Xᵀ` (`d × 3m`).
 //!
-//! The printed Eq. 13 has `A` as `n × n`, `B` with `S G Xᵀ` (wrong dimensions) and λ in place of
+//! The printed StopShop Eq. 13 has `A` as `n × n`, `B` with `S G Xᵀ` (wrong dimensions) and λ in place of
 //! λ/2. The weight `w` cancels for `w > 0`, so saliency changes the labels, not this step.
 //! `S Sᵀ` is the diagonal of label counts and `S G Gᵀ Sᵀ` is the Laplacian of the label
 //! transition graph (one edge per non-cut frame pair whose labels differ), so `A` is
@@ -211,7 +211,7 @@ pub(crate) fn solve_pieces(
 mod tests {
     use super::*;
 
-    /// Direct evaluation of Eq. 10 for one scalar coordinate row.
+    /// Direct evaluation of StopShop Eq. 10 for one scalar coordinate row.
     fn energy(x: &[f64], r: &[f64], labels: &[u32], chains: &[Range<usize>], lambda: f64) -> f64 {
         let mut e = 0.0;
         for ch in chains {

@@ -1,7 +1,7 @@
 //! Exact label step: dynamic programming (Viterbi) along the frame chain.
 //!
-//! With the library fixed, Eq. 10 splits into unary terms (Eq. 15) and pairwise terms between
-//! consecutive frames of one clip (Eq. 16). The frame graph is a set of chains (cuts split it),
+//! With the library fixed, StopShop Eq. 10 splits into unary terms (StopShop Eq. 15) and pairwise terms between
+//! consecutive frames of one clip (StopShop Eq. 16). The frame graph is a set of chains (cuts split it),
 //! so the minimum over all `dⁿ` labelings is found exactly by dynamic programming; this is
 //! never worse than the α-expansion the paper uses.
 //!
@@ -47,7 +47,7 @@ impl LabelInputs<'_> {
         self.p[f * self.d + k] - self.p[(f - 1) * self.d + k]
     }
 
-    /// Energy (Eq. 10) of a labeling, from the same Gram matrices.
+    /// Energy (StopShop Eq. 10) of a labeling, from the same Gram matrices.
     #[cfg(test)]
     pub(crate) fn energy(&self, labels: &[u32]) -> f64 {
         let mut e = 0.0;
@@ -147,12 +147,12 @@ fn min_plus_block<const W: usize>(m: &mut [f64], alpha: &[f64], lg: &[f64], d: u
 /// # Arguments
 /// * `inp` — Gram matrices, chains and λ;
 /// * `labels` — output, one label per frame;
-/// * `cost` — output, the unary cost (Eq. 15) of each frame's chosen label (for empty-piece
+/// * `cost` — output, the unary cost (StopShop Eq. 15) of each frame's chosen label (for empty-piece
 ///   repair);
 /// * `work` — reusable buffers.
 ///
 /// # Returns
-/// The energy E(R, ℓ) of Eq. 10 (with the optimal ℓ).
+/// The energy E(R, ℓ) of StopShop Eq. 10 (with the optimal ℓ).
 ///
 /// # Performance
 /// `O(n · d²)` flops in a vectorized min-plus sweep (one pass over `λG` per frame) (`O(n · d)` when λ = 0), `O(n · d)`
@@ -236,8 +236,8 @@ pub(crate) fn label_step(
 
 #[cfg(test)]
 mod tests {
-    use anim::SplitMix64;
     use super::*;
+    use anim::SplitMix64;
 
     struct Case {
         p: Vec<f64>,

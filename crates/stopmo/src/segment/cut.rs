@@ -265,7 +265,7 @@ impl Tri<'_> {
 /// # Returns
 /// The cut mesh: triangles whose corners all win the same part are kept as they are; mixed
 /// triangles are split into convex pieces (one per part present) and fan-triangulated.
-pub fn cut_mesh(
+pub(super) fn cut_mesh(
     triangles: &[[u32; 3]],
     weld_class: &[u32],
     welded_count: usize,

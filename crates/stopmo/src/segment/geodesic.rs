@@ -1,10 +1,10 @@
-//! Geodesic distances between triangles (the unary term of Eq. 2).
+//! Geodesic distances between triangles (the unary term of StopShop Eq. 2).
 //!
 //! Method: Dijkstra on the dual graph of the average mesh. Nodes are triangle centroids;
 //! two triangles sharing an edge are linked by the path centroid → edge midpoint → centroid,
 //! so the path stays on the surface. This over-estimates the true geodesic by a few percent
-//! on irregular meshes (zig-zag), which is irrelevant for Eq. 2: the unary term only steers
-//! the cut where the motion term of Eq. 3 is flat.
+//! on irregular meshes (zig-zag), which is irrelevant for StopShop Eq. 2: the unary term only steers
+//! the cut where the motion term of StopShop Eq. 3 is flat.
 
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -15,7 +15,7 @@ use super::topology::DualEdge;
 
 /// The dual graph of a mesh with surface-path lengths on its links.
 #[derive(Debug, Clone)]
-pub struct DualGraph {
+pub(crate) struct DualGraph {
     offsets: Vec<u32>,
     links: Vec<(u32, f64)>,
     centroids: Vec<DVec3>,
@@ -37,7 +37,7 @@ impl Ord for Item {
 
 impl DualGraph {
     /// Builds the dual graph of `triangles` over `positions` (welded indices).
-    pub fn new(positions: &[DVec3], triangles: &[[u32; 3]], dual: &[DualEdge]) -> DualGraph {
+    pub(crate) fn new(positions: &[DVec3], triangles: &[[u32; 3]], dual: &[DualEdge]) -> DualGraph {
         let centroids: Vec<DVec3> = triangles
             .iter()
             .map(|t| t.iter().map(|&i| positions[i as usize]).sum::<DVec3>() / 3.0)
@@ -69,11 +69,6 @@ impl DualGraph {
         }
     }
 
-    /// Triangle centroids.
-    pub fn centroids(&self) -> &[DVec3] {
-        &self.centroids
-    }
-
     /// Distance of every triangle to the nearest of `seeds` (0 on the seeds).
     ///
     /// Triangles not connected to any seed get the straight-line distance between centroids
@@ -81,7 +76,7 @@ impl DualGraph {
     ///
     /// # Performance
     /// O(k log k) for k triangles.
-    pub fn distances(&self, seeds: &[u32]) -> Vec<f64> {
+    pub(crate) fn distances(&self, seeds: &[u32]) -> Vec<f64> {
         let k = self.centroids.len();
         let mut dist = vec![f64::INFINITY; k];
         let mut heap = BinaryHeap::new();

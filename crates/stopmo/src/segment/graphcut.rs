@@ -7,7 +7,7 @@ use super::maxflow::MaxFlow;
 /// Default cap on α-expansion cycles (one cycle tries every label once).
 pub const DEFAULT_MAX_EXPANSION_CYCLES: usize = 20;
 
-/// A Potts labeling problem: `E(l) = Σ_p D_p(l_p) + Σ_(p,q) w_pq [l_p ≠ l_q]` (Eq. 1 shape).
+/// A Potts labeling problem: `E(l) = Σ_p D_p(l_p) + Σ_(p,q) w_pq [l_p ≠ l_q]` (StopShop Eq. 1 shape).
 #[derive(Debug, Clone, Copy)]
 pub struct PottsProblem<'a> {
     /// Number of labels `s ≥ 1`.

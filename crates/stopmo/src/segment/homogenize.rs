@@ -1,7 +1,7 @@
-//! Part boundary homogenization (Section 3.2, Eqs. 4–9): every frame is deformed minimally —
-//! the squared cotangent-Laplacian energy of its displacement (Eq. 8, linear FEM with lumped
+//! Part boundary homogenization (Section 3.2, StopShop Eqs. 4–9): every frame is deformed minimally —
+//! the squared cotangent-Laplacian energy of its displacement (StopShop Eq. 8, linear FEM with lumped
 //! mass on the average mesh) is minimized — so that seam vertices and their one-ring sit at
-//! their average positions (Eqs. 5–6, 9).
+//! their average positions (StopShop Eqs. 5–6, 9).
 //!
 //! One sparse Cholesky factorization of `Q_FF = (L M⁻¹ L)_FF` over the free vertices F; each
 //! frame is then the back-substitution `Q_FF d_F = −Q_FP d_P` with `d_P = ỹ_P − y_P` the
@@ -94,7 +94,7 @@ impl Homogenizer {
     /// * `average` — average positions of the (welded) vertices.
     /// * `triangles` — triangles over welded vertices.
     /// * `seam` — welded vertices on the seam; they and their one-ring are pinned to
-    ///   `average` (Eqs. 5–6). Connected components that touch no seam are left unchanged.
+    ///   `average` (StopShop Eqs. 5–6). Connected components that touch no seam are left unchanged.
     /// * `weld_class`, `representative` — map between the animation's vertices and the
     ///   welded ones (identity when nothing is welded).
     ///
@@ -250,7 +250,7 @@ impl Homogenizer {
         self.symbolic.nrows()
     }
 
-    /// Deforms every frame of `anim` in place (Eqs. 4–9), in parallel over chunks of
+    /// Deforms every frame of `anim` in place (StopShop Eqs. 4–9), in parallel over chunks of
     /// [`DEFAULT_CHUNK_FRAMES`] frames; each chunk is one multi-column back-substitution
     /// with `Par::Seq`.
     ///

@@ -1,5 +1,5 @@
 //! Cotangent Laplacian and lumped (barycentric) mass matrix of a triangle mesh, the linear
-//! FEM discretization used by Eqs. 7–8.
+//! FEM discretization used by StopShop Eqs. 7–8.
 
 use glam::DVec3;
 
@@ -9,7 +9,7 @@ pub const DEFAULT_MAX_COT: f64 = 1e4;
 
 /// A sparse matrix in compressed rows (sorted columns, duplicates summed).
 #[derive(Debug, Clone, PartialEq, Default)]
-pub struct SparseRows {
+pub(super) struct SparseRows {
     /// Row starts (`rows + 1` entries).
     pub offsets: Vec<usize>,
     /// Column of every entry.
@@ -20,7 +20,7 @@ pub struct SparseRows {
 
 impl SparseRows {
     /// Builds an `n`-row matrix from `(row, col, value)` triplets, summing duplicates.
-    pub fn from_triplets(n: usize, mut t: Vec<(u32, u32, f64)>) -> SparseRows {
+    pub(super) fn from_triplets(n: usize, mut t: Vec<(u32, u32, f64)>) -> SparseRows {
         t.sort_unstable_by_key(|e| (e.0, e.1));
         let mut offsets = vec![0usize; n + 1];
         let mut cols = Vec::with_capacity(t.len());
@@ -47,12 +47,12 @@ impl SparseRows {
     }
 
     /// Number of rows.
-    pub fn rows(&self) -> usize {
+    pub(super) fn rows(&self) -> usize {
         self.offsets.len() - 1
     }
 
     /// Entries of row `i` as `(column, value)`.
-    pub fn row(&self, i: usize) -> impl Iterator<Item = (u32, f64)> + '_ {
+    pub(super) fn row(&self, i: usize) -> impl Iterator<Item = (u32, f64)> + '_ {
         let r = self.offsets[i]..self.offsets[i + 1];
         self.cols[r.clone()]
             .iter()
@@ -69,7 +69,10 @@ impl SparseRows {
 ///
 /// # Performance
 /// O(k log k) for k triangles.
-pub fn cotangent_laplacian(positions: &[DVec3], triangles: &[[u32; 3]]) -> (SparseRows, Vec<f64>) {
+pub(super) fn cotangent_laplacian(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+) -> (SparseRows, Vec<f64>) {
     let n = positions.len();
     let mut t = Vec::with_capacity(triangles.len() * 9);
     let mut mass = vec![0.0; n];
@@ -113,15 +116,15 @@ pub fn cotangent_laplacian(positions: &[DVec3], triangles: &[[u32; 3]]) -> (Spar
 }
 
 /// A sparse matrix entry `(row, column, value)`.
-pub type Entry = (u32, u32, f64);
+pub(super) type Entry = (u32, u32, f64);
 
-/// The bi-Laplacian `Q = L M⁻¹ L` of Eq. 8 restricted to the rows in `keep` (true) and
+/// The bi-Laplacian `Q = L M⁻¹ L` of StopShop Eq. 8 restricted to the rows in `keep` (true) and
 /// split by column into kept and other columns.
 ///
 /// # Returns
 /// Triplets `(row, col, value)` of `Q[keep, keep]` and of `Q[keep, !keep]`, both in the local
 /// numbering given by `local` (position of a vertex within its own group).
-pub fn bilaplacian_blocks(
+pub(super) fn bilaplacian_blocks(
     l: &SparseRows,
     mass: &[f64],
     keep: &[bool],

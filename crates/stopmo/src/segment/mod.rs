@@ -4,17 +4,17 @@
 //! 1. **Weld** coincident vertices of the average mesh ([`Weld`]; glTF duplicates vertices
 //!    along UV seams) — connectivity, geodesics and Laplacians use the welded mesh, outputs
 //!    keep the input vertex order.
-//! 2. **Label triangles** (Eqs. 1–3, [`SegmentationProblem::label`]): unary = geodesic
+//! 2. **Label triangles** (StopShop Eqs. 1–3, [`SegmentationProblem::label`]): unary = geodesic
 //!    distance to the part's seeds on the average mesh (Dijkstra on the dual graph), binary =
 //!    Σ_f edge length × (1 + displacement of the edge's ends) for every pair of adjacent
 //!    triangles in different parts, γ = 100 after scaling to a unit bounding box. Seed
 //!    triangles are hard constraints. Exact min-cut for two parts, α-expansion beyond, on
-//!    our own Boykov–Kolmogorov max-flow ([`MaxFlow`]).
+//!    our own Boykov–Kolmogorov max-flow ([`solver::MaxFlow`]).
 //! 3. **Smooth boundaries** (Fig. 5): area-weighted per-vertex votes, Laplacian smoothing,
 //!    then triangles are cut along the level sets where the winning vote changes
-//!    ([`cut_mesh`]). New vertices sit at fixed barycentric coordinates, evaluated
+//!    ([`CutMesh`]). New vertices sit at fixed barycentric coordinates, evaluated
 //!    identically in every frame, so the surface geometry is unchanged.
-//! 4. **Homogenize seams** (Eqs. 4–9, [`Homogenizer`]): per frame the squared cotangent
+//! 4. **Homogenize seams** (StopShop Eqs. 4–9, [`Homogenizer`]): per frame the squared cotangent
 //!    Laplacian energy of the displacement is minimized with the seam and its one-ring
 //!    pinned to their average positions; one sparse Cholesky factorization, all frames
 //!    solved in parallel.
@@ -74,24 +74,27 @@ mod smooth;
 mod topology;
 mod weld;
 
-pub use cut::{cut_mesh, CutMesh, VertexSource, DEFAULT_SNAP};
+pub use cut::{CutMesh, VertexSource, DEFAULT_SNAP};
 pub use error::{Result, SegmentError};
-pub use geodesic::DualGraph;
-pub use graphcut::{minimize_potts, solve_two_labels, PottsProblem, DEFAULT_MAX_EXPANSION_CYCLES};
 pub use homogenize::{HomogenizeStats, Homogenizer, DEFAULT_CHUNK_FRAMES};
-pub use laplacian::{cotangent_laplacian, SparseRows, DEFAULT_MAX_COT};
-pub use maxflow::MaxFlow;
+pub use laplacian::DEFAULT_MAX_COT;
 pub use pipeline::{
     auto_parts, homogenize, segment, segment_with, Part, SegmentOptions, SegmentReport,
     Segmentation,
 };
 pub use problem::{SegmentationProblem, DEFAULT_GAMMA};
 pub use seeds::{
-    auto_seeds, closest_point_on_triangle, nearest_triangle, resolve_seeds, PartSpec, Seed,
-    DEFAULT_AUTO_CENTERING_ITERATIONS, DEFAULT_AUTO_SAMPLES, DEFAULT_AUTO_SEED_RADIUS,
+    auto_seeds, resolve_seeds, PartSpec, Seed, DEFAULT_AUTO_CENTERING_ITERATIONS,
+    DEFAULT_AUTO_SAMPLES, DEFAULT_AUTO_SEED_RADIUS,
 };
-pub use smooth::{
-    smooth_votes, vertex_votes, winners, DEFAULT_SMOOTH_ITERATIONS, DEFAULT_SMOOTH_STEP,
-};
-pub use topology::{vertex_components, Csr, DualEdge, Topology};
+pub use smooth::{DEFAULT_SMOOTH_ITERATIONS, DEFAULT_SMOOTH_STEP};
 pub use weld::{Weld, DEFAULT_WELD_EPSILON};
+
+/// The graph-cut solvers behind StopShop Eq. 1: public for tests and benchmarks (and for
+/// anyone with another Potts problem), not part of the segmentation interface.
+pub mod solver {
+    pub use super::graphcut::{
+        minimize_potts, solve_two_labels, PottsProblem, DEFAULT_MAX_EXPANSION_CYCLES,
+    };
+    pub use super::maxflow::MaxFlow;
+}

@@ -1,5 +1,5 @@
-//! The segmentation pipeline: seeds → graph cut (Eqs. 1–3) → smooth boundaries → cut mesh →
-//! seam homogenization (Eqs. 4–9) → per-part animations.
+//! The segmentation pipeline: seeds → graph cut (StopShop Eqs. 1–3) → smooth boundaries → cut mesh →
+//! seam homogenization (StopShop Eqs. 4–9) → per-part animations.
 
 use anim::{Mesh, MeshAnimation};
 use glam::{DVec3, Vec3};
@@ -15,9 +15,10 @@ use super::topology::Topology;
 use super::weld::{Weld, DEFAULT_WELD_EPSILON};
 
 /// Parameters of [`segment`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
 pub struct SegmentOptions {
-    /// Weight γ of the binary term of Eq. 1 (unit-box units).
+    /// Weight γ of the binary term of StopShop Eq. 1 (unit-box units).
     pub gamma: f64,
     /// Laplacian smoothing iterations of the part votes (0 keeps the jagged per-triangle
     /// boundary, cut exactly along edges).
@@ -213,7 +214,7 @@ pub fn auto_parts(anim: &MeshAnimation, n: usize) -> Result<Vec<PartSpec>> {
 /// Bad seeds or parts ([`SegmentError`]), or a failed factorization.
 ///
 /// # Performance
-/// One parallel pass over the frames for Eq. 3, one min-cut (or a few α-expansion cycles),
+/// One parallel pass over the frames for StopShop Eq. 3, one min-cut (or a few α-expansion cycles),
 /// one sparse Cholesky factorization and one parallel back-substitution pass.
 pub fn segment(
     anim: &MeshAnimation,
@@ -255,7 +256,7 @@ fn check_options(o: &SegmentOptions) -> Result<()> {
 }
 
 /// [`segment`] on a prepared problem with resolved seeds (reuse the problem to try several
-/// seeds or γ values without recomputing Eq. 3).
+/// seeds or γ values without recomputing StopShop Eq. 3).
 pub fn segment_with(
     anim: &MeshAnimation,
     problem: &SegmentationProblem,
@@ -450,7 +451,7 @@ fn build_cut_animation(anim: &MeshAnimation, cut: &CutMesh) -> Result<MeshAnimat
 }
 
 /// Homogenizes the seams of an animation whose triangles already carry part labels
-/// (Section 3.2, Eqs. 4–9), without cutting.
+/// (Section 3.2, StopShop Eqs. 4–9), without cutting.
 ///
 /// # Arguments
 /// * `anim` — the animation (vertices coincident in the average mesh are welded).

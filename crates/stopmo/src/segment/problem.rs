@@ -1,4 +1,4 @@
-//! The segmentation energy of Eqs. 1–3 on one animation, precomputed once so that seeds and
+//! The segmentation energy of StopShop Eqs. 1–3 on one animation, precomputed once so that seeds and
 //! γ can be changed cheaply.
 
 use anim::MeshAnimation;
@@ -11,13 +11,13 @@ use super::graphcut::{minimize_potts, PottsProblem, DEFAULT_MAX_EXPANSION_CYCLES
 use super::topology::Topology;
 use super::weld::{Weld, DEFAULT_WELD_EPSILON};
 
-/// Frames per parallel task when summing Eq. 3 over the animation.
+/// Frames per parallel task when summing StopShop Eq. 3 over the animation.
 const FRAMES_PER_TASK: usize = 32;
 
-/// Default weight γ of the binary term (Eq. 1), for models scaled to a unit bounding box.
+/// Default weight γ of the binary term (StopShop Eq. 1), for models scaled to a unit bounding box.
 pub const DEFAULT_GAMMA: f64 = 100.0;
 
-/// The precomputed terms of Eqs. 1–3 for one animation.
+/// The precomputed terms of StopShop Eqs. 1–3 for one animation.
 ///
 /// Everything is measured after scaling the model so that the largest side of the bounding
 /// box of the average mesh is 1 ("unit bounding box"), which is what makes
@@ -32,7 +32,7 @@ pub struct SegmentationProblem {
     pub(crate) average_input: Vec<Vec3>,
     pub(crate) scale: f64,
     pub(crate) dual: DualGraph,
-    /// Eq. 3 per dual edge, averaged over frames, in unit-box units (γ not applied).
+    /// StopShop Eq. 3 per dual edge, averaged over frames, in unit-box units (γ not applied).
     pub(crate) motion: Vec<f64>,
     /// Animation-average triangle areas (model units²).
     pub(crate) areas: Vec<f64>,
@@ -40,7 +40,7 @@ pub struct SegmentationProblem {
 }
 
 impl SegmentationProblem {
-    /// Welds the mesh, builds the dual graph and evaluates the motion term of Eq. 3 over all
+    /// Welds the mesh, builds the dual graph and evaluates the motion term of StopShop Eq. 3 over all
     /// frames.
     ///
     /// # Arguments
@@ -85,7 +85,7 @@ impl SegmentationProblem {
         let scaled: Vec<DVec3> = average.iter().map(|p| *p * scale).collect();
         let dual = DualGraph::new(&scaled, &welded_triangles, &topology.dual);
 
-        // Eq. 3 (without γ) and average areas, in one pass over the frames.
+        // StopShop Eq. 3 (without γ) and average areas, in one pass over the frames.
         let rep = &weld.representative;
         let edges: Vec<[usize; 2]> = topology
             .dual
@@ -169,7 +169,7 @@ impl SegmentationProblem {
         &self.average_input
     }
 
-    /// Pairs of adjacent triangles and their Eq. 3 cost divided by the frame count (γ not
+    /// Pairs of adjacent triangles and their StopShop Eq. 3 cost divided by the frame count (γ not
     /// applied, unit-box units, each unordered pair once).
     pub fn motion_costs(&self) -> impl Iterator<Item = (u32, u32, f64)> + '_ {
         self.topology
@@ -184,10 +184,10 @@ impl SegmentationProblem {
         self.dual.distances(seeds)
     }
 
-    /// Per-triangle part labels minimizing Eq. 1 with unary Eq. 2 and binary Eq. 3.
+    /// Per-triangle part labels minimizing StopShop Eq. 1 with unary StopShop Eq. 2 and binary StopShop Eq. 3.
     ///
     /// Decisions where the paper is ambiguous:
-    /// * Eq. 3's sum over frames is divided by the frame count (a mean over frames). Summed
+    /// * StopShop Eq. 3's sum over frames is divided by the frame count (a mean over frames). Summed
     ///   literally, the binary term grows with the clip length, so one default γ could not
     ///   serve the paper's clips of 260 to 5,177 frames: with hundreds of frames the cheapest
     ///   cut simply encircles a seed triangle. With the mean, the default γ = 100 (SPEC.md)
@@ -196,7 +196,7 @@ impl SegmentationProblem {
     ///   (γ ≈ 10,000 on the face) the shrinking bias of graph cuts wins and the cut encircles
     ///   a seed (measured in `tests/segment_face.rs`).
     /// * Seed triangles are hard constraints (a seed always belongs to its part).
-    /// * The double sum of Eq. 1 runs over ordered pairs, so every adjacent pair contributes
+    /// * The double sum of StopShop Eq. 1 runs over ordered pairs, so every adjacent pair contributes
     ///   `2 γ b(α, β)` (as printed).
     ///
     /// # Arguments

@@ -47,7 +47,7 @@ impl PartSpec {
 }
 
 /// Closest point to `p` on triangle `(a, b, c)` (Ericson, Real-Time Collision Detection 5.1.5).
-pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+pub(super) fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let (d1, d2) = (ab.dot(ap), ac.dot(ap));
     if d1 <= 0.0 && d2 <= 0.0 {
@@ -86,7 +86,7 @@ pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec
 ///
 /// # Performance
 /// Brute force, O(k) in parallel.
-pub fn nearest_triangle(positions: &[Vec3], triangles: &[[u32; 3]], p: Vec3) -> Option<u32> {
+pub(super) fn nearest_triangle(positions: &[Vec3], triangles: &[[u32; 3]], p: Vec3) -> Option<u32> {
     let p = p.as_dvec3();
     triangles
         .par_iter()
@@ -168,7 +168,7 @@ pub fn resolve_seeds(
 /// distance `sqrt(g² + r²)`, where `g` is the geodesic distance to a chosen seed divided by
 /// the largest geodesic distance from the first seed, and `r` the RMS difference of the
 /// trajectories divided by the largest RMS displacement. Seeds thus land on regions that are
-/// both far apart and move differently; the graph cut (Eqs. 1–3) then places the
+/// both far apart and move differently; the graph cut (StopShop Eqs. 1–3) then places the
 /// boundaries where motion is lowest. Deterministic (ties → lowest triangle id).
 ///
 /// A few Lloyd-style iterations then cluster the triangles by that distance and move every
@@ -290,7 +290,7 @@ pub fn auto_seeds(
     }
     // Grow every seed into a small patch (geodesic radius DEFAULT_AUTO_SEED_RADIUS in the
     // unit box, triangles nearer to another seed excluded): a single triangle is so cheap to
-    // cut around that Eq. 1 may confine a part to it.
+    // cut around that StopShop Eq. 1 may confine a part to it.
     let dists: Vec<Vec<f64>> = seeds
         .iter()
         .map(|&s| problem.geodesic_distances(&[s]))

@@ -15,7 +15,7 @@ pub const DEFAULT_SMOOTH_STEP: f64 = 0.5;
 /// `vote_j(v) = Σ_{t ∋ v} A_t χ_j(t) / Σ_{t ∋ v} A_t` with `A_t` the animation-average area of
 /// triangle t. Votes of a vertex sum to 1 (vertices on zero-area triangles only use uniform
 /// weights; vertices on no triangle vote 1 for part 0).
-pub fn vertex_votes(
+pub(super) fn vertex_votes(
     parts: usize,
     vertex_triangles: &Csr,
     labels: &[u32],
@@ -50,7 +50,7 @@ pub fn vertex_votes(
 ///
 /// # Performance
 /// O(iterations × (edges + vertices) × parts), one scratch buffer.
-pub fn smooth_votes(
+pub(super) fn smooth_votes(
     votes: &mut Vec<f64>,
     parts: usize,
     neighbors: &Csr,
@@ -77,20 +77,4 @@ pub fn smooth_votes(
         }
         std::mem::swap(votes, &mut next);
     }
-}
-
-/// Winning part of every vertex (the lowest part index on ties).
-pub fn winners(votes: &[f64], parts: usize) -> Vec<u32> {
-    votes
-        .chunks_exact(parts)
-        .map(|v| {
-            let mut best = 0;
-            for j in 1..parts {
-                if v[j] > v[best] {
-                    best = j;
-                }
-            }
-            best as u32
-        })
-        .collect()
 }

@@ -2,7 +2,7 @@
 
 /// An edge shared by two triangles (a link of the dual graph).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct DualEdge {
+pub(crate) struct DualEdge {
     /// First triangle.
     pub a: u32,
     /// Second triangle (`a < b`).
@@ -13,7 +13,7 @@ pub struct DualEdge {
 
 /// Compressed adjacency lists (`offsets.len() = n + 1`).
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
-pub struct Csr {
+pub(crate) struct Csr {
     /// Start of every row in `items`.
     pub offsets: Vec<u32>,
     /// Concatenated rows.
@@ -22,18 +22,13 @@ pub struct Csr {
 
 impl Csr {
     /// Row `i`.
-    pub fn row(&self, i: usize) -> &[u32] {
+    pub(crate) fn row(&self, i: usize) -> &[u32] {
         &self.items[self.offsets[i] as usize..self.offsets[i + 1] as usize]
     }
 
     /// Number of rows.
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.offsets.len().saturating_sub(1)
-    }
-
-    /// True when there is no row.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
     }
 
     fn from_pairs(n: usize, pairs: &mut [(u32, u32)]) -> Csr {
@@ -58,7 +53,7 @@ impl Csr {
 
 /// Edges, dual graph and vertex one-rings of a triangle mesh.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Topology {
+pub(crate) struct Topology {
     /// Unique undirected edges `(a, b)`, `a < b`, sorted.
     pub edges: Vec<[u32; 2]>,
     /// Pairs of triangles sharing an edge. Non-manifold edges link every pair of their
@@ -75,7 +70,7 @@ impl Topology {
     ///
     /// # Performance
     /// O(k log k) for k triangles (sorting).
-    pub fn new(vertices: usize, triangles: &[[u32; 3]]) -> Topology {
+    pub(crate) fn new(vertices: usize, triangles: &[[u32; 3]]) -> Topology {
         let mut half: Vec<([u32; 2], u32)> = Vec::with_capacity(triangles.len() * 3);
         let mut vt: Vec<(u32, u32)> = Vec::with_capacity(triangles.len() * 3);
         for (t, tri) in triangles.iter().enumerate() {
@@ -126,7 +121,7 @@ impl Topology {
 }
 
 /// Connected components of the vertex graph (component id per vertex, and the count).
-pub fn vertex_components(neighbors: &Csr) -> (Vec<u32>, usize) {
+pub(super) fn vertex_components(neighbors: &Csr) -> (Vec<u32>, usize) {
     let n = neighbors.len();
     let mut comp = vec![u32::MAX; n];
     let mut count = 0u32;

@@ -1,0 +1,112 @@
+//! The output layout of a library (SPEC "Output layouts"), as relative paths and data, so
+//! every front end writes the same files with its own writer (`tkio::save` in the CLI).
+
+use std::borrow::Cow;
+
+use anim::{Mesh, MeshAnimation};
+
+use super::error::Result;
+use super::result::LibraryResult;
+
+/// What one output file holds; the path's extension says which format it is written in.
+#[derive(Debug, Clone)]
+pub enum FileData<'a> {
+    /// Text written as is (CSV, JSON, Markdown).
+    Text(String),
+    /// Bytes written as is (an encoded PNG).
+    Bytes(Vec<u8>),
+    /// One static mesh (`.obj` surface or `.stl` solid).
+    Mesh(&'a Mesh),
+    /// Several animations with the same frames, one node per part (`.glb`, morph targets).
+    Parts(Vec<&'a MeshAnimation>),
+    /// One point cache (`.pc2`).
+    PointCache(Cow<'a, MeshAnimation>),
+    /// A rest mesh that is not borrowed from the result (`.obj`).
+    OwnedMesh(Mesh),
+}
+
+/// One file of the layout: a path relative to the output directory and its data.
+#[derive(Debug, Clone)]
+pub struct OutputFile<'a> {
+    /// Relative path with `/` separators (`pieces/upper_03.stl`, `report.json`, …).
+    pub path: String,
+    /// The data.
+    pub data: FileData<'a>,
+}
+
+impl LibraryResult {
+    /// Every file of the output layout: `pieces/<part>_<NN>.obj` and `.stl`, `assembly.csv`,
+    /// `assembly.md`, `shooting_order.csv`, `report.json`, `reconstruction.glb`,
+    /// `reconstruction.pc2` + `rest.obj`, `error_curve.csv` / `.png` after a size search and,
+    /// for [`run`](crate::run()), `segmentation.glb`, `segmentation.json` and
+    /// `segmentation.png` (when the figure was asked for).
+    ///
+    /// # Errors
+    /// When the reconstruction cannot be merged or the curve chart cannot be drawn.
+    pub fn files(&self) -> Result<Vec<OutputFile<'_>>> {
+        let mut out = Vec::new();
+        if let Some(seg) = &self.segmented {
+            out.push(file(
+                "segmentation.glb",
+                FileData::Parts(seg.part_animations()),
+            ));
+            out.push(file("segmentation.json", FileData::Text(seg.report_json())));
+            if let Some(png) = &seg.figure {
+                out.push(file("segmentation.png", FileData::Bytes(png.clone())));
+            }
+        }
+        for p in &self.pieces {
+            out.push(file(
+                format!("pieces/{}.obj", p.id),
+                FileData::Mesh(&p.surface),
+            ));
+            out.push(file(
+                format!("pieces/{}.stl", p.id),
+                FileData::Mesh(&p.solid),
+            ));
+        }
+        out.push(file("assembly.csv", FileData::Text(self.assembly_csv())));
+        out.push(file(
+            "assembly.md",
+            FileData::Text(self.assembly_markdown()),
+        ));
+        out.push(file(
+            "shooting_order.csv",
+            FileData::Text(self.shooting_order_csv()),
+        ));
+        out.push(file(
+            "reconstruction.glb",
+            FileData::Parts(self.reconstruction.iter().collect()),
+        ));
+        let merged = self.merged_reconstruction()?;
+        out.push(file("rest.obj", FileData::OwnedMesh(merged.mesh.clone())));
+        out.push(file("reconstruction.pc2", FileData::PointCache(merged)));
+        if let Some(csv) = self.error_curve_csv() {
+            out.push(file("error_curve.csv", FileData::Text(csv)));
+        }
+        if let Some(png) = self.error_curve_png()? {
+            out.push(file("error_curve.png", FileData::Bytes(png)));
+        }
+        out.push(file("report.json", FileData::Text(self.report.to_json())));
+        Ok(out)
+    }
+
+    /// All parts' reconstructions merged into one point cache, in part order (the vertex
+    /// order of `reconstruction.pc2` and `rest.obj`).
+    ///
+    /// # Errors
+    /// When the parts' frames differ (they never do for a library's own reconstruction).
+    pub fn merged_reconstruction(&self) -> Result<Cow<'_, MeshAnimation>> {
+        Ok(match self.reconstruction.as_slice() {
+            [one] => Cow::Borrowed(one),
+            all => Cow::Owned(MeshAnimation::concat("reconstruction", all)?),
+        })
+    }
+}
+
+fn file(path: impl Into<String>, data: FileData<'_>) -> OutputFile<'_> {
+    OutputFile {
+        path: path.into(),
+        data,
+    }
+}

@@ -1,0 +1,299 @@
+//! The library job: size rule → StopShop Eq. 10 libraries and labels → printable pieces,
+//! assembly, shooting order, reconstruction, report; and `run` (segment, then library).
+
+use std::time::Instant;
+
+use anim::MeshAnimation;
+use rayon::prelude::*;
+
+use super::error::{Error, Result};
+use super::options::{LibraryJobOptions, PieceCount, RunOptions};
+use super::report::{LibraryReport, ReportInputs};
+use super::result::{LibraryResult, Piece};
+use super::segment_job::segment;
+use crate::library::{
+    add_plugs, build_library, plan_plugs, print_scale, scaled, shooting_order, Library,
+    LibraryOptions, LibrarySize, PartInput, PartSetup, Plug, PlugOptions,
+};
+
+/// A name that is safe as a file stem: every character other than letters, digits, `-` and
+/// `_` becomes `_` (`"part"` when empty). Part names name the piece files.
+pub fn file_safe_name(name: &str) -> String {
+    let s: String = name
+        .chars()
+        .map(|c| {
+            if c.is_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if s.is_empty() {
+        "part".into()
+    } else {
+        s
+    }
+}
+
+/// Builds the replacement library of `parts` (one animation per part, named by its mesh
+/// name) and everything needed to print and shoot it (StopShop Sections 3.3–3.4, 5): the
+/// whole job of `toonkit stopmo library`.
+///
+/// # Errors
+/// [`Error::Option`] for an invalid size rule, thickness, saliency or fixed pieces (see
+/// [`Error::option`]); the optimization's and fabrication's own errors
+/// ([`Error::Library`]).
+pub fn library(parts: &[MeshAnimation], opts: &LibraryJobOptions) -> Result<LibraryResult> {
+    let refs: Vec<&MeshAnimation> = parts.iter().collect();
+    let names: Vec<String> = parts.iter().map(|a| a.mesh.name.clone()).collect();
+    build(&refs, &names, opts)
+}
+
+/// Segments `anim`, then builds the library of its parts (named after the parts, made
+/// file-safe): the whole job of `toonkit stopmo run`. The result carries the segmentation in
+/// [`LibraryResult::segmented`].
+///
+/// # Errors
+/// Those of [`crate::segment()`] and [`library`].
+pub fn run(anim: &MeshAnimation, opts: &RunOptions) -> Result<LibraryResult> {
+    let segmented = segment(anim, &opts.segment)?;
+    let names: Vec<String> = segmented
+        .parts
+        .iter()
+        .map(|p| file_safe_name(&p.name))
+        .collect();
+    let mut result = build(&segmented.part_animations(), &names, &opts.library)?;
+    result.segmented = Some(segmented);
+    Ok(result)
+}
+
+/// The library size rule of the options, resolved against the parts.
+fn library_size(
+    opts: &LibraryJobOptions,
+    anims: &[&MeshAnimation],
+    names: &[String],
+) -> Result<LibrarySize> {
+    Ok(match &opts.pieces {
+        PieceCount::Each(n) => LibrarySize::Pieces(*n),
+        PieceCount::PerPart(sizes) => {
+            if let Some(unknown) = sizes.keys().find(|k| !names.contains(k)) {
+                return Err(Error::option_error(
+                    "pieces",
+                    format!("no part '{unknown}' (parts: {})", names.join(", ")),
+                ));
+            }
+            let missing: Vec<&str> = names
+                .iter()
+                .filter(|n| !sizes.contains_key(*n))
+                .map(String::as_str)
+                .collect();
+            if !missing.is_empty() {
+                return Err(Error::option_error(
+                    "pieces",
+                    format!("no size for part(s) {}", missing.join(", ")),
+                ));
+            }
+            LibrarySize::PerPart(names.iter().map(|n| sizes[n]).collect())
+        }
+        PieceCount::MaxErrorMm(e) => {
+            if !(e.is_finite() && *e > 0.0) {
+                return Err(Error::option_error(
+                    "max_error_mm",
+                    format!("must be a positive number of millimetres, got {e}"),
+                ));
+            }
+            LibrarySize::MaxError(e / print_scale(anims, opts.print_height_mm))
+        }
+        PieceCount::Budget(b) => LibrarySize::Budget(*b),
+    })
+}
+
+/// Per-part saliency, fixed pieces and cuts.
+fn setups(
+    opts: &LibraryJobOptions,
+    anims: &[&MeshAnimation],
+    names: &[String],
+) -> Result<Vec<PartSetup>> {
+    let total: usize = anims.iter().map(|a| a.vertex_count()).sum();
+    if let Some(s) = &opts.saliency {
+        if s.len() != total {
+            return Err(Error::option_error(
+                "saliency",
+                format!(
+                    "{} weights, expected {total} (one per vertex of the parts, in part order)",
+                    s.len()
+                ),
+            ));
+        }
+    }
+    if let Some(unknown) = opts.fixed.keys().find(|k| !names.contains(k)) {
+        return Err(Error::option_error(
+            "fixed",
+            format!("no part '{unknown}' (parts: {})", names.join(", ")),
+        ));
+    }
+    let mut at = 0;
+    Ok(anims
+        .iter()
+        .zip(names)
+        .map(|(a, name)| {
+            let n = a.vertex_count();
+            let saliency = opts.saliency.as_ref().map(|s| s[at..at + n].to_vec());
+            at += n;
+            PartSetup {
+                saliency,
+                fixed: opts.fixed.get(name).cloned().unwrap_or_default(),
+                cuts: opts.cuts.clone(),
+            }
+        })
+        .collect())
+}
+
+/// The library of `anims`, named `names` (unique), and everything built from it.
+fn build(
+    anims: &[&MeshAnimation],
+    names: &[String],
+    opts: &LibraryJobOptions,
+) -> Result<LibraryResult> {
+    let start = Instant::now();
+    for (i, n) in names.iter().enumerate() {
+        if names[..i].contains(n) {
+            return Err(Error::option_error(
+                "parts",
+                format!("two parts are named '{n}'; part names must be unique"),
+            ));
+        }
+    }
+    let size = library_size(opts, anims, names)?;
+    if !(opts.thickness_mm.is_finite() && opts.thickness_mm > 0.0) {
+        return Err(Error::option_error(
+            "thickness_mm",
+            "must be a positive number of millimetres",
+        ));
+    }
+    let inputs: Vec<PartInput<'_>> = anims
+        .iter()
+        .zip(setups(opts, anims, names)?)
+        .map(|(a, setup)| PartInput {
+            animation: a,
+            setup,
+        })
+        .collect();
+    let lib_opts = LibraryOptions {
+        size,
+        method: opts.method,
+        solve: opts.solve,
+        print_height_mm: opts.print_height_mm,
+        ..LibraryOptions::default()
+    };
+    let mut lib = build_library(&inputs, &lib_opts)?;
+    for (p, n) in lib.parts.iter_mut().zip(names) {
+        p.name.clone_from(n);
+    }
+    let plugs = match &opts.plugs {
+        Some(p) => plan_part_plugs(
+            &lib,
+            anims,
+            &PlugOptions {
+                thickness_mm: opts.thickness_mm,
+                ..*p
+            },
+        )?,
+        None => Vec::new(),
+    };
+    let segments = opts.plugs.map(|p| p.segments);
+    let pieces = make_pieces(&lib, anims, opts.thickness_mm, &plugs, segments)?;
+    let assembly = lib.assembly();
+    let order = shooting_order(&assembly);
+    let reconstruction = anims
+        .iter()
+        .zip(names)
+        .enumerate()
+        .map(|(i, (a, name))| {
+            let mut r = lib.reconstruction(i, a).ok_or_else(|| {
+                Error::option_error("parts", format!("no reconstruction of part '{name}'"))
+            })?;
+            r.mesh.name.clone_from(name);
+            Ok(r)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let mut report = LibraryReport::new(
+        &lib,
+        &ReportInputs {
+            names,
+            plugs: &plugs,
+            order: &order,
+            frames: assembly.frames.len(),
+            fps: anims[0].fps,
+            print_height_mm: opts.print_height_mm,
+            thickness_mm: opts.thickness_mm,
+            restarts: opts.solve.restarts,
+        },
+    );
+    report.total_seconds = start.elapsed().as_secs_f64();
+    Ok(LibraryResult {
+        segmented: None,
+        part_names: names.to_vec(),
+        library: lib,
+        pieces,
+        assembly,
+        shooting_order: order,
+        plugs,
+        reconstruction,
+        report,
+    })
+}
+
+/// One plug per seam between two parts, placed on the average geometry in millimetres (the
+/// STL coordinates).
+fn plan_part_plugs(
+    lib: &Library,
+    anims: &[&MeshAnimation],
+    opts: &PlugOptions,
+) -> Result<Vec<Plug>> {
+    let surfaces: Vec<anim::Mesh> = anims
+        .iter()
+        .map(|a| {
+            let mut m = a.mesh.clone();
+            m.positions = a.average_positions();
+            scaled(&m, lib.mm_per_unit as f32)
+        })
+        .collect();
+    Ok(plan_plugs(&surfaces, opts)?)
+}
+
+/// Surface (model units) and printable solid (mm, with the part's plug shells) of every
+/// piece, in parallel.
+fn make_pieces(
+    lib: &Library,
+    anims: &[&MeshAnimation],
+    thickness_mm: f64,
+    plugs: &[Plug],
+    segments: Option<usize>,
+) -> Result<Vec<Piece>> {
+    let jobs: Vec<(usize, usize)> = lib
+        .parts
+        .iter()
+        .enumerate()
+        .flat_map(|(p, r)| (0..r.solution.pieces.len()).map(move |k| (p, k)))
+        .collect();
+    let segments = segments.unwrap_or(crate::library::DEFAULT_PLUG_SEGMENTS);
+    jobs.par_iter()
+        .map(|&(p, k)| {
+            let topology = &anims[p].mesh;
+            let surface = lib.piece_surface(p, k, topology).ok_or_else(|| {
+                Error::option_error("pieces", format!("no piece {k} of part {p}"))
+            })?;
+            let solid = lib.printable_piece(p, k, topology, thickness_mm)?;
+            let solid = add_plugs(&solid, p, plugs, segments);
+            Ok(Piece {
+                id: surface.name.clone(),
+                part: p,
+                index: k,
+                surface,
+                solid,
+            })
+        })
+        .collect()
+}

@@ -1,0 +1,20 @@
+//! Whole jobs on in-memory data: [`segment`], [`library`], [`run`], with serde options and
+//! results that carry their reports and list their output files.
+
+mod error;
+mod figure;
+mod files;
+mod library_job;
+mod options;
+mod report;
+mod result;
+mod segment_job;
+mod text;
+
+pub use error::{Error, Result};
+pub use files::{FileData, OutputFile};
+pub use library_job::{file_safe_name, library, run};
+pub use options::{LibraryJobOptions, PieceCount, RunOptions, SegmentJobOptions, DEFAULT_PIECES};
+pub use report::{LibraryReport, OrderReport, PartReport, PlugReport};
+pub use result::{LibraryResult, Piece};
+pub use segment_job::{segment, PartSummary, SegmentSummary, Segmented};

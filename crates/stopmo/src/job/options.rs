@@ -1,0 +1,117 @@
+//! Options of the whole jobs: plain data with serde, so the same options come from CLI flags,
+//! a TOML/JSON file, Python keyword arguments or a web form. Every field has a default.
+
+use std::collections::BTreeMap;
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::library::{
+    Method, PlugOptions, SolveOptions, DEFAULT_PRINT_HEIGHT_MM, DEFAULT_THICKNESS_MM,
+};
+use crate::segment::{PartSpec, SegmentOptions};
+
+/// Pieces per part when no size is given.
+pub const DEFAULT_PIECES: usize = 20;
+
+/// Options of [`segment`](crate::segment()).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SegmentJobOptions {
+    /// Named parts with their seeds (at least two), unless `auto_parts` is given.
+    pub parts: Vec<PartSpec>,
+    /// Choose this many parts automatically instead (named `part1`, `part2`, …).
+    pub auto_parts: Option<usize>,
+    /// Also draw StopShop Fig. 5 (parts beside the mean displacement) as a PNG.
+    pub figure: bool,
+    /// γ (StopShop Eq. 1), boundary smoothing, snapping, homogenization, welding.
+    #[serde(flatten)]
+    pub segment: SegmentOptions,
+}
+
+impl Default for SegmentJobOptions {
+    fn default() -> Self {
+        SegmentJobOptions {
+            parts: Vec::new(),
+            auto_parts: None,
+            figure: false,
+            segment: SegmentOptions::default(),
+        }
+    }
+}
+
+/// How many pieces each part gets.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PieceCount {
+    /// The same number of pieces for every part (fixed pieces included).
+    Each(usize),
+    /// A number per part, by part name; every part is named exactly once.
+    PerPart(BTreeMap<String, usize>),
+    /// The smallest library per part whose worst frame's mean position error is at most this
+    /// many millimetres at the print height (StopShop Fig. 16).
+    MaxErrorMm(f64),
+    /// A total number of pieces over all parts, allocated greedily.
+    Budget(usize),
+}
+
+impl Default for PieceCount {
+    fn default() -> Self {
+        PieceCount::Each(DEFAULT_PIECES)
+    }
+}
+
+/// Options of [`library`](crate::library()).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct LibraryJobOptions {
+    /// Library size rule.
+    pub pieces: PieceCount,
+    /// Which algorithm picks the pieces (StopShop Eq. 10, k-means or uniform sampling).
+    pub method: Method,
+    /// λ of StopShop Eq. 10, restarts, seed, iteration cap, tolerance.
+    #[serde(flatten)]
+    pub solve: SolveOptions,
+    /// Printed height of the whole model in millimetres (scales the solids and the errors).
+    pub print_height_mm: f64,
+    /// Wall thickness of the printed pieces in millimetres.
+    pub thickness_mm: f64,
+    /// Male/female plugs across every seam shared by two parts (StopShop Fig. 13); their
+    /// `thickness_mm` is taken from [`LibraryJobOptions::thickness_mm`].
+    pub plugs: Option<PlugOptions>,
+    /// Per-vertex saliency weights in the merged vertex order of the parts (parts one after
+    /// the other).
+    pub saliency: Option<Vec<f32>>,
+    /// Frames that start a new, unrelated shot (no velocity term across them, StopShop
+    /// StopShop Eq. 12).
+    pub cuts: Vec<usize>,
+    /// Pre-made pieces per part name (model units, one position per vertex of the part):
+    /// they are kept and new pieces are added up to the library size.
+    pub fixed: BTreeMap<String, Vec<Vec<Vec3>>>,
+}
+
+impl Default for LibraryJobOptions {
+    fn default() -> Self {
+        LibraryJobOptions {
+            pieces: PieceCount::default(),
+            method: Method::StopShop,
+            solve: SolveOptions::default(),
+            print_height_mm: DEFAULT_PRINT_HEIGHT_MM,
+            thickness_mm: DEFAULT_THICKNESS_MM,
+            plugs: None,
+            saliency: None,
+            cuts: Vec::new(),
+            fixed: BTreeMap::new(),
+        }
+    }
+}
+
+/// Options of [`run`](crate::run()): segmentation, then the library of the parts.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct RunOptions {
+    /// How to segment.
+    pub segment: SegmentJobOptions,
+    /// How to build the library of the segmented parts.
+    pub library: LibraryJobOptions,
+}

@@ -1,0 +1,180 @@
+//! The numbers of `report.json` (SPEC "Output layouts").
+
+use serde::Serialize;
+
+use crate::library::{ErrorSummary, Library, Method, Plug, ShootingOrder};
+
+/// One plug in the report (millimetres, print coordinates).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PlugReport {
+    /// Part carrying the pin.
+    pub male: String,
+    /// Part carrying the socket.
+    pub female: String,
+    /// Anchor on the seam.
+    pub anchor_mm: [f32; 3],
+    /// Outward surface normal at the anchor.
+    pub normal: [f32; 3],
+    /// Plug axis, from the male into the female part.
+    pub axis: [f32; 3],
+    /// Axis point below the anchor.
+    pub center_mm: [f32; 3],
+    /// Pin radius.
+    pub radius_mm: f32,
+    /// Socket bore radius.
+    pub socket_radius_mm: f32,
+    /// Outer radius of boss and socket.
+    pub outer_radius_mm: f32,
+    /// Boss plus pin length.
+    pub length_mm: f32,
+    /// Seam vertices shared by the two parts.
+    pub seam_vertices: usize,
+}
+
+/// One part in the report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PartReport {
+    /// Part name.
+    pub name: String,
+    /// Library size.
+    pub pieces: usize,
+    /// Vertices.
+    pub vertices: usize,
+    /// StopShop Eq. 10 energy of the part (model units²).
+    pub energy: f64,
+    /// Block-coordinate-descent iterations of the best restart.
+    pub iterations: usize,
+    /// Restarts run.
+    pub restarts: usize,
+    /// Errors in millimetres at the print height.
+    pub errors_mm: ErrorSummary,
+}
+
+/// The shooting order in the report.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct OrderReport {
+    /// Distinct assemblies to shoot.
+    pub shots: usize,
+    /// Piece swaps along the proposed order.
+    pub swaps: usize,
+    /// Piece swaps when shooting in frame order.
+    pub sequential_swaps: usize,
+}
+
+/// `report.json`: energy, λ, pieces, per-part and total mean/max position and velocity errors
+/// in millimetres, timing, iterations, restarts, plugs, shooting order.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LibraryReport {
+    /// The input file, when a front end sets it (not serialized when `None`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub input: Option<String>,
+    /// Method used.
+    pub method: Method,
+    /// Total StopShop Eq. 10 energy (model units²).
+    pub energy: f64,
+    /// λ of StopShop Eq. 10.
+    pub lambda: f64,
+    /// Total pieces.
+    pub pieces: usize,
+    /// Frames.
+    pub frames: usize,
+    /// Frames per second of the animation.
+    pub fps: f32,
+    /// Millimetres per model unit.
+    pub mm_per_unit: f64,
+    /// Printed height of the model.
+    pub print_height_mm: f64,
+    /// Wall thickness of the pieces.
+    pub thickness_mm: f64,
+    /// Plugs across the seams.
+    pub plugs: Vec<PlugReport>,
+    /// Errors over all parts in millimetres.
+    pub errors_mm: ErrorSummary,
+    /// Per part.
+    pub parts: Vec<PartReport>,
+    /// Iterations summed over parts.
+    pub iterations: usize,
+    /// Restarts per solve.
+    pub restarts: usize,
+    /// Shooting order summary.
+    pub shooting_order: OrderReport,
+    /// Wall time of the optimization in seconds.
+    pub seconds: f64,
+    /// Wall time of the whole job in seconds.
+    pub total_seconds: f64,
+}
+
+/// Inputs of [`LibraryReport::new`] beyond the library.
+pub(crate) struct ReportInputs<'a> {
+    pub(crate) names: &'a [String],
+    pub(crate) plugs: &'a [Plug],
+    pub(crate) order: &'a ShootingOrder,
+    pub(crate) frames: usize,
+    pub(crate) fps: f32,
+    pub(crate) print_height_mm: f64,
+    pub(crate) thickness_mm: f64,
+    pub(crate) restarts: usize,
+}
+
+impl LibraryReport {
+    /// The report of `lib` (`total_seconds` 0 until the job sets it).
+    pub(crate) fn new(lib: &Library, x: &ReportInputs<'_>) -> LibraryReport {
+        LibraryReport {
+            input: None,
+            method: lib.method,
+            energy: lib.energy,
+            lambda: lib.lambda,
+            pieces: lib.total_pieces(),
+            frames: x.frames,
+            fps: x.fps,
+            mm_per_unit: lib.mm_per_unit,
+            print_height_mm: x.print_height_mm,
+            thickness_mm: x.thickness_mm,
+            plugs: x.plugs.iter().map(|p| plug_report(p, x.names)).collect(),
+            errors_mm: lib.errors_mm,
+            parts: lib
+                .parts
+                .iter()
+                .map(|p| PartReport {
+                    name: p.name.clone(),
+                    pieces: p.solution.pieces.len(),
+                    vertices: p.vertices,
+                    energy: p.solution.energy,
+                    iterations: p.solution.iterations,
+                    restarts: p.solution.restarts,
+                    errors_mm: p.errors_mm,
+                })
+                .collect(),
+            iterations: lib.parts.iter().map(|p| p.solution.iterations).sum(),
+            restarts: x.restarts,
+            shooting_order: OrderReport {
+                shots: x.order.shots.len(),
+                swaps: x.order.swaps,
+                sequential_swaps: x.order.sequential_swaps,
+            },
+            seconds: lib.seconds,
+            total_seconds: 0.0,
+        }
+    }
+
+    /// Pretty-printed JSON (`report.json`).
+    pub fn to_json(&self) -> String {
+        super::segment_job::to_pretty_json(self)
+    }
+}
+
+fn plug_report(p: &Plug, names: &[String]) -> PlugReport {
+    PlugReport {
+        male: names[p.male].clone(),
+        female: names[p.female].clone(),
+        anchor_mm: p.anchor,
+        normal: p.normal,
+        axis: p.axis,
+        center_mm: p.center,
+        radius_mm: p.radius_mm,
+        socket_radius_mm: p.socket_radius_mm,
+        outer_radius_mm: p.outer_radius_mm,
+        length_mm: p.length_mm,
+        seam_vertices: p.seam_vertices,
+    }
+}

@@ -1,0 +1,68 @@
+//! What [`library`](crate::library()) and [`run`](crate::run()) return.
+
+use anim::{Mesh, MeshAnimation};
+
+use super::report::LibraryReport;
+use super::segment_job::Segmented;
+use crate::library::{Assembly, Library, Plug, ShootingOrder};
+
+/// One printable piece.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Piece {
+    /// Identifier `<part>_<NN>` (the file stem of `pieces/<id>.stl`).
+    pub id: String,
+    /// Index of the part.
+    pub part: usize,
+    /// Index of the piece in its part's library (fixed pieces first).
+    pub index: usize,
+    /// The piece's surface in model units, with the part's topology and UVs.
+    pub surface: Mesh,
+    /// The printable solid in millimetres (with the part's plug shells, if any).
+    pub solid: Mesh,
+}
+
+/// The replacement library of every part and everything needed to print and shoot it.
+#[derive(Debug, Clone)]
+pub struct LibraryResult {
+    /// The segmentation the parts came from ([`run`](crate::run()) only).
+    pub segmented: Option<Segmented>,
+    /// Part names (file-safe), in part order.
+    pub part_names: Vec<String>,
+    /// Libraries, labels, per-frame errors and size curves of every part.
+    pub library: Library,
+    /// Every piece, part by part.
+    pub pieces: Vec<Piece>,
+    /// Which piece of each part goes on each frame.
+    pub assembly: Assembly,
+    /// A proposed order to shoot the frames with few piece swaps.
+    pub shooting_order: ShootingOrder,
+    /// Plugs across the seams (empty unless asked for).
+    pub plugs: Vec<Plug>,
+    /// The stop-motion reconstruction of every part (model units, input timing).
+    pub reconstruction: Vec<MeshAnimation>,
+    /// The numbers of `report.json`.
+    pub report: LibraryReport,
+}
+
+impl LibraryResult {
+    /// Piece label of every frame, per part.
+    pub fn labels(&self) -> Vec<&[u32]> {
+        self.library
+            .parts
+            .iter()
+            .map(|p| p.solution.labels.as_slice())
+            .collect()
+    }
+
+    /// Whether a size search ran (then there is a size-versus-error curve).
+    pub fn has_curve(&self) -> bool {
+        self.library.parts.iter().any(|p| !p.curve.is_empty())
+    }
+
+    /// Piece identifiers of every frame (rows of the assembly sheet).
+    pub fn frame_ids(&self) -> Vec<Vec<String>> {
+        (0..self.assembly.frames.len())
+            .map(|f| self.assembly.frame_ids(f))
+            .collect()
+    }
+}

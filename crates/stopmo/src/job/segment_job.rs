@@ -1,0 +1,158 @@
+//! The segmentation job: seeds or automatic parts → [`Segmentation`] → one animation per
+//! part, with the report of SPEC "Output layouts" and the Fig. 5 figure.
+
+use std::time::Instant;
+
+use anim::MeshAnimation;
+use serde::Serialize;
+
+use super::error::{Error, Result};
+use super::options::SegmentJobOptions;
+use crate::segment::{HomogenizeStats, Part, SegmentReport, Segmentation};
+
+/// The result of [`segment`]: the segmentation, its parts, and what the job measured.
+#[derive(Debug, Clone)]
+pub struct Segmented {
+    /// The cut (and homogenized) animation with its labels, seams and measurements.
+    pub segmentation: Segmentation,
+    /// Every part as its own animation, in part order, named after the part.
+    pub parts: Vec<Part>,
+    /// StopShop Fig. 5 as PNG bytes, when [`SegmentJobOptions::figure`] asked for it.
+    pub figure: Option<Vec<u8>>,
+    /// Wall time of the job in seconds.
+    pub seconds: f64,
+}
+
+/// One part in a [`SegmentSummary`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PartSummary {
+    /// Part name.
+    pub name: String,
+    /// Vertices of the part (seam vertices are in every part they bound).
+    pub vertices: usize,
+    /// Triangles of the part.
+    pub triangles: usize,
+}
+
+/// A short machine-readable summary of a segmentation (what `toonkit stopmo segment --json`
+/// prints, without paths and timing).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SegmentSummary {
+    /// The parts.
+    pub parts: Vec<PartSummary>,
+    /// Frames of the animation.
+    pub frames: usize,
+    /// γ used (StopShop Eq. 1).
+    pub gamma: f64,
+    /// Length of the part boundaries on the average mesh (model units).
+    pub cut_length: f64,
+    /// Number of seam vertices.
+    pub seam_vertices: usize,
+    /// Homogenization measurements, `null` when not run.
+    pub homogenization: Option<HomogenizeStats>,
+}
+
+/// Segments `anim` into parts and homogenizes the seams (StopShop Sections 3.1–3.2): the
+/// whole job of `toonkit stopmo segment`.
+///
+/// # Errors
+/// [`Error::Option`] (`parts`) when fewer than two parts are given, or the segmentation's
+/// own errors ([`Error::Segment`]).
+pub fn segment(anim: &MeshAnimation, opts: &SegmentJobOptions) -> Result<Segmented> {
+    let start = Instant::now();
+    let parts = match opts.auto_parts {
+        Some(n) => crate::segment::auto_parts(anim, n)?,
+        None => opts.parts.clone(),
+    };
+    if parts.len() < 2 {
+        return Err(Error::option_error(
+            "parts",
+            "give at least two parts, each with a seed (or auto_parts = N)",
+        ));
+    }
+    let segmentation = crate::segment::segment(anim, &parts, &opts.segment)?;
+    let parts = segmentation.parts()?;
+    let figure = if opts.figure {
+        Some(render::encode_png(&super::figure::parts_figure(
+            &segmentation,
+        )?)?)
+    } else {
+        None
+    };
+    Ok(Segmented {
+        segmentation,
+        parts,
+        figure,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+impl Segmented {
+    /// The report of SPEC "Output layouts" (`parts`, `triangle_part`, `seam_vertices`,
+    /// `gamma`, `cut_length`, `homogenization`).
+    pub fn report(&self) -> SegmentReport {
+        self.segmentation.report()
+    }
+
+    /// [`Segmented::report`] as pretty-printed JSON (`segmentation.json`).
+    pub fn report_json(&self) -> String {
+        to_pretty_json(&self.report())
+    }
+
+    /// The part animations, as a [`crate::library()`] input.
+    pub fn part_animations(&self) -> Vec<&MeshAnimation> {
+        self.parts.iter().map(|p| &p.animation).collect()
+    }
+
+    /// A short summary (no paths, no timing).
+    pub fn summary(&self) -> SegmentSummary {
+        let s = &self.segmentation;
+        SegmentSummary {
+            parts: self
+                .parts
+                .iter()
+                .map(|p| PartSummary {
+                    name: p.name.clone(),
+                    vertices: p.animation.vertex_count(),
+                    triangles: p.animation.mesh.triangle_count(),
+                })
+                .collect(),
+            frames: s.animation.frame_count(),
+            gamma: s.gamma,
+            cut_length: s.cut_length,
+            seam_vertices: s.seam_vertices.len(),
+            homogenization: s.homogenization,
+        }
+    }
+
+    /// One line for people: `upper (N triangles), lower (M triangles) over F frames, cut
+    /// length L, K seam vertices`.
+    pub fn describe(&self) -> String {
+        let names: Vec<String> = self
+            .parts
+            .iter()
+            .map(|p| {
+                format!(
+                    "{} ({} triangles)",
+                    p.name,
+                    p.animation.mesh.triangle_count()
+                )
+            })
+            .collect();
+        format!(
+            "{} over {} frames, cut length {:.3}, {} seam vertices",
+            names.join(", "),
+            self.segmentation.animation.frame_count(),
+            self.segmentation.cut_length,
+            self.segmentation.seam_vertices.len(),
+        )
+    }
+}
+
+/// Pretty JSON through [`serde_json::Value`] (keys sorted, numbers as serde_json prints
+/// them), the form every toonkit report uses.
+pub(crate) fn to_pretty_json<T: Serialize>(value: &T) -> String {
+    serde_json::to_value(value)
+        .and_then(|v| serde_json::to_string_pretty(&v))
+        .unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+}

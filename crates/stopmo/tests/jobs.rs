@@ -1,0 +1,273 @@
+//! The whole jobs `stopmo::{segment, library, run}` on a synthetic talking tube and on the
+//! ICT face (sampled at 1 fps: 60 frames, cheap): options from serde, results, reports and
+//! the output layout.
+
+mod common;
+mod segment_support;
+
+use anim::{MeshAnimation, SampleOptions};
+use glam::Vec3;
+use segment_support::talking_tube;
+use stopmo::segment::{PartSpec, Seed};
+use stopmo::{FileData, LibraryJobOptions, PieceCount, RunOptions, SegmentJobOptions};
+
+fn tube_parts() -> Vec<PartSpec> {
+    vec![
+        PartSpec::new("upper", vec![Seed::Point(Vec3::new(0.0, 0.95, 1.0))]),
+        PartSpec::new("lower", vec![Seed::Point(Vec3::new(0.0, -0.95, 1.0))]),
+    ]
+}
+
+/// The face's single mesh sampled at `fps`.
+fn face(fps: f32) -> MeshAnimation {
+    let scene = tkio::gltf::read(&common::asset("face/ict-face-talk.glb")).unwrap();
+    let s = anim::sample(
+        &scene,
+        &SampleOptions {
+            fps,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    s.objects.into_iter().next().unwrap().animation
+}
+
+#[test]
+fn segment_then_library_on_a_tube_gives_the_spec_layout() {
+    let anim = talking_tube(24, 30, 36);
+    let seg = stopmo::segment(
+        &anim,
+        &SegmentJobOptions {
+            parts: tube_parts(),
+            figure: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let names: Vec<&str> = seg.parts.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(names, ["upper", "lower"]);
+    let summary = seg.summary();
+    assert_eq!(summary.frames, 36);
+    assert!(
+        summary.seam_vertices > 10 && summary.cut_length > 1.0,
+        "{summary:?}"
+    );
+    let png = render::decode_png(seg.figure.as_ref().unwrap()).unwrap();
+    assert!(
+        png.width() > png.height(),
+        "Fig. 5 has two panels side by side"
+    );
+    let report: serde_json::Value = serde_json::from_str(&seg.report_json()).unwrap();
+    assert_eq!(report["parts"], serde_json::json!(["upper", "lower"]));
+
+    let parts: Vec<MeshAnimation> = seg.parts.iter().map(|p| p.animation.clone()).collect();
+    let opts = LibraryJobOptions {
+        pieces: PieceCount::PerPart([("upper".into(), 3), ("lower".into(), 5)].into()),
+        ..Default::default()
+    };
+    let lib = stopmo::library(&parts, &opts).unwrap();
+    assert_eq!(lib.pieces.len(), 8);
+    assert_eq!(lib.report.pieces, 8);
+    assert_eq!(lib.labels().len(), 2);
+    assert!(lib.labels().iter().all(|l| l.len() == 36));
+    // Every piece is a closed solid in millimetres and a surface in model units.
+    for p in &lib.pieces {
+        let check = stopmo::library::check_solid(&p.solid);
+        assert!(check.is_closed_manifold(), "{}: {check:?}", p.id);
+        assert_eq!(p.surface.vertex_count(), parts[p.part].vertex_count());
+    }
+    // The reconstruction shows each frame's piece.
+    for (part, recon) in lib.reconstruction.iter().enumerate() {
+        let sol = &lib.library.parts[part].solution;
+        for f in [0, 17, 35] {
+            assert_eq!(recon.frame(f), &sol.pieces[sol.labels[f] as usize][..]);
+        }
+    }
+    // The report's errors are the library's, in mm at the default 25 mm print height.
+    assert_eq!(lib.report.errors_mm, lib.library.errors_mm);
+    assert!(lib.report.errors_mm.position_mean > 0.0);
+    assert!(lib.report.errors_mm.position_mean < lib.report.errors_mm.position_max);
+    // The output layout.
+    let files = lib.files().unwrap();
+    let paths: Vec<&str> = files.iter().map(|f| f.path.as_str()).collect();
+    for want in [
+        "pieces/upper_00.obj",
+        "pieces/upper_02.stl",
+        "pieces/lower_04.stl",
+        "assembly.csv",
+        "assembly.md",
+        "shooting_order.csv",
+        "report.json",
+        "reconstruction.glb",
+        "reconstruction.pc2",
+        "rest.obj",
+    ] {
+        assert!(paths.contains(&want), "no {want} in {paths:?}");
+    }
+    assert!(
+        !paths.iter().any(|p| p.starts_with("error_curve")),
+        "no size search ran"
+    );
+    assert!(
+        !paths.iter().any(|p| p.starts_with("segmentation")),
+        "library only"
+    );
+    let csv = lib.assembly_csv();
+    assert_eq!(csv.lines().count(), 37);
+    assert!(csv.starts_with("frame,upper,lower\n0,upper_"));
+    let order = lib.shooting_order_csv();
+    assert!(order.starts_with("shot,upper,lower,frames\n"));
+    assert_eq!(order.lines().count(), lib.shooting_order.shots.len() + 1);
+    let report: serde_json::Value = serde_json::from_str(&lib.report.to_json()).unwrap();
+    for key in [
+        "energy",
+        "lambda",
+        "pieces",
+        "errors_mm",
+        "parts",
+        "seconds",
+        "iterations",
+        "restarts",
+    ] {
+        assert!(!report[key].is_null(), "report.json lacks {key}");
+    }
+    assert!(
+        report.get("input").is_none(),
+        "no input file in a library call"
+    );
+    match &files
+        .iter()
+        .find(|f| f.path == "reconstruction.pc2")
+        .unwrap()
+        .data
+    {
+        FileData::PointCache(a) => {
+            assert_eq!(a.frame_count(), 36);
+            assert_eq!(
+                a.vertex_count(),
+                parts.iter().map(|p| p.vertex_count()).sum::<usize>()
+            );
+        }
+        other => panic!("reconstruction.pc2 holds {other:?}"),
+    }
+}
+
+#[test]
+fn options_come_from_json_and_bad_options_name_themselves() {
+    let opts: RunOptions = serde_json::from_str(
+        r#"{
+            "segment": {"parts": [
+                {"name": "upper", "seeds": [{"Point": [0.0, 0.95, 1.0]}]},
+                {"name": "lower", "seeds": [{"Point": [0.0, -0.95, 1.0]}]}
+            ], "gamma": 1000.0},
+            "library": {"pieces": {"each": 4}, "lambda": 1.5, "restarts": 2}
+        }"#,
+    )
+    .unwrap();
+    assert_eq!(opts.segment.segment.gamma, 1000.0);
+    assert_eq!(opts.library.solve.lambda, 1.5);
+    assert_eq!(opts.library.pieces, PieceCount::Each(4));
+    assert_eq!(
+        opts.library.thickness_mm,
+        stopmo::library::DEFAULT_THICKNESS_MM
+    );
+    let anim = talking_tube(16, 20, 24);
+    let result = stopmo::run(&anim, &opts).unwrap();
+    assert_eq!(result.pieces.len(), 8);
+    assert_eq!(result.report.lambda, 1.5);
+    let paths: Vec<String> = result
+        .files()
+        .unwrap()
+        .into_iter()
+        .map(|f| f.path)
+        .collect();
+    assert!(paths.iter().any(|p| p == "segmentation.glb"));
+    assert!(paths.iter().any(|p| p == "segmentation.json"));
+    assert!(
+        !paths.iter().any(|p| p == "segmentation.png"),
+        "no figure asked for"
+    );
+
+    let parts: Vec<MeshAnimation> = result
+        .segmented
+        .as_ref()
+        .unwrap()
+        .parts
+        .iter()
+        .map(|p| p.animation.clone())
+        .collect();
+    let bad = |o: LibraryJobOptions| stopmo::library(&parts, &o).unwrap_err();
+    let e = bad(LibraryJobOptions {
+        saliency: Some(vec![1.0; 3]),
+        ..Default::default()
+    });
+    assert_eq!(e.option(), Some("saliency"), "{e}");
+    let e = bad(LibraryJobOptions {
+        pieces: PieceCount::PerPart([("nose".into(), 3)].into()),
+        ..Default::default()
+    });
+    assert_eq!(e.option(), Some("pieces"));
+    assert!(e.to_string().contains("nose"), "{e}");
+    let e = bad(LibraryJobOptions {
+        pieces: PieceCount::MaxErrorMm(-1.0),
+        ..Default::default()
+    });
+    assert_eq!(e.option(), Some("max_error_mm"));
+    let e = stopmo::segment(&anim, &SegmentJobOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("two parts"), "{e}");
+    // Stage errors keep their source chain.
+    let e = bad(LibraryJobOptions {
+        pieces: PieceCount::Each(0),
+        ..Default::default()
+    });
+    assert!(matches!(e, stopmo::Error::Library(_)), "{e:?}");
+}
+
+#[test]
+fn face_run_equals_segment_then_library_and_searches_a_size() {
+    let anim = face(1.0);
+    assert_eq!(anim.frame_count(), 60);
+    let opts = RunOptions {
+        segment: SegmentJobOptions {
+            parts: vec![
+                PartSpec::new("upper", vec![Seed::Point(Vec3::new(0.0, 10.0, 13.0))]),
+                PartSpec::new("lower", vec![Seed::Point(Vec3::new(0.0, -14.0, 10.0))]),
+            ],
+            ..Default::default()
+        },
+        library: LibraryJobOptions {
+            pieces: PieceCount::MaxErrorMm(0.3),
+            solve: stopmo::library::SolveOptions {
+                restarts: 2,
+                ..Default::default()
+            },
+            ..Default::default()
+        },
+    };
+    let run = stopmo::run(&anim, &opts).unwrap();
+    let seg = stopmo::segment(&anim, &opts.segment).unwrap();
+    let parts: Vec<MeshAnimation> = seg.parts.iter().map(|p| p.animation.clone()).collect();
+    let lib = stopmo::library(&parts, &opts.library).unwrap();
+    assert_eq!(run.labels(), lib.labels(), "run = segment + library");
+    assert_eq!(run.report.pieces, lib.report.pieces);
+    assert_eq!(run.report.energy, lib.report.energy);
+    // A size search ran: every part has a curve, and the chosen size meets the bound.
+    assert!(run.has_curve());
+    for p in &run.library.parts {
+        let chosen = p
+            .curve
+            .iter()
+            .find(|c| c.pieces == p.solution.pieces.len())
+            .expect("chosen size on the curve");
+        assert!(chosen.worst_frame_error * run.library.mm_per_unit <= 0.3);
+    }
+    let csv = run.error_curve_csv().unwrap();
+    assert!(csv.starts_with("part,pieces,energy,worst_frame_error_mm,mean_error_mm\n"));
+    let png = render::decode_png(&run.error_curve_png().unwrap().unwrap()).unwrap();
+    assert_eq!((png.width(), png.height()), (720, 420));
+    assert!(
+        run.report.errors_mm.position_max < 5.0,
+        "{:?}",
+        run.report.errors_mm
+    );
+}
