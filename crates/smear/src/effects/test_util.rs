@@ -4,7 +4,7 @@ use anim::{Mesh, MeshAnimation};
 use glam::Vec3;
 
 /// A UV sphere of radius `r`.
-pub fn ball(r: f32, rings: usize, segments: usize) -> Mesh {
+pub(crate) fn ball(r: f32, rings: usize, segments: usize) -> Mesh {
     let mut p = vec![Vec3::Y * r, -Vec3::Y * r];
     for a in 1..rings {
         let th = std::f32::consts::PI * a as f32 / rings as f32;
@@ -27,7 +27,7 @@ pub fn ball(r: f32, rings: usize, segments: usize) -> Mesh {
 }
 
 /// A ball translating along +X by `speed` per frame.
-pub fn translating_ball(frames: usize, speed: f32) -> MeshAnimation {
+pub(crate) fn translating_ball(frames: usize, speed: f32) -> MeshAnimation {
     let mesh = ball(1.0, 12, 24);
     let pos = (0..frames)
         .flat_map(|f| {
