@@ -20,6 +20,7 @@ mod progress;
 mod scene;
 mod smear_job;
 mod smear_py;
+mod stopmo_py;
 
 use pyo3::prelude::*;
 
@@ -38,6 +39,11 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(smear_job::stylize, m)?)?;
     m.add_class::<loa_py::Line>()?;
     m.add_function(wrap_pyfunction!(loa_py::line, m)?)?;
+    m.add_class::<stopmo_py::Segmented>()?;
+    m.add_class::<stopmo_py::Library>()?;
+    m.add_function(wrap_pyfunction!(stopmo_py::segment, m)?)?;
+    m.add_function(wrap_pyfunction!(stopmo_py::library, m)?)?;
+    m.add_function(wrap_pyfunction!(stopmo_py::run, m)?)?;
     m.add_class::<loa_animate::Motion>()?;
     m.add_function(wrap_pyfunction!(loa_animate::animate, m)?)?;
     Ok(())
