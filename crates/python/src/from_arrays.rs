@@ -20,6 +20,7 @@ pub(crate) fn sampled(
     triangles: &ArrayIn<'_, i64>,
     fps: f32,
     skin: Option<&Bound<'_, PyDict>>,
+    objects: Option<Vec<(String, usize, usize)>>,
 ) -> PyResult<SampledScene> {
     if !(fps.is_finite() && fps > 0.0) {
         return Err(value_error(format!(
@@ -53,10 +54,97 @@ pub(crate) fn sampled(
     let animation =
         MeshAnimation::new(mesh, fps, points).map_err(|e| value_error(at(SOURCE, e)))?;
     let mut scene = SampledScene::from_animation(animation);
+    let mut object_parents = None;
     if let Some(skin) = skin {
         add_skin(&mut scene, skin)?;
+        if let Some(p) = skin.get_item("object_parents")? {
+            object_parents = Some(p.extract::<Vec<i64>>()?);
+        }
+    }
+    if let Some(objects) = objects {
+        split_objects(&mut scene, &objects, object_parents.as_deref())?;
     }
     Ok(scene)
+}
+
+/// Splits the one object of `scene` into `objects` (`(name, start, stop)` vertex ranges
+/// tiling the vertices in order). An object whose vertices have no skin weight is unskinned
+/// (a simple object, SMEAR Eq. 1), carried by `object_parents[i]` when that is a joint.
+fn split_objects(
+    scene: &mut SampledScene,
+    objects: &[(String, usize, usize)],
+    object_parents: Option<&[i64]>,
+) -> PyResult<()> {
+    let whole = scene.objects.remove(0);
+    let vertices = whole.animation.vertex_count();
+    let mut next = 0;
+    for (name, start, stop) in objects {
+        if *start != next || stop < start || *stop > vertices {
+            return Err(value_error(format!(
+                "objects must tile the {vertices} vertices in order; {name:?} covers {start}..{stop}"
+            )));
+        }
+        next = *stop;
+    }
+    if next != vertices {
+        return Err(value_error(format!(
+            "objects cover {next} of the {vertices} vertices"
+        )));
+    }
+    if let Some(p) = object_parents {
+        if p.len() != objects.len() {
+            return Err(value_error(format!(
+                "skin has {} object_parents for {} objects",
+                p.len(),
+                objects.len()
+            )));
+        }
+    }
+    let mut triangles: Vec<Vec<[u32; 3]>> = vec![Vec::new(); objects.len()];
+    for (i, t) in whole.animation.mesh.triangles.iter().enumerate() {
+        let k = objects.partition_point(|o| o.2 <= t[0] as usize);
+        let (_, a, b) = &objects[k];
+        if !t.iter().all(|&v| (*a..*b).contains(&(v as usize))) {
+            return Err(value_error(format!(
+                "triangles[{i}] joins vertices of two objects"
+            )));
+        }
+        triangles[k].push(t.map(|v| v - *a as u32));
+    }
+    let frames = whole.animation.frame_count();
+    for (k, ((name, a, b), tris)) in objects.iter().zip(triangles).enumerate() {
+        let mut positions = Vec::with_capacity(frames * (b - a));
+        for f in 0..frames {
+            positions.extend_from_slice(&whole.animation.frame(f)[*a..*b]);
+        }
+        let mesh = Mesh::new(name.clone(), positions[..b - a].to_vec(), tris);
+        let animation = MeshAnimation::new(mesh, whole.animation.fps, positions)
+            .map_err(|e| value_error(at(SOURCE, e)))?;
+        let skin = whole.skin.as_ref().and_then(|s| {
+            let rows: Vec<Vec<(u32, f32)>> = (*a..*b)
+                .map(|v| {
+                    let (j, w) = s.weights.influences(v);
+                    j.iter().copied().zip(w.iter().copied()).collect()
+                })
+                .collect();
+            rows.iter().any(|r| !r.is_empty()).then(|| Skin {
+                joints: s.joints.clone(),
+                inverse_bind: s.inverse_bind.clone(),
+                weights: VertexWeights::from_influences(rows),
+            })
+        });
+        let parent_joint = object_parents
+            .and_then(|p| usize::try_from(p[k]).ok())
+            .filter(|&j| j < scene.skeleton.len());
+        scene.objects.push(anim::MeshObject {
+            node: k,
+            name: name.clone(),
+            animation,
+            skin,
+            parent_joint,
+        });
+    }
+    Ok(())
 }
 
 fn item<'py>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<Bound<'py, PyAny>> {
@@ -200,5 +288,11 @@ pub(crate) fn skin_dict<'py>(
     d.set_item("parents", frozen(py, &[joints], parents)?)?;
     d.set_item("matrices", frozen(py, &[frames, joints, 4, 4], matrices)?)?;
     d.set_item("weights", frozen(py, &[vertices, joints], weights)?)?;
+    let object_parents: Vec<i64> = scene
+        .objects
+        .iter()
+        .map(|o| o.parent_joint.map_or(-1, |j| j as i64))
+        .collect();
+    d.set_item("object_parents", object_parents)?;
     Ok(Some(d))
 }

@@ -176,6 +176,10 @@ impl Scene {
     /// so that articulated offsets (SMEAR Eqs. 3-9) work on data from Blender too.
     /// ``Scene.skin`` returns the same dict for a loaded scene.
     ///
+    /// ``objects`` (``[(name, range(start, stop)), ...]`` tiling the vertices, as
+    /// ``Scene.objects`` returns them) splits the mesh into objects: an object without skin
+    /// weights is a simple object (SMEAR Eq. 1), carried by ``skin["object_parents"][i]``.
+    ///
     /// Arrays are read in place when they are C-contiguous float32 (int for indices).
     ///
     /// >>> s = toonkit.load("assets/characters/RobotExpressive.glb", clip="Dance")
@@ -183,15 +187,27 @@ impl Scene {
     /// >>> t.positions.shape == s.positions.shape
     /// True
     #[staticmethod]
-    #[pyo3(signature = (positions, triangles, fps=24.0, skin=None))]
+    #[pyo3(signature = (positions, triangles, fps=24.0, skin=None, objects=None))]
     fn from_arrays(
         py: Python<'_>,
         positions: crate::arrays::ArrayIn<'_, f32>,
         triangles: crate::arrays::ArrayIn<'_, i64>,
         fps: f32,
         skin: Option<&Bound<'_, PyDict>>,
+        objects: Option<Vec<(String, Bound<'_, PyAny>)>>,
     ) -> PyResult<Scene> {
-        let sampled = crate::from_arrays::sampled(&positions, &triangles, fps, skin)?;
+        let objects = objects
+            .map(|list| {
+                list.into_iter()
+                    .map(|(name, r)| {
+                        let start: usize = r.getattr("start")?.extract()?;
+                        let stop: usize = r.getattr("stop")?.extract()?;
+                        Ok((name, start, stop))
+                    })
+                    .collect::<PyResult<Vec<_>>>()
+            })
+            .transpose()?;
+        let sampled = crate::from_arrays::sampled(&positions, &triangles, fps, skin, objects)?;
         Scene::new(py, sampled, "<arrays>".to_string(), None)
     }
 

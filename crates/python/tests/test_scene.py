@@ -57,8 +57,13 @@ def test_skin_round_trip(robot):
     assert skin["matrices"].shape == (robot.frame_count, joints, 4, 4)
     assert skin["weights"].shape == (robot.vertex_count, joints)
     assert skin["parents"].shape == (joints,)
-    # Rows are normalized weights (every robot vertex is skinned).
-    np.testing.assert_allclose(skin["weights"].sum(axis=1), 1.0, atol=1e-5)
+    # Rows are normalized weights on skinned objects, zero on the rigid props (most of the
+    # robot's objects are props parented to joints: object_parents names their joints).
+    sums = skin["weights"].sum(axis=1)
+    assert np.all((np.abs(sums - 1.0) < 1e-5) | (sums == 0.0))
+    assert len(skin["object_parents"]) == len(robot.objects)
+    for (name, r), parent in zip(robot.objects, skin["object_parents"]):
+        assert parent >= 0 or sums[r.start] == 1.0, name
     # Matrices are row-major with the translation in column 3.
     np.testing.assert_allclose(skin["matrices"][:, :, 3, :], [[[0, 0, 0, 1]] * joints] * robot.frame_count, atol=1e-6)
 

@@ -43,11 +43,15 @@ def test_offset_options_equal_cli_flags(robot, tmp_path, kwargs, flags):
 
 def test_from_arrays_with_skin_gives_the_same_offsets(robot):
     scene = toonkit.Scene.from_arrays(
-        robot.positions, robot.triangles, fps=robot.fps, skin=robot.skin
+        robot.positions, robot.triangles, fps=robot.fps, skin=robot.skin, objects=robot.objects
     )
+    assert scene.objects == robot.objects
     assert scene.joint_names == robot.joint_names
     loaded = toonkit.smear.offsets(robot)
     np.testing.assert_allclose(toonkit.smear.offsets(scene), loaded, atol=1e-6, rtol=0)
+    np.testing.assert_allclose(
+        toonkit.smear.offsets(scene, whole_body=True), toonkit.smear.offsets(robot, whole_body=True),
+        atol=1e-6, rtol=0)
     # Without the skin the robot is one simple object (SMEAR Eq. 1): different offsets.
     simple = toonkit.Scene.from_arrays(robot.positions, robot.triangles, fps=robot.fps)
     assert np.abs(toonkit.smear.offsets(simple) - loaded).max() > 0.1
@@ -120,7 +124,7 @@ def test_restyling_reuses_the_offsets(prepared):
     second = toonkit.smear.stylize(prepared, {"multiples": {"past": 2, "future": 0}})
     assert second.report["offset_solves"] == first.report["offset_solves"]
     copies = second.multiples
-    assert len(copies) == 2
+    assert len(copies) == 2 * len(prepared.report["objects"])  # two past copies per object
     for c in copies:
         f, v, _ = c["positions"].shape
         assert c["alpha"].shape == (f, v) and c["triangles"].shape[1] == 3
@@ -135,13 +139,14 @@ def test_multiples_only_style_keeps_the_body(robot, prepared):
 def test_motion_lines(robot, prepared):
     look = toonkit.smear.stylize(prepared, {"lines": {"count": 30}})
     assert look.lines, "the robot dances: some lines show"
+    shown = []
     for obj in look.lines:
         assert len(obj["frames"]) == robot.frame_count
-        shown = [m for m in obj["frames"] if len(m["triangles"])]
-        assert shown
-        for m in shown:
-            assert m["positions"].shape[1] == 3 and m["alpha"].shape == (len(m["positions"]),)
-            assert m["triangles"].max() < len(m["positions"])
+        shown += [m for m in obj["frames"] if len(m["triangles"])]
+    assert shown
+    for m in shown:
+        assert m["positions"].shape[1] == 3 and m["alpha"].shape == (len(m["positions"]),)
+        assert m["triangles"].max() < len(m["positions"])
 
 
 def test_style_errors(prepared, tmp_path):

@@ -55,4 +55,4 @@ def test_bad_parts_raise(face):
     with pytest.raises(ValueError):
         toonkit.stopmo.segment(face, parts={"a": [(0, 0)]})
     with pytest.raises(ValueError, match="options"):
-        toonkit.stopmo.library(toonkit.stopmo.segment(face, parts=PARTS), bogus=1)
+        toonkit.stopmo.library(toonkit.stopmo.segment(face, parts=PARTS), pieces=-1)

@@ -20,6 +20,7 @@ class Scene:
         triangles: npt.ArrayLike,
         fps: float = 24.0,
         skin: Optional[Mapping[str, Any]] = None,
+        objects: Optional[Sequence[tuple[str, range]]] = None,
     ) -> Scene: ...
     @property
     def positions(self) -> npt.NDArray[np.float32]: ...
