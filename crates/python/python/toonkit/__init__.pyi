@@ -1,0 +1,7 @@
+"""toonkit: stylization tools for 3D animation on numpy arrays (type stubs)."""
+
+from . import loa as loa, smear as smear, stopmo as stopmo
+from ._native import Scene as Scene, ToonkitError as ToonkitError, __version__ as __version__
+from ._native import load as load
+
+__all__ = ["Scene", "ToonkitError", "load", "loa", "smear", "stopmo", "__version__"]

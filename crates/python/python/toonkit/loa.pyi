@@ -1,0 +1,25 @@
+"""Dynamic lines of action (SBIM 2015) (type stubs)."""
+
+from typing import Any, Callable, Iterable, Mapping, Optional, Union
+
+import os
+
+from ._native import Line as Line, Motion as Motion, Scene
+
+def line(
+    keystrokes: Iterable[Mapping[str, Any]],
+    mode: str = "physics",
+    fps: float = 24.0,
+    progress: Optional[Callable[[str, float], Any]] = None,
+    **options: Any,
+) -> Line: ...
+def animate(
+    character: Union[Scene, str, os.PathLike[str]],
+    line: Line,
+    bones: Union[str, Iterable[str], None] = None,
+    contacts: Union[str, Iterable[str], None] = None,
+    twists: Union[str, Iterable[str], None] = None,
+    pose: str = "rest",
+    progress: Optional[Callable[[str, float], Any]] = None,
+    **options: Any,
+) -> Motion: ...

@@ -1,0 +1,124 @@
+"""Smear frames (Basset, Bénard, Barla, SIGGRAPH 2024) on :class:`toonkit.Scene`.
+
+Example::
+
+    import toonkit
+    scene = toonkit.load("assets/characters/RobotExpressive.glb", clip="Dance")
+    delta = toonkit.smear.offsets(scene, smooth=2)   # float32 (frames, vertices), in [-1, 1]
+
+    prepared = toonkit.smear.prepare(scene)          # offsets solved once ...
+    look = toonkit.smear.stylize(prepared, {"elongate": {"function": {"stages": [{"op": "scale", "by": 2}]}}})
+    look = toonkit.smear.stylize(prepared, "examples/smear/fig11c_speed.toml")  # ... reused
+    look.elongated                                   # float32 (frames, vertices, 3)
+    look.save("smear.glb")
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Callable, Iterable, Mapping, Optional, Union
+
+import numpy as np
+
+from . import _native
+from ._native import Prepared, Stylized
+
+__all__ = ["Prepared", "Stylized", "offsets", "prepare", "stylize"]
+
+
+def _prune_list(prune: Iterable[str]) -> list:
+    if isinstance(prune, str):
+        return [p for p in prune.split(",") if p]
+    return list(prune)
+
+
+def offsets(
+    scene: "_native.Scene",
+    smooth: int = 2,
+    whole_body: bool = False,
+    prune: Iterable[str] = (),
+    camera: Optional[Union[str, int]] = None,
+    progress: Optional[Callable[[str, float], None]] = None,
+) -> np.ndarray:
+    """Motion offsets per frame and vertex (SMEAR Eqs. 1-9).
+
+    Returns float32 ``(frames, vertices)`` in ``scene.positions``' vertex order: leading
+    parts > 0, trailing parts < 0 -- the array ``toonkit smear offsets IN -o OUT.npy`` writes.
+
+    ``smooth`` is the half-window N of SMEAR Eq. 2 (0 = off); ``whole_body`` treats each
+    skinned character as one object (Fig. 14); ``prune`` names joints whose vertices follow
+    their nearest kept ancestor; ``camera`` (name or index) measures motion relative to a
+    camera. The GIL is released while computing. ``progress(stage, fraction)`` is called
+    before and after.
+
+    >>> scene = toonkit.load("assets/characters/RobotExpressive.glb", clip="Dance")
+    >>> toonkit.smear.offsets(scene, prune=["Head"]).shape == scene.positions.shape[:2]
+    True
+    """
+    return _native.smear_offsets(
+        scene, int(smooth), bool(whole_body), _prune_list(prune), camera, progress
+    )
+
+
+def prepare(
+    scene: "_native.Scene",
+    smooth: int = 2,
+    whole_body: bool = False,
+    prune: Iterable[str] = (),
+    camera: Optional[Union[str, int]] = None,
+    weights: Optional[Mapping[str, Any]] = None,
+    merge: Optional[str] = None,
+    progress: Optional[Callable[[str, float], None]] = None,
+) -> Prepared:
+    """Everything a style does not change, computed once: offsets, camera, weights, velocities.
+
+    Takes the options of :func:`offsets`, plus ``weights`` (painted weights, the ``weights``
+    table of a style file, e.g. ``{"group": ["Head"]}``) and ``merge`` (merge all objects
+    into one of this name, as ``toonkit smear elongate`` does). Pass the result to
+    :func:`stylize` as often as you like: the offsets are never solved again.
+
+    >>> prepared = toonkit.smear.prepare(scene, smooth=2)
+    >>> prepared.offsets.shape == scene.positions.shape[:2]
+    True
+    """
+    extra = {}
+    if weights is not None:
+        extra["weights"] = dict(weights)
+    if merge is not None:
+        extra["merge"] = str(merge)
+    return _native.smear_prepare(
+        scene,
+        int(smooth),
+        bool(whole_body),
+        _prune_list(prune),
+        camera,
+        json.dumps(extra) if extra else None,
+        progress,
+    )
+
+
+def stylize(
+    prepared: Prepared,
+    style: Union[Mapping[str, Any], str, "os.PathLike[str]"],
+    progress: Optional[Callable[[str, float], None]] = None,
+) -> Stylized:
+    """Applies a style to prepared offsets (SMEAR Section 4 effects, Section 5 functions).
+
+    ``style`` is a dict with the keys of the TOML style files (``elongate``, ``multiples``,
+    ``lines``, ``weights``, ``objects``; see ``examples/smear/``) or the path of such a file.
+    A style without ``offsets`` uses the prepared ones; different ``offsets`` are an error
+    (prepare again to change them). Returns a :class:`Stylized` with ``.elongated``
+    ``(frames, vertices, 3)``, ``.multiples`` and ``.lines`` (per-frame meshes with
+    per-vertex ``alpha``), ``.report`` and ``.save(path)`` (``.glb`` or ``.usda``, as the CLI
+    writes them). The GIL is released while computing.
+
+    >>> look = toonkit.smear.stylize(prepared, {"multiples": {"past": 2, "future": 0}})
+    >>> len(look.multiples)
+    2
+    """
+    if isinstance(style, Mapping):
+        return _native.smear_stylize(prepared, json.dumps(style), None, progress)
+    if isinstance(style, (str, os.PathLike)):
+        return _native.smear_stylize(prepared, None, os.fspath(style), progress)
+    raise TypeError(f"style must be a dict or a path, got {type(style).__name__}")

@@ -1,0 +1,33 @@
+"""Smear frames (SIGGRAPH 2024) on toonkit.Scene (type stubs)."""
+
+import os
+from typing import Any, Callable, Iterable, Mapping, Optional, Union
+
+import numpy as np
+import numpy.typing as npt
+
+from ._native import Prepared as Prepared, Scene, Stylized as Stylized
+
+def offsets(
+    scene: Scene,
+    smooth: int = 2,
+    whole_body: bool = False,
+    prune: Iterable[str] = (),
+    camera: Optional[Union[str, int]] = None,
+    progress: Optional[Callable[[str, float], Any]] = None,
+) -> npt.NDArray[np.float32]: ...
+def prepare(
+    scene: Scene,
+    smooth: int = 2,
+    whole_body: bool = False,
+    prune: Iterable[str] = (),
+    camera: Optional[Union[str, int]] = None,
+    weights: Optional[Mapping[str, Any]] = None,
+    merge: Optional[str] = None,
+    progress: Optional[Callable[[str, float], Any]] = None,
+) -> Prepared: ...
+def stylize(
+    prepared: Prepared,
+    style: Union[Mapping[str, Any], str, os.PathLike[str]],
+    progress: Optional[Callable[[str, float], Any]] = None,
+) -> Stylized: ...

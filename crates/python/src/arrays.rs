@@ -1,0 +1,75 @@
+//! numpy in and out: inputs are read in place when they are C-contiguous with the right dtype
+//! (numpy converts other layouts and dtypes once); outputs hand their Rust buffer to numpy
+//! without copying.
+
+use numpy::ndarray::{ArrayD, IxDyn};
+use numpy::{
+    AllowTypeChange, Element, IntoPyArray, PyArrayDyn, PyArrayLikeDyn, PyUntypedArrayMethods,
+};
+use pyo3::prelude::*;
+
+use crate::errors::value_error;
+
+/// An input array of element type `T` (any array-like numpy can convert).
+pub(crate) type ArrayIn<'py, T> = PyArrayLikeDyn<'py, T, AllowTypeChange>;
+
+/// The shape of `a`, checked against `expected` (`None` = any extent) and naming `what` in
+/// the error.
+pub(crate) fn shape<T: Element>(
+    a: &ArrayIn<'_, T>,
+    what: &str,
+    expected: &[Option<usize>],
+) -> PyResult<Vec<usize>> {
+    let s = a.shape().to_vec();
+    let fits = s.len() == expected.len()
+        && s.iter()
+            .zip(expected)
+            .all(|(n, e)| e.is_none_or(|e| e == *n));
+    if !fits {
+        let want: Vec<String> = expected
+            .iter()
+            .enumerate()
+            .map(|(i, e)| e.map_or(format!("n{i}"), |e| e.to_string()))
+            .collect();
+        return Err(value_error(format!(
+            "{what} must have shape ({}), got {s:?}",
+            want.join(", ")
+        )));
+    }
+    Ok(s)
+}
+
+/// The values of `a` in C order, borrowed when contiguous.
+pub(crate) fn values<'a, T: Element + Copy>(a: &'a ArrayIn<'_, T>) -> std::borrow::Cow<'a, [T]> {
+    match a.as_slice() {
+        Ok(s) => std::borrow::Cow::Borrowed(s),
+        Err(_) => std::borrow::Cow::Owned(a.as_array().iter().copied().collect()),
+    }
+}
+
+/// A numpy array of `shape` owning `data` (no copy).
+pub(crate) fn output<'py, T: Element>(
+    py: Python<'py>,
+    shape: &[usize],
+    data: Vec<T>,
+) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
+    let a = ArrayD::from_shape_vec(IxDyn(shape), data)
+        .map_err(|e| value_error(format!("internal shape error: {e}")))?;
+    Ok(a.into_pyarray(py))
+}
+
+/// [`output`], then marked read-only (arrays a result keeps and returns on every access).
+pub(crate) fn frozen<'py, T: Element>(
+    py: Python<'py>,
+    shape: &[usize],
+    data: Vec<T>,
+) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
+    let a = output(py, shape, data)?;
+    a.call_method1("setflags", (false,))?;
+    Ok(a)
+}
+
+/// Flattens 3D points into `[x, y, z, …]`.
+pub(crate) fn flat3(points: &[glam::Vec3]) -> Vec<f32> {
+    points.iter().flat_map(|p| p.to_array()).collect()
+}

@@ -1,0 +1,89 @@
+"""Shared fixtures: repository assets and the `toonkit` CLI built from the same tree.
+
+The CLI is `$TOONKIT_CLI` if set, else `target/debug/toonkit` (built with
+`cargo build -p toonkit-cli` when missing), so module and CLI results are compared on the
+same inputs.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import toonkit
+
+REPO = Path(__file__).resolve().parents[3]
+ROBOT = "characters/RobotExpressive.glb"
+
+
+def asset(rel: str) -> Path:
+    """A repository asset (`assets/<rel>`); fails loudly when missing."""
+    p = REPO / "assets" / rel
+    assert p.exists(), f"missing asset {p}"
+    return p
+
+
+def example(rel: str) -> Path:
+    """A file under the repository's `examples/`."""
+    p = REPO / "examples" / rel
+    assert p.exists(), f"missing example {p}"
+    return p
+
+
+def _cli_path() -> Path:
+    env = os.environ.get("TOONKIT_CLI")
+    if env:
+        return Path(env)
+    p = REPO / "target" / "debug" / "toonkit"
+    if not p.exists():
+        subprocess.run(
+            ["cargo", "build", "--quiet", "-p", "toonkit-cli"], cwd=REPO, check=True
+        )
+    return p
+
+
+CLI = _cli_path()
+
+
+def run_cli(*args: object, check: bool = True) -> subprocess.CompletedProcess:
+    """Runs `toonkit ARGS` and returns the completed process (text output)."""
+    out = subprocess.run(
+        [str(CLI), *map(str, args)], capture_output=True, text=True, cwd=REPO
+    )
+    if check and out.returncode != 0:
+        raise AssertionError(f"toonkit {args} failed: {out.stderr}")
+    return out
+
+
+def cli_error(*args: object) -> str:
+    """The CLI's one-line error for ARGS, without its `toonkit: error: ` prefix."""
+    out = run_cli(*args, check=False)
+    assert out.returncode != 0, f"toonkit {args} unexpectedly succeeded"
+    line = out.stderr.strip()
+    assert "\n" not in line
+    return line.removeprefix("toonkit: error: ")
+
+
+def cli_json(*args: object) -> dict:
+    """Runs `toonkit --json ARGS` and parses its summary."""
+    return json.loads(run_cli("--json", *args).stdout)
+
+
+def read_pc2(path: Path) -> np.ndarray:
+    """Positions of a PC2 point cache, float32 (frames, points, 3)."""
+    data = path.read_bytes()
+    assert data[:12] == b"POINTCACHE2\0"
+    points = int(np.frombuffer(data, "<i4", 1, 16)[0])
+    frames = int(np.frombuffer(data, "<i4", 1, 28)[0])
+    return np.frombuffer(data, "<f4", frames * points * 3, 32).reshape(frames, points, 3)
+
+
+@pytest.fixture(scope="session")
+def robot() -> toonkit.Scene:
+    """RobotExpressive's Dance clip at 24 fps."""
+    return toonkit.load(asset(ROBOT), clip="Dance")

@@ -1,0 +1,94 @@
+"""toonkit.loa against `toonkit loa line` on the examples' keystrokes."""
+
+import json
+
+import numpy as np
+import pytest
+
+import toonkit
+from conftest import example, run_cli
+
+
+def keystrokes(name):
+    doc = json.loads(example(f"loa/{name}").read_text())
+    keys = []
+    for k in doc["keystrokes"]:
+        entry = {"frame": k["frame"], "points": np.array(k["points"])}
+        for opt in ("stiffness", "damping"):
+            if opt in k or opt in doc:
+                entry[opt] = k.get(opt, doc.get(opt))
+        keys.append(entry)
+    return keys, doc.get("fps", 24.0)
+
+
+@pytest.mark.parametrize("name, mode", [("jump.json", "physics"), ("whip.json", "hermite")])
+def test_line_equals_cli_json(tmp_path, name, mode):
+    out = tmp_path / "line.json"
+    run_cli("loa", "line", example(f"loa/{name}"), "--mode", mode, "-o", out)
+    expected = json.loads(out.read_text())
+    keys, fps = keystrokes(name)
+    line = toonkit.loa.line(keys, mode=mode, fps=fps)
+    assert line.keystroke_frames == expected["keystroke_frames"]
+    assert line.frames == [f["frame"] for f in expected["frames"]]
+    points = np.array([f["points"] for f in expected["frames"]])
+    assert line.points.shape == points.shape and line.points.shape[2] == 2
+    np.testing.assert_allclose(line.points, points, atol=1e-9, rtol=0)
+    np.testing.assert_allclose(line.angles, [f["angles"] for f in expected["frames"]], atol=1e-12)
+    assert json.loads(line.to_json()) == expected
+    saved = line.save(tmp_path / "again.json")
+    assert json.loads(saved.read_text()) == expected
+
+
+def test_bad_keystrokes_raise():
+    with pytest.raises(ValueError, match="frame"):
+        toonkit.loa.line([{"frame": 5, "points": [[0, 0], [1, 1]]},
+                          {"frame": 2, "points": [[0, 0], [1, 2]]}])
+    with pytest.raises(ValueError, match="shape"):
+        toonkit.loa.line([{"frame": 0, "points": [0, 1, 2]}])
+    with pytest.raises(ValueError, match="bouncy"):
+        toonkit.loa.line([{"frame": 0, "points": [[0, 0], [1, 1]]}], mode="bouncy")
+    with pytest.raises(ValueError):
+        toonkit.loa.line([])
+    line = toonkit.loa.line([{"frame": 0, "points": [[0, 0], [1, 1]]},
+                             {"frame": 4, "points": [[0, 0], [1, 2]]}])
+    with pytest.raises(ValueError, match=r"\.json or \.svg"):
+        line.save("line.png")
+
+
+JUMP_FLAGS = ["--bones", "right-leg-spine-head@0", "--bones", "left-leg-spine-head@22",
+              "--contact", "FootL@0..3", "--twist", "Torso_1@22:20"]
+
+
+def test_animate_equals_cli_bvh(robot, tmp_path):
+    from conftest import ROBOT, asset
+
+    out = tmp_path / "cli.bvh"
+    run_cli("loa", "animate", asset(ROBOT), example("loa/jump.json"), "-o", out, *JUMP_FLAGS)
+    keys, fps = keystrokes("jump.json")
+    line = toonkit.loa.line(keys, fps=fps)
+    motion = toonkit.loa.animate(
+        asset(ROBOT), line,
+        bones=["right-leg-spine-head@0", "left-leg-spine-head@22"],
+        contacts="FootL@0..3", twists=["Torso_1@22:20"],
+    )
+    frames = len(line.frames)
+    assert motion.rotations.shape == (frames, len(motion.joint_names), 4)
+    np.testing.assert_allclose(np.linalg.norm(motion.rotations, axis=2), 1.0, atol=1e-6)
+    assert motion.report["line_distance_mean"] < 0.5
+    saved = motion.save(tmp_path / "py.bvh")
+    assert saved.read_text() == out.read_text()
+    # A loaded scene works as the character too.
+    again = toonkit.loa.animate(toonkit.load(asset(ROBOT)), line,
+                                bones=["right-leg-spine-head@0", "left-leg-spine-head@22"],
+                                contacts="FootL@0..3", twists=["Torso_1@22:20"])
+    np.testing.assert_array_equal(again.rotations, motion.rotations)
+
+
+def test_animate_bad_input(robot):
+    keys, fps = keystrokes("jump.json")
+    line = toonkit.loa.line(keys, fps=fps)
+    with pytest.raises(ValueError, match="no joint named 'no-such-preset'"):
+        toonkit.loa.animate(robot, line, bones=["no-such-preset@0"])
+    arrays = toonkit.Scene.from_arrays(robot.positions, robot.triangles)
+    with pytest.raises(ValueError, match="not a character"):
+        toonkit.loa.animate(arrays, line)

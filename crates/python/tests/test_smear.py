@@ -1,0 +1,181 @@
+"""toonkit.smear against `toonkit smear ...` on the same inputs."""
+
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import toonkit
+from conftest import ROBOT, asset, example, read_pc2, run_cli
+
+STRETCH = {"elongate": {"function": {"stages": [{"op": "scale", "by": 2}]}}}
+
+
+def cli_offsets(tmp_path, *flags):
+    out = tmp_path / "offsets.npy"
+    run_cli("smear", "offsets", asset(ROBOT), "--clip", "Dance", *flags, "-o", out)
+    return np.load(out)
+
+
+def test_offsets_equal_cli_npy(robot, tmp_path):
+    delta = toonkit.smear.offsets(robot)
+    expected = cli_offsets(tmp_path)
+    assert delta.dtype == np.float32
+    assert delta.shape == expected.shape == robot.positions.shape[:2]
+    assert np.abs(delta - expected).max() <= 1e-6
+    assert np.isfinite(delta).all() and np.abs(delta).max() <= 1.0 + 1e-6
+
+
+@pytest.mark.parametrize(
+    "kwargs, flags",
+    [
+        ({"smooth": 0}, ["--smooth", "0"]),
+        ({"whole_body": True}, ["--whole-body"]),
+        ({"prune": ["Head", "ShoulderL"]}, ["--prune", "Head,ShoulderL"]),
+    ],
+)
+def test_offset_options_equal_cli_flags(robot, tmp_path, kwargs, flags):
+    delta = toonkit.smear.offsets(robot, **kwargs)
+    assert np.abs(delta - cli_offsets(tmp_path, *flags)).max() <= 1e-6
+    assert np.abs(delta - toonkit.smear.offsets(robot)).max() > 1e-3  # the option acts
+
+
+def test_from_arrays_with_skin_gives_the_same_offsets(robot):
+    scene = toonkit.Scene.from_arrays(
+        robot.positions, robot.triangles, fps=robot.fps, skin=robot.skin, objects=robot.objects
+    )
+    assert scene.objects == robot.objects
+    assert scene.joint_names == robot.joint_names
+    loaded = toonkit.smear.offsets(robot)
+    np.testing.assert_allclose(toonkit.smear.offsets(scene), loaded, atol=1e-6, rtol=0)
+    np.testing.assert_allclose(
+        toonkit.smear.offsets(scene, whole_body=True), toonkit.smear.offsets(robot, whole_body=True),
+        atol=1e-6, rtol=0)
+    # Without the skin the robot is one simple object (SMEAR Eq. 1): different offsets.
+    simple = toonkit.Scene.from_arrays(robot.positions, robot.triangles, fps=robot.fps)
+    assert np.abs(toonkit.smear.offsets(simple) - loaded).max() > 0.1
+
+
+def test_progress_is_called(robot):
+    calls = []
+    toonkit.smear.offsets(robot, progress=lambda stage, f: calls.append((stage, f)))
+    assert calls == [("offsets", 0.0), ("offsets", 1.0)]
+
+
+def test_progress_exception_aborts(robot):
+    def stop(stage, fraction):
+        raise KeyboardInterrupt("stop")
+
+    with pytest.raises(KeyboardInterrupt):
+        toonkit.smear.offsets(robot, progress=stop)
+
+
+def count_while(job):
+    """Runs `job` in a thread; counts how often the main thread ran meanwhile."""
+    done = threading.Event()
+    result = {}
+
+    def work():
+        result["value"] = job()
+        done.set()
+
+    t = threading.Thread(target=work)
+    ticks = 0
+    start = time.perf_counter()
+    t.start()
+    while not done.is_set():
+        ticks += 1
+        time.sleep(0.001)
+    t.join()
+    return ticks, time.perf_counter() - start, result["value"]
+
+
+@pytest.fixture(scope="module")
+def prepared(robot):
+    return toonkit.smear.prepare(robot)
+
+
+def test_prepared_offsets_equal_offsets(robot, prepared):
+    np.testing.assert_array_equal(prepared.offsets, toonkit.smear.offsets(robot))
+    assert [o["name"] for o in prepared.report["objects"]] == [n for n, _ in robot.objects]
+
+
+def test_style_file_saves_what_the_cli_writes(robot, prepared, tmp_path):
+    style = example("smear/fig11b_linear.toml")
+    cli = tmp_path / "cli.glb"
+    run_cli("smear", asset(ROBOT), "--clip", "Dance", "--style", style, "-o", cli)
+    ours = toonkit.smear.stylize(prepared, style).save(tmp_path / "py.glb")
+    assert ours.read_bytes() == cli.read_bytes()
+
+
+def test_elongated_equals_cli_elongate(robot, prepared, tmp_path):
+    out = tmp_path / "elongated.pc2"
+    run_cli("smear", "elongate", asset(ROBOT), "--clip", "Dance", "--beta-max", "2", "-o", out)
+    expected = read_pc2(out)
+    elongated = toonkit.smear.stylize(prepared, STRETCH).elongated
+    assert elongated.dtype == np.float32 and elongated.shape == expected.shape
+    assert np.abs(elongated - expected).max() <= 1e-5
+    assert np.abs(elongated - robot.positions).max() > 1e-3  # it did elongate
+
+
+def test_restyling_reuses_the_offsets(prepared):
+    first = toonkit.smear.stylize(prepared, STRETCH)
+    second = toonkit.smear.stylize(prepared, {"multiples": {"past": 2, "future": 0}})
+    assert second.report["offset_solves"] == first.report["offset_solves"]
+    copies = second.multiples
+    assert len(copies) == 2 * len(prepared.report["objects"])  # two past copies per object
+    for c in copies:
+        f, v, _ = c["positions"].shape
+        assert c["alpha"].shape == (f, v) and c["triangles"].shape[1] == 3
+        assert 0.0 <= c["alpha"].min() and c["alpha"].max() <= 1.0
+
+
+def test_multiples_only_style_keeps_the_body(robot, prepared):
+    look = toonkit.smear.stylize(prepared, {"multiples": {"past": 1, "future": 1}})
+    np.testing.assert_array_equal(look.elongated, robot.positions)
+
+
+def test_motion_lines(robot, prepared):
+    look = toonkit.smear.stylize(prepared, {"lines": {"count": 30}})
+    assert look.lines, "the robot dances: some lines show"
+    shown = []
+    for obj in look.lines:
+        assert len(obj["frames"]) == robot.frame_count
+        shown += [m for m in obj["frames"] if len(m["triangles"])]
+    assert shown
+    for m in shown:
+        assert m["positions"].shape[1] == 3 and m["alpha"].shape == (len(m["positions"]),)
+        assert m["triangles"].max() < len(m["positions"])
+
+
+def test_style_errors(prepared, tmp_path):
+    with pytest.raises(ValueError, match="style"):
+        toonkit.smear.stylize(prepared, {"elongate": {"bogus": 1}})
+    with pytest.raises(FileNotFoundError):
+        toonkit.smear.stylize(prepared, tmp_path / "missing.toml")
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[elongate\n")
+    with pytest.raises(ValueError, match="bad.toml"):
+        toonkit.smear.stylize(prepared, bad)
+    with pytest.raises(ValueError, match=r"\.glb or \.usda"):
+        toonkit.smear.stylize(prepared, STRETCH).save(tmp_path / "x.obj")
+    with pytest.raises(TypeError):
+        toonkit.smear.stylize(prepared, 3)
+
+
+def test_stylize_releases_the_gil(prepared):
+    ticks, seconds, look = count_while(
+        lambda: toonkit.smear.stylize(prepared, {"lines": {"count": 200}, **STRETCH})
+    )
+    assert look.elongated.ndim == 3
+    assert ticks >= max(3, int(seconds / 0.001 * 0.2)), (ticks, seconds)
+
+
+def test_offsets_release_the_gil(robot):
+    # A 1 ms sleep loop on the main thread keeps running while a worker computes: with the
+    # GIL held it would tick once or twice in total.
+    ticks, seconds, delta = count_while(lambda: toonkit.smear.offsets(robot))
+    assert delta.shape == robot.positions.shape[:2]
+    assert seconds > 0.01
+    assert ticks >= max(5, int(seconds / 0.001 * 0.2)), (ticks, seconds)
