@@ -87,7 +87,7 @@ pub(crate) fn flipbook_scene(book: &Flipbook) -> Scene {
 
 /// All parts as one USD stage: one `Mesh` prim per part, point caches with their per-frame
 /// colours, per-frame meshes with per-frame topology.
-pub(crate) fn flipbook_usda(book: &Flipbook) -> Result<String> {
+pub(crate) fn flipbook_stage(book: &Flipbook) -> UsdStage<'_> {
     let meshes = book
         .parts
         .iter()
@@ -100,7 +100,7 @@ pub(crate) fn flipbook_usda(book: &Flipbook) -> Result<String> {
             }
         })
         .collect();
-    crate::usda::write(&UsdStage::new(book.fps, meshes))
+    UsdStage::new(book.fps, meshes)
 }
 
 /// A body and its motion lines as a glTF scene: the body (one node per frame, named
@@ -154,10 +154,7 @@ pub(crate) fn lines_scene(body: &MeshAnimation, lines: &[Mesh]) -> Scene {
 
 /// A body and its motion lines as a USD stage: the body's point cache and one
 /// `motion_lines` mesh whose topology changes per frame.
-pub(crate) fn lines_usda(body: &MeshAnimation, lines: &[Mesh]) -> Result<String> {
+pub(crate) fn lines_stage<'a>(body: &'a MeshAnimation, lines: &'a [Mesh]) -> UsdStage<'a> {
     let lines = UsdMesh::frames("motion_lines", lines.iter().collect());
-    crate::usda::write(&UsdStage::new(
-        body.fps,
-        vec![UsdMesh::animation(body, None), lines],
-    ))
+    UsdStage::new(body.fps, vec![UsdMesh::animation(body, None), lines])
 }
