@@ -146,7 +146,7 @@ impl Interval<'_> {
         let laid = self.lay_at(sim, t_star, correction, arrival)?;
         let approach = &laid.chains[..(arrival.floor() as usize).min(laid.chains.len())];
         let jump = max_jump(&self.from.chain, approach);
-        if arrival >= gap || !(jump > MAX_FRAME_MOTION * length) {
+        if arrival >= gap || jump.is_nan() || jump <= MAX_FRAME_MOTION * length {
             return Ok(laid);
         }
         arrival = (arrival * jump / (MAX_FRAME_MOTION * length)).min(gap);

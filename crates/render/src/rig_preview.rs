@@ -70,7 +70,8 @@ impl RigPreview<'_> {
 
 /// One orthographic view per frame along `axes`, centred on the joints' centroid smoothed
 /// over `±DEFAULT_FOLLOW_SMOOTHING` frames, with one scale for the whole clip: the largest
-/// distance of any joint or line point from its frame's centre (plus a margin).
+/// distance of any joint, mesh vertex or line point from its frame's centre (plus a
+/// margin).
 fn follow(p: &RigPreview<'_>, axes: ViewAxes, aspect: f32) -> Vec<View> {
     let frames = p.frames();
     let raw: Vec<Vec3> = (0..frames)
@@ -88,7 +89,13 @@ fn follow(p: &RigPreview<'_>, axes: ViewAxes, aspect: f32) -> Vec<View> {
     let mut half: f32 = 1e-6;
     for (f, c) in centres.iter().enumerate() {
         let line = p.lines.get(f).map_or(&[][..], |l| l.as_slice());
-        for q in p.joints_at(f).iter().chain(line).filter(|q| q.is_finite()) {
+        let meshes = p
+            .meshes
+            .iter()
+            .filter(|m| f < m.frame_count())
+            .flat_map(|m| m.frame(f).iter());
+        let points = p.joints_at(f).iter().chain(line).chain(meshes);
+        for q in points.filter(|q| q.is_finite()) {
             let d = *q - *c;
             half = half.max(d.dot(axes.right).abs() / aspect.max(1e-6));
             half = half.max(d.dot(axes.up).abs());

@@ -24,14 +24,14 @@ pub enum LoaCommand {
     /// Interpolate sketched keystrokes into a dynamic line of action (Guay et al. 2015, §3).
     Line(line::LineArgs),
     /// Synthesize 3D character motion that follows the dynamic line (Guay et al. 2015, §4).
-    Animate(animate::AnimateArgs),
+    Animate(Box<animate::AnimateArgs>),
 }
 
 /// Runs `toonkit loa …`.
 pub fn run(ctx: &Context, args: LoaArgs) -> Result<()> {
     match args.command {
         LoaCommand::Line(a) => line::run(ctx, a),
-        LoaCommand::Animate(a) => animate::run(ctx, a),
+        LoaCommand::Animate(a) => animate::run(ctx, *a),
     }
 }
 
