@@ -36,7 +36,7 @@ enum Command {
     /// Smear frames: motion offsets (Basset et al. 2024).
     Smear(Box<commands::smear::SmearArgs>),
     /// Replacement libraries for 3D-printed stop-motion (StopShop).
-    Stopmo(commands::stopmo::StopmoArgs),
+    Stopmo(Box<commands::stopmo::StopmoArgs>),
     /// Many shots from a manifest: in parallel here, or as an Open Job Description farm job.
     Batch(commands::batch::BatchArgs),
 }
@@ -99,7 +99,7 @@ fn run(ctx: &commands::Context, command: Command) -> anyhow::Result<()> {
         Command::Loa(a) => commands::loa::run(ctx, a),
         Command::Render(a) => commands::render::run(ctx, a),
         Command::Smear(a) => commands::smear::run(ctx, *a),
-        Command::Stopmo(a) => commands::stopmo::run(ctx, a),
+        Command::Stopmo(a) => commands::stopmo::run(ctx, *a),
         Command::Batch(a) => commands::batch::run(ctx, a),
     }
 }

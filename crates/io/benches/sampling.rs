@@ -2,7 +2,6 @@
 //! Target: ≥ 50 M vertex-frames per second on 2 cores. Prints the rate after criterion's
 //! own timing.
 
-use std::path::Path;
 use std::time::Instant;
 
 use anim::{sample, SampleOptions};

@@ -1,7 +1,6 @@
 //! USD export benchmark: RobotExpressive `Dance` at 24 fps (7,214 vertices × 81 frames) as a
 //! `.usda` layer, without and with per-frame vertex colours. Target: well under a second.
 
-use std::path::Path;
 use std::time::Instant;
 
 use anim::{sample, MeshAnimation, SampleOptions};

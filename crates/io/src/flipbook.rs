@@ -8,7 +8,6 @@ use anim::glam::Vec3;
 use anim::{Channel, Clip, Flipbook, FlipbookPart, Mesh, MeshAnimation, Node, Scene, SceneMesh};
 
 use crate::usda::{UsdMesh, UsdStage};
-use crate::Result;
 
 /// The mesh part `part` shows at frame `f` (`None` when it shows nothing), named
 /// `<part>_fNNNN`: a point cache's frame with its UVs and that frame's colours, or the

@@ -51,23 +51,23 @@ pub(crate) enum Kind {
 /// Bits of a property header's `info` word (AbcCoreOgawa).
 pub(crate) mod info {
     /// Property type: 0 compound, 1 scalar, 2 array (3: scalar-like array).
-    pub const KIND: u32 = 0x3;
+    pub(crate) const KIND: u32 = 0x3;
     /// Byte width of the sizes that follow: 0 → 1 byte, 1 → 2, 2 → 4.
-    pub const SIZE_HINT: u32 = 0xc;
+    pub(crate) const SIZE_HINT: u32 = 0xc;
     /// Plain-old-data type, bits 4–7.
-    pub const POD: u32 = 0xf0;
+    pub(crate) const POD: u32 = 0xf0;
     /// A time sampling index follows.
-    pub const HAS_TIME_SAMPLING: u32 = 0x100;
+    pub(crate) const HAS_TIME_SAMPLING: u32 = 0x100;
     /// First and last changed sample indices follow.
-    pub const FIRST_LAST: u32 = 0x200;
+    pub(crate) const FIRST_LAST: u32 = 0x200;
     /// Every sample has the same size.
-    pub const HOMOGENOUS: u32 = 0x400;
+    pub(crate) const HOMOGENOUS: u32 = 0x400;
     /// Every sample equals the first (one sample stored).
-    pub const CONSTANT: u32 = 0x800;
+    pub(crate) const CONSTANT: u32 = 0x800;
     /// Extent (values per element), bits 12–19.
-    pub const EXTENT: u32 = 0xff000;
+    pub(crate) const EXTENT: u32 = 0xff000;
     /// Index into the archive's metadata table, bits 20–27 (`0xff`: written inline).
-    pub const METADATA: u32 = 0xff0_0000;
+    pub(crate) const METADATA: u32 = 0xff0_0000;
 }
 
 /// Metadata index of the empty metadata string.
