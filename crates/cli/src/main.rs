@@ -41,19 +41,26 @@ enum Command {
     Batch(commands::batch::BatchArgs),
 }
 
-/// Runs `toonkit ARGS…` in this process without printing its summary: the demo's steps are
-/// exactly the command lines a user would type.
+/// Runs `toonkit ARGS…` in this process, quietly (no summary, no spinner): the demo's steps
+/// and batch shots are exactly the command lines a user would type. A panic in a command is
+/// an error of that command, not a crash of the caller.
 pub(crate) fn run_args(args: &[String]) -> anyhow::Result<()> {
     let argv = std::iter::once("toonkit").chain(args.iter().map(String::as_str));
     let cli = Cli::try_parse_from(argv).map_err(|e| {
         let text = e.to_string();
-        anyhow::anyhow!("{}", text.lines().next().unwrap_or("invalid arguments"))
+        let first = text.lines().next().unwrap_or("invalid arguments");
+        anyhow::anyhow!("{}", first.trim_start_matches("error: "))
     })?;
     let ctx = commands::Context {
-        json: cli.json,
+        json: true,
         quiet: true,
     };
-    run(&ctx, cli.command)
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(&ctx, cli.command)))
+        .unwrap_or_else(|_| {
+            Err(anyhow::anyhow!(
+                "the command panicked (a bug: please report it)"
+            ))
+        })
 }
 
 fn main() -> ExitCode {

@@ -30,7 +30,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context as _, Result};
-use clap::{Args, CommandFactory, Parser};
+use clap::{Args, CommandFactory};
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -376,7 +376,7 @@ fn run_shot(shot: &Shot, base: &Path, out: &Path, force: bool, bar: &ProgressBar
     let start = Instant::now();
     let outputs: Vec<PathBuf> = shot.outputs.iter().map(|o| out.join(o)).collect();
     let result = (|| -> Result<&'static str> {
-        let hash = shot_hash(shot, base)?;
+        let hash = shot_hash(shot, base).with_context(|| format!("shot '{}'", shot.name))?;
         let stamp_file = stamp_path(out, shot);
         let recorded = std::fs::read(&stamp_file)
             .ok()
@@ -388,7 +388,7 @@ fn run_shot(shot: &Shot, base: &Path, out: &Path, force: bool, bar: &ProgressBar
             tkio::remove_stale_temps(o);
             bar.set_message(format!("{} ({}/{})", o.display(), k + 1, outputs.len()));
             let argv = command_line(shot, base, o)?;
-            run_in_process(&argv)
+            crate::run_args(&argv[1..])
                 .with_context(|| format!("shot '{}' ({})", shot.name, argv[1..].join(" ")))?;
         }
         let stamp = current_stamp(shot, out, &hash).ok_or_else(|| {
@@ -409,32 +409,6 @@ fn run_shot(shot: &Shot, base: &Path, out: &Path, force: bool, bar: &ProgressBar
         seconds: start.elapsed().as_secs_f64(),
         error,
     }
-}
-
-/// Parses `argv` with the `toonkit` parser and runs it with the binary's dispatcher, quietly
-/// (no summary, no spinner). A panic in a command is a failed shot, not a failed batch.
-fn run_in_process(argv: &[String]) -> Result<()> {
-    let cli = crate::Cli::try_parse_from(argv).map_err(|e| {
-        let text = e.to_string();
-        let first = text
-            .lines()
-            .next()
-            .unwrap_or("invalid arguments")
-            .to_string();
-        anyhow::anyhow!(first.trim_start_matches("error: ").to_string())
-    })?;
-    let ctx = Context {
-        json: true,
-        quiet: true,
-    };
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        crate::run(&ctx, cli.command)
-    }))
-    .unwrap_or_else(|_| {
-        Err(anyhow::anyhow!(
-            "the command panicked (a bug: please report it)"
-        ))
-    })
 }
 
 /// One progress line per shot, shown on a terminal (never with `--json`).
