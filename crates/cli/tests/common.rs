@@ -6,10 +6,7 @@ use std::process::{Command, Output};
 
 /// Path of a shared test asset; panics (fails loudly) if it is missing.
 pub fn data(rel: &str) -> PathBuf {
-    let p = PathBuf::from(format!(
-        "{}/../../assets/{rel}",
-        env!("CARGO_MANIFEST_DIR")
-    ));
+    let p = PathBuf::from(format!("{}/../../assets/{rel}", env!("CARGO_MANIFEST_DIR")));
     assert!(p.exists(), "missing test asset {}", p.display());
     p
 }

@@ -14,6 +14,7 @@ pub mod smear_style;
 pub mod stopmo;
 mod stopmo_curve;
 mod stopmo_library;
+mod stopmo_print;
 mod stopmo_run;
 
 /// Options every command sees.

@@ -91,6 +91,10 @@ pub struct SegmentOptionsArgs {
     /// Keep the seams as they move (skip Section 3.2).
     #[arg(long)]
     pub no_homogenize: bool,
+    /// Reuse the cut and seam targets of an earlier segmentation of the same mesh (its
+    /// `segmentation.json`, or the `.glb` next to it): parts of both clips assemble together.
+    #[arg(long, value_name = "SEG.json|SEG.glb", conflicts_with_all = ["parts", "auto_parts"])]
+    pub segmentation: Option<PathBuf>,
 }
 
 /// Runs `toonkit stopmo …`.
@@ -180,6 +184,8 @@ pub(super) struct Segmented {
     pub summary: serde_json::Value,
     /// One-line human summary (no timing).
     pub text: String,
+    /// The segmentation itself.
+    pub segmentation: Segmentation,
 }
 
 /// Segments `anim` (read from `input`) and writes the parts, the report and the render:
@@ -197,15 +203,6 @@ pub(super) fn segment_and_write(
             out.glb.display()
         );
     }
-    let parts = match opts.auto_parts {
-        Some(n) => {
-            stopmo::segment::auto_parts(anim, n).with_context(|| input.display().to_string())?
-        }
-        None => parse_parts(&opts.parts)?,
-    };
-    if parts.len() < 2 {
-        bail!("give at least two parts (--part NAME=SEED twice, or --auto-parts N)");
-    }
     let mut options = SegmentOptions {
         gamma: opts.gamma,
         homogenize: !opts.no_homogenize,
@@ -214,8 +211,29 @@ pub(super) fn segment_and_write(
     if let Some(k) = opts.smooth_iters {
         options.smooth_iterations = k;
     }
-    let spinner = crate::progress::spinner("segmenting", ctx.json);
-    let seg = stopmo::segment::segment(anim, &parts, &options)
+    let seg = match &opts.segmentation {
+        Some(path) => {
+            let saved = read_saved(path)?;
+            stopmo::segment::segment_reusing(anim, &saved, &options)
+                .with_context(|| format!("--segmentation {}", path.display()))?
+        }
+        None => {
+            let parts = match opts.auto_parts {
+                Some(n) => stopmo::segment::auto_parts(anim, n)
+                    .with_context(|| input.display().to_string())?,
+                None => parse_parts(&opts.parts)?,
+            };
+            if parts.len() < 2 {
+                bail!("give at least two parts (--part NAME=SEED twice, or --auto-parts N)");
+            }
+            let spinner = crate::progress::spinner("segmenting", ctx.json);
+            let seg = stopmo::segment::segment(anim, &parts, &options)
+                .with_context(|| input.display().to_string())?;
+            spinner.finish_and_clear();
+            seg
+        }
+    };
+    seg.check_parts()
         .with_context(|| input.display().to_string())?;
     let pieces = seg.parts()?;
     let layout = match out.layout {
@@ -228,12 +246,14 @@ pub(super) fn segment_and_write(
     tkio::write_atomic(out.glb, &bytes)?;
     let report = serde_json::to_value(seg.report())?;
     if let Some(path) = out.report {
-        tkio::write_atomic(path, serde_json::to_string_pretty(&report)?.as_bytes())?;
+        let mut file = report.clone();
+        file["reuse"] =
+            serde_json::to_value(seg.saved(anim.vertex_count(), anim.mesh.triangle_count()))?;
+        tkio::write_atomic(path, serde_json::to_string(&file)?.as_bytes())?;
     }
     if let Some(path) = out.render {
         tkio::write_atomic(path, &render_parts(&seg)?)?;
     }
-    spinner.finish_and_clear();
     let summary = json!({
         "input": input,
         "output": out.glb,
@@ -267,7 +287,33 @@ pub(super) fn segment_and_write(
         parts: pieces,
         summary,
         text,
+        segmentation: seg,
     })
+}
+
+/// Reads the reusable segmentation: `"reuse"` of a `segmentation.json` (a `.glb` stands for
+/// the `.json` of the same name next to it, as `stopmo run` writes them).
+fn read_saved(path: &Path) -> Result<stopmo::segment::SavedSegmentation> {
+    let json = if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+    {
+        path.with_extension("json")
+    } else {
+        path.to_path_buf()
+    };
+    let bytes =
+        tkio::read_file(&json).with_context(|| format!("--segmentation {}", path.display()))?;
+    let value: serde_json::Value = serde_json::from_slice(&bytes)
+        .with_context(|| format!("--segmentation {}: not JSON", json.display()))?;
+    let reuse = value.get("reuse").with_context(|| {
+        format!(
+            "--segmentation {}: no \"reuse\" section; write it with `stopmo segment --report` or `stopmo run`",
+            json.display()
+        )
+    })?;
+    serde_json::from_value(reuse.clone())
+        .with_context(|| format!("--segmentation {}: bad \"reuse\" section", json.display()))
 }
 
 /// Paper Fig. 5: the parts on the average mesh, beside the mean displacement from the

@@ -15,12 +15,11 @@ use anim::glam::Vec3;
 use anim::MeshAnimation;
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, ValueEnum};
-use rayon::prelude::*;
 use serde_json::json;
 use stopmo::library::{
-    add_plugs, build_library, plan_plugs, print_scale, scaled, shooting_order, Library,
-    LibraryOptions, LibrarySize, Method, PartInput, PartSetup, Plug, PlugOptions, SolveOptions,
-    DEFAULT_LAMBDA, DEFAULT_PRINT_HEIGHT_MM, DEFAULT_RESTARTS, DEFAULT_SEED, DEFAULT_THICKNESS_MM,
+    build_library, plan_plugs, print_scale, scaled, shooting_order, Library, LibraryOptions,
+    LibrarySize, Method, PartInput, PartSetup, Plug, PlugOptions, SolveOptions, DEFAULT_LAMBDA,
+    DEFAULT_PRINT_HEIGHT_MM, DEFAULT_RESTARTS, DEFAULT_SEED, DEFAULT_THICKNESS_MM,
 };
 
 use super::Context;
@@ -126,6 +125,17 @@ pub struct LibraryOptionsArgs {
     #[arg(long, value_name = "MM", requires = "plugs",
           default_value_t = stopmo::library::DEFAULT_PLUG_CLEARANCE_MM)]
     pub plug_clearance: f64,
+    /// Printer resolution in millimetres: pieces that differ from a sibling by less are
+    /// reported (a warning and report.json "printing.parts[].below_resolution").
+    #[arg(long, value_name = "MM", default_value_t = 0.05)]
+    pub resolution: f64,
+    /// No registration keys (domes on the shared back surface that fix all six degrees of
+    /// freedom on the armature/head).
+    #[arg(long)]
+    pub no_keys: bool,
+    /// No piece ID (`P-NN`) embossed on the back of every piece.
+    #[arg(long)]
+    pub no_ids: bool,
     /// Also write the JSON report here (it is always written to DIR/report.json).
     #[arg(long)]
     pub report: Option<PathBuf>,
@@ -217,7 +227,7 @@ fn parse_pieces(spec: &str, names: &[&str]) -> Result<LibrarySize> {
 }
 
 /// Splits the saliency file into per-part weights.
-fn read_saliency(path: &Path, parts: &[MeshAnimation]) -> Result<Vec<Vec<f32>>> {
+pub(super) fn read_saliency(path: &Path, parts: &[MeshAnimation]) -> Result<Vec<Vec<f32>>> {
     let bytes = tkio::read_file(path)?;
     let (shape, values) = tkio::npy::read_f32(&bytes).map_err(|e| e.at(path))?;
     let total: usize = parts.iter().map(|p| p.vertex_count()).sum();
@@ -273,12 +283,30 @@ fn read_fixed(dir: &Path, part: &MeshAnimation) -> Result<Vec<Vec<Vec3>>> {
 /// Runs `toonkit stopmo library`.
 pub fn library(ctx: &Context, args: LibraryArgs) -> Result<()> {
     let anims = parts(&args.input, &args.input_args)?;
-    let out = build_and_write(ctx, &args.input, &anims, &args.library, &args.output)?;
+    let out = build_and_write(
+        ctx,
+        &args.input,
+        &anims,
+        &args.library,
+        &args.output,
+        Given::default(),
+    )?;
     if let Some(p) = &args.library.report {
         tkio::write_atomic(p, serde_json::to_string_pretty(&out.report)?.as_bytes())?;
     }
     ctx.report(&out.report, || out.text.clone());
     Ok(())
+}
+
+/// What the caller of [`build_and_write`] already has: per-part saliency (e.g. mapped from the
+/// input's vertex order through the cut) and the parts of the artist's animation before
+/// homogenization (errors are reported against them).
+#[derive(Default)]
+pub(super) struct Given<'a> {
+    /// Per-part saliency; read from `--saliency` when `None`.
+    pub saliency: Option<Vec<Vec<f32>>>,
+    /// Per-part input animations (the built animations themselves when `None`).
+    pub inputs: Option<&'a [MeshAnimation]>,
 }
 
 /// What [`build_and_write`] produced.
@@ -297,6 +325,7 @@ pub(super) fn build_and_write(
     anims: &[MeshAnimation],
     args: &LibraryOptionsArgs,
     dir: &Path,
+    given: Given,
 ) -> Result<LibraryOutcome> {
     let start = Instant::now();
     let names: Vec<&str> = anims.iter().map(|a| a.mesh.name.as_str()).collect();
@@ -315,9 +344,13 @@ pub(super) fn build_and_write(
     if !(args.thickness.is_finite() && args.thickness > 0.0) {
         bail!("--thickness must be a positive number of millimetres");
     }
-    let saliency = match &args.saliency {
-        Some(p) => Some(read_saliency(p, anims)?),
-        None => None,
+    if !(args.resolution.is_finite() && args.resolution >= 0.0) {
+        bail!("--resolution must be a number of millimetres >= 0");
+    }
+    let saliency = match (given.saliency, &args.saliency) {
+        (Some(s), _) => Some(s),
+        (None, Some(p)) => Some(read_saliency(p, anims)?),
+        (None, None) => None,
     };
     let mut setups = Vec::with_capacity(anims.len());
     for (i, a) in anims.iter().enumerate() {
@@ -354,6 +387,7 @@ pub(super) fn build_and_write(
     let spinner = crate::progress::spinner("optimizing the library", ctx.json);
     let lib = build_library(&inputs, &opts).with_context(|| input.display().to_string())?;
     spinner.finish_and_clear();
+    let input_errors = super::stopmo_print::input_errors(&lib, anims, given.inputs, &args.cuts)?;
     let plugs = if args.plugs {
         let opts = PlugOptions {
             radius_mm: args.plug_radius,
@@ -366,8 +400,28 @@ pub(super) fn build_and_write(
     } else {
         Vec::new()
     };
-    write_pieces(dir, &lib, anims, args.thickness, &plugs)?;
+    let (printing, warnings) = super::stopmo_print::write_pieces(
+        dir,
+        &lib,
+        anims,
+        &super::stopmo_print::PrintOptions {
+            thickness_mm: args.thickness,
+            print_height_mm: args.print_height,
+            resolution_mm: args.resolution,
+            keys: !args.no_keys,
+            ids: !args.no_ids,
+        },
+        &plugs,
+    )?;
+    for w in &warnings {
+        if !ctx.json {
+            eprintln!("toonkit: warning: {w}");
+        }
+    }
+    super::stopmo_print::write_catalogue(dir, &lib, anims)?;
     let assembly = lib.assembly();
+    let sheets =
+        super::stopmo_print::write_assembly_sheets(dir, &lib, anims, &assembly, &args.cuts)?;
     let frames = assembly.frames.len();
     let ids: Vec<Vec<String>> = (0..frames).map(|f| assembly.frame_ids(f)).collect();
     let mut csv = format!("frame,{}\n", names.join(","));
@@ -377,7 +431,7 @@ pub(super) fn build_and_write(
     tkio::write_atomic(&dir.join("assembly.csv"), csv.as_bytes())?;
     tkio::write_atomic(
         &dir.join("assembly.md"),
-        assembly_markdown(&lib, &names, &ids).as_bytes(),
+        super::stopmo_print::assembly_markdown(&lib, &names, &ids).as_bytes(),
     )?;
     let order = shooting_order(&assembly);
     let mut csv = format!("shot,{},frames\n", names.join(","));
@@ -433,15 +487,21 @@ pub(super) fn build_and_write(
             "length_mm": p.length_mm,
             "seam_vertices": p.seam_vertices,
         })).collect::<Vec<_>>(),
-        "errors_mm": lib.errors_mm,
-        "parts": lib.parts.iter().map(|p| json!({
+        "errors_mm": input_errors.total,
+        "library_errors_mm": lib.errors_mm,
+        "homogenization_errors_mm": input_errors.homogenization,
+        "printing": printing,
+        "warnings": warnings,
+        "assembly_sheets": sheets,
+        "parts": lib.parts.iter().enumerate().map(|(i, p)| json!({
             "name": p.name,
             "pieces": p.solution.pieces.len(),
             "vertices": p.vertices,
             "energy": p.solution.energy,
             "iterations": p.solution.iterations,
             "restarts": p.solution.restarts,
-            "errors_mm": p.errors_mm,
+            "errors_mm": input_errors.parts[i],
+            "library_errors_mm": p.errors_mm,
         })).collect::<Vec<_>>(),
         "iterations": lib.parts.iter().map(|p| p.solution.iterations).sum::<usize>(),
         "restarts": args.restarts,
@@ -453,7 +513,7 @@ pub(super) fn build_and_write(
     let json = serde_json::to_string_pretty(&report)?;
     tkio::write_atomic(&dir.join("report.json"), json.as_bytes())?;
     let text = {
-        let e = lib.errors_mm;
+        let e = input_errors.total;
         format!(
             "wrote {}: {} pieces over {} parts and {} frames; error mean {:.3} mm (max {:.3}), \
              velocity mean {:.3} mm (max {:.3}); {} shots, {} swaps (in sequence {}); {:.2} s",
@@ -492,43 +552,6 @@ fn plan_part_plugs(
     Ok(plan_plugs(&surfaces, opts)?)
 }
 
-/// `DIR/pieces/<id>.obj` (surface, model units) and `<id>.stl` (printable solid, mm, with the
-/// part's plug shells).
-fn write_pieces(
-    dir: &Path,
-    lib: &Library,
-    anims: &[MeshAnimation],
-    thickness: f64,
-    plugs: &[Plug],
-) -> Result<()> {
-    let jobs: Vec<(usize, usize)> = lib
-        .parts
-        .iter()
-        .enumerate()
-        .flat_map(|(p, r)| (0..r.solution.pieces.len()).map(move |k| (p, k)))
-        .collect();
-    jobs.par_iter().try_for_each(|&(p, k)| -> Result<()> {
-        let topology = &anims[p].mesh;
-        let surface = lib
-            .piece_surface(p, k, topology)
-            .context("piece index out of range")?;
-        let base = dir.join("pieces").join(&surface.name);
-        tkio::write_atomic(
-            &base.with_extension("obj"),
-            tkio::obj::write(&surface).as_bytes(),
-        )?;
-        let solid = lib
-            .printable_piece(p, k, topology, thickness)
-            .with_context(|| format!("piece {}", surface.name))?;
-        let solid = add_plugs(&solid, p, plugs, stopmo::library::DEFAULT_PLUG_SEGMENTS);
-        tkio::write_atomic(
-            &base.with_extension("stl"),
-            &tkio::stl::write_binary(&solid),
-        )?;
-        Ok(())
-    })
-}
-
 /// `DIR/reconstruction.glb` (one node per part), `DIR/reconstruction.pc2` + `DIR/rest.obj`
 /// (all parts merged in part order), model units.
 fn write_reconstruction(dir: &Path, lib: &Library, anims: &[MeshAnimation]) -> Result<()> {
@@ -557,37 +580,4 @@ fn write_reconstruction(dir: &Path, lib: &Library, anims: &[MeshAnimation]) -> R
         tkio::obj::write(&merged.mesh).as_bytes(),
     )?;
     Ok(())
-}
-
-/// A readable assembly sheet: pieces per part, then runs of frames with the same assembly.
-fn assembly_markdown(lib: &Library, names: &[&str], ids: &[Vec<String>]) -> String {
-    let mut md = String::from("# Assembly sheet\n\n");
-    let _ = writeln!(
-        md,
-        "{} frames, {} pieces ({}).\n",
-        ids.len(),
-        lib.total_pieces(),
-        lib.parts
-            .iter()
-            .map(|p| format!("{}: {}", p.name, p.solution.pieces.len()))
-            .collect::<Vec<_>>()
-            .join(", ")
-    );
-    let _ = writeln!(md, "| frames | {} |", names.join(" | "));
-    let _ = writeln!(md, "|---|{}", "---|".repeat(names.len()));
-    let mut f = 0;
-    while f < ids.len() {
-        let mut end = f;
-        while end + 1 < ids.len() && ids[end + 1] == ids[f] {
-            end += 1;
-        }
-        let range = if end == f {
-            f.to_string()
-        } else {
-            format!("{f}–{end}")
-        };
-        let _ = writeln!(md, "| {range} | {} |", ids[f].join(" | "));
-        f = end + 1;
-    }
-    md
 }

@@ -15,7 +15,7 @@ use clap::Args;
 use serde_json::json;
 
 use super::stopmo::{segment_and_write, PartsLayout, SegmentOptionsArgs, SegmentOutputs};
-use super::stopmo_library::{build_and_write, file_safe, LibraryOptionsArgs};
+use super::stopmo_library::{build_and_write, file_safe, Given, LibraryOptionsArgs};
 use super::Context;
 use crate::input::{self, InputArgs};
 
@@ -38,12 +38,30 @@ pub struct RunArgs {
     pub input_args: InputArgs,
 }
 
+/// Reads `--saliency` for `stopmo run`: one weight per vertex of the input mesh, in its order.
+fn read_input_saliency(path: &std::path::Path, vertices: usize) -> Result<Vec<f32>> {
+    let bytes = tkio::read_file(path)?;
+    let (shape, values) = tkio::npy::read_f32(&bytes).map_err(|e| e.at(path))?;
+    if !matches!(shape.as_slice(), [n] | [1, n] if *n == vertices) {
+        anyhow::bail!(
+            "{}: saliency shape {shape:?}, expected ({vertices},) or (1, {vertices}): one weight per input vertex, in the input's order",
+            path.display()
+        );
+    }
+    Ok(values)
+}
+
 /// Runs `toonkit stopmo run`.
 pub fn run(ctx: &Context, args: RunArgs) -> Result<()> {
     let start = Instant::now();
     let sampled = input::open(&args.input, &args.input_args)?;
     let anim = input::merged(&args.input, &sampled)?;
     drop(sampled);
+    // Saliency is given in the input's vertex order: check it before writing anything.
+    let saliency = match &args.library.saliency {
+        Some(p) => Some(read_input_saliency(p, anim.vertex_count())?),
+        None => None,
+    };
     let dir = &args.output;
     let png = dir.join("segmentation.png");
     let seg = segment_and_write(
@@ -58,8 +76,26 @@ pub fn run(ctx: &Context, args: RunArgs) -> Result<()> {
             render: args.render.then_some(png.as_path()),
         },
     )?;
-    drop(anim);
     let seg_seconds = start.elapsed().as_secs_f64();
+    let per_part_saliency = match &saliency {
+        Some(values) => {
+            let mapped = seg.segmentation.map_vertex_values(values)?;
+            Some(
+                seg.parts
+                    .iter()
+                    .map(|p| p.vertices.iter().map(|&v| mapped[v as usize]).collect())
+                    .collect(),
+            )
+        }
+        None => None,
+    };
+    let inputs: Vec<MeshAnimation> = seg
+        .segmentation
+        .input_parts(&anim)?
+        .into_iter()
+        .map(|p| p.animation)
+        .collect();
+    drop(anim);
     let parts: Vec<MeshAnimation> = seg
         .parts
         .into_iter()
@@ -69,7 +105,17 @@ pub fn run(ctx: &Context, args: RunArgs) -> Result<()> {
             a
         })
         .collect();
-    let lib = build_and_write(ctx, &args.input, &parts, &args.library, dir)?;
+    let lib = build_and_write(
+        ctx,
+        &args.input,
+        &parts,
+        &args.library,
+        dir,
+        Given {
+            saliency: per_part_saliency,
+            inputs: Some(&inputs),
+        },
+    )?;
     let mut summary = seg.summary;
     summary["seconds"] = json!(seg_seconds);
     let report = json!({

@@ -8,9 +8,9 @@ use rayon::prelude::*;
 use super::error::{LibraryError, Result};
 use super::metrics::evaluate;
 use super::problem::PartProblem;
-use anim::SplitMix64;
 use super::update::{right_hand_side, solve_pieces, system_matrix, Dense, Positions};
 use super::viterbi::{label_step, LabelInputs, ViterbiWork};
+use anim::SplitMix64;
 
 /// Velocity weight λ of Eq. 10 (the paper's results use 2).
 pub const DEFAULT_LAMBDA: f64 = 2.0;

@@ -236,8 +236,8 @@ pub(crate) fn label_step(
 
 #[cfg(test)]
 mod tests {
-    use anim::SplitMix64;
     use super::*;
+    use anim::SplitMix64;
 
     struct Case {
         p: Vec<f64>,

@@ -69,9 +69,11 @@ mod laplacian;
 mod maxflow;
 mod pipeline;
 mod problem;
+mod reuse;
 mod seeds;
 mod smooth;
 mod topology;
+mod transfer;
 mod weld;
 
 pub use cut::{cut_mesh, CutMesh, VertexSource, DEFAULT_SNAP};
@@ -86,6 +88,7 @@ pub use pipeline::{
     Segmentation,
 };
 pub use problem::{SegmentationProblem, DEFAULT_GAMMA};
+pub use reuse::{segment_reusing, SavedSegmentation};
 pub use seeds::{
     auto_seeds, closest_point_on_triangle, nearest_triangle, resolve_seeds, PartSpec, Seed,
     DEFAULT_AUTO_CENTERING_ITERATIONS, DEFAULT_AUTO_SAMPLES, DEFAULT_AUTO_SEED_RADIUS,
@@ -94,4 +97,5 @@ pub use smooth::{
     smooth_votes, vertex_votes, winners, DEFAULT_SMOOTH_ITERATIONS, DEFAULT_SMOOTH_STEP,
 };
 pub use topology::{vertex_components, Csr, DualEdge, Topology};
+pub use transfer::DEFAULT_MIN_PART_FRACTION;
 pub use weld::{Weld, DEFAULT_WELD_EPSILON};
