@@ -117,7 +117,8 @@ impl Homogenizer {
     /// [`Homogenizer::new`] with vertices that keep the input's motion: `keep[v]` pins welded
     /// vertex `v` to a zero displacement (open mesh borders such as the neck and scalp, or
     /// vertices the user pins), so the deformation decays from the seam to them instead of
-    /// moving them. Seam vertices and their one-ring win where both apply.
+    /// moving them. Seam vertices win where both apply; kept vertices in the seam's one-ring
+    /// keep the input's motion.
     ///
     /// # Errors
     /// [`SegmentError::Solver`] when the factorization fails, [`SegmentError::Parameter`]
@@ -148,7 +149,7 @@ impl Homogenizer {
                 }
             }
         }
-        let keep_input: Vec<bool> = (0..n).map(|v| keep[v] && !pinned_mask[v]).collect();
+        let keep_input: Vec<bool> = (0..n).map(|v| keep[v] && !seam[v]).collect();
         for v in 0..n {
             pinned_mask[v] |= keep_input[v];
         }
