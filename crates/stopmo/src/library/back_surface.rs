@@ -22,11 +22,13 @@ use super::fabricate::{check_solid, split_fans, DEFAULT_THICKNESS_MM};
 use super::intersect::self_intersecting_triangles;
 
 /// Radius over which the offset direction field is smoothed, in millimetres.
-pub const DEFAULT_NORMAL_SMOOTHING_MM: f64 = 3.0;
+pub const DEFAULT_NORMAL_SMOOTHING_MM: f64 = 8.0;
 /// Laplacian smoothing steps of the back surface.
-pub const DEFAULT_BACK_SMOOTHING_ITERATIONS: usize = 40;
+pub const DEFAULT_BACK_SMOOTHING_ITERATIONS: usize = 300;
+/// Boundary loops shorter than this fraction of the longest one are capped.
+pub const DEFAULT_CAP_FRACTION: f64 = 0.5;
 /// Rounds of local repair where the exact test still finds crossings.
-pub const DEFAULT_REPAIR_ROUNDS: usize = 12;
+pub const DEFAULT_REPAIR_ROUNDS: usize = 0;
 
 /// Options of the shared back surface (millimetres, like the printable pieces).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -40,6 +42,11 @@ pub struct ShellOptions {
     pub smoothing_iterations: usize,
     /// Rounds of local repair driven by the exact intersection test.
     pub repair_rounds: usize,
+    /// Boundary loops shorter than this fraction of the longest loop (eye and mouth
+    /// openings) are capped instead of walled.
+    pub cap_fraction: f64,
+    /// Smooth the back surface's boundary too (walls may lean inward).
+    pub smooth_boundary: bool,
 }
 
 impl Default for ShellOptions {
@@ -49,6 +56,8 @@ impl Default for ShellOptions {
             normal_smoothing_mm: DEFAULT_NORMAL_SMOOTHING_MM,
             smoothing_iterations: DEFAULT_BACK_SMOOTHING_ITERATIONS,
             repair_rounds: DEFAULT_REPAIR_ROUNDS,
+            cap_fraction: DEFAULT_CAP_FRACTION,
+            smooth_boundary: false,
         }
     }
 }
@@ -70,6 +79,9 @@ pub struct PartShell {
     /// For every shell vertex, the input vertex it copies (UV-seam duplicates welded, bow-tie
     /// vertices split per fan).
     source: Vec<u32>,
+    /// Capped boundary loops (shell vertices, boundary order); cap `i` adds the shell vertex
+    /// `source.len() + i` at the loop's centroid.
+    caps: Vec<Vec<u32>>,
     /// Front triangles over shell vertices (outward oriented, like the input).
     triangles: Vec<[u32; 3]>,
     /// Directed boundary edges `a → b` of the front.
@@ -90,6 +102,54 @@ pub struct PartShell {
 pub(super) struct BackVertex {
     /// On the part boundary (walls start there: leave it in place).
     pub is_boundary: bool,
+}
+
+/// Front positions of the shell vertices for one piece (input vertex order): welded copies,
+/// then one centroid per cap.
+fn front_positions(source: &[u32], caps: &[Vec<u32>], piece: &[Vec3]) -> Vec<Vec3> {
+    let mut out: Vec<Vec3> = source.iter().map(|&s| piece[s as usize]).collect();
+    for lp in caps {
+        let c = lp.iter().map(|&v| out[v as usize]).sum::<Vec3>() / lp.len().max(1) as f32;
+        out.push(c);
+    }
+    out
+}
+
+/// Splits the directed boundary edges into loops, removes the loops shorter than
+/// `fraction` of the longest one from `boundary` and returns them (vertices in edge order).
+fn cap_loops(front: &[Vec3], boundary: &mut Vec<(u32, u32)>, fraction: f64) -> Vec<Vec<u32>> {
+    let next: HashMap<u32, u32> = boundary.iter().copied().collect();
+    let mut seen: HashMap<u32, ()> = HashMap::new();
+    let mut loops: Vec<(Vec<u32>, f64)> = Vec::new();
+    for &(start, _) in boundary.iter() {
+        if seen.contains_key(&start) {
+            continue;
+        }
+        let (mut lp, mut len, mut v) = (Vec::new(), 0.0f64, start);
+        let mut closed = false;
+        while seen.insert(v, ()).is_none() {
+            lp.push(v);
+            let Some(&w) = next.get(&v) else { break };
+            len += f64::from(front[v as usize].distance(front[w as usize]));
+            if w == start {
+                closed = true;
+                break;
+            }
+            v = w;
+        }
+        if closed && lp.len() >= 3 {
+            loops.push((lp, len));
+        }
+    }
+    let longest = loops.iter().map(|l| l.1).fold(0.0, f64::max);
+    let caps: Vec<Vec<u32>> = loops
+        .into_iter()
+        .filter(|l| l.1 < fraction * longest)
+        .map(|l| l.0)
+        .collect();
+    let capped: std::collections::HashSet<u32> = caps.iter().flatten().copied().collect();
+    boundary.retain(|(a, _)| !capped.contains(a));
+    caps
 }
 
 /// Vertex adjacency (sorted, deduplicated) of a triangle list.
@@ -231,6 +291,19 @@ impl PartShell {
             .filter(|&(a, b)| !directed.contains_key(&(b, a)))
             .collect();
         boundary.sort_unstable();
+        // Cap the small boundary loops (eye and mouth openings): a fan from the loop's
+        // centroid, so only the outer boundary (seams, neck, scalp) needs a wall.
+        let (mut front, mut tris) = (front, tris);
+        let caps = cap_loops(&front, &mut boundary, opts.cap_fraction);
+        let regular = front.len();
+        for (i, lp) in caps.iter().enumerate() {
+            let c = (regular + i) as u32;
+            front.push(lp.iter().map(|&v| front[v as usize]).sum::<Vec3>() / lp.len() as f32);
+            for k in 0..lp.len() {
+                let (a, b) = (lp[k], lp[(k + 1) % lp.len()]);
+                tris.push([b, a, c]);
+            }
+        }
         let n = front.len();
         let adj = neighbours(n, &tris);
         let on_boundary = {
@@ -265,7 +338,11 @@ impl PartShell {
                 .collect();
             normals = next;
         }
-        let piece_at = |k: usize, v: usize| pieces[k][src[v] as usize];
+        let fronts: Vec<Vec<Vec3>> = pieces
+            .iter()
+            .map(|p| front_positions(&src, &caps, p))
+            .collect();
+        let piece_at = |k: usize, v: usize| fronts[k][v];
         // Deepest point any piece reaches along the direction field, per vertex.
         let wall = opts.wall_mm as f32;
         let limit: Vec<f32> = (0..n)
@@ -312,7 +389,10 @@ impl PartShell {
         let smooth = |back: &mut Vec<Vec3>, mask: Option<&[bool]>| {
             let next: Vec<Vec3> = (0..n)
                 .map(|v| {
-                    if on_boundary[v] || mask.is_some_and(|m| !m[v]) || adj[v].is_empty() {
+                    if (on_boundary[v] && !opts.smooth_boundary)
+                        || mask.is_some_and(|m| !m[v])
+                        || adj[v].is_empty()
+                    {
                         return back[v];
                     }
                     let c = adj[v].iter().fold(Vec3::ZERO, |a, &w| a + back[w as usize])
@@ -328,6 +408,7 @@ impl PartShell {
         }
         let mut shell = PartShell {
             source: src,
+            caps,
             triangles: tris,
             boundary,
             back,
@@ -450,7 +531,7 @@ impl PartShell {
 
     fn solid_unchecked(&self, piece: &[Vec3], name: &str) -> Mesh {
         let m = self.back.len() as u32;
-        let mut positions: Vec<Vec3> = self.source.iter().map(|&s| piece[s as usize]).collect();
+        let mut positions = front_positions(&self.source, &self.caps, piece);
         positions.extend_from_slice(&self.back);
         let mut tris = self.triangles.clone();
         tris.extend(
@@ -494,9 +575,9 @@ impl PartShell {
     /// Smallest distance (mm) from a front vertex of `piece` to the back surface's triangles.
     pub fn min_wall(&self, piece: &[Vec3]) -> f64 {
         let grid = super::intersect::TriangleGrid::new(&self.back, &self.triangles);
-        self.source
+        front_positions(&self.source, &self.caps, piece)
             .iter()
-            .map(|&s| grid.distance(piece[s as usize]))
+            .map(|&p| grid.distance(p))
             .fold(f64::INFINITY, f64::min)
     }
 }

@@ -64,7 +64,7 @@ pub use assembly::{
     DEFAULT_TWO_OPT_PASSES,
 };
 pub use back_surface::{
-    PartShell, ShellOptions, ShellStats, DEFAULT_BACK_SMOOTHING_ITERATIONS,
+    PartShell, ShellOptions, ShellStats, DEFAULT_BACK_SMOOTHING_ITERATIONS, DEFAULT_CAP_FRACTION,
     DEFAULT_NORMAL_SMOOTHING_MM, DEFAULT_REPAIR_ROUNDS,
 };
 pub use build::{

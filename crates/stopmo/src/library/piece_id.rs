@@ -16,8 +16,8 @@ use super::error::{LibraryError, Result};
 
 /// Keys per part.
 pub const DEFAULT_KEY_COUNT: usize = 3;
-/// Key radius as a fraction of the print height (clamped to 1–4 mm).
-pub const KEY_RADIUS_PER_HEIGHT: f64 = 0.05;
+/// Key radius as a fraction of the print height (clamped to 0.75–4 mm).
+pub const KEY_RADIUS_PER_HEIGHT: f64 = 0.035;
 /// Key height as a fraction of its radius.
 pub const KEY_HEIGHT_PER_RADIUS: f64 = 0.5;
 /// Relief of an embossed ID in millimetres.
@@ -44,7 +44,7 @@ impl Default for KeyOptions {
 impl KeyOptions {
     /// Keys sized from the print height.
     pub fn for_print_height(height_mm: f64) -> KeyOptions {
-        let r = (height_mm * KEY_RADIUS_PER_HEIGHT).clamp(1.0, 4.0);
+        let r = (height_mm * KEY_RADIUS_PER_HEIGHT).clamp(0.75, 4.0);
         KeyOptions {
             count: DEFAULT_KEY_COUNT,
             radius_mm: r,
@@ -144,7 +144,7 @@ impl PartShell {
         for _ in 0..opts.count {
             let from_keys = distances(self.back(), &centres);
             let best = (0..self.back().len())
-                .filter(|&v| from_boundary[v] >= 2.0 * r)
+                .filter(|&v| from_boundary[v] >= 1.5 * r)
                 .max_by(|&a, &b| {
                     let s = |v: usize| from_keys[v].min(4.0 * from_boundary[v]);
                     s(a).total_cmp(&s(b))
