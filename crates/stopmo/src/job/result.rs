@@ -9,7 +9,8 @@ use crate::library::{Assembly, Library, Plug, ShootingOrder};
 /// One printable piece.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Piece {
-    /// Identifier `<part>_<NN>` (the file stem of `pieces/<id>.stl`).
+    /// Identifier `<part>_<NN>` (the file stem of `pieces/<id>.stl`); the ID embossed on
+    /// the back is [`piece_label`](crate::piece_label)`(part, index)`.
     pub id: String,
     /// Index of the part.
     pub part: usize,
@@ -40,6 +41,10 @@ pub struct LibraryResult {
     pub plugs: Vec<Plug>,
     /// The stop-motion reconstruction of every part (model units, input timing).
     pub reconstruction: Vec<MeshAnimation>,
+    /// `catalogue.png`: every piece with its embossed ID.
+    pub catalogue: Vec<u8>,
+    /// `assembly_shotNN.png` per shot: (file name, PNG bytes).
+    pub sheets: Vec<(String, Vec<u8>)>,
     /// The numbers of `report.json`.
     pub report: LibraryReport,
 }

@@ -73,6 +73,9 @@ pub struct Homogenizer {
     /// Per welded vertex: `Some(local pinned index)`.
     pinned_index: Vec<Option<u32>>,
     pinned: Vec<u32>,
+    /// Per welded vertex: pinned to its input motion (displacement 0) rather than to its
+    /// average position (open borders, user pins).
+    keep_input: Vec<bool>,
     targets: Vec<Vec3>,
     representative: Vec<u32>,
     /// `Q_FP` by pinned column: `(free row, value)`.
@@ -107,8 +110,36 @@ impl Homogenizer {
         weld_class: Vec<u32>,
         representative: Vec<u32>,
     ) -> Result<Homogenizer> {
+        let keep = vec![false; average.len()];
+        Self::with_kept(average, triangles, seam, &keep, weld_class, representative)
+    }
+
+    /// [`Homogenizer::new`] with vertices that keep the input's motion: `keep[v]` pins welded
+    /// vertex `v` to a zero displacement (open mesh borders such as the neck and scalp, or
+    /// vertices the user pins), so the deformation decays from the seam to them instead of
+    /// moving them. Seam vertices win where both apply; kept vertices in the seam's one-ring
+    /// keep the input's motion.
+    ///
+    /// # Errors
+    /// [`SegmentError::Solver`] when the factorization fails, [`SegmentError::Parameter`]
+    /// when `keep` has the wrong length.
+    pub fn with_kept(
+        average: &[DVec3],
+        triangles: &[[u32; 3]],
+        seam: &[bool],
+        keep: &[bool],
+        weld_class: Vec<u32>,
+        representative: Vec<u32>,
+    ) -> Result<Homogenizer> {
         let start = Instant::now();
         let n = average.len();
+        if keep.len() != n || seam.len() != n {
+            return Err(SegmentError::Parameter(format!(
+                "{} seam and {} kept flags for {n} welded vertices",
+                seam.len(),
+                keep.len()
+            )));
+        }
         let topo = Topology::new(n, triangles);
         let mut pinned_mask = seam.to_vec();
         for v in 0..n {
@@ -117,6 +148,10 @@ impl Homogenizer {
                     pinned_mask[w as usize] = true;
                 }
             }
+        }
+        let keep_input: Vec<bool> = (0..n).map(|v| keep[v] && !seam[v]).collect();
+        for v in 0..n {
+            pinned_mask[v] |= keep_input[v];
         }
         let (comp, count) = vertex_components(&topo.neighbors);
         let mut comp_pinned = vec![false; count];
@@ -196,6 +231,7 @@ impl Homogenizer {
             free_index,
             pinned_index,
             pinned,
+            keep_input,
             targets,
             representative,
             qfp,
@@ -293,6 +329,16 @@ impl Homogenizer {
         }
     }
 
+    /// Prescribed displacement of pinned welded vertex `w` in frame `y`: to its average
+    /// position, or none when it keeps the input's motion.
+    fn pinned_displacement(&self, w: usize, y: &[Vec3]) -> DVec3 {
+        if self.keep_input[w] {
+            DVec3::ZERO
+        } else {
+            (self.targets[w] - y[self.representative[w] as usize]).as_dvec3()
+        }
+    }
+
     /// Solves the frames of one chunk; returns [Σ|d|, max|d|, Σ|d_F|, max|d_F|, max grad, n_F].
     fn solve_chunk(&self, frames: &mut [Vec3], m: usize, nf: usize) -> [f64; 6] {
         let nfr = frames.len() / m.max(1);
@@ -308,9 +354,7 @@ impl Homogenizer {
             for lf in 0..nfr {
                 let y = &frames[lf * m..(lf + 1) * m];
                 for (pl, &p) in self.pinned.iter().enumerate() {
-                    let d = (self.targets[p as usize]
-                        - y[self.representative[p as usize] as usize])
-                        .as_dvec3();
+                    let d = self.pinned_displacement(p as usize, y);
                     for k in 0..3 {
                         dp[(pl, 3 * lf + k)] = d[k];
                     }
@@ -328,9 +372,7 @@ impl Homogenizer {
             for lf in 0..nfr {
                 let y = &frames[lf * m..(lf + 1) * m];
                 for (pl, &p) in self.pinned.iter().enumerate() {
-                    let d = (self.targets[p as usize]
-                        - y[self.representative[p as usize] as usize])
-                        .as_dvec3();
+                    let d = self.pinned_displacement(p as usize, y);
                     for (r, q) in self.qfp.row(pl) {
                         for k in 0..3 {
                             rhs[(r as usize, 3 * lf + k)] -= q * d[k];
@@ -347,21 +389,20 @@ impl Homogenizer {
         for lf in 0..nfr {
             let y = &mut frames[lf * m..(lf + 1) * m];
             for w in 0..nw {
-                let rep = self.representative[w] as usize;
                 disp[w] = match (self.free_index[w], self.pinned_index[w]) {
                     (Some(r), _) => DVec3::new(
                         rhs[(r as usize, 3 * lf)],
                         rhs[(r as usize, 3 * lf + 1)],
                         rhs[(r as usize, 3 * lf + 2)],
                     ),
-                    (None, Some(_)) => (self.targets[w] - y[rep]).as_dvec3(),
+                    (None, Some(_)) => self.pinned_displacement(w, y),
                     (None, None) => DVec3::ZERO,
                 };
             }
             for (i, p) in y.iter_mut().enumerate() {
                 let w = self.weld_class[i] as usize;
                 let old = *p;
-                *p = if self.pinned_index[w].is_some() {
+                *p = if self.pinned_index[w].is_some() && !self.keep_input[w] {
                     self.targets[w]
                 } else {
                     (p.as_dvec3() + disp[w]).as_vec3()
