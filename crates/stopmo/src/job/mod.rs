@@ -17,7 +17,9 @@ pub use error::{Error, Result};
 pub use files::{FileData, OutputFile};
 pub use library_job::{file_safe_name, library, run};
 pub use options::{LibraryJobOptions, PieceCount, RunOptions, SegmentJobOptions, DEFAULT_PIECES};
-pub use print::{piece_label, PartPrintReport, PrintReport, PrintTime, DEFAULT_RESOLUTION_MM};
+pub use print::{
+    piece_label, PartPrintReport, Piece, PrintReport, PrintTime, DEFAULT_RESOLUTION_MM,
+};
 pub use report::{LibraryReport, OrderReport, PartReport, PlugReport};
-pub use result::{LibraryResult, Piece};
+pub use result::LibraryResult;
 pub use segment_job::{saved_segmentation, segment, PartSummary, SegmentSummary, Segmented};

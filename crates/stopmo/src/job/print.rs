@@ -11,7 +11,6 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::error::{Error, Result};
-use super::result::Piece;
 use crate::library::{
     add_plugs, material, piece_id, Bitmap, Key, KeyOptions, Library, MaterialEstimate, PartShell,
     Plug, ShellOptions, ShellStats, DEFAULT_ID_RELIEF_MM,
@@ -94,6 +93,22 @@ pub struct PrintReport {
     pub ids: bool,
     /// Per part.
     pub parts: Vec<PartPrintReport>,
+}
+
+/// One printable piece.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Piece {
+    /// Identifier `<part>_<NN>` (the file stem of `pieces/<id>.stl`); the ID embossed on
+    /// the back is [`piece_label`](crate::piece_label)`(part, index)`.
+    pub id: String,
+    /// Index of the part.
+    pub part: usize,
+    /// Index of the piece in its part's library (fixed pieces first).
+    pub index: usize,
+    /// The piece's surface in model units, with the part's topology and UVs.
+    pub surface: Mesh,
+    /// The printable solid in millimetres (with the part's plug shells, if any).
+    pub solid: Mesh,
 }
 
 /// Renders `text` with the built-in font into a bitmap (one font pixel per bitmap pixel).

@@ -1,26 +1,11 @@
 //! What [`library`](crate::library()) and [`run`](crate::run()) return.
 
-use anim::{Mesh, MeshAnimation};
+use anim::MeshAnimation;
 
+use super::print::Piece;
 use super::report::LibraryReport;
 use super::segment_job::Segmented;
 use crate::library::{Assembly, Library, Plug, ShootingOrder};
-
-/// One printable piece.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Piece {
-    /// Identifier `<part>_<NN>` (the file stem of `pieces/<id>.stl`); the ID embossed on
-    /// the back is [`piece_label`](crate::piece_label)`(part, index)`.
-    pub id: String,
-    /// Index of the part.
-    pub part: usize,
-    /// Index of the piece in its part's library (fixed pieces first).
-    pub index: usize,
-    /// The piece's surface in model units, with the part's topology and UVs.
-    pub surface: Mesh,
-    /// The printable solid in millimetres (with the part's plug shells, if any).
-    pub solid: Mesh,
-}
 
 /// The replacement library of every part and everything needed to print and shoot it.
 #[derive(Debug, Clone)]

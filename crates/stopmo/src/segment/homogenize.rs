@@ -42,8 +42,11 @@ pub const DEFAULT_CHUNK_FRAMES: usize = 64;
 pub struct HomogenizeStats {
     /// Welded vertices on the seam.
     pub seam_vertices: usize,
-    /// Welded vertices pinned (seam and one-ring).
+    /// Welded vertices pinned to the seam targets (seam and one-ring).
     pub pinned_vertices: usize,
+    /// Welded vertices pinned to their input motion (open borders), not counted in
+    /// `pinned_vertices`.
+    pub kept_vertices: usize,
     /// Welded vertices solved for.
     pub free_vertices: usize,
     /// Mean |z − y| over all vertices and frames, in model units.
@@ -317,7 +320,8 @@ impl Homogenizer {
         }
         HomogenizeStats {
             seam_vertices: self.seam_count,
-            pinned_vertices: self.pinned.len(),
+            pinned_vertices: self.pinned.len() - self.kept_count(),
+            kept_vertices: self.kept_count(),
             free_vertices: nf,
             mean_change: s[0] / (m.max(1) as f64 * frames),
             max_change: s[1],
@@ -327,6 +331,11 @@ impl Homogenizer {
             factor_seconds: self.factor_seconds,
             solve_seconds: start.elapsed().as_secs_f64(),
         }
+    }
+
+    /// Pinned welded vertices that keep the input's motion.
+    fn kept_count(&self) -> usize {
+        self.keep_input.iter().filter(|&&k| k).count()
     }
 
     /// Prescribed displacement of pinned welded vertex `w` in frame `y`: to its average
