@@ -329,7 +329,7 @@ impl PartProblem<'_> {
     /// Optimizes a library of `pieces` pieces (fixed ones included) and the labels (StopShop Eqs. 10–16).
     ///
     /// Block coordinate descent in the reduced coordinates: k-means++ seeding, exact label
-    /// steps (Viterbi, see [`label_step`](super::viterbi)), library steps from the normal
+    /// steps (Viterbi, the `viterbi` module), library steps from the normal
     /// equations with empty-piece repair; `opts.restarts` restarts run in parallel and the
     /// lowest energy wins (ties: lowest restart index). A final library step in full space
     /// gives the pieces, and the energy is evaluated exactly.
