@@ -16,10 +16,10 @@ use stopmo::segment::{
     segment, segment_reusing, PartSpec, SavedSegmentation, Seed, SegmentOptions, Segmentation,
 };
 
-const FACE: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../assets/face/ict-face-talk.glb"
-);
+mod common;
+
+/// The ICT face clip, relative to `assets/`.
+const FACE: &str = "face/ict-face-talk.glb";
 
 /// Print height of the acceptance (mm).
 const HEIGHT_MM: f64 = 25.0;
@@ -28,7 +28,7 @@ const HEIGHT_MM: f64 = 25.0;
 fn face() -> &'static MeshAnimation {
     static FACE_ANIM: OnceLock<MeshAnimation> = OnceLock::new();
     FACE_ANIM.get_or_init(|| {
-        let scene = tkio::gltf::read(std::path::Path::new(FACE))
+        let scene = tkio::gltf::read(&common::asset(FACE))
             .unwrap_or_else(|e| panic!("cannot read {FACE}: {e}"));
         let opts = SampleOptions {
             fps: 1.0,
