@@ -36,7 +36,8 @@ pub struct OutputFile<'a> {
 
 impl LibraryResult {
     /// Every file of the output layout: `pieces/<part>_<NN>.obj` and `.stl`, `assembly.csv`,
-    /// `assembly.md`, `shooting_order.csv`, `report.json`, `reconstruction.glb`,
+    /// `assembly.md`, `catalogue.png`, `assembly_shotNN.png` (one per shot),
+    /// `shooting_order.csv`, `report.json`, `reconstruction.glb`,
     /// `reconstruction.pc2` + `rest.obj`, `error_curve.csv` / `.png` after a size search and,
     /// for [`run`](crate::run()), `segmentation.glb`, `segmentation.json` and
     /// `segmentation.png` (when the figure was asked for).
@@ -70,6 +71,13 @@ impl LibraryResult {
             "assembly.md",
             FileData::Text(self.assembly_markdown()),
         ));
+        out.push(file(
+            "catalogue.png",
+            FileData::Bytes(self.catalogue.clone()),
+        ));
+        for (name, png) in &self.sheets {
+            out.push(file(name.clone(), FileData::Bytes(png.clone())));
+        }
         out.push(file(
             "shooting_order.csv",
             FileData::Text(self.shooting_order_csv()),

@@ -4,16 +4,17 @@
 use std::time::Instant;
 
 use anim::MeshAnimation;
-use rayon::prelude::*;
 
 use super::error::{Error, Result};
 use super::options::{LibraryJobOptions, PieceCount, RunOptions};
-use super::report::{LibraryReport, ReportInputs};
-use super::result::{LibraryResult, Piece};
+use super::print::{print_pieces, PrintSettings};
+use super::report::{InputErrors, LibraryReport, ReportInputs};
+use super::result::LibraryResult;
 use super::segment_job::segment;
+use super::sheets::{assembly_sheets, catalogue_png};
 use crate::library::{
-    add_plugs, build_library, plan_plugs, print_scale, scaled, shooting_order, Library,
-    LibraryOptions, LibrarySize, PartInput, PartSetup, Plug, PlugOptions,
+    build_library, compare_frames, plan_plugs, print_scale, scaled, shooting_order, ErrorSummary,
+    Library, LibraryOptions, LibrarySize, PartInput, PartSetup, Plug, PlugOptions,
 };
 
 /// A name that is safe as a file stem: every character other than letters, digits, `-` and
@@ -47,7 +48,7 @@ pub fn file_safe_name(name: &str) -> String {
 pub fn library(parts: &[MeshAnimation], opts: &LibraryJobOptions) -> Result<LibraryResult> {
     let refs: Vec<&MeshAnimation> = parts.iter().collect();
     let names: Vec<String> = parts.iter().map(|a| a.mesh.name.clone()).collect();
-    build(&refs, &names, opts)
+    build(&refs, &names, opts, None)
 }
 
 /// Segments `anim`, then builds the library of its parts (named after the parts, made
@@ -57,15 +58,93 @@ pub fn library(parts: &[MeshAnimation], opts: &LibraryJobOptions) -> Result<Libr
 /// # Errors
 /// Those of [`crate::segment()`] and [`library`].
 pub fn run(anim: &MeshAnimation, opts: &RunOptions) -> Result<LibraryResult> {
+    // Saliency is given in the input's vertex order: check it before segmenting.
+    if let Some(s) = &opts.library.saliency {
+        if s.len() != anim.vertex_count() {
+            return Err(Error::option_error(
+                "saliency",
+                format!(
+                    "{} weights, expected {}: one weight per input vertex, in the input's order",
+                    s.len(),
+                    anim.vertex_count()
+                ),
+            ));
+        }
+    }
     let segmented = segment(anim, &opts.segment)?;
     let names: Vec<String> = segmented
         .parts
         .iter()
         .map(|p| file_safe_name(&p.name))
         .collect();
-    let mut result = build(&segmented.part_animations(), &names, &opts.library)?;
+    let mut library = opts.library.clone();
+    if let Some(values) = &opts.library.saliency {
+        let mapped = segmented.segmentation.map_vertex_values(values)?;
+        library.saliency = Some(
+            segmented
+                .parts
+                .iter()
+                .flat_map(|p| p.vertices.iter().map(|&v| mapped[v as usize]))
+                .collect(),
+        );
+    }
+    // Errors are reported against the artist's animation, before homogenization.
+    let inputs: Vec<MeshAnimation> = segmented
+        .segmentation
+        .input_parts(anim)?
+        .into_iter()
+        .map(|p| p.animation)
+        .collect();
+    let input_refs: Vec<&MeshAnimation> = inputs.iter().collect();
+    let mut result = build(
+        &segmented.part_animations(),
+        &names,
+        &library,
+        Some(&input_refs),
+    )?;
     result.segmented = Some(segmented);
     Ok(result)
+}
+
+/// Reconstruction errors against `inputs` (the parts before homogenization; the built parts
+/// themselves when `None`), and what homogenization alone changed.
+fn input_errors(
+    lib: &Library,
+    anims: &[&MeshAnimation],
+    inputs: Option<&[&MeshAnimation]>,
+    cuts: &[usize],
+) -> Result<InputErrors> {
+    let Some(inputs) = inputs else {
+        return Ok(InputErrors {
+            total: lib.errors_mm,
+            parts: lib.parts.iter().map(|p| p.errors_mm).collect(),
+            homogenization: None,
+        });
+    };
+    let mm = lib.mm_per_unit;
+    let mut parts = Vec::new();
+    let mut homog = Vec::new();
+    for (p, (a, x)) in anims.iter().zip(inputs).enumerate() {
+        let e = lib.errors_against(p, x, cuts).ok_or_else(|| {
+            Error::option_error(
+                "parts",
+                format!("part {}: input and library disagree", a.mesh.name),
+            )
+        })?;
+        parts.push(e.summary(mm));
+        let h = compare_frames(a.frame_count(), cuts, |f| x.frame(f), |f| a.frame(f));
+        homog.push((h.summary(mm), a.vertex_count()));
+    }
+    let weighted: Vec<(ErrorSummary, usize)> = parts
+        .iter()
+        .zip(anims)
+        .map(|(e, a)| (*e, a.vertex_count()))
+        .collect();
+    Ok(InputErrors {
+        total: ErrorSummary::combine(&weighted),
+        parts,
+        homogenization: Some(ErrorSummary::combine(&homog)),
+    })
 }
 
 /// The library size rule of the options, resolved against the parts.
@@ -155,6 +234,7 @@ fn build(
     anims: &[&MeshAnimation],
     names: &[String],
     opts: &LibraryJobOptions,
+    inputs: Option<&[&MeshAnimation]>,
 ) -> Result<LibraryResult> {
     let start = Instant::now();
     for (i, n) in names.iter().enumerate() {
@@ -172,7 +252,13 @@ fn build(
             "must be a positive number of millimetres",
         ));
     }
-    let inputs: Vec<PartInput<'_>> = anims
+    if !(opts.resolution_mm.is_finite() && opts.resolution_mm >= 0.0) {
+        return Err(Error::option_error(
+            "resolution_mm",
+            "must be a number of millimetres >= 0",
+        ));
+    }
+    let part_inputs: Vec<PartInput<'_>> = anims
         .iter()
         .zip(setups(opts, anims, names)?)
         .map(|(a, setup)| PartInput {
@@ -187,7 +273,7 @@ fn build(
         print_height_mm: opts.print_height_mm,
         ..LibraryOptions::default()
     };
-    let mut lib = build_library(&inputs, &lib_opts)?;
+    let mut lib = build_library(&part_inputs, &lib_opts)?;
     for (p, n) in lib.parts.iter_mut().zip(names) {
         p.name.clone_from(n);
     }
@@ -203,8 +289,23 @@ fn build(
         None => Vec::new(),
     };
     let segments = opts.plugs.map(|p| p.segments);
-    let pieces = make_pieces(&lib, anims, opts.thickness_mm, &plugs, segments)?;
+    let errors = input_errors(&lib, anims, inputs, &opts.cuts)?;
+    let (pieces, printing, warnings) = print_pieces(
+        &lib,
+        anims,
+        &PrintSettings {
+            thickness_mm: opts.thickness_mm,
+            print_height_mm: opts.print_height_mm,
+            resolution_mm: opts.resolution_mm,
+            keys: opts.keys,
+            ids: opts.ids,
+            plugs: &plugs,
+            plug_segments: segments.unwrap_or(crate::library::DEFAULT_PLUG_SEGMENTS),
+        },
+    )?;
+    let catalogue = catalogue_png(&lib, anims)?;
     let assembly = lib.assembly();
+    let sheets = assembly_sheets(&lib, anims, &assembly, &opts.cuts)?;
     let order = shooting_order(&assembly);
     let reconstruction = anims
         .iter()
@@ -220,7 +321,7 @@ fn build(
         .collect::<Result<Vec<_>>>()?;
     let mut report = LibraryReport::new(
         &lib,
-        &ReportInputs {
+        ReportInputs {
             names,
             plugs: &plugs,
             order: &order,
@@ -229,6 +330,10 @@ fn build(
             print_height_mm: opts.print_height_mm,
             thickness_mm: opts.thickness_mm,
             restarts: opts.solve.restarts,
+            errors,
+            printing,
+            warnings,
+            sheets: sheets.iter().map(|(n, _)| n.clone()).collect(),
         },
     );
     report.total_seconds = start.elapsed().as_secs_f64();
@@ -241,6 +346,8 @@ fn build(
         shooting_order: order,
         plugs,
         reconstruction,
+        catalogue,
+        sheets,
         report,
     })
 }
@@ -261,39 +368,4 @@ fn plan_part_plugs(
         })
         .collect();
     Ok(plan_plugs(&surfaces, opts)?)
-}
-
-/// Surface (model units) and printable solid (mm, with the part's plug shells) of every
-/// piece, in parallel.
-fn make_pieces(
-    lib: &Library,
-    anims: &[&MeshAnimation],
-    thickness_mm: f64,
-    plugs: &[Plug],
-    segments: Option<usize>,
-) -> Result<Vec<Piece>> {
-    let jobs: Vec<(usize, usize)> = lib
-        .parts
-        .iter()
-        .enumerate()
-        .flat_map(|(p, r)| (0..r.solution.pieces.len()).map(move |k| (p, k)))
-        .collect();
-    let segments = segments.unwrap_or(crate::library::DEFAULT_PLUG_SEGMENTS);
-    jobs.par_iter()
-        .map(|&(p, k)| {
-            let topology = &anims[p].mesh;
-            let surface = lib.piece_surface(p, k, topology).ok_or_else(|| {
-                Error::option_error("pieces", format!("no piece {k} of part {p}"))
-            })?;
-            let solid = lib.printable_piece(p, k, topology, thickness_mm)?;
-            let solid = add_plugs(&solid, p, plugs, segments);
-            Ok(Piece {
-                id: surface.name.clone(),
-                part: p,
-                index: k,
-                surface,
-                solid,
-            })
-        })
-        .collect()
 }

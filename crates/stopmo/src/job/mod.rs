@@ -6,15 +6,20 @@ mod figure;
 mod files;
 mod library_job;
 mod options;
+mod print;
 mod report;
 mod result;
 mod segment_job;
+mod sheets;
 mod text;
 
 pub use error::{Error, Result};
 pub use files::{FileData, OutputFile};
 pub use library_job::{file_safe_name, library, run};
 pub use options::{LibraryJobOptions, PieceCount, RunOptions, SegmentJobOptions, DEFAULT_PIECES};
+pub use print::{
+    piece_label, PartPrintReport, Piece, PrintReport, PrintTime, DEFAULT_RESOLUTION_MM,
+};
 pub use report::{LibraryReport, OrderReport, PartReport, PlugReport};
-pub use result::{LibraryResult, Piece};
-pub use segment_job::{segment, PartSummary, SegmentSummary, Segmented};
+pub use result::LibraryResult;
+pub use segment_job::{saved_segmentation, segment, PartSummary, SegmentSummary, Segmented};

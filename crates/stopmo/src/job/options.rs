@@ -6,10 +6,11 @@ use std::collections::BTreeMap;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+use super::print::DEFAULT_RESOLUTION_MM;
 use crate::library::{
     Method, PlugOptions, SolveOptions, DEFAULT_PRINT_HEIGHT_MM, DEFAULT_THICKNESS_MM,
 };
-use crate::segment::{PartSpec, SegmentOptions};
+use crate::segment::{PartSpec, SavedSegmentation, SegmentOptions};
 
 /// Pieces per part when no size is given.
 pub const DEFAULT_PIECES: usize = 20;
@@ -24,6 +25,10 @@ pub struct SegmentJobOptions {
     pub auto_parts: Option<usize>,
     /// Also draw StopShop Fig. 5 (parts beside the mean displacement) as a PNG.
     pub figure: bool,
+    /// Reuse the cut and seam targets of an earlier segmentation of the same mesh (the
+    /// `"reuse"` section of its `segmentation.json`) instead of `parts`: parts of both clips
+    /// assemble together.
+    pub reuse: Option<SavedSegmentation>,
     /// γ (StopShop Eq. 1), boundary smoothing, snapping, homogenization, welding.
     #[serde(flatten)]
     pub segment: SegmentOptions,
@@ -69,7 +74,8 @@ pub struct LibraryJobOptions {
     /// `thickness_mm` is taken from [`LibraryJobOptions::thickness_mm`].
     pub plugs: Option<PlugOptions>,
     /// Per-vertex saliency weights in the merged vertex order of the parts (parts one after
-    /// the other).
+    /// the other); in [`run`](crate::run()), in the vertex order of the input animation
+    /// (checked before segmenting, then carried through the cut to the parts).
     pub saliency: Option<Vec<f32>>,
     /// Frames that start a new, unrelated shot (no velocity term across them, StopShop
     /// StopShop Eq. 12).
@@ -77,6 +83,14 @@ pub struct LibraryJobOptions {
     /// Pre-made pieces per part name (model units, one position per vertex of the part):
     /// they are kept and new pieces are added up to the library size.
     pub fixed: BTreeMap<String, Vec<Vec<Vec3>>>,
+    /// Printer resolution in millimetres: pieces that differ from a sibling by less are
+    /// reported (a warning and `printing.parts[].below_resolution`).
+    pub resolution_mm: f64,
+    /// Registration keys (domes on the shared back surface that fix all six degrees of
+    /// freedom on the armature/head).
+    pub keys: bool,
+    /// Piece ID (`P-NN`) embossed on the back of every piece.
+    pub ids: bool,
 }
 
 impl Default for LibraryJobOptions {
@@ -91,6 +105,9 @@ impl Default for LibraryJobOptions {
             saliency: None,
             cuts: Vec::new(),
             fixed: BTreeMap::new(),
+            resolution_mm: DEFAULT_RESOLUTION_MM,
+            keys: true,
+            ids: true,
         }
     }
 }

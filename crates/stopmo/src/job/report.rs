@@ -2,6 +2,7 @@
 
 use serde::Serialize;
 
+use super::print::PrintReport;
 use crate::library::{ErrorSummary, Library, Method, Plug, ShootingOrder};
 
 /// One plug in the report (millimetres, print coordinates).
@@ -46,8 +47,11 @@ pub struct PartReport {
     pub iterations: usize,
     /// Restarts run.
     pub restarts: usize,
-    /// Errors in millimetres at the print height.
+    /// Errors in millimetres at the print height, against the artist's animation (before
+    /// homogenization) when it is known ([`run`](crate::run())).
     pub errors_mm: ErrorSummary,
+    /// Errors against the animation the library was built from (homogenized seams).
+    pub library_errors_mm: ErrorSummary,
 }
 
 /// The shooting order in the report.
@@ -88,8 +92,20 @@ pub struct LibraryReport {
     pub thickness_mm: f64,
     /// Plugs across the seams.
     pub plugs: Vec<PlugReport>,
-    /// Errors over all parts in millimetres.
+    /// Errors over all parts in millimetres, against the artist's animation (before
+    /// homogenization) when it is known ([`run`](crate::run())).
     pub errors_mm: ErrorSummary,
+    /// Errors against the animation the library was built from.
+    pub library_errors_mm: ErrorSummary,
+    /// What homogenization alone changed (homogenized parts against the input), when the
+    /// input is known.
+    pub homogenization_errors_mm: Option<ErrorSummary>,
+    /// Back surfaces, keys, IDs, resolution check, material and print time.
+    pub printing: PrintReport,
+    /// Printing warnings (e.g. pieces below the printer resolution).
+    pub warnings: Vec<String>,
+    /// The assembly sheets with thumbnails (`assembly_shotNN.png`).
+    pub assembly_sheets: Vec<String>,
     /// Per part.
     pub parts: Vec<PartReport>,
     /// Iterations summed over parts.
@@ -114,11 +130,25 @@ pub(crate) struct ReportInputs<'a> {
     pub(crate) print_height_mm: f64,
     pub(crate) thickness_mm: f64,
     pub(crate) restarts: usize,
+    pub(crate) errors: InputErrors,
+    pub(crate) printing: PrintReport,
+    pub(crate) warnings: Vec<String>,
+    pub(crate) sheets: Vec<String>,
+}
+
+/// Errors against the artist's animation, in millimetres.
+pub(crate) struct InputErrors {
+    /// All parts.
+    pub(crate) total: ErrorSummary,
+    /// Per part.
+    pub(crate) parts: Vec<ErrorSummary>,
+    /// What homogenization alone changed, when the input is known.
+    pub(crate) homogenization: Option<ErrorSummary>,
 }
 
 impl LibraryReport {
     /// The report of `lib` (`total_seconds` 0 until the job sets it).
-    pub(crate) fn new(lib: &Library, x: &ReportInputs<'_>) -> LibraryReport {
+    pub(crate) fn new(lib: &Library, x: ReportInputs<'_>) -> LibraryReport {
         LibraryReport {
             input: None,
             method: lib.method,
@@ -131,18 +161,25 @@ impl LibraryReport {
             print_height_mm: x.print_height_mm,
             thickness_mm: x.thickness_mm,
             plugs: x.plugs.iter().map(|p| plug_report(p, x.names)).collect(),
-            errors_mm: lib.errors_mm,
+            errors_mm: x.errors.total,
+            library_errors_mm: lib.errors_mm,
+            homogenization_errors_mm: x.errors.homogenization,
+            printing: x.printing,
+            warnings: x.warnings,
+            assembly_sheets: x.sheets,
             parts: lib
                 .parts
                 .iter()
-                .map(|p| PartReport {
+                .enumerate()
+                .map(|(i, p)| PartReport {
                     name: p.name.clone(),
                     pieces: p.solution.pieces.len(),
                     vertices: p.vertices,
                     energy: p.solution.energy,
                     iterations: p.solution.iterations,
                     restarts: p.solution.restarts,
-                    errors_mm: p.errors_mm,
+                    errors_mm: x.errors.parts[i],
+                    library_errors_mm: p.errors_mm,
                 })
                 .collect(),
             iterations: lib.parts.iter().map(|p| p.solution.iterations).sum(),

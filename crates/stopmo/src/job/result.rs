@@ -1,25 +1,11 @@
 //! What [`library`](crate::library()) and [`run`](crate::run()) return.
 
-use anim::{Mesh, MeshAnimation};
+use anim::MeshAnimation;
 
+use super::print::Piece;
 use super::report::LibraryReport;
 use super::segment_job::Segmented;
 use crate::library::{Assembly, Library, Plug, ShootingOrder};
-
-/// One printable piece.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Piece {
-    /// Identifier `<part>_<NN>` (the file stem of `pieces/<id>.stl`).
-    pub id: String,
-    /// Index of the part.
-    pub part: usize,
-    /// Index of the piece in its part's library (fixed pieces first).
-    pub index: usize,
-    /// The piece's surface in model units, with the part's topology and UVs.
-    pub surface: Mesh,
-    /// The printable solid in millimetres (with the part's plug shells, if any).
-    pub solid: Mesh,
-}
 
 /// The replacement library of every part and everything needed to print and shoot it.
 #[derive(Debug, Clone)]
@@ -40,6 +26,10 @@ pub struct LibraryResult {
     pub plugs: Vec<Plug>,
     /// The stop-motion reconstruction of every part (model units, input timing).
     pub reconstruction: Vec<MeshAnimation>,
+    /// `catalogue.png`: every piece with its embossed ID.
+    pub catalogue: Vec<u8>,
+    /// `assembly_shotNN.png` per shot: (file name, PNG bytes).
+    pub sheets: Vec<(String, Vec<u8>)>,
     /// The numbers of `report.json`.
     pub report: LibraryReport,
 }

@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use super::error::{Error, Result};
 use super::options::SegmentJobOptions;
-use crate::segment::{HomogenizeStats, Part, SegmentReport, Segmentation};
+use crate::segment::{HomogenizeStats, Part, SavedSegmentation, SegmentReport, Segmentation};
 
 /// The result of [`segment`]: the segmentation, its parts, and what the job measured.
 #[derive(Debug, Clone)]
@@ -19,6 +19,9 @@ pub struct Segmented {
     pub parts: Vec<Part>,
     /// StopShop Fig. 5 as PNG bytes, when [`SegmentJobOptions::figure`] asked for it.
     pub figure: Option<Vec<u8>>,
+    /// What another clip of the same mesh needs to reuse this cut
+    /// ([`SegmentJobOptions::reuse`]); `"reuse"` in `segmentation.json`.
+    pub saved: SavedSegmentation,
     /// Wall time of the job in seconds.
     pub seconds: f64,
 }
@@ -60,17 +63,24 @@ pub struct SegmentSummary {
 /// own errors ([`Error::Segment`]).
 pub fn segment(anim: &MeshAnimation, opts: &SegmentJobOptions) -> Result<Segmented> {
     let start = Instant::now();
-    let parts = match opts.auto_parts {
-        Some(n) => crate::segment::auto_parts(anim, n)?,
-        None => opts.parts.clone(),
+    let segmentation = match &opts.reuse {
+        Some(saved) => crate::segment::segment_reusing(anim, saved, &opts.segment)?,
+        None => {
+            let parts = match opts.auto_parts {
+                Some(n) => crate::segment::auto_parts(anim, n)?,
+                None => opts.parts.clone(),
+            };
+            if parts.len() < 2 {
+                return Err(Error::option_error(
+                    "parts",
+                    "give at least two parts, each with a seed (or auto_parts = N)",
+                ));
+            }
+            crate::segment::segment(anim, &parts, &opts.segment)?
+        }
     };
-    if parts.len() < 2 {
-        return Err(Error::option_error(
-            "parts",
-            "give at least two parts, each with a seed (or auto_parts = N)",
-        ));
-    }
-    let segmentation = crate::segment::segment(anim, &parts, &opts.segment)?;
+    segmentation.check_parts()?;
+    let saved = segmentation.saved(anim.vertex_count(), anim.mesh.triangle_count());
     let parts = segmentation.parts()?;
     let figure = if opts.figure {
         Some(render::encode_png(&super::figure::parts_figure(
@@ -83,6 +93,7 @@ pub fn segment(anim: &MeshAnimation, opts: &SegmentJobOptions) -> Result<Segment
         segmentation,
         parts,
         figure,
+        saved,
         seconds: start.elapsed().as_secs_f64(),
     })
 }
@@ -94,9 +105,14 @@ impl Segmented {
         self.segmentation.report()
     }
 
-    /// [`Segmented::report`] as pretty-printed JSON (`segmentation.json`).
+    /// [`Segmented::report`] with the reusable segmentation under `"reuse"`, as
+    /// pretty-printed JSON (`segmentation.json`).
     pub fn report_json(&self) -> String {
-        to_pretty_json(&self.report())
+        let mut value = serde_json::to_value(self.report()).unwrap_or_default();
+        if let (Some(map), Ok(reuse)) = (value.as_object_mut(), serde_json::to_value(&self.saved)) {
+            map.insert("reuse".into(), reuse);
+        }
+        to_pretty_json(&value)
     }
 
     /// The part animations, as a [`crate::library()`] input.
@@ -155,4 +171,22 @@ pub(crate) fn to_pretty_json<T: Serialize>(value: &T) -> String {
     serde_json::to_value(value)
         .and_then(|v| serde_json::to_string_pretty(&v))
         .unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+}
+
+/// The reusable segmentation of a `segmentation.json` (its `"reuse"` section), for
+/// [`SegmentJobOptions::reuse`].
+///
+/// # Errors
+/// [`Error::Option`] (`reuse`) when the text is not JSON or has no valid `"reuse"` section.
+pub fn saved_segmentation(json: &str) -> Result<SavedSegmentation> {
+    let value: serde_json::Value = serde_json::from_str(json)
+        .map_err(|e| Error::option_error("reuse", format!("not JSON: {e}")))?;
+    let reuse = value.get("reuse").ok_or_else(|| {
+        Error::option_error(
+            "reuse",
+            "no \"reuse\" section; write it with `stopmo segment --report` or `stopmo run`",
+        )
+    })?;
+    serde_json::from_value(reuse.clone())
+        .map_err(|e| Error::option_error("reuse", format!("bad \"reuse\" section: {e}")))
 }

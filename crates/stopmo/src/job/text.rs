@@ -32,6 +32,17 @@ impl LibraryResult {
                 .collect::<Vec<_>>()
                 .join(", ")
         );
+        let _ = writeln!(
+            md,
+            "Piece IDs embossed on the backs: {}; renders in catalogue.png, thumbnails per shot in assembly_shotNN.png.\n",
+            self.library
+                .parts
+                .iter()
+                .enumerate()
+                .map(|(p, part)| format!("{} = {}-NN", part.name, p + 1))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
         let _ = writeln!(md, "| frames | {} |", names.join(" | "));
         let _ = writeln!(md, "|---|{}", "---|".repeat(names.len()));
         let mut f = 0;

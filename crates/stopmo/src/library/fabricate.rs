@@ -120,7 +120,7 @@ fn find(parent: &mut [usize], mut x: usize) -> usize {
 
 /// Splits every vertex into one copy per edge-connected fan of its triangles (corners of two
 /// triangles sharing an edge through the vertex belong to the same fan).
-fn split_fans(positions: Vec<Vec3>, tris: Vec<[u32; 3]>) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+pub(super) fn split_fans(positions: Vec<Vec3>, tris: Vec<[u32; 3]>) -> (Vec<Vec3>, Vec<[u32; 3]>) {
     let mut parent: Vec<usize> = (0..tris.len() * 3).collect();
     let mut edges: HashMap<(u32, u32), (usize, usize)> = HashMap::with_capacity(tris.len() * 3);
     for (t, tri) in tris.iter().enumerate() {

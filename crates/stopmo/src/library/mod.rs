@@ -43,10 +43,14 @@
 //! ```
 
 mod assembly;
+mod back_surface;
 mod build;
 mod error;
 mod fabricate;
+mod input_errors;
+mod intersect;
 mod metrics;
+mod piece_id;
 mod plugs;
 mod problem;
 mod size;
@@ -59,6 +63,10 @@ pub use assembly::{
     piece_id, shooting_order, Assembly, ShootingOrder, Shot, DEFAULT_TWO_OPT_LIMIT,
     DEFAULT_TWO_OPT_PASSES,
 };
+pub use back_surface::{
+    PartShell, ShellOptions, ShellStats, DEFAULT_BACK_SMOOTHING_ITERATIONS, DEFAULT_CAP_FRACTION,
+    DEFAULT_NORMAL_SMOOTHING_MM, DEFAULT_REPAIR_ROUNDS,
+};
 pub use build::{
     build_library, print_scale, Library, LibraryOptions, LibrarySize, Method, PartInput, PartResult,
 };
@@ -67,7 +75,15 @@ pub use fabricate::{
     check_solid, material, scaled, solidify, volume, MaterialEstimate, SolidCheck,
     DEFAULT_PRINT_HEIGHT_MM, DEFAULT_THICKNESS_MM, PLA_DENSITY_G_PER_MM3,
 };
+pub use input_errors::compare_frames;
+pub use intersect::{
+    closest_point_on_triangle, self_intersecting_triangles, TriangleGrid, MAX_EXACT_COORDINATE,
+};
 pub use metrics::{ErrorSummary, FrameErrors};
+pub use piece_id::{
+    Bitmap, Key, KeyOptions, DEFAULT_ID_RELIEF_MM, DEFAULT_KEY_COUNT, KEY_HEIGHT_PER_RADIUS,
+    KEY_RADIUS_PER_HEIGHT,
+};
 pub use plugs::{
     add_plugs, components, plan_plugs, Plug, PlugOptions, DEFAULT_PLUG_CLEARANCE_MM,
     DEFAULT_PLUG_LENGTH_MM, DEFAULT_PLUG_RADIUS_MM, DEFAULT_PLUG_SEGMENTS, DEFAULT_PLUG_WALL_MM,

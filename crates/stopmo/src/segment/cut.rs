@@ -14,7 +14,7 @@ pub const DEFAULT_SNAP: f64 = 0.05;
 const TIE_BIAS: f64 = 1e-12;
 
 /// How a vertex of the cut mesh is computed from the input vertices.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum VertexSource {
     /// An input vertex.
     Original(u32),
@@ -54,7 +54,7 @@ impl VertexSource {
 }
 
 /// A mesh cut along part boundaries (the sequence Y of Section 3.1).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CutMesh {
     /// One source per vertex; the first `m` are the input vertices in input order.
     pub sources: Vec<VertexSource>,

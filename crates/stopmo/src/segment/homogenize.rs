@@ -42,8 +42,11 @@ pub const DEFAULT_CHUNK_FRAMES: usize = 64;
 pub struct HomogenizeStats {
     /// Welded vertices on the seam.
     pub seam_vertices: usize,
-    /// Welded vertices pinned (seam and one-ring).
+    /// Welded vertices pinned to the seam targets (seam and one-ring).
     pub pinned_vertices: usize,
+    /// Welded vertices pinned to their input motion (open borders), not counted in
+    /// `pinned_vertices`.
+    pub kept_vertices: usize,
     /// Welded vertices solved for.
     pub free_vertices: usize,
     /// Mean |z − y| over all vertices and frames, in model units.
@@ -73,6 +76,9 @@ pub struct Homogenizer {
     /// Per welded vertex: `Some(local pinned index)`.
     pinned_index: Vec<Option<u32>>,
     pinned: Vec<u32>,
+    /// Per welded vertex: pinned to its input motion (displacement 0) rather than to its
+    /// average position (open borders, user pins).
+    keep_input: Vec<bool>,
     targets: Vec<Vec3>,
     representative: Vec<u32>,
     /// `Q_FP` by pinned column: `(free row, value)`.
@@ -107,8 +113,36 @@ impl Homogenizer {
         weld_class: Vec<u32>,
         representative: Vec<u32>,
     ) -> Result<Homogenizer> {
+        let keep = vec![false; average.len()];
+        Self::with_kept(average, triangles, seam, &keep, weld_class, representative)
+    }
+
+    /// [`Homogenizer::new`] with vertices that keep the input's motion: `keep[v]` pins welded
+    /// vertex `v` to a zero displacement (open mesh borders such as the neck and scalp, or
+    /// vertices the user pins), so the deformation decays from the seam to them instead of
+    /// moving them. Seam vertices win where both apply; kept vertices in the seam's one-ring
+    /// keep the input's motion.
+    ///
+    /// # Errors
+    /// [`SegmentError::Solver`] when the factorization fails, [`SegmentError::Parameter`]
+    /// when `keep` has the wrong length.
+    pub fn with_kept(
+        average: &[DVec3],
+        triangles: &[[u32; 3]],
+        seam: &[bool],
+        keep: &[bool],
+        weld_class: Vec<u32>,
+        representative: Vec<u32>,
+    ) -> Result<Homogenizer> {
         let start = Instant::now();
         let n = average.len();
+        if keep.len() != n || seam.len() != n {
+            return Err(SegmentError::Parameter(format!(
+                "{} seam and {} kept flags for {n} welded vertices",
+                seam.len(),
+                keep.len()
+            )));
+        }
         let topo = Topology::new(n, triangles);
         let mut pinned_mask = seam.to_vec();
         for v in 0..n {
@@ -117,6 +151,10 @@ impl Homogenizer {
                     pinned_mask[w as usize] = true;
                 }
             }
+        }
+        let keep_input: Vec<bool> = (0..n).map(|v| keep[v] && !seam[v]).collect();
+        for v in 0..n {
+            pinned_mask[v] |= keep_input[v];
         }
         let (comp, count) = vertex_components(&topo.neighbors);
         let mut comp_pinned = vec![false; count];
@@ -196,6 +234,7 @@ impl Homogenizer {
             free_index,
             pinned_index,
             pinned,
+            keep_input,
             targets,
             representative,
             qfp,
@@ -281,7 +320,8 @@ impl Homogenizer {
         }
         HomogenizeStats {
             seam_vertices: self.seam_count,
-            pinned_vertices: self.pinned.len(),
+            pinned_vertices: self.pinned.len() - self.kept_count(),
+            kept_vertices: self.kept_count(),
             free_vertices: nf,
             mean_change: s[0] / (m.max(1) as f64 * frames),
             max_change: s[1],
@@ -290,6 +330,21 @@ impl Homogenizer {
             max_displacement_gradient: s[4],
             factor_seconds: self.factor_seconds,
             solve_seconds: start.elapsed().as_secs_f64(),
+        }
+    }
+
+    /// Pinned welded vertices that keep the input's motion.
+    fn kept_count(&self) -> usize {
+        self.keep_input.iter().filter(|&&k| k).count()
+    }
+
+    /// Prescribed displacement of pinned welded vertex `w` in frame `y`: to its average
+    /// position, or none when it keeps the input's motion.
+    fn pinned_displacement(&self, w: usize, y: &[Vec3]) -> DVec3 {
+        if self.keep_input[w] {
+            DVec3::ZERO
+        } else {
+            (self.targets[w] - y[self.representative[w] as usize]).as_dvec3()
         }
     }
 
@@ -308,9 +363,7 @@ impl Homogenizer {
             for lf in 0..nfr {
                 let y = &frames[lf * m..(lf + 1) * m];
                 for (pl, &p) in self.pinned.iter().enumerate() {
-                    let d = (self.targets[p as usize]
-                        - y[self.representative[p as usize] as usize])
-                        .as_dvec3();
+                    let d = self.pinned_displacement(p as usize, y);
                     for k in 0..3 {
                         dp[(pl, 3 * lf + k)] = d[k];
                     }
@@ -328,9 +381,7 @@ impl Homogenizer {
             for lf in 0..nfr {
                 let y = &frames[lf * m..(lf + 1) * m];
                 for (pl, &p) in self.pinned.iter().enumerate() {
-                    let d = (self.targets[p as usize]
-                        - y[self.representative[p as usize] as usize])
-                        .as_dvec3();
+                    let d = self.pinned_displacement(p as usize, y);
                     for (r, q) in self.qfp.row(pl) {
                         for k in 0..3 {
                             rhs[(r as usize, 3 * lf + k)] -= q * d[k];
@@ -347,21 +398,20 @@ impl Homogenizer {
         for lf in 0..nfr {
             let y = &mut frames[lf * m..(lf + 1) * m];
             for w in 0..nw {
-                let rep = self.representative[w] as usize;
                 disp[w] = match (self.free_index[w], self.pinned_index[w]) {
                     (Some(r), _) => DVec3::new(
                         rhs[(r as usize, 3 * lf)],
                         rhs[(r as usize, 3 * lf + 1)],
                         rhs[(r as usize, 3 * lf + 2)],
                     ),
-                    (None, Some(_)) => (self.targets[w] - y[rep]).as_dvec3(),
+                    (None, Some(_)) => self.pinned_displacement(w, y),
                     (None, None) => DVec3::ZERO,
                 };
             }
             for (i, p) in y.iter_mut().enumerate() {
                 let w = self.weld_class[i] as usize;
                 let old = *p;
-                *p = if self.pinned_index[w].is_some() {
+                *p = if self.pinned_index[w].is_some() && !self.keep_input[w] {
                     self.targets[w]
                 } else {
                     (p.as_dvec3() + disp[w]).as_vec3()

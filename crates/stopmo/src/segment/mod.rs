@@ -69,9 +69,11 @@ mod laplacian;
 mod maxflow;
 mod pipeline;
 mod problem;
+mod reuse;
 mod seeds;
 mod smooth;
 mod topology;
+mod transfer;
 mod weld;
 
 pub use cut::{CutMesh, VertexSource, DEFAULT_SNAP};
@@ -83,11 +85,13 @@ pub use pipeline::{
     Segmentation,
 };
 pub use problem::{SegmentationProblem, DEFAULT_GAMMA};
+pub use reuse::{segment_reusing, SavedSegmentation};
 pub use seeds::{
     auto_seeds, resolve_seeds, PartSpec, Seed, DEFAULT_AUTO_CENTERING_ITERATIONS,
     DEFAULT_AUTO_SAMPLES, DEFAULT_AUTO_SEED_RADIUS,
 };
 pub use smooth::{DEFAULT_SMOOTH_ITERATIONS, DEFAULT_SMOOTH_STEP};
+pub use transfer::DEFAULT_MIN_PART_FRACTION;
 pub use weld::{Weld, DEFAULT_WELD_EPSILON};
 
 /// The graph-cut solvers behind StopShop Eq. 1: public for tests and benchmarks (and for

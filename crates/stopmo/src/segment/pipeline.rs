@@ -31,6 +31,9 @@ pub struct SegmentOptions {
     pub homogenize: bool,
     /// Welding tolerance relative to the bounding-box diagonal.
     pub weld_epsilon: f32,
+    /// Open mesh borders (neck, scalp) keep the input's motion during homogenization, so the
+    /// deformation decays from the seams instead of moving the whole part.
+    pub keep_open_borders: bool,
 }
 
 impl Default for SegmentOptions {
@@ -42,6 +45,7 @@ impl Default for SegmentOptions {
             snap: DEFAULT_SNAP,
             homogenize: true,
             weld_epsilon: DEFAULT_WELD_EPSILON,
+            keep_open_borders: true,
         }
     }
 }
@@ -70,6 +74,10 @@ pub struct Segmentation {
     pub cut_length: f64,
     /// Homogenization measurements (`None` when not requested).
     pub homogenization: Option<HomogenizeStats>,
+    /// Average position of every vertex of `animation` over the input clip: the seam targets
+    /// of homogenization, kept so that another clip can reuse this cut
+    /// ([`Segmentation::saved`]).
+    pub reference: Vec<Vec3>,
 }
 
 /// One part as its own animation.
@@ -308,8 +316,40 @@ pub fn segment_with(
         s,
         options.snap,
     );
-    let mut animation = build_cut_animation(anim, &cut)?;
+    let average_input = problem.average_positions();
+    let reference: Vec<Vec3> = cut.sources.iter().map(|s| s.eval(average_input)).collect();
+    finish(
+        anim,
+        cut,
+        Labels {
+            part_names,
+            seeds,
+            input_triangle_part: labels,
+            gamma: options.gamma,
+        },
+        reference,
+        options,
+    )
+}
 
+/// What a cut carries besides its geometry.
+pub(super) struct Labels {
+    pub part_names: Vec<String>,
+    pub seeds: Vec<Vec<u32>>,
+    pub input_triangle_part: Vec<u32>,
+    pub gamma: f64,
+}
+
+/// Evaluates the cut on `anim`, finds the seam and homogenizes it towards `reference` (the
+/// average positions of the cut vertices on the clip that defined the cut).
+pub(super) fn finish(
+    anim: &MeshAnimation,
+    cut: CutMesh,
+    labels: Labels,
+    reference: Vec<Vec3>,
+    options: &SegmentOptions,
+) -> Result<Segmentation> {
+    let mut animation = build_cut_animation(anim, &cut)?;
     // Seam and cut length on the welded cut mesh.
     let weld_y = Weld {
         class: cut.weld_class.clone(),
@@ -317,11 +357,10 @@ pub fn segment_with(
     };
     let welded_tris = weld_y.triangles(&cut.triangles);
     let topo = Topology::new(weld_y.len(), &welded_tris);
-    let avg_input = problem.average_positions();
     let average: Vec<DVec3> = weld_y
         .representative
         .iter()
-        .map(|&r| cut.sources[r as usize].eval(avg_input).as_dvec3())
+        .map(|&r| reference[r as usize].as_dvec3())
         .collect();
     let mut seam = vec![false; weld_y.len()];
     let mut first_part = vec![u32::MAX; weld_y.len()];
@@ -346,10 +385,16 @@ pub fn segment_with(
         .collect();
 
     let homogenization = if options.homogenize {
-        let h = Homogenizer::new(
+        let keep = if options.keep_open_borders {
+            open_border(weld_y.len(), &welded_tris)
+        } else {
+            vec![false; weld_y.len()]
+        };
+        let h = Homogenizer::with_kept(
             &average,
             &welded_tris,
             &seam,
+            &keep,
             weld_y.class.clone(),
             weld_y.representative.clone(),
         )?;
@@ -358,17 +403,38 @@ pub fn segment_with(
         None
     };
     Ok(Segmentation {
-        part_names,
-        gamma: options.gamma,
-        seeds,
-        input_triangle_part: labels,
+        part_names: labels.part_names,
+        gamma: labels.gamma,
+        seeds: labels.seeds,
+        input_triangle_part: labels.input_triangle_part,
         animation,
         triangle_part: cut.triangle_part.clone(),
         cut,
         seam_vertices,
         cut_length,
         homogenization,
+        reference,
     })
+}
+
+/// Vertices on an edge used by a single triangle (open mesh borders).
+fn open_border(n: usize, tris: &[[u32; 3]]) -> Vec<bool> {
+    let mut count: std::collections::HashMap<(u32, u32), u32> =
+        std::collections::HashMap::with_capacity(tris.len() * 3);
+    for t in tris {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *count.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    let mut out = vec![false; n];
+    for (&(a, b), &c) in &count {
+        if c == 1 {
+            out[a as usize] = true;
+            out[b as usize] = true;
+        }
+    }
+    out
 }
 
 fn representatives(class: &[u32], count: usize) -> Vec<u32> {
@@ -502,10 +568,12 @@ pub fn homogenize(
         }
     }
     let average: Vec<DVec3> = weld.gather(&avg).iter().map(|p| p.as_dvec3()).collect();
-    let h = Homogenizer::new(
+    let keep = open_border(weld.len(), &tris);
+    let h = Homogenizer::with_kept(
         &average,
         &tris,
         &seam,
+        &keep,
         weld.class.clone(),
         weld.representative.clone(),
     )?;

@@ -8,7 +8,7 @@ use anim::MeshAnimation;
 use anyhow::{bail, Result};
 use clap::Args;
 
-use super::{save_files, LibraryOptionsArgs};
+use super::{save_files, warn, LibraryOptionsArgs};
 use crate::commands::Context;
 use crate::input::{self, InputArgs};
 
@@ -58,6 +58,7 @@ pub(super) fn library(ctx: &Context, args: LibraryArgs) -> Result<()> {
     drop(anims);
     result.report.input = Some(args.input.display().to_string());
     save_files(&args.output, &result.files()?)?;
+    warn(ctx, &result);
     let report = serde_json::to_value(&result.report)?;
     if let Some(p) = &args.library.report {
         tkio::save(p, &tkio::Output::Text(&result.report.to_json()))?;

@@ -77,6 +77,10 @@ pub struct SegmentOptionsArgs {
     /// Keep the seams as they move (skip Section 3.2).
     #[arg(long)]
     pub no_homogenize: bool,
+    /// Reuse the cut and seam targets of an earlier segmentation of the same mesh (its
+    /// `segmentation.json`, or the `.glb` next to it): parts of both clips assemble together.
+    #[arg(long, value_name = "SEG.json|SEG.glb", conflicts_with_all = ["parts", "auto_parts"])]
+    pub segmentation: Option<PathBuf>,
 }
 
 impl SegmentOptionsArgs {
@@ -90,13 +94,35 @@ impl SegmentOptionsArgs {
         if let Some(k) = self.smooth_iters {
             segment.smooth_iterations = k;
         }
+        let reuse = match &self.segmentation {
+            Some(path) => Some(read_saved(path)?),
+            None => None,
+        };
         Ok(SegmentJobOptions {
             parts: parse_parts(&self.parts)?,
             auto_parts: self.auto_parts,
             figure,
+            reuse,
             segment,
         })
     }
+}
+
+/// Reads `--segmentation`: a `segmentation.json` (a `.glb` stands for the `.json` of the same
+/// name next to it, as `stopmo run` writes them).
+fn read_saved(path: &Path) -> Result<stopmo::segment::SavedSegmentation> {
+    let json = if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+    {
+        path.with_extension("json")
+    } else {
+        path.to_path_buf()
+    };
+    let bytes =
+        tkio::read_file(&json).with_context(|| format!("--segmentation {}", path.display()))?;
+    stopmo::saved_segmentation(&String::from_utf8_lossy(&bytes))
+        .with_context(|| format!("--segmentation {}", json.display()))
 }
 
 /// Parses `NAME=tri:ID` or `NAME=point:X,Y,Z` and groups seeds by part name (in order).
@@ -178,7 +204,8 @@ pub struct LibraryOptionsArgs {
     #[arg(long, default_value_t = DEFAULT_SEED)]
     pub seed: u64,
     /// Per-vertex saliency weights: float32 `.npy` of shape (vertices,) or (1, vertices), in
-    /// the merged vertex order of the input (parts one after the other).
+    /// the merged vertex order of the input (parts one after the other; for `stopmo run`, the
+    /// input mesh's own vertex order, checked before anything is written).
     #[arg(long, value_name = "FILE.npy")]
     pub saliency: Option<PathBuf>,
     /// Frames that start a new, unrelated shot (no velocity term across them).
@@ -213,6 +240,17 @@ pub struct LibraryOptionsArgs {
     #[arg(long, value_name = "MM", requires = "plugs",
           default_value_t = DEFAULT_PLUG_CLEARANCE_MM)]
     pub plug_clearance: f64,
+    /// Printer resolution in millimetres: pieces that differ from a sibling by less are
+    /// reported (a warning and report.json "printing.parts[].below_resolution").
+    #[arg(long, value_name = "MM", default_value_t = stopmo::DEFAULT_RESOLUTION_MM)]
+    pub resolution: f64,
+    /// No registration keys (domes on the shared back surface that fix all six degrees of
+    /// freedom on the armature/head).
+    #[arg(long)]
+    pub no_keys: bool,
+    /// No piece ID (`P-NN`) embossed on the back of every piece.
+    #[arg(long)]
+    pub no_ids: bool,
     /// Also write the JSON report here (it is always written to DIR/report.json).
     #[arg(long)]
     pub report: Option<PathBuf>,
@@ -263,6 +301,9 @@ impl LibraryOptionsArgs {
             saliency,
             cuts: self.cuts.clone(),
             fixed,
+            resolution_mm: self.resolution,
+            keys: !self.no_keys,
+            ids: !self.no_ids,
         })
     }
 
@@ -272,6 +313,7 @@ impl LibraryOptionsArgs {
         let at = match (e.option(), &self.saliency, &self.fixed) {
             (Some("saliency"), Some(p), _) => p.display().to_string(),
             (Some("fixed"), _, Some(d)) => format!("--fixed {}", d.display()),
+            (Some("resolution_mm"), _, _) => format!("--resolution {}", self.resolution),
             (Some("pieces"), _, _) => format!("--pieces {}", self.pieces.as_deref().unwrap_or("")),
             _ => input.display().to_string(),
         };
@@ -342,6 +384,15 @@ fn read_fixed(dir: &Path, names: &[String]) -> Result<BTreeMap<String, Vec<Vec<V
         }
     }
     Ok(out)
+}
+
+/// Prints the printing warnings of a library (not with `--json`: they are in the report).
+fn warn(ctx: &Context, result: &stopmo::LibraryResult) {
+    if !ctx.json {
+        for w in &result.report.warnings {
+            eprintln!("toonkit: warning: {w}");
+        }
+    }
 }
 
 /// Writes every file of a result under `dir` with `tkio::save`.

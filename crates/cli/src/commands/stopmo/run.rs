@@ -12,7 +12,7 @@ use anyhow::{Context as _, Result};
 use clap::Args;
 use serde_json::json;
 
-use super::{save_files, LibraryOptionsArgs, SegmentOptionsArgs};
+use super::{save_files, warn, LibraryOptionsArgs, SegmentOptionsArgs};
 use crate::commands::Context;
 use crate::input::{self, InputArgs};
 
@@ -40,14 +40,21 @@ pub(super) fn run(ctx: &Context, args: RunArgs) -> Result<()> {
     let start = Instant::now();
     let segment = args.segment.options(args.render)?;
     // Part names are known before segmenting: the --part names, or part1… for --auto-parts.
-    let names: Vec<String> = match args.segment.auto_parts {
-        Some(n) => (1..=n).map(|i| format!("part{i}")).collect(),
-        None => segment
+    // (the saved part names with --segmentation).
+    let names: Vec<String> = match (&segment.reuse, args.segment.auto_parts) {
+        (Some(saved), _) => saved
+            .parts
+            .iter()
+            .map(|n| stopmo::file_safe_name(n))
+            .collect(),
+        (None, Some(n)) => (1..=n).map(|i| format!("part{i}")).collect(),
+        (None, None) => segment
             .parts
             .iter()
             .map(|p| stopmo::file_safe_name(&p.name))
             .collect(),
     };
+    // --saliency is in the input's vertex order here; the crate carries it through the cut.
     let options = stopmo::RunOptions {
         segment,
         library: args.library.options(&names)?,
@@ -65,6 +72,7 @@ pub(super) fn run(ctx: &Context, args: RunArgs) -> Result<()> {
     result.report.input = Some(args.input.display().to_string());
     let dir = &args.output;
     save_files(dir, &result.files()?)?;
+    warn(ctx, &result);
     let seg = result
         .segmented
         .as_ref()

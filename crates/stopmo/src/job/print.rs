@@ -1,0 +1,275 @@
+//! The printing side of a library (issue 19): solids closed onto one shared back surface per
+//! part with registration keys and an embossed ID, the printer-resolution check and the
+//! material and print-time estimates of `report.json` `"printing"`.
+//!
+//! Piece IDs: `P-NN`, the part's number (1-based, part order) and the piece number — the
+//! digits the built-in font can draw and a printer can emboss; `upper_07` is `1-07`.
+
+use anim::{Mesh, MeshAnimation};
+use glam::Vec3;
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::error::{Error, Result};
+use crate::library::{
+    add_plugs, material, piece_id, Bitmap, Key, KeyOptions, Library, MaterialEstimate, PartShell,
+    Plug, ShellOptions, ShellStats, DEFAULT_ID_RELIEF_MM,
+};
+
+/// Resin layer height assumed by the print-time estimate (mm).
+const LAYER_MM: f64 = 0.05;
+/// Seconds per resin layer (exposure plus peel), independent of how many pieces are on the
+/// plate.
+const SECONDS_PER_LAYER: f64 = 8.0;
+/// Build plate of a small resin printer (mm).
+const PLATE_MM: [f64; 2] = [120.0, 68.0];
+
+/// Printer resolution assumed when none is given (mm).
+pub const DEFAULT_RESOLUTION_MM: f64 = 0.05;
+
+/// The ID embossed on piece `k` of part `part` (`P-NN`, 1-based part number).
+pub fn piece_label(part: usize, k: usize) -> String {
+    format!("{}-{k:02}", part + 1)
+}
+
+/// How the pieces are printed.
+pub(crate) struct PrintSettings<'a> {
+    pub(crate) thickness_mm: f64,
+    pub(crate) print_height_mm: f64,
+    pub(crate) resolution_mm: f64,
+    pub(crate) keys: bool,
+    pub(crate) ids: bool,
+    pub(crate) plugs: &'a [Plug],
+    pub(crate) plug_segments: usize,
+}
+
+/// One part in [`PrintReport`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PartPrintReport {
+    /// Part name.
+    pub name: String,
+    /// Measurements of the part's shared back surface.
+    pub shell: ShellStats,
+    /// Registration keys on the back surface (empty without keys).
+    pub keys: Vec<Key>,
+    /// Pieces closer to a sibling than the printer resolution.
+    pub below_resolution: Vec<String>,
+    /// Smallest largest-vertex-distance between two pieces of the part (mm; `null` for one
+    /// piece).
+    pub min_sibling_distance_mm: f64,
+}
+
+/// The print-time estimate.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PrintTime {
+    /// Estimated hours.
+    pub hours: f64,
+    /// Build plates needed.
+    pub plates: f64,
+    /// Layers per plate.
+    pub layers_per_plate: f64,
+    /// Layer height (mm).
+    pub layer_mm: f64,
+    /// Seconds per layer.
+    pub seconds_per_layer: f64,
+    /// Build plate (mm).
+    pub plate_mm: [f64; 2],
+    /// What the estimate assumes.
+    pub assumes: String,
+}
+
+/// `report.json` `"printing"`: material, print time, resolution check, keys and IDs.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PrintReport {
+    /// Material of all solids.
+    pub material: MaterialEstimate,
+    /// Print-time estimate.
+    pub print_time: PrintTime,
+    /// Printer resolution checked against (mm).
+    pub resolution_mm: f64,
+    /// Whether registration keys were added.
+    pub keys: bool,
+    /// Whether IDs were embossed.
+    pub ids: bool,
+    /// Per part.
+    pub parts: Vec<PartPrintReport>,
+}
+
+/// One printable piece.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Piece {
+    /// Identifier `<part>_<NN>` (the file stem of `pieces/<id>.stl`); the ID embossed on
+    /// the back is [`piece_label`](crate::piece_label)`(part, index)`.
+    pub id: String,
+    /// Index of the part.
+    pub part: usize,
+    /// Index of the piece in its part's library (fixed pieces first).
+    pub index: usize,
+    /// The piece's surface in model units, with the part's topology and UVs.
+    pub surface: Mesh,
+    /// The printable solid in millimetres (with the part's plug shells, if any).
+    pub solid: Mesh,
+}
+
+/// Renders `text` with the built-in font into a bitmap (one font pixel per bitmap pixel).
+fn text_bitmap(text: &str) -> Result<Bitmap> {
+    let (w, h) = render::text_size(text, 1);
+    let mut img = render::Image::new(w.max(1), h.max(1), [0, 0, 0, 0])?;
+    render::draw_text(&mut img, text, 0, 0, 1, [255, 255, 255, 255], None);
+    Ok(Bitmap {
+        width: w as usize,
+        height: h as usize,
+        pixels: img.pixels().iter().map(|p| p[3] > 0).collect(),
+    })
+}
+
+/// Surface (model units) and printable solid (mm, on the part's shared back surface, with
+/// keys, ID and plug shells) of every piece; the `"printing"` report and warnings.
+pub(crate) fn print_pieces(
+    lib: &Library,
+    anims: &[&MeshAnimation],
+    s: &PrintSettings<'_>,
+) -> Result<(Vec<Piece>, PrintReport, Vec<String>)> {
+    let mm = lib.mm_per_unit as f32;
+    let mut parts_report = Vec::new();
+    let mut warnings = Vec::new();
+    let mut pieces_out: Vec<Piece> = Vec::new();
+    let mut shared: Vec<(Vec3, Vec3)> = Vec::new();
+    for (p, a) in anims.iter().enumerate() {
+        let part = &lib.parts[p];
+        let avg: Vec<Vec3> = a.average_positions().iter().map(|x| *x * mm).collect();
+        let pieces_mm: Vec<Vec<Vec3>> = part
+            .solution
+            .pieces
+            .iter()
+            .map(|q| q.iter().map(|x| *x * mm).collect())
+            .collect();
+        let refs: Vec<&[Vec3]> = pieces_mm.iter().map(Vec::as_slice).collect();
+        let shell_opts = ShellOptions {
+            wall_mm: s.thickness_mm,
+            ..ShellOptions::default()
+        };
+        let mut shell = PartShell::new_sharing(&a.mesh, &avg, &refs, &shell_opts, &shared)?;
+        shared.extend(shell.boundary_pairs(&avg));
+        let keys = if s.keys {
+            shell.add_keys(&KeyOptions::for_print_height(s.print_height_mm))?
+        } else {
+            Vec::new()
+        };
+        let pixel = (s.print_height_mm * 0.02).clamp(0.3, 1.0);
+        let made: Vec<Piece> = (0..pieces_mm.len())
+            .into_par_iter()
+            .map(|k| -> Result<Piece> {
+                let surface = lib.piece_surface(p, k, &a.mesh).ok_or_else(|| {
+                    Error::option_error("pieces", format!("no piece {k} of part {p}"))
+                })?;
+                let id = if s.ids {
+                    text_bitmap(&piece_label(p, k))?
+                } else {
+                    Bitmap::default()
+                };
+                let solid = shell.solid_with_id(
+                    &pieces_mm[k],
+                    &surface.name,
+                    &id,
+                    pixel,
+                    DEFAULT_ID_RELIEF_MM,
+                    &keys,
+                )?;
+                let solid = add_plugs(&solid, p, s.plugs, s.plug_segments);
+                Ok(Piece {
+                    id: surface.name.clone(),
+                    part: p,
+                    index: k,
+                    surface,
+                    solid,
+                })
+            })
+            .collect::<Result<_>>()?;
+        let (close, nearest) = below_resolution(&part.name, &pieces_mm, s.resolution_mm);
+        let n = pieces_mm.len();
+        if !close.is_empty() {
+            warnings.push(format!(
+                "part {}: {} of {n} pieces differ from a sibling by less than the printer resolution ({} mm): {}; print larger (print height) or use fewer pieces",
+                part.name,
+                close.len(),
+                s.resolution_mm,
+                close.join(", ")
+            ));
+        }
+        parts_report.push(PartPrintReport {
+            name: part.name.clone(),
+            shell: shell.stats,
+            keys,
+            below_resolution: close,
+            min_sibling_distance_mm: nearest,
+        });
+        pieces_out.extend(made);
+    }
+    let solids: Vec<Mesh> = pieces_out.iter().map(|p| p.solid.clone()).collect();
+    let report = PrintReport {
+        material: material(&solids),
+        print_time: print_time(&solids),
+        resolution_mm: s.resolution_mm,
+        keys: s.keys,
+        ids: s.ids,
+        parts: parts_report,
+    };
+    Ok((pieces_out, report, warnings))
+}
+
+/// Pieces closer to a sibling than `resolution_mm` (largest vertex distance), and the
+/// smallest such distance of the part.
+fn below_resolution(name: &str, pieces_mm: &[Vec<Vec3>], resolution_mm: f64) -> (Vec<String>, f64) {
+    let n = pieces_mm.len();
+    let mut nearest = vec![f64::INFINITY; n];
+    for i in 0..n {
+        for j in i + 1..n {
+            let d = pieces_mm[i]
+                .iter()
+                .zip(&pieces_mm[j])
+                .map(|(x, y)| x.distance(*y))
+                .fold(0.0f32, f32::max) as f64;
+            nearest[i] = nearest[i].min(d);
+            nearest[j] = nearest[j].min(d);
+        }
+    }
+    let close = (0..n)
+        .filter(|&k| nearest[k] < resolution_mm)
+        .map(|k| piece_id(name, k, n))
+        .collect();
+    (close, nearest.iter().copied().fold(f64::INFINITY, f64::min))
+}
+
+/// Resin print time: plates by footprint (pieces laid on their smallest extent, 50 % margin),
+/// layers by the tallest piece.
+fn print_time(solids: &[Mesh]) -> PrintTime {
+    let tallest = solids
+        .iter()
+        .map(|s| {
+            let b = s.bbox();
+            f64::from((b.max - b.min).min_element())
+        })
+        .fold(0.0, f64::max);
+    let footprint: f64 = solids
+        .iter()
+        .map(|s| {
+            let b = s.bbox();
+            let e = b.max - b.min;
+            let mut d = [f64::from(e.x), f64::from(e.y), f64::from(e.z)];
+            d.sort_by(f64::total_cmp);
+            d[1] * d[2] * 1.5
+        })
+        .sum();
+    let plates = (footprint / (PLATE_MM[0] * PLATE_MM[1])).ceil().max(1.0);
+    let layers = (tallest / LAYER_MM).ceil();
+    PrintTime {
+        hours: plates * layers * SECONDS_PER_LAYER / 3600.0,
+        plates,
+        layers_per_plate: layers,
+        layer_mm: LAYER_MM,
+        seconds_per_layer: SECONDS_PER_LAYER,
+        plate_mm: PLATE_MM,
+        assumes: "resin printer, pieces laid flat on their smallest extent".into(),
+    }
+}

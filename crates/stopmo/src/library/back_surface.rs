@@ -1,0 +1,583 @@
+//! Printable pieces on one shared back surface (StopShop Section 3.4, made robust).
+//!
+//! The paper prints each piece as its surface offset inward; offsetting every vertex along its
+//! own normal folds at eye rims and bursts through noses and ears. Here all pieces of a part
+//! share one smooth *back surface*: the part's average surface moved inward along a smoothed
+//! normal field, deep enough that every piece keeps at least the minimum wall in front of it,
+//! then smoothed (Laplacian steps, each followed by the wall constraint) so that it has no
+//! folds. A piece is its animated front, the common back (reversed) and a wall joining the
+//! two along the part boundary. Every piece therefore seats identically on one armature/head,
+//! and the construction is checked (not assumed) with the exact self-intersection test of
+//! [`self_intersecting_triangles`](super::self_intersecting_triangles): where it finds
+//! crossings the back surface is smoothed and pushed back locally until none remain.
+
+use std::collections::HashMap;
+
+use anim::Mesh;
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use super::error::{LibraryError, Result};
+use super::fabricate::{check_solid, split_fans, DEFAULT_THICKNESS_MM};
+use super::intersect::self_intersecting_triangles;
+
+/// Radius over which the offset direction field is smoothed, in millimetres.
+pub const DEFAULT_NORMAL_SMOOTHING_MM: f64 = 8.0;
+/// Laplacian smoothing steps of the back surface.
+pub const DEFAULT_BACK_SMOOTHING_ITERATIONS: usize = 300;
+/// Boundary loops shorter than this fraction of the longest one are capped.
+pub const DEFAULT_CAP_FRACTION: f64 = 0.5;
+/// Rounds of local repair where the exact test still finds crossings.
+pub const DEFAULT_REPAIR_ROUNDS: usize = 0;
+
+/// Options of the shared back surface (millimetres, like the printable pieces).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct ShellOptions {
+    /// Minimum wall between any piece's front and the back surface.
+    pub wall_mm: f64,
+    /// Radius over which the inward direction field is smoothed.
+    pub normal_smoothing_mm: f64,
+    /// Laplacian smoothing steps of the back surface.
+    pub smoothing_iterations: usize,
+    /// Rounds of local repair driven by the exact intersection test.
+    pub repair_rounds: usize,
+    /// Boundary loops shorter than this fraction of the longest loop (eye and mouth
+    /// openings) are capped instead of walled.
+    pub cap_fraction: f64,
+    /// Smooth the back surface's boundary too (walls may lean inward).
+    pub smooth_boundary: bool,
+}
+
+impl Default for ShellOptions {
+    fn default() -> Self {
+        ShellOptions {
+            wall_mm: DEFAULT_THICKNESS_MM,
+            normal_smoothing_mm: DEFAULT_NORMAL_SMOOTHING_MM,
+            smoothing_iterations: DEFAULT_BACK_SMOOTHING_ITERATIONS,
+            repair_rounds: DEFAULT_REPAIR_ROUNDS,
+            cap_fraction: DEFAULT_CAP_FRACTION,
+            smooth_boundary: false,
+        }
+    }
+}
+
+/// Measurements of a [`PartShell`].
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct ShellStats {
+    /// Repair rounds used.
+    pub repair_rounds: usize,
+    /// Self-intersecting triangles left over all pieces after the repair (0 when printable).
+    pub self_intersecting_triangles: usize,
+    /// Smallest distance from a front vertex of any piece to the back surface (mm).
+    pub min_wall_mm: f64,
+}
+
+/// The shared back surface of one part and how pieces are closed onto it.
+#[derive(Debug, Clone)]
+pub struct PartShell {
+    /// For every shell vertex, the input vertex it copies (UV-seam duplicates welded, bow-tie
+    /// vertices split per fan).
+    source: Vec<u32>,
+    /// Capped boundary loops (shell vertices, boundary order); cap `i` adds the shell vertex
+    /// `source.len() + i` at the loop's centroid.
+    caps: Vec<Vec<u32>>,
+    /// Front triangles over shell vertices (outward oriented, like the input).
+    triangles: Vec<[u32; 3]>,
+    /// Directed boundary edges `a → b` of the front.
+    boundary: Vec<(u32, u32)>,
+    /// Back surface position of every shell vertex.
+    back: Vec<Vec3>,
+    /// Smoothed outward direction of the front at every shell vertex (the back lies along
+    /// its negative).
+    normals: Vec<Vec3>,
+    /// Whether a shell vertex lies on the part boundary.
+    on_boundary: Vec<bool>,
+    /// Measurements.
+    pub stats: ShellStats,
+}
+
+/// What [`PartShell::displace_back`] tells about a back vertex.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct BackVertex {
+    /// On the part boundary (walls start there: leave it in place).
+    pub is_boundary: bool,
+}
+
+/// Front positions of the shell vertices for one piece (input vertex order): welded copies,
+/// then one centroid per cap.
+fn front_positions(source: &[u32], caps: &[Vec<u32>], piece: &[Vec3]) -> Vec<Vec3> {
+    let mut out: Vec<Vec3> = source.iter().map(|&s| piece[s as usize]).collect();
+    for lp in caps {
+        let c = lp.iter().map(|&v| out[v as usize]).sum::<Vec3>() / lp.len().max(1) as f32;
+        out.push(c);
+    }
+    out
+}
+
+/// Splits the directed boundary edges into loops, removes the loops shorter than
+/// `fraction` of the longest one from `boundary` and returns them (vertices in edge order).
+fn cap_loops(front: &[Vec3], boundary: &mut Vec<(u32, u32)>, fraction: f64) -> Vec<Vec<u32>> {
+    let next: HashMap<u32, u32> = boundary.iter().copied().collect();
+    let mut seen: HashMap<u32, ()> = HashMap::new();
+    let mut loops: Vec<(Vec<u32>, f64)> = Vec::new();
+    for &(start, _) in boundary.iter() {
+        if seen.contains_key(&start) {
+            continue;
+        }
+        let (mut lp, mut len, mut v) = (Vec::new(), 0.0f64, start);
+        let mut closed = false;
+        while seen.insert(v, ()).is_none() {
+            lp.push(v);
+            let Some(&w) = next.get(&v) else { break };
+            len += f64::from(front[v as usize].distance(front[w as usize]));
+            if w == start {
+                closed = true;
+                break;
+            }
+            v = w;
+        }
+        if closed && lp.len() >= 3 {
+            loops.push((lp, len));
+        }
+    }
+    let longest = loops.iter().map(|l| l.1).fold(0.0, f64::max);
+    let caps: Vec<Vec<u32>> = loops
+        .into_iter()
+        .filter(|l| l.1 < fraction * longest)
+        .map(|l| l.0)
+        .collect();
+    let capped: std::collections::HashSet<u32> = caps.iter().flatten().copied().collect();
+    boundary.retain(|(a, _)| !capped.contains(a));
+    caps
+}
+
+/// Vertex adjacency (sorted, deduplicated) of a triangle list.
+fn neighbours(n: usize, tris: &[[u32; 3]]) -> Vec<Vec<u32>> {
+    let mut adj = vec![Vec::new(); n];
+    for t in tris {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            adj[a as usize].push(b);
+            adj[b as usize].push(a);
+        }
+    }
+    for a in &mut adj {
+        a.sort_unstable();
+        a.dedup();
+    }
+    adj
+}
+
+impl PartShell {
+    /// Builds the back surface of a part.
+    ///
+    /// # Arguments
+    /// * `topology` — the part's triangles (outward oriented, edge-manifold after welding).
+    /// * `average` — the part's average surface, millimetres.
+    /// * `pieces` — every piece of the part, millimetres (same vertex count).
+    /// * `opts` — wall and smoothing.
+    ///
+    /// # Errors
+    /// [`LibraryError::InvalidParameter`] for bad options or sizes,
+    /// [`LibraryError::BadSurface`] when the surface is not an oriented 2-manifold.
+    pub fn new(
+        topology: &Mesh,
+        average: &[Vec3],
+        pieces: &[&[Vec3]],
+        opts: &ShellOptions,
+    ) -> Result<PartShell> {
+        Self::new_sharing(topology, average, pieces, opts, &[])
+    }
+
+    /// [`PartShell::new`] for a part that meets already built parts along seams: a boundary
+    /// vertex whose average position equals the first element of a pair in `shared` (see
+    /// [`PartShell::boundary_pairs`]) gets that pair's back position, so the walls of both
+    /// parts along their common seam are the same surface and the parts mate face to face.
+    ///
+    /// # Errors
+    /// As [`PartShell::new`].
+    pub fn new_sharing(
+        topology: &Mesh,
+        average: &[Vec3],
+        pieces: &[&[Vec3]],
+        opts: &ShellOptions,
+        shared: &[(Vec3, Vec3)],
+    ) -> Result<PartShell> {
+        let bad = |reason: String| LibraryError::BadSurface {
+            mesh: topology.name.clone(),
+            reason,
+        };
+        if !(opts.wall_mm.is_finite() && opts.wall_mm > 0.0) {
+            return Err(LibraryError::InvalidParameter(format!(
+                "wall must be finite and > 0 mm, got {}",
+                opts.wall_mm
+            )));
+        }
+        if !(opts.normal_smoothing_mm.is_finite() && opts.normal_smoothing_mm >= 0.0) {
+            return Err(LibraryError::InvalidParameter(format!(
+                "normal smoothing must be finite and >= 0 mm, got {}",
+                opts.normal_smoothing_mm
+            )));
+        }
+        let nv = topology.positions.len();
+        if average.len() != nv || pieces.iter().any(|p| p.len() != nv) {
+            return Err(LibraryError::InvalidParameter(format!(
+                "part '{}': average and pieces need {nv} vertices",
+                topology.name
+            )));
+        }
+        if topology.triangles.is_empty() {
+            return Err(bad("no triangle".into()));
+        }
+        // Weld exact duplicates of the average (glTF UV seams), compact to used vertices.
+        let mut by_bits: HashMap<[u32; 3], u32> = HashMap::new();
+        let mut class = vec![u32::MAX; nv];
+        let mut source: Vec<u32> = Vec::new();
+        let mut tris = Vec::with_capacity(topology.triangles.len());
+        for t in &topology.triangles {
+            let mut out = [0u32; 3];
+            for (o, &i) in out.iter_mut().zip(t) {
+                let i = i as usize;
+                if i >= nv {
+                    return Err(bad(format!("index {i} out of range ({nv} vertices)")));
+                }
+                if class[i] == u32::MAX {
+                    let key = average[i].to_array().map(f32::to_bits);
+                    class[i] = *by_bits.entry(key).or_insert_with(|| {
+                        source.push(i as u32);
+                        (source.len() - 1) as u32
+                    });
+                }
+                *o = class[i];
+            }
+            if out[0] != out[1] && out[1] != out[2] && out[0] != out[2] {
+                tris.push(out);
+            }
+        }
+        let front: Vec<Vec3> = source.iter().map(|&s| average[s as usize]).collect();
+        let (front, tris) = split_fans(front, tris);
+        // Copies made by the fan split come after the welded vertices: find their source.
+        let mut src = source.clone();
+        if front.len() > src.len() {
+            let mut at: HashMap<[u32; 3], u32> = HashMap::new();
+            for (i, &s) in source.iter().enumerate() {
+                at.insert(front[i].to_array().map(f32::to_bits), s);
+                let _ = i;
+            }
+            for p in &front[source.len()..] {
+                src.push(
+                    at.get(&p.to_array().map(f32::to_bits))
+                        .copied()
+                        .unwrap_or(0),
+                );
+            }
+        }
+        let mut directed: HashMap<(u32, u32), ()> = HashMap::with_capacity(tris.len() * 3);
+        for t in &tris {
+            for k in 0..3 {
+                let e = (t[k], t[(k + 1) % 3]);
+                if directed.insert(e, ()).is_some() {
+                    return Err(bad(format!(
+                        "edge {}–{} used twice in the same direction",
+                        e.0, e.1
+                    )));
+                }
+            }
+        }
+        let mut boundary: Vec<(u32, u32)> = tris
+            .iter()
+            .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+            .filter(|&(a, b)| !directed.contains_key(&(b, a)))
+            .collect();
+        boundary.sort_unstable();
+        // Cap the small boundary loops (eye and mouth openings): a fan from the loop's
+        // centroid, so only the outer boundary (seams, neck, scalp) needs a wall.
+        let (mut front, mut tris) = (front, tris);
+        let caps = cap_loops(&front, &mut boundary, opts.cap_fraction);
+        let regular = front.len();
+        for (i, lp) in caps.iter().enumerate() {
+            let c = (regular + i) as u32;
+            front.push(lp.iter().map(|&v| front[v as usize]).sum::<Vec3>() / lp.len() as f32);
+            for k in 0..lp.len() {
+                let (a, b) = (lp[k], lp[(k + 1) % lp.len()]);
+                tris.push([b, a, c]);
+            }
+        }
+        let n = front.len();
+        let adj = neighbours(n, &tris);
+        let on_boundary = {
+            let mut m = vec![false; n];
+            for &(a, b) in &boundary {
+                m[a as usize] = true;
+                m[b as usize] = true;
+            }
+            m
+        };
+        // Inward direction field: vertex normals diffused over the smoothing radius.
+        let mean_edge = {
+            let (s, c) = tris.iter().fold((0.0f64, 0usize), |(s, c), t| {
+                let l = (0..3)
+                    .map(|k| front[t[k] as usize].distance(front[t[(k + 1) % 3] as usize]) as f64)
+                    .sum::<f64>();
+                (s + l, c + 3)
+            });
+            (s / c.max(1) as f64).max(1e-9)
+        };
+        let steps = ((opts.normal_smoothing_mm / mean_edge).powi(2)).ceil() as usize;
+        let steps = steps.min(4000);
+        let mut normals = anim::vertex_normals(&front, &tris);
+        for _ in 0..steps {
+            let next: Vec<Vec3> = (0..n)
+                .map(|v| {
+                    let s = adj[v]
+                        .iter()
+                        .fold(normals[v], |acc, &w| acc + normals[w as usize]);
+                    s.try_normalize().unwrap_or(normals[v])
+                })
+                .collect();
+            normals = next;
+        }
+        let fronts: Vec<Vec<Vec3>> = pieces
+            .iter()
+            .map(|p| front_positions(&src, &caps, p))
+            .collect();
+        let piece_at = |k: usize, v: usize| fronts[k][v];
+        // Deepest point any piece reaches along the direction field, per vertex.
+        let wall = opts.wall_mm as f32;
+        let limit: Vec<f32> = (0..n)
+            .map(|v| {
+                let d = pieces
+                    .iter()
+                    .enumerate()
+                    .map(|(k, _)| piece_at(k, v).dot(normals[v]))
+                    .fold(front[v].dot(normals[v]), f32::min);
+                d - wall
+            })
+            .collect();
+        let shared_at: HashMap<[u32; 3], Vec3> = shared
+            .iter()
+            .map(|(a, b)| (a.to_array().map(f32::to_bits), *b))
+            .collect();
+        let fixed: Vec<Option<Vec3>> = (0..n)
+            .map(|v| {
+                if on_boundary[v] {
+                    shared_at
+                        .get(&front[v].to_array().map(f32::to_bits))
+                        .copied()
+                } else {
+                    None
+                }
+            })
+            .collect();
+        let enforce = |back: &mut [Vec3], extra: &[f32]| {
+            for v in 0..n {
+                if let Some(p) = fixed[v] {
+                    back[v] = p;
+                    continue;
+                }
+                let lim = limit[v] - extra[v];
+                let h = back[v].dot(normals[v]);
+                if h > lim {
+                    back[v] -= normals[v] * (h - lim);
+                }
+            }
+        };
+        let mut back: Vec<Vec3> = (0..n).map(|v| front[v] - normals[v] * wall).collect();
+        let mut extra = vec![0.0f32; n];
+        enforce(&mut back, &extra);
+        let smooth = |back: &mut Vec<Vec3>, mask: Option<&[bool]>| {
+            let next: Vec<Vec3> = (0..n)
+                .map(|v| {
+                    if (on_boundary[v] && !opts.smooth_boundary)
+                        || mask.is_some_and(|m| !m[v])
+                        || adj[v].is_empty()
+                    {
+                        return back[v];
+                    }
+                    let c = adj[v].iter().fold(Vec3::ZERO, |a, &w| a + back[w as usize])
+                        / adj[v].len() as f32;
+                    back[v] + (c - back[v]) * 0.5
+                })
+                .collect();
+            *back = next;
+        };
+        for _ in 0..opts.smoothing_iterations {
+            smooth(&mut back, None);
+            enforce(&mut back, &extra);
+        }
+        let mut shell = PartShell {
+            source: src,
+            caps,
+            triangles: tris,
+            boundary,
+            back,
+            normals: normals.clone(),
+            on_boundary: on_boundary.clone(),
+            stats: ShellStats::default(),
+        };
+        // Repair: smooth and push back around crossings found by the exact test.
+        let mut rounds = 0;
+        loop {
+            let bad_vertices = shell.crossing_vertices(pieces);
+            let count = bad_vertices.len();
+            shell.stats.self_intersecting_triangles = count;
+            if count == 0 || rounds >= opts.repair_rounds {
+                break;
+            }
+            rounds += 1;
+            let mut mask = vec![false; n];
+            for &v in &bad_vertices {
+                mask[v as usize] = true;
+            }
+            // Grow the region by a few rings.
+            for _ in 0..(2 + rounds) {
+                let grown: Vec<bool> = (0..n)
+                    .map(|v| mask[v] || adj[v].iter().any(|&w| mask[w as usize]))
+                    .collect();
+                mask = grown;
+            }
+            for (v, m) in mask.iter().enumerate() {
+                if *m {
+                    extra[v] += wall * 0.25;
+                }
+            }
+            for _ in 0..10 * rounds {
+                smooth(&mut shell.back, Some(&mask));
+                enforce(&mut shell.back, &extra);
+            }
+        }
+        shell.stats.repair_rounds = rounds;
+        shell.stats.min_wall_mm = pieces
+            .iter()
+            .map(|p| shell.min_wall(p))
+            .fold(f64::INFINITY, f64::min);
+        Ok(shell)
+    }
+
+    /// Shell vertices (front or back copies folded onto shell ids) of the triangles that
+    /// cross another triangle in some piece's solid.
+    fn crossing_vertices(&self, pieces: &[&[Vec3]]) -> Vec<u32> {
+        let n = self.back.len() as u32;
+        let mut out: Vec<u32> = Vec::new();
+        for p in pieces {
+            let solid = self.solid_unchecked(p, "");
+            if let Some(hits) = self_intersecting_triangles(&solid.positions, &solid.triangles) {
+                for t in hits {
+                    for v in solid.triangles[t as usize] {
+                        out.push(v % n);
+                    }
+                }
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// Back surface positions of the shell vertices (millimetres).
+    pub fn back(&self) -> &[Vec3] {
+        &self.back
+    }
+
+    /// `(average front position, back position)` of every boundary vertex, to share the seam
+    /// walls with the next part ([`PartShell::new_sharing`]).
+    pub fn boundary_pairs(&self, average: &[Vec3]) -> Vec<(Vec3, Vec3)> {
+        let mut out: Vec<(Vec3, Vec3)> = (0..self.back.len())
+            .filter(|&v| self.on_boundary[v])
+            .filter_map(|v| {
+                average
+                    .get(self.source[v] as usize)
+                    .map(|a| (*a, self.back[v]))
+            })
+            .collect();
+        out.dedup();
+        out
+    }
+
+    /// Directed boundary edges `a → b` of the front (shell vertices).
+    pub fn boundary_edges(&self) -> &[(u32, u32)] {
+        &self.boundary
+    }
+
+    /// Smoothed outward direction of the front at shell vertex `v`.
+    pub fn direction(&self, v: usize) -> Vec3 {
+        self.normals[v]
+    }
+
+    /// Moves every back vertex `f(info, position)` millimetres out of the solid (against the
+    /// smoothed front direction).
+    pub(super) fn displace_back(&mut self, f: impl Fn(BackVertex, Vec3) -> f32) {
+        for v in 0..self.back.len() {
+            let info = BackVertex {
+                is_boundary: self.on_boundary[v],
+            };
+            let d = f(info, self.back[v]);
+            if d.is_finite() && d != 0.0 {
+                self.back[v] -= self.normals[v] * d;
+            }
+        }
+    }
+
+    /// Front triangles over the shell vertices.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
+    /// Input vertex of every shell vertex.
+    pub fn sources(&self) -> &[u32] {
+        &self.source
+    }
+
+    fn solid_unchecked(&self, piece: &[Vec3], name: &str) -> Mesh {
+        let m = self.back.len() as u32;
+        let mut positions = front_positions(&self.source, &self.caps, piece);
+        positions.extend_from_slice(&self.back);
+        let mut tris = self.triangles.clone();
+        tris.extend(
+            self.triangles
+                .iter()
+                .map(|t| [t[0] + m, t[2] + m, t[1] + m]),
+        );
+        for &(a, b) in &self.boundary {
+            tris.push([b, a, a + m]);
+            tris.push([b, a + m, b + m]);
+        }
+        Mesh::new(name, positions, tris)
+    }
+
+    /// Piece `piece` (millimetres, input vertex order) closed onto the back surface: the
+    /// printable solid, named `name`.
+    ///
+    /// # Errors
+    /// [`LibraryError::InvalidParameter`] for a wrong vertex count, [`LibraryError::BadSurface`]
+    /// if the result is not a closed oriented manifold.
+    pub fn solid(&self, piece: &[Vec3], name: &str) -> Result<Mesh> {
+        if let Some(&s) = self.source.iter().max() {
+            if s as usize >= piece.len() {
+                return Err(LibraryError::InvalidParameter(format!(
+                    "piece {name}: {} vertices, the part needs more than {s}",
+                    piece.len()
+                )));
+            }
+        }
+        let solid = self.solid_unchecked(piece, name);
+        let check = check_solid(&solid);
+        if !check.is_closed_manifold() {
+            return Err(LibraryError::BadSurface {
+                mesh: name.to_string(),
+                reason: format!("shell is not a closed manifold ({check:?})"),
+            });
+        }
+        Ok(solid)
+    }
+
+    /// Smallest distance (mm) from a front vertex of `piece` to the back surface's triangles.
+    pub fn min_wall(&self, piece: &[Vec3]) -> f64 {
+        let grid = super::intersect::TriangleGrid::new(&self.back, &self.triangles);
+        front_positions(&self.source, &self.caps, piece)
+            .iter()
+            .map(|&p| grid.distance(p))
+            .fold(f64::INFINITY, f64::min)
+    }
+}

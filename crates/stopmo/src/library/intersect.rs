@@ -1,0 +1,543 @@
+//! Exact triangle–triangle intersection and a self-intersection count for printable solids.
+//!
+//! Coordinates are snapped to a grid of 2⁻²⁴ units (6·10⁻⁸ mm for solids in millimetres) and
+//! every orientation test is evaluated exactly in `i128`, so the answer does not depend on
+//! rounding: two triangles intersect when their closed point sets share a point, except that
+//! triangles sharing a vertex (or an edge) only count when they meet anywhere else. A grid of
+//! cells about the size of the mean triangle limits the exact tests to nearby pairs.
+
+use std::collections::HashMap;
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+/// Largest coordinate magnitude (in the mesh's units) the exact test accepts: `2¹²`, so snapped
+/// coordinates fit 36 bits and orientation determinants fit `i128`.
+pub const MAX_EXACT_COORDINATE: f32 = 4096.0;
+
+const GRID: f64 = (1u64 << 24) as f64;
+
+type P = [i64; 3];
+
+fn snap(p: Vec3) -> P {
+    [
+        (f64::from(p.x) * GRID).round() as i64,
+        (f64::from(p.y) * GRID).round() as i64,
+        (f64::from(p.z) * GRID).round() as i64,
+    ]
+}
+
+fn sub(a: P, b: P) -> [i128; 3] {
+    [
+        i128::from(a[0] - b[0]),
+        i128::from(a[1] - b[1]),
+        i128::from(a[2] - b[2]),
+    ]
+}
+
+/// Sign of the volume of the tetrahedron `(a, b, c, d)` (positive when `d` is below the plane
+/// of the counter-clockwise triangle `a b c`, following Shewchuk's convention).
+fn orient3d(a: P, b: P, c: P, d: P) -> i32 {
+    let (u, v, w) = (sub(a, d), sub(b, d), sub(c, d));
+    let det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
+        + u[2] * (v[0] * w[1] - v[1] * w[0]);
+    det.signum() as i32
+}
+
+/// The two coordinate axes kept when projecting a plane with normal `n` (drop its largest
+/// component).
+fn projection_axes(a: P, b: P, c: P) -> (usize, usize) {
+    let (u, v) = (sub(b, a), sub(c, a));
+    let n = [
+        (u[1] * v[2] - u[2] * v[1]).abs(),
+        (u[2] * v[0] - u[0] * v[2]).abs(),
+        (u[0] * v[1] - u[1] * v[0]).abs(),
+    ];
+    if n[0] >= n[1] && n[0] >= n[2] {
+        (1, 2)
+    } else if n[1] >= n[2] {
+        (2, 0)
+    } else {
+        (0, 1)
+    }
+}
+
+type Q = [i128; 2];
+
+fn orient2d(a: Q, b: Q, c: Q) -> i32 {
+    ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])).signum() as i32
+}
+
+/// Closed segments `ab` and `cd` share a point (2D).
+fn segments_meet_2d(a: Q, b: Q, c: Q, d: Q) -> bool {
+    let (o1, o2, o3, o4) = (
+        orient2d(a, b, c),
+        orient2d(a, b, d),
+        orient2d(c, d, a),
+        orient2d(c, d, b),
+    );
+    if o1 * o2 < 0 && o3 * o4 < 0 {
+        return true;
+    }
+    let on = |p: Q, q: Q, r: Q| {
+        r[0] >= p[0].min(q[0])
+            && r[0] <= p[0].max(q[0])
+            && r[1] >= p[1].min(q[1])
+            && r[1] <= p[1].max(q[1])
+    };
+    (o1 == 0 && on(a, b, c))
+        || (o2 == 0 && on(a, b, d))
+        || (o3 == 0 && on(c, d, a))
+        || (o4 == 0 && on(c, d, b))
+}
+
+/// `p` lies in the closed triangle `t` (2D, either orientation).
+fn point_in_triangle_2d(p: Q, t: [Q; 3]) -> bool {
+    let o = [
+        orient2d(t[0], t[1], p),
+        orient2d(t[1], t[2], p),
+        orient2d(t[2], t[0], p),
+    ];
+    !(o.iter().any(|&x| x > 0) && o.iter().any(|&x| x < 0))
+}
+
+fn project(p: P, axes: (usize, usize)) -> Q {
+    [i128::from(p[axes.0]), i128::from(p[axes.1])]
+}
+
+/// Closed segment `pq` meets closed triangle `t` (3D, exact).
+fn segment_meets_triangle(p: P, q: P, t: [P; 3]) -> bool {
+    let (op, oq) = (orient3d(t[0], t[1], t[2], p), orient3d(t[0], t[1], t[2], q));
+    if op * oq > 0 {
+        return false;
+    }
+    if op == 0 && oq == 0 {
+        let axes = projection_axes(t[0], t[1], t[2]);
+        let (a, b) = (project(p, axes), project(q, axes));
+        let tt = t.map(|v| project(v, axes));
+        return point_in_triangle_2d(a, tt)
+            || point_in_triangle_2d(b, tt)
+            || (0..3).any(|k| segments_meet_2d(a, b, tt[k], tt[(k + 1) % 3]));
+    }
+    let s = [
+        orient3d(p, q, t[0], t[1]),
+        orient3d(p, q, t[1], t[2]),
+        orient3d(p, q, t[2], t[0]),
+    ];
+    !(s.iter().any(|&x| x > 0) && s.iter().any(|&x| x < 0))
+}
+
+/// Closed triangles share a point (exact; no shared vertex assumed).
+fn triangles_meet(a: [P; 3], b: [P; 3]) -> bool {
+    let oa = a.map(|v| orient3d(b[0], b[1], b[2], v));
+    if oa.iter().all(|&o| o > 0) || oa.iter().all(|&o| o < 0) {
+        return false;
+    }
+    let ob = b.map(|v| orient3d(a[0], a[1], a[2], v));
+    if ob.iter().all(|&o| o > 0) || ob.iter().all(|&o| o < 0) {
+        return false;
+    }
+    // The intersection (if any) is a segment whose ends lie on an edge of one triangle inside
+    // the other (also in the coplanar case, or a vertex of one lies inside the other).
+    (0..3).any(|k| segment_meets_triangle(a[k], a[(k + 1) % 3], b))
+        || (0..3).any(|k| segment_meets_triangle(b[k], b[(k + 1) % 3], a))
+}
+
+/// Triangles `a` and `b` share exactly the vertex at corner `ia` of `a` and `ib` of `b`: do they
+/// meet anywhere else?
+fn meet_beyond_vertex(a: [P; 3], ia: usize, b: [P; 3], ib: usize) -> bool {
+    let (a1, a2) = (a[(ia + 1) % 3], a[(ia + 2) % 3]);
+    let (b1, b2) = (b[(ib + 1) % 3], b[(ib + 2) % 3]);
+    let coplanar = orient3d(b[0], b[1], b[2], a1) == 0 && orient3d(b[0], b[1], b[2], a2) == 0;
+    if !coplanar {
+        // Both meet the common line of their planes in segments starting at the shared vertex:
+        // they overlap beyond it iff the shorter one's far end (on its opposite edge) lies in
+        // the other triangle.
+        return segment_meets_triangle(a1, a2, b) || segment_meets_triangle(b1, b2, a);
+    }
+    let axes = projection_axes(b[0], b[1], b[2]);
+    let (v, pa1, pa2, pb1, pb2) = (
+        project(a[ia], axes),
+        project(a1, axes),
+        project(a2, axes),
+        project(b1, axes),
+        project(b2, axes),
+    );
+    // Opposite edges meeting the other triangle, or an edge from the shared vertex running
+    // into the other triangle's angle.
+    let ta = [v, pa1, pa2];
+    let tb = [v, pb1, pb2];
+    let strictly_inside_angle = |p: Q, t: [Q; 3]| {
+        let (o1, o2) = (orient2d(t[0], t[1], p), orient2d(t[0], t[2], p));
+        let s = orient2d(t[0], t[1], t[2]);
+        (o1 == s && o2 == -s) || (o1 == 0 && o2 == -s && dot_positive(t[0], t[1], p))
+    };
+    (0..3).any(|k| segments_meet_2d(pa1, pa2, tb[k], tb[(k + 1) % 3]))
+        || (0..3).any(|k| segments_meet_2d(pb1, pb2, ta[k], ta[(k + 1) % 3]))
+        || strictly_inside_angle(pa1, tb)
+        || strictly_inside_angle(pa2, tb)
+        || strictly_inside_angle(pb1, ta)
+        || strictly_inside_angle(pb2, ta)
+}
+
+/// `p − o` points the same way as `q − o` (positive dot product).
+fn dot_positive(o: Q, q: Q, p: Q) -> bool {
+    (q[0] - o[0]) * (p[0] - o[0]) + (q[1] - o[1]) * (p[1] - o[1]) > 0
+}
+
+/// Triangles sharing the edge `a[ia] a[ia+1]` (as `b[ib+1] b[ib]` or `b[ib] b[ib+1]`): do they
+/// overlap (fold onto each other)?
+fn overlap_across_edge(a: [P; 3], opposite_a: P, b: [P; 3], opposite_b: P) -> bool {
+    if orient3d(b[0], b[1], b[2], opposite_a) != 0 {
+        return false;
+    }
+    // Coplanar: they overlap when both opposite vertices lie on the same side of the edge.
+    let axes = projection_axes(b[0], b[1], b[2]);
+    let (pa, pb) = (project(opposite_a, axes), project(opposite_b, axes));
+    let shared: Vec<P> = a.iter().copied().filter(|v| b.contains(v)).collect();
+    if shared.len() < 2 {
+        return false;
+    }
+    let (e0, e1) = (project(shared[0], axes), project(shared[1], axes));
+    orient2d(e0, e1, pa) * orient2d(e0, e1, pb) > 0
+}
+
+/// Whether triangles `i` and `j` of a mesh intersect anywhere but in the vertices and edges
+/// they share.
+fn pair_intersects(tris: &[[u32; 3]], snapped: &[P], i: usize, j: usize) -> bool {
+    let (ti, tj) = (tris[i], tris[j]);
+    let (a, b) = (
+        ti.map(|v| snapped[v as usize]),
+        tj.map(|v| snapped[v as usize]),
+    );
+    let shared: Vec<(usize, usize)> = (0..3)
+        .flat_map(|x| (0..3).map(move |y| (x, y)))
+        .filter(|&(x, y)| ti[x] == tj[y])
+        .collect();
+    match shared.len() {
+        0 => triangles_meet(a, b),
+        1 => meet_beyond_vertex(a, shared[0].0, b, shared[0].1),
+        2 => {
+            let oa = (0..3)
+                .find(|x| shared.iter().all(|s| s.0 != *x))
+                .unwrap_or(0);
+            let ob = (0..3)
+                .find(|y| shared.iter().all(|s| s.1 != *y))
+                .unwrap_or(0);
+            overlap_across_edge(a, a[oa], b, b[ob])
+        }
+        _ => true, // the same triangle twice
+    }
+}
+
+/// The triangles of `tris` (over `positions`) that intersect another triangle of the same
+/// mesh anywhere but in the vertices and edges they share (MeshLab's "self-intersecting
+/// faces"). Degenerate (zero-area) triangles count as intersecting.
+///
+/// # Returns
+/// Sorted ids of the intersecting triangles; `None` when a coordinate exceeds
+/// [`MAX_EXACT_COORDINATE`] or is not finite.
+///
+/// # Performance
+/// One uniform grid (cell ≈ mean triangle size), exact tests only for pairs whose bounding
+/// boxes overlap, in parallel over cells.
+pub fn self_intersecting_triangles(positions: &[Vec3], tris: &[[u32; 3]]) -> Option<Vec<u32>> {
+    if positions
+        .iter()
+        .any(|p| !p.is_finite() || p.abs().max_element() > MAX_EXACT_COORDINATE)
+        || tris
+            .iter()
+            .any(|t| t.iter().any(|&v| v as usize >= positions.len()))
+    {
+        return None;
+    }
+    if tris.is_empty() {
+        return Some(Vec::new());
+    }
+    let snapped: Vec<P> = positions.iter().map(|&p| snap(p)).collect();
+    let boxes: Vec<(Vec3, Vec3)> = tris
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| positions[v as usize]);
+            (a.min(b).min(c), a.max(b).max(c))
+        })
+        .collect();
+    let mean_size = boxes
+        .iter()
+        .map(|(lo, hi)| (*hi - *lo).max_element())
+        .sum::<f32>()
+        / tris.len() as f32;
+    let lo = boxes.iter().fold(Vec3::INFINITY, |m, b| m.min(b.0));
+    let cell = (mean_size * 2.0).max(1e-6);
+    let key = |p: Vec3| -> [i32; 3] {
+        let q = ((p - lo) / cell).floor();
+        [q.x as i32, q.y as i32, q.z as i32]
+    };
+    let mut grid: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
+    for (t, (a, b)) in boxes.iter().enumerate() {
+        let (ka, kb) = (key(*a), key(*b));
+        for x in ka[0]..=kb[0] {
+            for y in ka[1]..=kb[1] {
+                for z in ka[2]..=kb[2] {
+                    grid.entry([x, y, z]).or_default().push(t as u32);
+                }
+            }
+        }
+    }
+    let degenerate: Vec<u32> = tris
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| {
+            let [a, b, c] = t.map(|v| snapped[v as usize]);
+            let (u, v) = (sub(b, a), sub(c, a));
+            u[1] * v[2] == u[2] * v[1] && u[2] * v[0] == u[0] * v[2] && u[0] * v[1] == u[1] * v[0]
+        })
+        .map(|(t, _)| t as u32)
+        .collect();
+    let cells: Vec<(&[i32; 3], &Vec<u32>)> = grid.iter().collect();
+    let mut hits: Vec<u32> = cells
+        .par_iter()
+        .flat_map_iter(|(cell_key, list)| {
+            let mut out = Vec::new();
+            for (x, &i) in list.iter().enumerate() {
+                for &j in &list[x + 1..] {
+                    let (bi, bj) = (boxes[i as usize], boxes[j as usize]);
+                    if bi.0.cmpgt(bj.1).any() || bj.0.cmpgt(bi.1).any() {
+                        continue;
+                    }
+                    // Test each pair once: in the first cell of their boxes' overlap.
+                    if key(bi.0.max(bj.0)) != **cell_key {
+                        continue;
+                    }
+                    if pair_intersects(tris, &snapped, i as usize, j as usize) {
+                        out.push(i);
+                        out.push(j);
+                    }
+                }
+            }
+            out
+        })
+        .collect();
+    hits.extend(degenerate);
+    hits.sort_unstable();
+    hits.dedup();
+    Some(hits)
+}
+
+/// Closest point of triangle `abc` to `p` (Ericson, *Real-Time Collision Detection* 5.1.5).
+pub fn closest_point_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
+    let (p, a, b, c) = (p.as_dvec3(), a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a.as_vec3();
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return b.as_vec3();
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return (a + ab * v).as_vec3();
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return c.as_vec3();
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return (a + ac * w).as_vec3();
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (b + (c - b) * w).as_vec3();
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, w) = (vb * denom, vc * denom);
+    (a + ab * v + ac * w).as_vec3()
+}
+
+/// A uniform grid of triangles for nearest-distance queries.
+#[derive(Debug, Clone)]
+pub struct TriangleGrid<'a> {
+    positions: &'a [Vec3],
+    triangles: &'a [[u32; 3]],
+    lo: Vec3,
+    cell: f32,
+    dims: [i32; 3],
+    cells: HashMap<[i32; 3], Vec<u32>>,
+}
+
+impl<'a> TriangleGrid<'a> {
+    /// Bins the triangles (indices must be valid) into cells of about twice their mean size.
+    pub fn new(positions: &'a [Vec3], triangles: &'a [[u32; 3]]) -> TriangleGrid<'a> {
+        let boxes: Vec<(Vec3, Vec3)> = triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|v| positions[v as usize]);
+                (a.min(b).min(c), a.max(b).max(c))
+            })
+            .collect();
+        let lo = boxes.iter().fold(Vec3::INFINITY, |m, b| m.min(b.0));
+        let hi = boxes.iter().fold(Vec3::NEG_INFINITY, |m, b| m.max(b.1));
+        let mean = boxes
+            .iter()
+            .map(|(l, h)| (*h - *l).max_element())
+            .sum::<f32>()
+            / triangles.len().max(1) as f32;
+        let cell = (2.0 * mean).max(1e-6);
+        let key = |p: Vec3| -> [i32; 3] {
+            let q = ((p - lo) / cell).floor();
+            [q.x as i32, q.y as i32, q.z as i32]
+        };
+        let mut cells: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
+        for (t, (a, b)) in boxes.iter().enumerate() {
+            let (ka, kb) = (key(*a), key(*b));
+            for x in ka[0]..=kb[0] {
+                for y in ka[1]..=kb[1] {
+                    for z in ka[2]..=kb[2] {
+                        cells.entry([x, y, z]).or_default().push(t as u32);
+                    }
+                }
+            }
+        }
+        let dims = if triangles.is_empty() {
+            [0; 3]
+        } else {
+            key(hi).map(|d| d + 1)
+        };
+        TriangleGrid {
+            positions,
+            triangles,
+            lo,
+            cell,
+            dims,
+            cells,
+        }
+    }
+
+    /// Distance from `p` to the nearest triangle (infinity without triangles).
+    pub fn distance(&self, p: Vec3) -> f64 {
+        if self.triangles.is_empty() {
+            return f64::INFINITY;
+        }
+        let q = ((p - self.lo) / self.cell).floor();
+        let c = [q.x as i32, q.y as i32, q.z as i32];
+        let max_ring = (0..3)
+            .map(|k| (c[k]).abs().max((self.dims[k] - c[k]).abs()))
+            .max()
+            .unwrap_or(0)
+            + 1;
+        let mut best = f64::INFINITY;
+        for r in 0..=max_ring {
+            for x in c[0] - r..=c[0] + r {
+                for y in c[1] - r..=c[1] + r {
+                    for z in c[2] - r..=c[2] + r {
+                        let on_ring =
+                            (x - c[0]).abs() == r || (y - c[1]).abs() == r || (z - c[2]).abs() == r;
+                        if !on_ring {
+                            continue;
+                        }
+                        if let Some(list) = self.cells.get(&[x, y, z]) {
+                            for &t in list {
+                                let [a, b, cc] =
+                                    self.triangles[t as usize].map(|v| self.positions[v as usize]);
+                                let d =
+                                    f64::from(closest_point_on_triangle(p, a, b, cc).distance(p));
+                                best = best.min(d);
+                            }
+                        }
+                    }
+                }
+            }
+            if best <= f64::from(r as f32 * self.cell) {
+                break;
+            }
+        }
+        best
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn count(p: &[Vec3], t: &[[u32; 3]]) -> usize {
+        self_intersecting_triangles(p, t).unwrap().len()
+    }
+
+    #[test]
+    fn crossing_and_separate_triangles() {
+        let p = vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(0.2, 0.2, -1.0),
+            Vec3::new(0.2, 0.2, 1.0),
+            Vec3::new(0.3, 0.9, 1.0),
+        ];
+        assert_eq!(count(&p, &[[0, 1, 2], [3, 4, 5]]), 2);
+        let far: Vec<Vec3> = p
+            .iter()
+            .enumerate()
+            .map(|(i, v)| if i >= 3 { *v + Vec3::X * 5.0 } else { *v })
+            .collect();
+        assert_eq!(count(&far, &[[0, 1, 2], [3, 4, 5]]), 0);
+    }
+
+    #[test]
+    fn neighbours_only_count_when_they_fold_or_cross() {
+        // A flat quad: two triangles sharing an edge, no intersection.
+        let p = vec![
+            Vec3::ZERO,
+            Vec3::X,
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::Y,
+            Vec3::new(0.8, 0.2, 0.0),
+        ];
+        assert_eq!(count(&p, &[[0, 1, 2], [0, 2, 3]]), 0);
+        // Folded onto each other (same side of the shared edge, coplanar).
+        assert_eq!(count(&p, &[[0, 1, 2], [0, 2, 4]]), 2);
+        // Sharing one vertex, coplanar and overlapping.
+        assert_eq!(count(&p, &[[0, 1, 2], [0, 4, 3]]), 2);
+        // Sharing one vertex, not overlapping.
+        let q = vec![Vec3::ZERO, Vec3::X, Vec3::Y, -Vec3::X, -Vec3::Y];
+        assert_eq!(count(&q, &[[0, 1, 2], [0, 3, 4]]), 0);
+        // Sharing one vertex and piercing: the second triangle dips through the first.
+        let r = vec![
+            Vec3::ZERO,
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 2.0, 0.0),
+            Vec3::new(1.0, 0.5, -1.0),
+            Vec3::new(0.5, 1.0, 1.0),
+        ];
+        assert_eq!(count(&r, &[[0, 1, 2], [0, 3, 4]]), 2);
+    }
+
+    #[test]
+    fn closed_box_is_clean() {
+        let p: Vec<Vec3> = (0..8)
+            .map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32))
+            .collect();
+        let t = [
+            [0, 2, 1],
+            [1, 2, 3],
+            [4, 5, 6],
+            [5, 7, 6],
+            [0, 1, 4],
+            [1, 5, 4],
+            [2, 6, 3],
+            [3, 6, 7],
+            [0, 4, 2],
+            [2, 4, 6],
+            [1, 3, 5],
+            [3, 7, 5],
+        ];
+        assert_eq!(count(&p, &t), 0);
+    }
+}
