@@ -36,6 +36,15 @@ pub enum Format {
 }
 
 impl Format {
+    /// Whether the format holds a whole scene of several meshes whose topology may change per
+    /// frame (a stylized smear, motion lines): `.glb`, `.usda`, `.usdc`, `.usdz`, `.abc`.
+    pub fn holds_scenes(self) -> bool {
+        matches!(
+            self,
+            Format::Glb | Format::Usda | Format::Usdc | Format::Usdz | Format::Abc
+        )
+    }
+
     /// Format from a file extension (for outputs).
     pub fn from_extension(path: &Path) -> Option<Format> {
         let ext = path.extension()?.to_str()?.to_ascii_lowercase();

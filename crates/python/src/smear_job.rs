@@ -306,14 +306,12 @@ impl Stylized {
     }
 
     /// Writes every part as the CLI's ``toonkit smear IN --style S -o OUT`` does: ``.glb``
-    /// (flipbooks) or ``.usda`` (one Mesh prim per part), atomically. Returns the path.
+    /// (flipbooks) or a scene cache (``.usda``, ``.usdc``, ``.usdz``, ``.abc``: one mesh per
+    /// part), atomically. Returns the path.
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<PathBuf> {
-        if !matches!(
-            tkio::Format::from_extension(&path),
-            Some(tkio::Format::Glb | tkio::Format::Usda)
-        ) {
+        if !tkio::Format::from_extension(&path).is_some_and(tkio::Format::holds_scenes) {
             return Err(value_error(format!(
-                "{}: a styled smear is written as .glb or .usda",
+                "{}: a styled smear is written as .glb, .usda, .usdc, .usdz or .abc",
                 path.display()
             )));
         }

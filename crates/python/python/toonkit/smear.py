@@ -110,8 +110,8 @@ def stylize(
     A style without ``offsets`` uses the prepared ones; different ``offsets`` are an error
     (prepare again to change them). Returns a :class:`Stylized` with ``.elongated``
     ``(frames, vertices, 3)``, ``.multiples`` and ``.lines`` (per-frame meshes with
-    per-vertex ``alpha``), ``.report`` and ``.save(path)`` (``.glb`` or ``.usda``, as the CLI
-    writes them). The GIL is released while computing.
+    per-vertex ``alpha``), ``.report`` and ``.save(path)`` (``.glb``, ``.usda``, ``.usdc``,
+    ``.usdz`` or ``.abc``, as the CLI writes them). The GIL is released while computing.
 
     >>> look = toonkit.smear.stylize(prepared, {"multiples": {"past": 2, "future": 0}})
     >>> len(look.multiples)

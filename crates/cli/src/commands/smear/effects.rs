@@ -155,11 +155,11 @@ fn check(spec: &FunctionSpec, flag: &str) -> Result<()> {
 }
 
 fn require_scene_output(path: &Path, what: &str) -> Result<()> {
-    if !matches!(
-        Format::from_extension(path),
-        Some(Format::Glb | Format::Usda)
-    ) {
-        bail!("{}: smear {what} writes .glb or .usda", path.display());
+    if !Format::from_extension(path).is_some_and(Format::holds_scenes) {
+        bail!(
+            "{}: smear {what} writes .glb, .usda, .usdc, .usdz or .abc",
+            path.display()
+        );
     }
     Ok(())
 }

@@ -58,12 +58,9 @@ pub fn run(ctx: &Context, args: StyleArgs) -> Result<()> {
             "usage: toonkit smear IN --style STYLE.toml -o OUT.glb|OUT.usda (or a subcommand, see --help)"
         );
     };
-    if !matches!(
-        Format::from_extension(output),
-        Some(Format::Glb | Format::Usda)
-    ) {
+    if !Format::from_extension(output).is_some_and(Format::holds_scenes) {
         bail!(
-            "{}: a styled smear is written as .glb or .usda",
+            "{}: a styled smear is written as .glb, .usda, .usdc, .usdz or .abc",
             output.display()
         );
     }
