@@ -20,7 +20,8 @@ test -x "$VENV/bin/python" || "$PY" -m venv "$VENV"
 "$VENV/bin/pip" install --quiet --disable-pip-version-check \
     "bpy==4.2.0" "numpy<2" "openjd-cli" "usd-core==26.11"
 
-cargo build --quiet --bin toonkit
+# --workspace: the same features as `cargo test --workspace`, so its dependencies are reused.
+cargo build --quiet --workspace --bins
 TK="$ROOT/target/debug/toonkit"
 WORK="$ROOT/target/caches"
 rm -rf "$WORK"
@@ -45,7 +46,6 @@ outputs = ["elongate/robot_punch.abc", "elongate/robot_punch.usdc", "elongate/ro
 name = "cesium_walk"
 tool = "convert"
 input = "$ASSETS/CesiumMan.glb"
-options = { fps = 30 }
 outputs = ["cesium_walk.abc", "cesium_walk.usdc", "cesium_walk.pc2"]
 TOML
 
@@ -63,7 +63,7 @@ echo "== Open Job Description"
 "$TK" batch "$WORK/shots.toml" -o "$WORK/openjd" --openjd "$WORK/job.yaml"
 "$VENV/bin/openjd" check "$WORK/job.yaml"
 for step in convert smear; do
-    "$VENV/bin/openjd" run "$WORK/job.yaml" --step "$step"
+    "$VENV/bin/openjd" run "$WORK/job.yaml" --step "$step" --job-param Toonkit="$TK"
 done
 (cd "$WORK/batch" && find . -type f ! -path './.toonkit-batch/*' | sort) > "$WORK/batch.files"
 (cd "$WORK/openjd" && find . -type f ! -path './.toonkit-batch/*' | sort) > "$WORK/openjd.files"

@@ -35,5 +35,6 @@ fi
 (cd /tmp && "$OLDPWD/$VENV/bin/python" -c "import toonkit; print('python: toonkit', toonkit.__version__, 'from', toonkit.__file__)")
 
 # The CLI the tests compare against, from the same tree.
-cargo build --quiet -p toonkit-cli
+# --workspace: the same features as `cargo test --workspace`, so its dependencies are reused.
+cargo build --quiet --workspace --bins
 TOONKIT_CLI="$PWD/target/debug/toonkit" "$VENV/bin/python" -m pytest -q -p no:cacheprovider crates/python/tests

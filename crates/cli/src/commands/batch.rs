@@ -160,7 +160,8 @@ pub fn run(ctx: &Context, args: BatchArgs) -> Result<()> {
     }
     if let Some(job) = &args.openjd {
         let exe = std::env::current_exe().context("cannot locate the toonkit executable")?;
-        let text = openjd::template(&args.manifest, &out, &exe, &manifest)?;
+        let dir = job.parent().unwrap_or(Path::new(""));
+        let text = openjd::template(&args.manifest, &out, &exe, &manifest, dir)?;
         tkio::save(job, &tkio::Output::Text(&text))?;
         let summary = json!({"manifest": args.manifest, "openjd": job, "shots": shots.len()});
         ctx.report(&summary, || {

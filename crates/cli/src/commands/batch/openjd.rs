@@ -11,19 +11,18 @@ use serde_json::{json, Value};
 
 use super::Manifest;
 
-/// The job template of `manifest`, as YAML text. `out` and `exe` become the defaults of the
-/// `OutputDir` and `Toonkit` job parameters (override them per job, e.g.
-/// `openjd run job.yaml --job-param OutputDir=/farm/out`).
+/// The job template of `manifest`, as YAML text, to be written into the folder `dir`. `out` and
+/// `exe` become the defaults of the `OutputDir` and `Toonkit` job parameters (override them
+/// per job, e.g. `openjd run job.yaml --job-param OutputDir=/farm/out`). OpenJD joins PATH
+/// defaults to the template's folder and refuses absolute ones, so defaults are relative to `dir`.
 pub fn template(
     manifest_path: &Path,
     out: &Path,
     exe: &Path,
     manifest: &Manifest,
+    dir: &Path,
 ) -> Result<String> {
-    let absolute = |p: &Path| -> Result<String> {
-        let p = std::path::absolute(p)?;
-        Ok(p.to_string_lossy().into_owned())
-    };
+    let absolute = |p: &Path| relative_to(dir, p);
     // Steps in the order tools first appear; shots in manifest order.
     let mut steps: Vec<(String, Vec<String>)> = Vec::new();
     for shot in &manifest.shots {
@@ -144,6 +143,26 @@ fn is_block(v: &Value) -> bool {
         Value::Array(a) => !a.is_empty(),
         _ => false,
     }
+}
+
+/// `p` relative to the folder `base` (both made absolute lexically, as OpenJD joins them).
+fn relative_to(base: &Path, p: &Path) -> Result<String> {
+    let (base, p) = (std::path::absolute(base)?, std::path::absolute(p)?);
+    let b: Vec<_> = base.components().collect();
+    let q: Vec<_> = p.components().collect();
+    let common = b.iter().zip(&q).take_while(|(x, y)| x == y).count();
+    let mut rel = std::path::PathBuf::new();
+    for _ in common..b.len() {
+        rel.push("..");
+    }
+    for c in &q[common..] {
+        rel.push(c);
+    }
+    Ok(if rel.as_os_str().is_empty() {
+        ".".to_string()
+    } else {
+        rel.to_string_lossy().into_owned()
+    })
 }
 
 #[cfg(test)]
