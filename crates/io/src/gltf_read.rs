@@ -42,7 +42,7 @@ pub(crate) fn read_bytes_at(bytes: &[u8], path: &Path) -> Result<Scene> {
 }
 
 fn read_with_base(bytes: &[u8], base: Option<&Path>) -> Result<Scene> {
-    precheck(bytes)?;
+    crate::gltf_precheck::precheck(bytes).map_err(bad)?;
     // gltf-json's validation indexes some arrays unchecked; `precheck` covers the known
     // cases and this guard turns any other panic into an error.
     let parsed = std::panic::catch_unwind(|| gltf::Gltf::from_slice(bytes))
@@ -64,84 +64,6 @@ fn read_with_base(bytes: &[u8], base: Option<&Path>) -> Result<Scene> {
         .map_err(|_| bad("the document is inconsistent (rejected while reading)"))??;
     scene.validate()?;
     Ok(scene)
-}
-
-/// Checks what gltf-json 1.4 validation assumes without checking: that every mesh
-/// attribute refers to an existing accessor.
-fn precheck(bytes: &[u8]) -> Result<()> {
-    let json: std::borrow::Cow<[u8]> = if bytes.starts_with(b"glTF") {
-        gltf::binary::Glb::from_slice(bytes)
-            .map_err(|e| bad(e.to_string()))?
-            .json
-    } else {
-        std::borrow::Cow::Borrowed(bytes)
-    };
-    let Ok(root) = serde_json::from_slice::<gltf_json::Root>(&json) else {
-        return Ok(()); // syntax errors are reported by the full parse
-    };
-    use gltf_json::validation::Checked;
-    for (k, a) in root.animations.iter().enumerate() {
-        for c in &a.channels {
-            if matches!(c.target.path, Checked::Invalid) {
-                return Err(bad(format!("animation {k} targets an unknown property")));
-            }
-            if c.target.node.value() >= root.nodes.len() || c.sampler.value() >= a.samplers.len() {
-                return Err(bad(format!(
-                    "animation {k} refers to a missing node or sampler"
-                )));
-            }
-        }
-        if a.samplers
-            .iter()
-            .any(|s| matches!(s.interpolation, Checked::Invalid))
-        {
-            return Err(bad(format!("animation {k} has an unknown interpolation")));
-        }
-    }
-    // A byte stride shorter than the element would make accessor reads overlap.
-    for (k, a) in root.accessors.iter().enumerate() {
-        let (Checked::Valid(ty), Checked::Valid(ct)) = (&a.type_, &a.component_type) else {
-            continue;
-        };
-        let stride = a
-            .buffer_view
-            .and_then(|v| root.buffer_views.get(v.value()))
-            .and_then(|v| v.byte_stride);
-        if let Some(st) = stride {
-            if st.0 < ty.multiplicity() * ct.0.size() {
-                return Err(bad(format!(
-                    "accessor {k}: byteStride {} is shorter than its elements",
-                    st.0
-                )));
-            }
-        }
-    }
-    let n = root.accessors.len();
-    for (m, mesh) in root.meshes.iter().enumerate() {
-        if mesh
-            .primitives
-            .iter()
-            .any(|p| matches!(p.mode, Checked::Invalid))
-        {
-            return Err(bad(format!("mesh {m} has an unknown primitive mode")));
-        }
-        for p in &mesh.primitives {
-            let refs = p.attributes.values().chain(p.indices.iter());
-            let targets = p.targets.iter().flatten().flat_map(|t| {
-                t.positions
-                    .iter()
-                    .chain(t.normals.iter())
-                    .chain(t.tangents.iter())
-            });
-            if let Some(bad_ref) = refs.chain(targets).find(|i| i.value() >= n) {
-                return Err(bad(format!(
-                    "mesh {m} refers to accessor {} but there are {n}",
-                    bad_ref.value()
-                )));
-            }
-        }
-    }
-    Ok(())
 }
 
 fn convert(doc: &gltf::Document, buffers: &[&[u8]]) -> Result<Scene> {

@@ -35,6 +35,7 @@ mod flipbook;
 mod gltf_accessors;
 mod gltf_attributes;
 mod gltf_flipbook;
+mod gltf_precheck;
 mod gltf_read;
 mod gltf_write;
 
