@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Blender extension CI (issue 16), called by .ci/run after python.sh and caches.sh:
+# builds the extension zip (python blender/build.py, reusing python.sh's release wheel in
+# target/pywheels/ when it is there), then on real Blender through `bpy` from PyPI -- 4.2.0
+# LTS (reusing caches.sh's target/caches-venv) and 5.0.1 (own venv), each with numpy<2 --
+# installs the zip with bpy.ops.extensions.package_install_files and runs
+# blender/tests/test_smear.py (one PASS/FAIL line per test, non-zero exit on a failure).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ROOT="$PWD"
+PY=python3.11
+command -v "$PY" >/dev/null || PY=python3
+PIP=(--disable-pip-version-check --quiet)
+
+wheel=$(ls target/pywheels/toonkit-*-cp311-abi3-*.whl 2>/dev/null | head -n 1 || true)
+if [ -n "$wheel" ]; then
+    zip=$("$PY" blender/build.py --wheel "$wheel" -o target/blender-dist | tail -n 1)
+else
+    zip=$("$PY" blender/build.py -o target/blender-dist | tail -n 1)
+fi
+echo "blender: extension $(basename "$zip"), $(stat -c %s "$zip") bytes"
+
+venv() {  # venv DIR BPY_VERSION
+    test -x "$1/bin/python" || "$PY" -m venv "$1"
+    "$1/bin/pip" install "${PIP[@]}" "bpy==$2" "numpy<2"
+}
+status=0
+for spec in "4.2.0:target/caches-venv" "5.0.1:target/blender-venv-5.0"; do
+    version=${spec%%:*}
+    dir=${spec#*:}
+    venv "$dir" "$version"
+    out="target/blender-out-$version"
+    rm -rf "$out" "target/blender-user-$version"
+    echo "== Blender $version"
+    BLENDER_USER_RESOURCES="$ROOT/target/blender-user-$version" \
+        "$dir/bin/python" blender/tests/test_smear.py "$zip" "$out" || status=1
+done
+exit $status

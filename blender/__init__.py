@@ -1,0 +1,21 @@
+"""toonkit for Blender: smear frames (elongated in-betweens, multiples, motion lines) from
+whatever Blender evaluates, on the bundled `toonkit` Python module.
+
+Operators: `bpy.ops.toonkit.smear_bake()`, `bpy.ops.toonkit.smear_update()`,
+`bpy.ops.toonkit.smear_unbake()`; settings in `context.scene.toonkit_smear`; panel in
+View3D ▸ Sidebar ▸ toonkit.
+"""
+
+from . import operators, panel, settings
+
+_MODULES = (settings, operators, panel)
+
+
+def register():
+    for m in _MODULES:
+        m.register()
+
+
+def unregister():
+    for m in reversed(_MODULES):
+        m.unregister()

@@ -1,0 +1,121 @@
+"""The smear operators (names fixed: tests and scripts call them). Each reports a failure in
+one line with `self.report({'ERROR'}, ...)` and leaves the scene as it was."""
+
+import bpy
+from bpy.props import StringProperty
+from bpy_extras.io_utils import ExportHelper, ImportHelper
+
+from . import job, style
+
+
+class TOONKIT_OT_smear_bake(bpy.types.Operator):
+    """Sample the selected meshes over the scene range and show their smear"""
+
+    bl_idname = "toonkit.smear_bake"
+    bl_label = "Bake smear"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        objects = job.sources(context)
+        if not objects:
+            self.report({"ERROR"}, "smear bake: select at least one mesh object")
+            return {"CANCELLED"}
+        try:
+            look = job.bake(context, objects)
+        except job.JobError as e:
+            self.report({"ERROR"}, f"smear bake: {e}")
+            return {"CANCELLED"}
+        r = look.report
+        self.report({"INFO"}, f"smear: {len(r['objects'])} object(s), "
+                              f"{context.scene.frame_end - context.scene.frame_start + 1} frames")
+        return {"FINISHED"}
+
+
+class TOONKIT_OT_smear_update(bpy.types.Operator):
+    """Re-stylize the baked smear from the cached offsets (no re-bake)"""
+
+    bl_idname = "toonkit.smear_update"
+    bl_label = "Update smear"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        if not job.is_baked(context.scene):
+            self.report({"ERROR"}, "smear update: nothing is baked; bake first")
+            return {"CANCELLED"}
+        error = job.restyle(context.scene)
+        context.scene.toonkit_smear.last_error = error or ""
+        if error:
+            self.report({"ERROR"}, f"smear update: {error}")
+            return {"CANCELLED"}
+        return {"FINISHED"}
+
+
+class TOONKIT_OT_smear_unbake(bpy.types.Operator):
+    """Remove every toonkit result and show the original objects again"""
+
+    bl_idname = "toonkit.smear_unbake"
+    bl_label = "Unbake smear"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        job.unbake(context.scene)
+        return {"FINISHED"}
+
+
+class TOONKIT_OT_style_load(bpy.types.Operator, ImportHelper):
+    """Load a style .toml (the CLI's --style format) into the panel"""
+
+    bl_idname = "toonkit.style_load"
+    bl_label = "Load style"
+    filename_ext = ".toml"
+    filter_glob: StringProperty(default="*.toml", options={"HIDDEN"})
+
+    def execute(self, context):
+        s = context.scene.toonkit_smear
+        try:
+            loaded = style.read(self.filepath)
+        except (OSError, ValueError) as e:
+            self.report({"ERROR"}, f"{self.filepath}: {' '.join(str(e).split())}")
+            return {"CANCELLED"}
+        fits = style.to_settings(loaded, s)
+        s.style_path = self.filepath
+        if not fits:
+            self.report({"INFO"}, "style kept as written (preset: From file)")
+        if job.is_baked(context.scene):
+            return bpy.ops.toonkit.smear_update()
+        return {"FINISHED"}
+
+
+class TOONKIT_OT_style_save(bpy.types.Operator, ExportHelper):
+    """Save the panel's style as a .toml for `toonkit smear --style`"""
+
+    bl_idname = "toonkit.style_save"
+    bl_label = "Save style"
+    filename_ext = ".toml"
+    filter_glob: StringProperty(default="*.toml", options={"HIDDEN"})
+
+    def execute(self, context):
+        s = context.scene.toonkit_smear
+        cached = job.cached(context.scene)
+        bones = cached[0].bones if cached else ()
+        try:
+            style.write(self.filepath, style.from_settings(s, bones))
+        except (OSError, ValueError) as e:
+            self.report({"ERROR"}, f"{self.filepath}: {' '.join(str(e).split())}")
+            return {"CANCELLED"}
+        s.style_path = self.filepath
+        return {"FINISHED"}
+
+
+CLASSES = (TOONKIT_OT_smear_bake, TOONKIT_OT_smear_update, TOONKIT_OT_smear_unbake,
+           TOONKIT_OT_style_load, TOONKIT_OT_style_save)
+
+
+def register():
+    for c in CLASSES:
+        bpy.utils.register_class(c)
+
+
+def unregister():
+    for c in reversed(CLASSES):
+        bpy.utils.unregister_class(c)

@@ -1,0 +1,250 @@
+"""toonkit-owned result objects: the smear stored inside the .blend, shown by a node group.
+
+Each result object (elongated body, each multiple in-between, each object's motion lines) is
+an ordinary mesh in the "toonkit" collection whose mesh holds one point attribute per baked
+frame (`tk_P<frame>` positions, `tk_A<frame>` opacity). The "toonkit smear" Geometry Nodes
+modifier picks the attribute of the current scene frame (clamped to the baked range), so the
+result plays in the viewport and in F12 / animation renders, survives save/reload (all data is
+in the .blend, no external cache, no frame handler) and needs no add-on to display. Motion
+lines change topology per frame: all frames are stored in one mesh with a `tk_frame` point
+attribute and the node group deletes the other frames. `tk_alpha` carries the opacity to the
+material (Attribute node).
+"""
+
+import bpy
+import numpy as np
+
+COLLECTION = "toonkit"
+GROUP = "toonkit smear"
+ROLE = "toonkit_role"  # custom property on every toonkit-owned object: body/multiple/lines
+SOURCE = "toonkit_source"  # the original object's name
+HIDDEN = "toonkit_hidden"  # the original's (hide_viewport, hide_render) before the bake
+
+
+def _frame_name(n, prefix, frame):
+    """`prefix + str(frame)` from the scene frame clamped to [Start, End] (node links)."""
+    g = n.id_data
+    t = n.new("GeometryNodeInputSceneTime")
+    gi = n.new("NodeGroupInput")
+    rnd = n.new("ShaderNodeMath")
+    rnd.operation = "ROUND"
+    g.links.new(t.outputs["Frame"], rnd.inputs[0])
+    clamp = n.new("ShaderNodeClamp")
+    g.links.new(rnd.outputs[0], clamp.inputs["Value"])
+    g.links.new(gi.outputs["Start"], clamp.inputs["Min"])
+    g.links.new(gi.outputs["End"], clamp.inputs["Max"])
+    text = n.new("FunctionNodeValueToString")
+    g.links.new(clamp.outputs[0], text.inputs["Value"])
+    head = n.new("FunctionNodeInputString")
+    head.string = prefix
+    join = n.new("GeometryNodeStringJoin")
+    # A multi-input socket lists its newest link first: link the number, then the prefix.
+    g.links.new(text.outputs[0], join.inputs["Strings"])
+    g.links.new(head.outputs[0], join.inputs["Strings"])
+    attr = n.new("GeometryNodeInputNamedAttribute")
+    attr.data_type = "FLOAT_VECTOR" if prefix == "tk_P" else "FLOAT"
+    g.links.new(join.outputs[0], attr.inputs["Name"])
+    return attr, clamp
+
+
+def node_group():
+    """The shared node group (made once per .blend)."""
+    g = bpy.data.node_groups.get(GROUP)
+    if g is not None:
+        return g
+    g = bpy.data.node_groups.new(GROUP, "GeometryNodeTree")
+    g.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+    for name in ("Start", "End"):
+        g.interface.new_socket(name, in_out="INPUT", socket_type="NodeSocketInt")
+    g.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    n, links = g.nodes, g.links
+    gin, gout = n.new("NodeGroupInput"), n.new("NodeGroupOutput")
+    pos, clamp = _frame_name(n, "tk_P", None)
+    alpha, _ = _frame_name(n, "tk_A", None)
+    setpos = n.new("GeometryNodeSetPosition")
+    links.new(gin.outputs["Geometry"], setpos.inputs["Geometry"])
+    links.new(pos.outputs["Exists"], setpos.inputs["Selection"])
+    links.new(pos.outputs["Attribute"], setpos.inputs["Position"])
+    store = n.new("GeometryNodeStoreNamedAttribute")
+    store.data_type, store.domain = "FLOAT", "POINT"
+    store.inputs["Name"].default_value = "tk_alpha"
+    links.new(setpos.outputs["Geometry"], store.inputs["Geometry"])
+    links.new(alpha.outputs["Exists"], store.inputs["Selection"])
+    links.new(alpha.outputs["Attribute"], store.inputs["Value"])
+    # Motion lines: keep only the points (and their faces) of the current frame.
+    frame = n.new("GeometryNodeInputNamedAttribute")
+    frame.data_type = "FLOAT"
+    frame.inputs["Name"].default_value = "tk_frame"
+    other = n.new("FunctionNodeCompare")
+    other.data_type, other.operation = "FLOAT", "NOT_EQUAL"
+    links.new(frame.outputs["Attribute"], other.inputs["A"])
+    links.new(clamp.outputs[0], other.inputs["B"])
+    both = n.new("FunctionNodeBooleanMath")
+    both.operation = "AND"
+    links.new(frame.outputs["Exists"], both.inputs[0])
+    links.new(other.outputs["Result"], both.inputs[1])
+    delete = n.new("GeometryNodeDeleteGeometry")
+    delete.domain = "POINT"
+    links.new(store.outputs["Geometry"], delete.inputs["Geometry"])
+    links.new(both.outputs[0], delete.inputs["Selection"])
+    links.new(delete.outputs["Geometry"], gout.inputs["Geometry"])
+    return g
+
+
+def material(name, color, alpha=True):
+    """A toonkit material: `color`, opacity from the `tk_alpha` attribute."""
+    m = bpy.data.materials.get(name)
+    if m is not None:
+        return m
+    m = bpy.data.materials.new(name)
+    m.use_nodes = True
+    m.diffuse_color = (*color, 0.5)
+    bsdf = next(x for x in m.node_tree.nodes if x.type == "BSDF_PRINCIPLED")
+    bsdf.inputs["Base Color"].default_value = (*color, 1.0)
+    if alpha:
+        a = m.node_tree.nodes.new("ShaderNodeAttribute")
+        a.attribute_name = "tk_alpha"
+        m.node_tree.links.new(a.outputs["Fac"], bsdf.inputs["Alpha"])
+        if hasattr(m, "surface_render_method"):
+            m.surface_render_method = "BLENDED"
+        else:
+            m.blend_method = "BLEND"
+    m[ROLE] = "material"
+    return m
+
+
+def collection(scene):
+    c = bpy.data.collections.get(COLLECTION)
+    if c is None:
+        c = bpy.data.collections.new(COLLECTION)
+        c[ROLE] = "collection"
+    if c.name not in scene.collection.children:
+        scene.collection.children.link(c)
+    return c
+
+
+def _object(scene, name, mesh, role, source, start, end):
+    obj = bpy.data.objects.new(name, mesh)
+    obj[ROLE], obj[SOURCE] = role, source
+    collection(scene).objects.link(obj)
+    mod = obj.modifiers.new(GROUP, "NODES")
+    mod.node_group = node_group()
+    set_range(obj, start, end)
+    return obj
+
+
+def set_range(obj, start, end):
+    """The modifier's baked frame range."""
+    mod = obj.modifiers[GROUP]
+    for item in mod.node_group.interface.items_tree:
+        if getattr(item, "in_out", None) == "INPUT" and item.name in ("Start", "End"):
+            mod[item.identifier] = start if item.name == "Start" else end
+    obj.update_tag()
+
+
+def mesh_like(source_mesh, name):
+    """A copy of `source_mesh`'s topology and materials (vertices set per frame)."""
+    m = source_mesh.copy()
+    m.name = name
+    for a in [a.name for a in m.attributes if a.name.startswith("tk_")]:
+        m.attributes.remove(m.attributes[a])
+    return m
+
+
+def write_frames(mesh, start, positions, alpha=None):
+    """Per-frame attributes `tk_P<frame>` (and `tk_A<frame>`); frame 0 also as the rest."""
+    attrs = mesh.attributes
+    for k in range(len(positions)):
+        f = start + k
+        for name, kind, data, field in (
+            (f"tk_P{f}", "FLOAT_VECTOR", positions, "vector"),
+            (f"tk_A{f}", "FLOAT", alpha, "value"),
+        ):
+            if data is None:
+                continue
+            a = attrs.get(name) or attrs.new(name, kind, "POINT")
+            a.data.foreach_set(field, np.ascontiguousarray(data[k], np.float32).ravel())
+    mesh.vertices.foreach_set("co", np.ascontiguousarray(positions[0], np.float32).ravel())
+    mesh.update()
+
+
+def write_lines(mesh, start, frames):
+    """All frames' line tubes in one mesh, `tk_frame` telling which frame a point shows at."""
+    pts, tris, alpha, frame, base = [], [], [], [], 0
+    for k, fr in enumerate(frames):
+        p = fr["positions"]
+        pts.append(p)
+        tris.append(fr["triangles"] + base)
+        alpha.append(fr["alpha"])
+        frame.append(np.full(len(p), start + k, np.float32))
+        base += len(p)
+    p = np.concatenate(pts) if pts else np.zeros((0, 3), np.float32)
+    t = np.concatenate(tris) if tris else np.zeros((0, 3), np.int32)
+    mesh.clear_geometry()
+    mesh.vertices.add(len(p))
+    mesh.vertices.foreach_set("co", np.ascontiguousarray(p, np.float32).ravel())
+    mesh.loops.add(3 * len(t))
+    mesh.loops.foreach_set("vertex_index", np.ascontiguousarray(t, np.int32).ravel())
+    mesh.polygons.add(len(t))
+    mesh.polygons.foreach_set("loop_start", np.arange(0, 3 * len(t), 3, dtype=np.int32))
+    mesh.update()
+    for name, data in (("tk_frame", frame), ("tk_alpha", alpha)):
+        a = mesh.attributes.get(name) or mesh.attributes.new(name, "FLOAT", "POINT")
+        if len(p):
+            a.data.foreach_set("value", np.concatenate(data).astype(np.float32))
+
+
+def owned(kind=None):
+    """Every toonkit-owned object (of one role)."""
+    return [o for o in bpy.data.objects if ROLE in o and (kind is None or o[ROLE] == kind)]
+
+
+def make_body(scene, original, mesh, start, end):
+    """The elongated body of `original` (its data untouched; it is hidden until unbake)."""
+    obj = _object(scene, f"{original.name} smear", mesh, "body", original.name, start, end)
+    obj[HIDDEN] = [original.hide_viewport, original.hide_render, original.hide_get()]
+    original.hide_render = True
+    original.hide_set(True)
+    return obj
+
+
+def make_copy(scene, body, index, start, end):
+    mesh = mesh_like(body.data, f"{body[SOURCE]} multiple {index}")
+    mesh.materials.clear()
+    mesh.materials.append(material("toonkit multiple", (0.8, 0.8, 0.8)))
+    return _object(scene, mesh.name, mesh, "multiple", body[SOURCE], start, end)
+
+
+def make_lines(scene, source, start, end):
+    mesh = bpy.data.meshes.new(f"{source} lines")
+    mesh.materials.append(material("toonkit line", (0.05, 0.05, 0.05)))
+    return _object(scene, mesh.name, mesh, "lines", source, start, end)
+
+
+def remove(obj):
+    mesh = obj.data
+    bpy.data.objects.remove(obj)
+    if mesh is not None and mesh.users == 0:
+        bpy.data.meshes.remove(mesh)
+
+
+def remove_all(scene):
+    """Removes every toonkit-owned object, mesh, material, node group and collection and
+    shows the originals as they were."""
+    for obj in owned("body"):
+        original = bpy.data.objects.get(obj[SOURCE])
+        if original is not None and HIDDEN in obj:
+            vp, render, hidden = obj[HIDDEN]
+            original.hide_viewport, original.hide_render = bool(vp), bool(render)
+            if original.name in scene.view_layers[0].objects:
+                original.hide_set(bool(hidden))
+    for obj in owned():
+        remove(obj)
+    for m in [m for m in bpy.data.materials if ROLE in m]:
+        bpy.data.materials.remove(m)
+    g = bpy.data.node_groups.get(GROUP)
+    if g is not None:
+        bpy.data.node_groups.remove(g)
+    c = bpy.data.collections.get(COLLECTION)
+    if c is not None and ROLE in c:
+        bpy.data.collections.remove(c)
