@@ -6,9 +6,9 @@ Operators: `bpy.ops.toonkit.smear_bake()`, `bpy.ops.toonkit.smear_update()`,
 View3D ▸ Sidebar ▸ toonkit.
 """
 
-from . import operators, panel, settings
+from . import operators, panel, settings, stopmo_ui
 
-_MODULES = (settings, operators, panel)
+_MODULES = (settings, operators, panel, stopmo_ui)
 
 
 def register():

@@ -19,8 +19,7 @@ import zipfile
 
 HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parent
-FILES = ["__init__.py", "settings.py", "style.py", "sample.py", "results.py", "job.py",
-         "operators.py", "panel.py"]
+SKIP = {"build.py"}  # the extension is every other .py file beside the manifest
 
 
 def platform_of(wheel: pathlib.Path) -> str:
@@ -76,8 +75,9 @@ def main() -> None:
     with tempfile.NamedTemporaryFile(dir=args.out, suffix=".zip", delete=False) as tmp:
         with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
             z.writestr("blender_manifest.toml", manifest_text(wheel, platform))
-            for name in FILES:
-                z.write(HERE / name, name)
+            for path in sorted(HERE.glob("*.py")):
+                if path.name not in SKIP:
+                    z.write(path, path.name)
             z.write(wheel, f"wheels/{wheel.name}")
     pathlib.Path(tmp.name).replace(target)
     print(target)

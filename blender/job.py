@@ -35,11 +35,16 @@ def is_baked(scene):
 
 
 def sources(context):
-    """The originals to bake: selected meshes, with toonkit results standing for theirs."""
+    """The originals to bake: selected meshes (a selected armature brings its child meshes),
+    with toonkit results standing for their originals."""
     import bpy
 
     names = []
     for o in context.selected_objects:
+        if o.type == "ARMATURE":  # a selected rig stands for its meshes
+            names += [c.name for c in o.children_recursive
+                      if c.type == "MESH" and results.ROLE not in c and c.name not in names]
+            continue
         name = o.get(results.SOURCE, o.name) if results.ROLE in o else o.name
         if name not in names:
             names.append(name)

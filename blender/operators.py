@@ -36,7 +36,9 @@ class TOONKIT_OT_smear_update(bpy.types.Operator):
 
     bl_idname = "toonkit.smear_update"
     bl_label = "Update smear"
-    bl_options = {"REGISTER", "UNDO"}
+    # No undo step of its own: a restyle is derived from the settings (whose edits are
+    # undoable), and an undo push copies the whole .blend (~50 ms on the robot).
+    bl_options = {"REGISTER"}
 
     def execute(self, context):
         if not job.is_baked(context.scene):

@@ -16,7 +16,7 @@ import numpy as np
 
 COLLECTION = "toonkit"
 GROUP = "toonkit smear"
-ROLE = "toonkit_role"  # custom property on every toonkit-owned object: body/multiple/lines
+ROLE = "toonkit_role"  # on every toonkit-owned object: body/multiple/lines/stopmo
 SOURCE = "toonkit_source"  # the original object's name
 HIDDEN = "toonkit_hidden"  # the original's (hide_viewport, hide_render) before the bake
 
@@ -42,7 +42,7 @@ def _frame_name(n, prefix, frame):
     g.links.new(text.outputs[0], join.inputs["Strings"])
     g.links.new(head.outputs[0], join.inputs["Strings"])
     attr = n.new("GeometryNodeInputNamedAttribute")
-    attr.data_type = "FLOAT_VECTOR" if prefix == "tk_P" else "FLOAT"
+    attr.data_type = {"tk_P": "FLOAT_VECTOR", "tk_I": "INT"}.get(prefix, "FLOAT")
     g.links.new(join.outputs[0], attr.inputs["Name"])
     return attr, clamp
 
@@ -71,6 +71,15 @@ def node_group():
     links.new(setpos.outputs["Geometry"], store.inputs["Geometry"])
     links.new(alpha.outputs["Exists"], store.inputs["Selection"])
     links.new(alpha.outputs["Attribute"], store.inputs["Value"])
+    # Stop-motion reconstructions: the piece shown at this frame, as the integer `piece`.
+    piece, _ = _frame_name(n, "tk_I", None)
+    store_piece = n.new("GeometryNodeStoreNamedAttribute")
+    store_piece.data_type, store_piece.domain = "INT", "POINT"
+    store_piece.inputs["Name"].default_value = "piece"
+    links.new(store.outputs["Geometry"], store_piece.inputs["Geometry"])
+    links.new(piece.outputs["Exists"], store_piece.inputs["Selection"])
+    links.new(piece.outputs["Attribute"], store_piece.inputs["Value"])
+    store = store_piece
     # Motion lines: keep only the points (and their faces) of the current frame.
     frame = n.new("GeometryNodeInputNamedAttribute")
     frame.data_type = "FLOAT"
@@ -123,7 +132,7 @@ def collection(scene):
     return c
 
 
-def _object(scene, name, mesh, role, source, start, end):
+def add_object(scene, name, mesh, role, source, start, end):
     obj = bpy.data.objects.new(name, mesh)
     obj[ROLE], obj[SOURCE] = role, source
     collection(scene).objects.link(obj)
@@ -201,7 +210,7 @@ def owned(kind=None):
 
 def make_body(scene, original, mesh, start, end):
     """The elongated body of `original` (its data untouched; it is hidden until unbake)."""
-    obj = _object(scene, f"{original.name} smear", mesh, "body", original.name, start, end)
+    obj = add_object(scene, f"{original.name} smear", mesh, "body", original.name, start, end)
     obj[HIDDEN] = [original.hide_viewport, original.hide_render, original.hide_get()]
     original.hide_render = True
     original.hide_set(True)
@@ -212,13 +221,13 @@ def make_copy(scene, body, index, start, end):
     mesh = mesh_like(body.data, f"{body[SOURCE]} multiple {index}")
     mesh.materials.clear()
     mesh.materials.append(material("toonkit multiple", (0.8, 0.8, 0.8)))
-    return _object(scene, mesh.name, mesh, "multiple", body[SOURCE], start, end)
+    return add_object(scene, mesh.name, mesh, "multiple", body[SOURCE], start, end)
 
 
 def make_lines(scene, source, start, end):
     mesh = bpy.data.meshes.new(f"{source} lines")
     mesh.materials.append(material("toonkit line", (0.05, 0.05, 0.05)))
-    return _object(scene, mesh.name, mesh, "lines", source, start, end)
+    return add_object(scene, mesh.name, mesh, "lines", source, start, end)
 
 
 def remove(obj):
@@ -228,10 +237,14 @@ def remove(obj):
         bpy.data.meshes.remove(mesh)
 
 
-def remove_all(scene):
-    """Removes every toonkit-owned object, mesh, material, node group and collection and
-    shows the originals as they were."""
-    for obj in owned("body"):
+SMEAR_ROLES = ("body", "multiple", "lines")
+
+
+def remove_all(scene, roles=SMEAR_ROLES):
+    """Removes the toonkit-owned objects of `roles` (and their meshes), shows their originals
+    as they were, and removes the materials, node group and collection once nothing of
+    toonkit's is left."""
+    for obj in owned("body") if "body" in roles else []:
         original = bpy.data.objects.get(obj[SOURCE])
         if original is not None and HIDDEN in obj:
             vp, render, hidden = obj[HIDDEN]
@@ -239,9 +252,12 @@ def remove_all(scene):
             if original.name in scene.view_layers[0].objects:
                 original.hide_set(bool(hidden))
     for obj in owned():
-        remove(obj)
-    for m in [m for m in bpy.data.materials if ROLE in m]:
+        if obj[ROLE] in roles:
+            remove(obj)
+    for m in [m for m in bpy.data.materials if ROLE in m and m.users == 0]:
         bpy.data.materials.remove(m)
+    if owned():
+        return
     g = bpy.data.node_groups.get(GROUP)
     if g is not None:
         bpy.data.node_groups.remove(g)

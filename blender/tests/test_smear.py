@@ -229,13 +229,13 @@ def test_render_save_reload_unbake():
     cam_data = bpy.data.cameras.new("cam")
     cam = bpy.data.objects.new("cam", cam_data)
     scene.collection.objects.link(cam)
-    cam.location = (0.0, -12.0, 3.0)
-    cam.rotation_euler = (1.40, 0.0, 0.0)
+    cam.location = (0.0, -9.0, 1.7)
+    cam.rotation_euler = (1.5708, 0.0, 0.0)
     scene.camera = cam
     light = bpy.data.objects.new("sun", bpy.data.lights.new("sun", "SUN"))
     scene.collection.objects.link(light)
     engine = render_engine(scene)
-    scene.render.resolution_x, scene.render.resolution_y = 320, 320
+    scene.render.resolution_x, scene.render.resolution_y = 480, 360
     scene.render.image_settings.file_format = "PNG"
     plain = render(scene, "unbaked.png")
     select(meshes)

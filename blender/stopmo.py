@@ -1,0 +1,152 @@
+"""Stop-motion replacement libraries (StopShop) from the active mesh's painted parts.
+
+Parts are the vertex groups named `part_<NAME>` (two or more): the triangles whose three
+vertices weigh >= 0.5 in a group seed that part. `toonkit.stopmo.run` segments the animation
+over the scene range and builds the library; the CLI's folder layout is written to the chosen
+directory, and a reconstruction object (toonkit-owned, beside the original) plays the
+replacement animation with an integer point attribute `piece` (the piece index of the
+vertex's part at the current frame).
+"""
+
+import os
+
+import bpy
+import numpy as np
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
+
+from . import job, results, sample
+
+PREFIX = "part_"
+
+
+class StopmoSettings(bpy.types.PropertyGroup):
+    """Settings of `toonkit.stopmo_run` (StopShop Sections 4-6)."""
+
+    count: EnumProperty(name="Library size", default="EACH", items=[
+        ("EACH", "Pieces per part", "The same number of pieces for every part"),
+        ("BUDGET", "Budget", "A total number of pieces over all parts"),
+        ("MAX_ERROR", "Max error", "The smallest library within an error (mm)")])
+    pieces: IntProperty(name="Pieces", default=8, min=1, max=500)
+    budget: IntProperty(name="Budget", default=16, min=2, max=2000)
+    max_error_mm: FloatProperty(name="Max error (mm)", default=0.5, min=0.001)
+    lam: FloatProperty(name="λ", default=1.0, min=0.0,
+                       description="Temporal smoothness weight (StopShop Eq. 10)")
+    restarts: IntProperty(name="Restarts", default=4, min=1, max=100)
+    seed: IntProperty(name="Seed", default=1, min=0)
+    print_height_mm: FloatProperty(name="Print height (mm)", default=25.0, min=1.0)
+    plugs: BoolProperty(name="Plugs", default=False,
+                        description="Registration plugs between parts")
+    directory: StringProperty(name="Directory", default="//stopmo", subtype="DIR_PATH")
+
+
+def parts_of(obj, triangles):
+    """{name: [triangle ids]} from the `part_<NAME>` vertex groups of `obj`."""
+    groups = [g for g in obj.vertex_groups if g.name.startswith(PREFIX)]
+    if len(groups) < 2:
+        raise job.JobError(f"{obj.name}: paint at least two vertex groups named "
+                           f"'{PREFIX}<NAME>' (found {len(groups)})")
+    n = len(obj.data.vertices)
+    weights = np.zeros((len(groups), n), np.float32)
+    index = {g.index: k for k, g in enumerate(groups)}
+    for v in obj.data.vertices:
+        for e in v.groups:
+            if e.group in index:
+                weights[index[e.group], v.index] = e.weight
+    parts = {}
+    for k, g in enumerate(groups):
+        inside = (weights[k][triangles] >= 0.5).all(axis=1)
+        ids = np.nonzero(inside)[0]
+        if len(ids) == 0:
+            raise job.JobError(f"{obj.name}: vertex group '{g.name}' covers no whole triangle")
+        parts[g.name[len(PREFIX):]] = [int(t) for t in ids]
+    return parts
+
+
+def options(s):
+    count = {"EACH": {"each": s.pieces}, "BUDGET": {"budget": s.budget},
+             "MAX_ERROR": {"max_error_mm": s.max_error_mm}}[s.count]
+    opts = {"pieces": count, "lambda": s.lam, "restarts": s.restarts, "seed": s.seed,
+            "print_height_mm": s.print_height_mm}
+    if s.plugs:
+        opts["plugs"] = {}
+    return opts
+
+
+def read_obj(path):
+    """Vertices and triangles of the `rest.obj` a library writes."""
+    v, f = [], []
+    with open(path, encoding="utf-8") as fh:
+        for line in fh:
+            if line.startswith("v "):
+                v.append([float(x) for x in line.split()[1:4]])
+            elif line.startswith("f "):
+                f.append([int(x.split("/")[0]) - 1 for x in line.split()[1:4]])
+    return np.array(v, np.float32), np.array(f, np.int32)
+
+
+def read_pc2(path):
+    """Frames of a `.pc2` point cache: (frames, points, 3) float32."""
+    with open(path, "rb") as fh:
+        head = fh.read(32)
+        if head[:12] != b"POINTCACHE2\0":
+            raise job.JobError(f"{path}: not a .pc2 point cache")
+        points = int(np.frombuffer(head[16:20], "<i4")[0])
+        frames = int(np.frombuffer(head[28:32], "<i4")[0])
+        data = np.frombuffer(fh.read(), "<f4")
+    return data[: frames * points * 3].reshape(frames, points, 3)
+
+
+def run(context, obj):
+    """Runs the job on `obj` and shows the reconstruction; returns the library."""
+    toonkit = job._toonkit()
+    s = context.scene.toonkit_stopmo
+    try:
+        taken = sample.sample(context, [obj])
+    except sample.SampleError as e:
+        raise job.JobError(str(e)) from e
+    parts = parts_of(obj, taken.triangles)
+    folder = bpy.path.abspath(s.directory)
+    if s.directory.startswith("//") and not bpy.data.filepath:
+        raise job.JobError("save the .blend first, or choose an absolute directory")
+    try:
+        scene = toonkit.Scene.from_arrays(taken.positions, taken.triangles, fps=taken.fps)
+        lib = toonkit.stopmo.run(scene, parts=parts, **options(s))
+        os.makedirs(folder, exist_ok=True)
+        lib.save(folder)
+    except (toonkit.ToonkitError, ValueError, OSError) as e:
+        raise job.JobError(job._one_line(e)) from e
+    show(context.scene, obj, folder, lib, taken.frame_start)
+    return lib
+
+
+def show(scene, obj, folder, lib, start):
+    """The reconstruction object (replacing an earlier one of `obj`) and the error curve."""
+    for old in results.owned("stopmo"):
+        if old[results.SOURCE] == obj.name:
+            results.remove(old)
+    rest, tris = read_obj(os.path.join(folder, "rest.obj"))
+    frames = read_pc2(os.path.join(folder, "reconstruction.pc2"))
+    mesh = bpy.data.meshes.new(f"{obj.name} stopmo")
+    mesh.from_pydata(rest.tolist(), [], tris.tolist())
+    end = start + len(frames) - 1
+    results.write_frames(mesh, start, frames)
+    labels = np.asarray(lib.labels)  # (frames, parts)
+    sizes = [p["vertices"] for p in lib.report["parts"]]  # part order of rest.obj
+    if sum(sizes) != len(rest):
+        raise job.JobError(f"{folder}: rest.obj has {len(rest)} vertices, parts {sum(sizes)}")
+    part_of_vertex = np.repeat(np.arange(len(sizes)), sizes)
+    for k in range(len(frames)):
+        a = mesh.attributes.new(f"tk_I{start + k}", "INT", "POINT")
+        a.data.foreach_set("value", labels[k][part_of_vertex].astype(np.int32))
+    rec = results.add_object(scene, mesh.name, mesh, "stopmo", obj.name, start, end)
+    width = float(np.ptp(rest[:, 0])) if len(rest) else 1.0
+    rec.location = (1.2 * width, 0.0, 0.0)
+    curve = os.path.join(folder, "error_curve.png")
+    if os.path.exists(curve):
+        old = bpy.data.images.get("toonkit error curve")
+        if old is not None:
+            bpy.data.images.remove(old)
+        img = bpy.data.images.load(curve)
+        img.name = "toonkit error curve"
+    return rec
+

@@ -1,0 +1,121 @@
+"""Headless tests of the extension's stop-motion operator (issue 17, first half):
+
+    python blender/tests/test_stopmo.py dist/toonkit-<version>-<platform>.zip [OUT_DIR]
+
+The bundled talking face (2 fps), two `part_<NAME>` vertex groups painted around the seed
+points the CLI tests use; `toonkit.stopmo_run` must write the same `assembly.csv` and energy as
+`toonkit.stopmo.run` on the same evaluated data (the module equals the CLI: crates/python/tests),
+and the reconstruction object must show at frame k the pieces of `assembly.csv` row k.
+"""
+
+import csv
+import json
+import os
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+os.environ.setdefault("BLENDER_USER_RESOURCES", os.path.join(
+    os.environ.get("TMPDIR", "/tmp"), f"toonkit-blender-user-{os.getpid()}"))
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+from harness import (REPO, argv_after_dashes, check, empty_scene, install, run,  # noqa: E402
+                     tmpdir, world_positions)
+
+ARGS = argv_after_dashes()
+ZIP = os.path.abspath(ARGS[0])
+OUT = os.path.abspath(ARGS[1]) if len(ARGS) > 1 else tmpdir()
+os.makedirs(OUT, exist_ok=True)
+toonkit = install(ZIP)
+# The CLI tests' seeds (glTF, Y up) in Blender's Z-up frame: (x, y, z) -> (x, -z, y).
+SEEDS = {"upper": (0.0, -13.0, 10.0), "lower": (0.0, -10.0, -14.0)}
+PIECES = 4
+
+
+def face():
+    scene = empty_scene()
+    scene.render.fps = 2
+    bpy.ops.import_scene.gltf(filepath=os.path.join(REPO, "assets", "face", "ict-face-talk.glb"))
+    obj = next(o for o in bpy.data.objects if o.type == "MESH" and o.name != "Icosphere")
+    ad = obj.data.shape_keys.animation_data if obj.data.shape_keys else obj.animation_data
+    first, last = ad.action.frame_range
+    scene.frame_start, scene.frame_end = int(first), int(last)
+    rest = world_positions(obj, scene.frame_start)
+    for name, seed in SEEDS.items():
+        d = np.linalg.norm(rest - np.array(seed), axis=1)
+        near = np.nonzero(d <= np.sort(d)[30])[0]  # the 31 vertices nearest the seed
+        g = obj.vertex_groups.new(name=f"part_{name}")
+        g.add([int(i) for i in near], 1.0, "REPLACE")
+    for o in bpy.data.objects:
+        o.select_set(False)
+    obj.select_set(True)
+    bpy.context.view_layer.objects.active = obj
+    return scene, obj
+
+
+def test_stopmo_run_matches_the_module():
+    scene, obj = face()
+    s = scene.toonkit_stopmo
+    s.count, s.pieces, s.restarts, s.seed = "EACH", PIECES, 2, 1
+    folder = os.path.join(OUT, "stopmo")
+    r = bpy.ops.toonkit.stopmo_run(directory=folder)
+    check(r == {"FINISHED"}, f"stopmo_run returned {r}")
+    from bl_ext.user_default.toonkit import sample, stopmo
+
+    taken = sample.sample(bpy.context, [obj])
+    parts = stopmo.parts_of(obj, taken.triangles)
+    ref = toonkit.stopmo.run(toonkit.Scene.from_arrays(taken.positions, taken.triangles,
+                                                       fps=taken.fps),
+                             parts=parts, **stopmo.options(s))
+    ref_dir = os.path.join(OUT, "module")
+    ref.save(ref_dir)
+    for name in ("assembly.csv", "shooting_order.csv"):
+        with open(os.path.join(folder, name)) as a, open(os.path.join(ref_dir, name)) as b:
+            check(a.read() == b.read(), f"{name} differs from the module's")
+    ours = json.load(open(os.path.join(folder, "report.json")))
+    theirs = json.load(open(os.path.join(ref_dir, "report.json")))
+    check(abs(ours["energy"] - theirs["energy"]) <= 1e-6 * abs(theirs["energy"]),
+          f"energy {ours['energy']} vs {theirs['energy']}")
+    pieces = sorted(os.listdir(os.path.join(folder, "pieces")))
+    check(len(pieces) > 0, "no pieces written")
+
+    # The reconstruction shows at frame k the pieces of assembly.csv row k.
+    rec = next(o for o in bpy.data.objects if o.get("toonkit_role") == "stopmo")
+    rows = list(csv.reader(open(os.path.join(folder, "assembly.csv"))))
+    header, rows = rows[0], rows[1:]
+    labels = np.asarray(ref.labels)
+    check(len(rows) == len(labels) == scene.frame_end - scene.frame_start + 1,
+          f"{len(rows)} assembly rows, {len(labels)} labels")
+    ids = {(p["part"], p["index"]): p["id"] for p in ref.pieces}
+    for k, f in enumerate(range(scene.frame_start, scene.frame_end + 1)):
+        scene.frame_set(f)
+        dg = bpy.context.evaluated_depsgraph_get()
+        mesh = rec.evaluated_get(dg).to_mesh()
+        piece = np.empty(len(mesh.vertices), np.int32)
+        mesh.attributes["piece"].data.foreach_get("value", piece)
+        rec.evaluated_get(dg).to_mesh_clear()
+        shown = [ids[(p, int(i))] for p, i in enumerate(labels[k])]
+        check(set(shown) <= set(rows[k]), f"frame {f}: {shown} not in {rows[k]}")
+        check(set(np.unique(piece)) == set(int(i) for i in labels[k]),
+              f"frame {f}: piece attribute {np.unique(piece)} vs labels {labels[k]}")
+    check(bpy.data.images.get("toonkit error curve") is not None or s.count == "EACH",
+          "no size-vs-error image")
+
+
+def test_stopmo_errors():
+    scene, obj = face()
+    obj.vertex_groups.remove(obj.vertex_groups["part_lower"])
+    before = sorted(o.name for o in bpy.data.objects)
+    try:
+        bpy.ops.toonkit.stopmo_run(directory=os.path.join(OUT, "bad"))
+    except RuntimeError as e:
+        check("at least two vertex groups" in str(e), f"message {e}")
+    else:
+        raise AssertionError("one part was accepted")
+    check(sorted(o.name for o in bpy.data.objects) == before, "the scene changed")
+
+
+if __name__ == "__main__":
+    sys.exit(run([test_stopmo_errors, test_stopmo_run_matches_the_module]))
