@@ -22,6 +22,9 @@ pub struct InputArgs {
     /// Rest mesh (.obj) for a PC2/MDD point cache (default: same name .obj, or rest.obj).
     #[arg(long)]
     pub rest: Option<PathBuf>,
+    /// Scene of a multi-scene glTF file, by name or index (default: the file's default scene).
+    #[arg(long)]
+    pub scene: Option<String>,
 }
 
 impl Default for InputArgs {
@@ -31,20 +34,28 @@ impl Default for InputArgs {
             fps: DEFAULT_FPS,
             mesh: Vec::new(),
             rest: None,
+            scene: None,
         }
     }
 }
 
 /// Reads a file of any supported format.
 pub fn load(path: &Path, args: &InputArgs) -> Result<Loaded> {
+    load_with_notes(path, args).map(|(loaded, _)| loaded)
+}
+
+/// Reads a file of any supported format, with the reader's notes (glTF extensions accepted,
+/// scene read, FBX units and axes converted).
+pub fn load_with_notes(path: &Path, args: &InputArgs) -> Result<(Loaded, Vec<String>)> {
     if !(args.fps.is_finite() && args.fps > 0.0) {
         anyhow::bail!("--fps must be a positive number, got {}", args.fps);
     }
     let options = LoadOptions {
         fps: args.fps,
         rest: args.rest.clone(),
+        scene: args.scene.clone(),
     };
-    Ok(tkio::load(path, &options)?)
+    Ok(tkio::load_with_notes(path, &options)?)
 }
 
 /// Samples what was loaded into per-object point caches (and skeleton, cameras).

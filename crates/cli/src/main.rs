@@ -17,6 +17,10 @@ pub struct Cli {
     /// Print a machine-readable JSON summary (timings included) on stdout instead of text.
     #[arg(long, global = true)]
     json: bool,
+    /// Write glTF flipbooks and morph outputs with float geometry instead of
+    /// KHR_mesh_quantization (about twice the size; for tools that cannot read it).
+    #[arg(long, global = true)]
+    no_quantize: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -54,6 +58,9 @@ pub(crate) fn run_args(args: &[String]) -> anyhow::Result<()> {
     let ctx = commands::Context {
         json: true,
         quiet: true,
+        save: tkio::SaveOptions {
+            quantize: !cli.no_quantize,
+        },
     };
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(&ctx, cli.command)))
         .unwrap_or_else(|_| {
@@ -79,6 +86,9 @@ fn main() -> ExitCode {
     let ctx = commands::Context {
         json: cli.json,
         quiet: false,
+        save: tkio::SaveOptions {
+            quantize: !cli.no_quantize,
+        },
     };
     match run(&ctx, cli.command) {
         Ok(()) => ExitCode::SUCCESS,

@@ -37,14 +37,16 @@ pub fn write_animation(
     anim: &MeshAnimation,
     layout: Layout,
     colors: Option<&[[f32; 4]]>,
+    options: tkio::SaveOptions,
 ) -> Result<Vec<PathBuf>> {
-    Ok(tkio::save(
+    Ok(tkio::save_with(
         path,
         &Output::Animation {
             animation: anim,
             layout: layout.into(),
             colors,
         },
+        options,
     )?)
 }
 

@@ -33,6 +33,8 @@ pub enum Format {
     Usdz,
     /// Alembic archive (`.abc`, Ogawa): written by toonkit; [`crate::abc::read`] reads it back.
     Abc,
+    /// Autodesk FBX (binary or ASCII, 6.x–7.x): read only.
+    Fbx,
 }
 
 impl Format {
@@ -61,6 +63,7 @@ impl Format {
             "usdc" => Format::Usdc,
             "usdz" => Format::Usdz,
             "abc" => Format::Abc,
+            "fbx" => Format::Fbx,
             _ => return None,
         })
     }
@@ -72,6 +75,9 @@ pub fn detect(bytes: &[u8], path: &Path) -> Option<Format> {
     let ext = Format::from_extension(path);
     if bytes.starts_with(b"glTF") {
         return Some(Format::Glb);
+    }
+    if bytes.starts_with(b"Kaydara FBX Binary") {
+        return Some(Format::Fbx);
     }
     if bytes.starts_with(b"POINTCACHE2\0") {
         return Some(Format::Pc2);
@@ -110,6 +116,9 @@ pub fn detect(bytes: &[u8], path: &Path) -> Option<Format> {
     if t.starts_with('{') {
         return Some(Format::Gltf);
     }
+    if t.starts_with("; FBX") || t.starts_with("FBXHeaderExtension") {
+        return Some(Format::Fbx);
+    }
     if t.starts_with("HIERARCHY") {
         return Some(Format::Bvh);
     }
@@ -144,6 +153,8 @@ pub struct LoadOptions {
     /// Rest mesh for PC2/MDD; default: the same-stem `.obj` beside the cache, else
     /// `rest.obj` in its folder.
     pub rest: Option<PathBuf>,
+    /// Scene of a multi-scene glTF file, by name or index (default: the file's default scene).
+    pub scene: Option<String>,
 }
 
 impl Default for LoadOptions {
@@ -151,6 +162,7 @@ impl Default for LoadOptions {
         LoadOptions {
             fps: DEFAULT_FPS,
             rest: None,
+            scene: None,
         }
     }
 }
@@ -160,39 +172,61 @@ impl Default for LoadOptions {
 /// # Errors
 /// One-line errors naming the file: unreadable, unknown format, malformed content.
 pub fn load(path: &Path, options: &LoadOptions) -> Result<Loaded> {
+    load_with_notes(path, options).map(|(loaded, _)| loaded)
+}
+
+/// [`load`], plus one line per thing worth telling the user about the file: glTF extensions
+/// accepted and what was done with them, the scene read, FBX units and axes converted.
+///
+/// # Errors
+/// As [`load`].
+pub fn load_with_notes(path: &Path, options: &LoadOptions) -> Result<(Loaded, Vec<String>)> {
     let bytes = read_file(path)?;
     let format = detect(&bytes, path).ok_or_else(|| {
         IoError::unsupported(
-            "unrecognized file format (expected glTF, GLB, OBJ, PC2, MDD, BVH or STL)",
+            "unrecognized file format (expected glTF, GLB, FBX, OBJ, PC2, MDD, BVH or STL)",
         )
         .at(path)
     })?;
     load_as(path, &bytes, format, options).map_err(|e| e.at(path))
 }
 
-fn load_as(path: &Path, bytes: &[u8], format: Format, options: &LoadOptions) -> Result<Loaded> {
+fn load_as(
+    path: &Path,
+    bytes: &[u8],
+    format: Format,
+    options: &LoadOptions,
+) -> Result<(Loaded, Vec<String>)> {
+    let scene = |(s, notes): (Scene, Vec<String>)| (Loaded::Scene(Box::new(s)), notes);
+    let plain = |l: Loaded| (l, Vec::new());
     match format {
         Format::Glb | Format::Gltf => {
-            crate::gltf_read::read_bytes_at(bytes, path).map(|s| Loaded::Scene(Box::new(s)))
+            crate::gltf_read::read_full(bytes, path.parent(), options.scene.as_deref()).map(scene)
         }
-        Format::Bvh => crate::bvh::read(bytes).map(|s| Loaded::Scene(Box::new(s))),
+        #[cfg(feature = "fbx")]
+        Format::Fbx => crate::fbx::read(bytes).map(scene),
+        #[cfg(not(feature = "fbx"))]
+        Format::Fbx => Err(IoError::unsupported(
+            "FBX support was not compiled in (feature \"fbx\")",
+        )),
+        Format::Bvh => crate::bvh::read(bytes).map(|s| plain(Loaded::Scene(Box::new(s)))),
         #[cfg(feature = "obj")]
         Format::Obj => {
             let seq = crate::obj::sequence_paths(path).unwrap_or_default();
             if seq.len() > 1 {
-                crate::obj::read_sequence(&seq, options.fps).map(Loaded::Cache)
+                crate::obj::read_sequence(&seq, options.fps).map(|c| plain(Loaded::Cache(c)))
             } else {
-                crate::obj::read(bytes).map(Loaded::Mesh)
+                crate::obj::read(bytes).map(|m| plain(Loaded::Mesh(m)))
             }
         }
         #[cfg(feature = "stl")]
-        Format::Stl => crate::stl::read(bytes).map(Loaded::Mesh),
+        Format::Stl => crate::stl::read(bytes).map(|m| plain(Loaded::Mesh(m))),
         Format::Pc2 | Format::Mdd => {
             let rest = rest_mesh(path, options)?;
             if format == Format::Pc2 {
-                crate::pc2::read(bytes, rest, options.fps).map(Loaded::Cache)
+                crate::pc2::read(bytes, rest, options.fps).map(|c| plain(Loaded::Cache(c)))
             } else {
-                crate::mdd::read(bytes, rest, options.fps).map(Loaded::Cache)
+                crate::mdd::read(bytes, rest, options.fps).map(|c| plain(Loaded::Cache(c)))
             }
         }
         Format::Npy => Err(IoError::unsupported("a .npy array is not an animation")),

@@ -51,6 +51,8 @@ struct Key {
     usage: Usage,
     bounds: bool,
     count: usize,
+    /// Byte stride of the buffer view (padded vertex attributes), `None` when tight.
+    stride: Option<usize>,
 }
 
 /// A stored accessor: its key, where its bytes are in the chunk, its index.
@@ -95,7 +97,12 @@ impl Builder {
     }
 
     /// Appends `bytes` as a new buffer view at a 4-byte aligned offset.
-    fn view(&mut self, bytes: &[u8], usage: Usage) -> (json::Index<json::buffer::View>, usize) {
+    fn view(
+        &mut self,
+        bytes: &[u8],
+        usage: Usage,
+        stride: Option<usize>,
+    ) -> (json::Index<json::buffer::View>, usize) {
         while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
@@ -110,7 +117,7 @@ impl Builder {
             buffer: json::Index::new(0),
             byte_length: USize64(bytes.len() as u64),
             byte_offset: Some(USize64(offset as u64)),
-            byte_stride: None,
+            byte_stride: stride.map(json::buffer::Stride),
             name: None,
             target,
             extensions: None,
@@ -143,7 +150,7 @@ impl Builder {
                 return s.index;
             }
         }
-        let (view, offset) = self.view(bytes, key.usage);
+        let (view, offset) = self.view(bytes, key.usage, key.stride);
         let (min, max) = if key.bounds {
             let (a, b) = bounds();
             (Some(js!(a)), Some(js!(b)))
@@ -198,6 +205,7 @@ impl Builder {
             usage,
             bounds,
             count: data.len() / n,
+            stride: None,
         };
         self.accessor(&bytes, key, || {
             let mut lo = vec![f32::INFINITY; n];
@@ -239,6 +247,7 @@ impl Builder {
             usage: Usage::Index,
             bounds: false,
             count: tris.len() * 3,
+            stride: None,
         };
         self.accessor(&bytes, key, no_bounds)
     }
@@ -257,6 +266,7 @@ impl Builder {
             usage: Usage::Vertex,
             bounds: false,
             count: data.len(),
+            stride: None,
         };
         self.accessor(&bytes, key, no_bounds)
     }
@@ -276,8 +286,64 @@ impl Builder {
             usage: Usage::Vertex,
             bounds: false,
             count: data.len(),
+            stride: None,
         };
         self.accessor(&bytes, key, no_bounds)
+    }
+
+    /// VEC3 of normalized signed integers (`KHR_mesh_quantization`): SHORT (`short`) or BYTE
+    /// from values in [−1, 1] (`round(x · max)`, clamped; non-finite → 0), each element
+    /// padded to four components (stride 8 or 4) as glTF requires of vertex attributes.
+    /// Bounds, when asked, are the integer values (glTF 2.0 §3.6.2: in the component type).
+    pub(crate) fn snorm_vec3s(
+        &mut self,
+        data: &[Vec3],
+        short: bool,
+        bounds: bool,
+    ) -> json::Index<json::Accessor> {
+        let max = if short { 32767.0 } else { 127.0 };
+        let q = |x: f32| {
+            if x.is_finite() {
+                (x * max).round().clamp(-max, max) as i32
+            } else {
+                0
+            }
+        };
+        let ints: Vec<[i32; 3]> = data.iter().map(|v| [q(v.x), q(v.y), q(v.z)]).collect();
+        let mut bytes = Vec::with_capacity(data.len() * if short { 8 } else { 4 });
+        for v in &ints {
+            for &c in v.iter().chain([0].iter()) {
+                if short {
+                    bytes.extend((c as i16).to_le_bytes());
+                } else {
+                    bytes.push(c as i8 as u8);
+                }
+            }
+        }
+        let key = Key {
+            ty: Type::Vec3,
+            component: if short {
+                ComponentType::I16
+            } else {
+                ComponentType::I8
+            },
+            normalized: true,
+            usage: Usage::Vertex,
+            bounds,
+            count: data.len(),
+            stride: Some(if short { 8 } else { 4 }),
+        };
+        self.accessor(&bytes, key, || {
+            let mut lo = vec![f32::INFINITY; 3];
+            let mut hi = vec![f32::NEG_INFINITY; 3];
+            for v in &ints {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(v[k] as f32);
+                    hi[k] = hi[k].max(v[k] as f32);
+                }
+            }
+            (lo, hi)
+        })
     }
 
     /// Serializes to GLB bytes.

@@ -4,12 +4,13 @@
 //! scalar attributes (`_NAME`, [`anim::Mesh::attributes`]) are on every frame; data that is the
 //! same in several frames or parts (triangles, UVs, attributes, still frames) is stored once.
 
-use anim::glam::Vec3;
+use anim::glam::{Quat, Vec3};
 use anim::{Channel, Clip, Interpolation, MeshAnimation, Property};
 use gltf_json as json;
 
 use crate::gltf_accessors::Builder;
-use crate::gltf_write::{frame_mesh, write_clip};
+use crate::gltf_quantize::{Dequant, GlbOptions};
+use crate::gltf_write::{frame_mesh, trs_node, write_clip};
 use crate::{IoError, Result};
 
 /// How a point cache is laid out in glTF.
@@ -48,6 +49,19 @@ pub fn write_animations(
     parts: &[(&MeshAnimation, Option<&[[f32; 4]]>)],
     layout: AnimationLayout,
 ) -> Result<Vec<u8>> {
+    write_animations_with(parts, layout, GlbOptions::default())
+}
+
+/// [`write_animations`] with writer options: with `options.quantize` every frame (flipbook)
+/// or the base mesh and its targets (morph) are written with `KHR_mesh_quantization`.
+///
+/// # Errors
+/// As [`write_animations`].
+pub fn write_animations_with(
+    parts: &[(&MeshAnimation, Option<&[[f32; 4]]>)],
+    layout: AnimationLayout,
+    options: GlbOptions,
+) -> Result<Vec<u8>> {
     let Some((first, _)) = parts.first() else {
         return Err(IoError::unsupported("nothing to write"));
     };
@@ -79,8 +93,12 @@ pub fn write_animations(
         let n = anim.vertex_count();
         let colors_of = |f: usize| colors.map(|c| &c[f * n..(f + 1) * n]);
         let root = match layout {
-            AnimationLayout::Flipbook => flipbook(&mut b, anim, &times, colors_of, &mut channels)?,
-            AnimationLayout::Morph => morph(&mut b, anim, &times, colors_of(0), &mut channels)?,
+            AnimationLayout::Flipbook => {
+                flipbook(&mut b, anim, &times, colors_of, options, &mut channels)?
+            }
+            AnimationLayout::Morph => {
+                morph(&mut b, anim, &times, colors_of(0), options, &mut channels)?
+            }
         };
         roots.push(root);
     }
@@ -125,6 +143,7 @@ fn flipbook<'a>(
     anim: &MeshAnimation,
     times: &[f32],
     colors_of: impl Fn(usize) -> Option<&'a [[f32; 4]]>,
+    options: GlbOptions,
     channels: &mut Vec<Channel>,
 ) -> Result<json::Index<json::Node>> {
     let frames = anim.frame_count();
@@ -132,9 +151,24 @@ fn flipbook<'a>(
     let mut children = Vec::with_capacity(frames);
     for f in 0..frames {
         let sm = frame_mesh(&anim.mesh, anim.frame(f), colors_of(f));
-        let mesh = b.mesh(&sm)?;
+        let q = options.quantize.then(|| Dequant::of(&sm));
+        let mesh = b.mesh_with(&sm, q)?;
+        // The frame node's scale switches visibility; a quantized mesh's dequantization
+        // goes on a child below it.
+        let (mesh, sub) = match q {
+            Some(q) => {
+                let child = b.root.push(json::Node {
+                    mesh: Some(mesh),
+                    name: Some(format!("{name}_f{:04}_quantized", f + 1)),
+                    ..trs_node(q.center, Quat::IDENTITY, Vec3::splat(q.scale))
+                });
+                (None, Some(vec![child]))
+            }
+            None => (Some(mesh), None),
+        };
         let node = b.root.push(json::Node {
-            mesh: Some(mesh),
+            mesh,
+            children: sub,
             name: Some(format!("{name}_f{:04}", f + 1)),
             scale: (f != 0).then_some([0.0; 3]),
             ..empty_node()
@@ -154,6 +188,7 @@ fn morph(
     anim: &MeshAnimation,
     times: &[f32],
     colors: Option<&[[f32; 4]]>,
+    options: GlbOptions,
     channels: &mut Vec<Channel>,
 ) -> Result<json::Index<json::Node>> {
     let frames = anim.frame_count();
@@ -173,11 +208,17 @@ fn morph(
             .collect();
         sm.default_weights = vec![0.0; frames];
     }
-    let mesh = b.mesh(&sm)?;
+    let q = options.quantize.then(|| Dequant::of(&sm));
+    let mesh = b.mesh_with(&sm, q)?;
+    // Only the weights of this node are animated: the dequantization is its own transform.
+    let trs = match q {
+        Some(q) => trs_node(q.center, Quat::IDENTITY, Vec3::splat(q.scale)),
+        None => empty_node(),
+    };
     let node = b.root.push(json::Node {
         mesh: Some(mesh),
         name: Some(mesh_name(anim).to_string()),
-        ..empty_node()
+        ..trs
     });
     if frames > 1 {
         let mut values = vec![0.0f32; frames * frames];

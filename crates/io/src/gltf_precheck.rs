@@ -4,17 +4,7 @@
 /// Checks what gltf-json 1.4 validation assumes without checking: that every mesh
 /// attribute refers to an existing accessor.
 /// The error is the message; the reader wraps it as a malformed-glTF error.
-pub(crate) fn precheck(bytes: &[u8]) -> Result<(), String> {
-    let json: std::borrow::Cow<[u8]> = if bytes.starts_with(b"glTF") {
-        gltf::binary::Glb::from_slice(bytes)
-            .map_err(|e| e.to_string())?
-            .json
-    } else {
-        std::borrow::Cow::Borrowed(bytes)
-    };
-    let Ok(root) = serde_json::from_slice::<gltf_json::Root>(&json) else {
-        return Ok(()); // syntax errors are reported by the full parse
-    };
+pub(crate) fn precheck(root: &gltf_json::Root) -> Result<(), String> {
     use gltf_json::validation::Checked;
     for (k, a) in root.animations.iter().enumerate() {
         for c in &a.channels {

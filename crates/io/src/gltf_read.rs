@@ -15,6 +15,7 @@ use anim::{
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 
+use crate::gltf_values::{vec2s, vec3s};
 use crate::{read_file, IoError, Result};
 
 const FORMAT: &str = "glTF";
@@ -35,21 +36,18 @@ pub fn read_bytes(bytes: &[u8]) -> Result<Scene> {
     read_with_base(bytes, None)
 }
 
-/// Reads a glTF document already read from `path` (external buffers are found beside it):
-/// what [`load`](crate::load) calls, so the file is read once.
-pub(crate) fn read_bytes_at(bytes: &[u8], path: &Path) -> Result<Scene> {
-    read_with_base(bytes, path.parent())
+fn read_with_base(bytes: &[u8], base: Option<&Path>) -> Result<Scene> {
+    read_full(bytes, base, None).map(|(scene, _)| scene)
 }
 
-fn read_with_base(bytes: &[u8], base: Option<&Path>) -> Result<Scene> {
-    crate::gltf_precheck::precheck(bytes).map_err(bad)?;
-    // gltf-json's validation indexes some arrays unchecked; `precheck` covers the known
-    // cases and this guard turns any other panic into an error.
-    let parsed = std::panic::catch_unwind(|| gltf::Gltf::from_slice(bytes))
-        .map_err(|_| bad("the document is inconsistent (rejected during validation)"))?;
-    let gltf = parsed.map_err(|e| bad(e.to_string()))?;
-    let blob = gltf.blob.clone();
-    let doc = gltf.document;
+/// Reads a glTF document; `choice` picks a scene by name or index (default: the file's
+/// default scene when it has several). Returns the scene and one note per extension the
+/// file uses (what toonkit did with it) and on the scene picked.
+pub(crate) fn read_full(
+    bytes: &[u8],
+    base: Option<&Path>,
+    choice: Option<&str>,
+) -> Result<(Scene, Vec<String>)> {
     let base = base.map(|b| {
         if b.as_os_str().is_empty() {
             Path::new(".")
@@ -57,13 +55,24 @@ fn read_with_base(bytes: &[u8], base: Option<&Path>) -> Result<Scene> {
             b
         }
     });
-    let buffers = gltf::import_buffers(&doc, base, blob).map_err(|e| bad(e.to_string()))?;
-    let data: Vec<&[u8]> = buffers.iter().map(|b| b.0.as_slice()).collect();
+    let prepared = crate::gltf_prepare::prepare(bytes, base)?;
+    crate::gltf_precheck::precheck(&prepared.root).map_err(bad)?;
+    let mut notes = prepared.notes;
+    // gltf-json's validation indexes some arrays unchecked; `precheck` covers the known
+    // cases and this guard turns any other panic into an error.
+    let root = prepared.root;
+    let doc = std::panic::catch_unwind(|| gltf::Document::from_json(root))
+        .map_err(|_| bad("the document is inconsistent (rejected during validation)"))?
+        .map_err(|e| bad(e.to_string()))?;
+    let data: Vec<&[u8]> = prepared.buffers.iter().map(Vec::as_slice).collect();
     // The gltf crate unwraps some fields it validated loosely; a panic there is bad input.
-    let scene = std::panic::catch_unwind(|| convert(&doc, &data))
+    let mut scene = std::panic::catch_unwind(|| convert(&doc, &data))
         .map_err(|_| bad("the document is inconsistent (rejected while reading)"))??;
+    if let Some(note) = crate::gltf_scenes::select(&doc, &mut scene, choice)? {
+        notes.push(note);
+    }
     scene.validate()?;
-    Ok(scene)
+    Ok((scene, notes))
 }
 
 fn convert(doc: &gltf::Document, buffers: &[&[u8]]) -> Result<Scene> {
@@ -220,10 +229,9 @@ fn read_mesh(mesh: &gltf::Mesh, buffers: &[&[u8]]) -> Result<SceneMesh> {
         let Some(pos_acc) = prim.get(&gltf::Semantic::Positions) else {
             continue;
         };
-        expect(&pos_acc, &[DataType::F32], Dimensions::Vec3, "POSITION")?;
-        let positions: Vec<Vec3> = reader
-            .read_positions()
-            .ok_or_else(|| outside("POSITION"))?
+        // KHR_mesh_quantization: integer positions, normals, texture coordinates.
+        let positions: Vec<Vec3> = vec3s(&pos_acc, buffers, "POSITION")?
+            .into_iter()
             .map(Vec3::from_array)
             .collect();
         let n = positions.len();
@@ -246,29 +254,11 @@ fn read_mesh(mesh: &gltf::Mesh, buffers: &[&[u8]]) -> Result<SceneMesh> {
         let triangles = assemble(mode, &indices);
         let mut part = Mesh::new(name.clone(), positions, triangles);
         if let Some(acc) = prim.get(&gltf::Semantic::Normals) {
-            expect(&acc, &[DataType::F32], Dimensions::Vec3, "NORMAL")?;
-            part.normals = Some(
-                reader
-                    .read_normals()
-                    .ok_or_else(|| outside("NORMAL"))?
-                    .map(Vec3::from_array)
-                    .collect(),
-            );
+            let normals = vec3s(&acc, buffers, "NORMAL")?;
+            part.normals = Some(normals.into_iter().map(Vec3::from_array).collect());
         }
         if let Some(acc) = prim.get(&gltf::Semantic::TexCoords(0)) {
-            expect(
-                &acc,
-                &[DataType::U8, DataType::U16, DataType::F32],
-                Dimensions::Vec2,
-                "TEXCOORD_0",
-            )?;
-            part.uvs = Some(
-                reader
-                    .read_tex_coords(0)
-                    .ok_or_else(|| outside("TEXCOORD_0"))?
-                    .into_f32()
-                    .collect(),
-            );
+            part.uvs = Some(vec2s(&acc, buffers, "TEXCOORD_0")?);
         }
         if let Some(acc) = prim.get(&gltf::Semantic::Colors(0)) {
             let dims = acc.dimensions();
@@ -331,14 +321,11 @@ fn read_mesh(mesh: &gltf::Mesh, buffers: &[&[u8]]) -> Result<SceneMesh> {
         }
         // Morph targets: all primitives of a mesh have the same number.
         let mut targets = Vec::new();
-        for (k, t) in prim.morph_targets().enumerate() {
+        for t in prim.morph_targets() {
             let d = match t.positions() {
                 Some(acc) => {
-                    expect(&acc, &[DataType::F32], Dimensions::Vec3, "morph POSITION")?;
-                    let mut it = reader.read_morph_targets();
-                    let (p, _, _) = it.nth(k).ok_or_else(|| outside("morph target"))?;
-                    let v: Vec<Vec3> = p
-                        .ok_or_else(|| outside("morph target"))?
+                    let v: Vec<Vec3> = vec3s(&acc, buffers, "morph POSITION")?
+                        .into_iter()
                         .map(Vec3::from_array)
                         .collect();
                     if v.len() != n {

@@ -10,9 +10,22 @@ use json::validation::Checked::Valid;
 use serde_json::json as js;
 
 use crate::gltf_accessors::{Builder, Usage};
+use crate::gltf_quantize::Dequant;
+use crate::gltf_quantize::GlbOptions;
 use crate::{IoError, Result};
 
+/// The extension quantized meshes need.
+const QUANTIZATION: &str = "KHR_mesh_quantization";
+
 impl Builder {
+    /// Declares `KHR_mesh_quantization` as used and required (once).
+    pub(crate) fn use_quantization(&mut self) {
+        if !self.root.extensions_used.iter().any(|e| e == QUANTIZATION) {
+            self.root.extensions_used.push(QUANTIZATION.into());
+            self.root.extensions_required.push(QUANTIZATION.into());
+        }
+    }
+
     /// The shared material: opaque, or alpha-blended for translucent vertex colours.
     pub(crate) fn material(&mut self, blend: bool) -> json::Index<json::Material> {
         let slot = if blend { self.blend } else { self.opaque };
@@ -47,7 +60,12 @@ impl Builder {
 
     /// Adds a mesh. Identical accessor data (a flipbook's triangles, UVs and painted
     /// attributes in every frame) is stored once.
-    pub(crate) fn mesh(&mut self, sm: &SceneMesh) -> Result<json::Index<json::Mesh>> {
+    /// A mesh, quantized with `q` (`KHR_mesh_quantization`) when given.
+    pub(crate) fn mesh_with(
+        &mut self,
+        sm: &SceneMesh,
+        q: Option<Dequant>,
+    ) -> Result<json::Index<json::Mesh>> {
         let m = &sm.mesh;
         if m.vertex_count() == 0 {
             return Err(IoError::unsupported(format!(
@@ -56,7 +74,13 @@ impl Builder {
             )));
         }
         let mut attributes = std::collections::BTreeMap::new();
-        let pos = self.vec3s(&m.positions, true);
+        if q.is_some() {
+            self.use_quantization();
+        }
+        let pos = match q {
+            Some(q) => self.snorm_vec3s(&q.encode(&m.positions), true, true),
+            None => self.vec3s(&m.positions, true),
+        };
         attributes.insert(Valid(json::mesh::Semantic::Positions), pos);
         let normals = match &m.normals {
             Some(n) => n
@@ -65,7 +89,10 @@ impl Builder {
                 .collect(),
             None => m.vertex_normals(&m.positions),
         };
-        let nrm = self.vec3s(&normals, false);
+        let nrm = match q {
+            Some(_) => self.snorm_vec3s(&normals, false, false),
+            None => self.vec3s(&normals, false),
+        };
         attributes.insert(Valid(json::mesh::Semantic::Normals), nrm);
         if let Some(uv) = &m.uvs {
             let flat: Vec<f32> = uv.iter().flatten().copied().collect();
@@ -100,7 +127,10 @@ impl Builder {
             sm.morph_targets
                 .iter()
                 .map(|t| json::mesh::MorphTarget {
-                    positions: Some(self.vec3s(&t.positions, true)),
+                    positions: Some(match q {
+                        Some(q) => self.snorm_vec3s(&q.encode_delta(&t.positions), true, true),
+                        None => self.vec3s(&t.positions, true),
+                    }),
                     normals: None,
                     tangents: None,
                 })
@@ -162,16 +192,31 @@ fn split_influences(w: &VertexWeights) -> Vec<InfluenceSet> {
     out
 }
 
-/// Writes a whole scene as `.glb` bytes.
+/// Writes a whole scene as `.glb` bytes (float geometry).
 ///
 /// # Errors
 /// When a mesh is empty or the result would exceed the GLB size limit.
 pub fn write_glb(scene: &Scene) -> Result<Vec<u8>> {
+    write_glb_with(scene, GlbOptions::default())
+}
+
+/// Writes a whole scene as `.glb` bytes; with `options.quantize`, unskinned meshes are
+/// written with `KHR_mesh_quantization` (see [`GlbOptions`]).
+///
+/// # Errors
+/// When a mesh is empty or the result would exceed the GLB size limit.
+pub fn write_glb_with(scene: &Scene, options: GlbOptions) -> Result<Vec<u8>> {
     scene.validate()?;
     let mut b = Builder::new();
+    let plan = if options.quantize {
+        crate::gltf_quantize::plan(scene)
+    } else {
+        vec![None; scene.meshes.len()]
+    };
+    let animated = crate::gltf_quantize::trs_animated(scene);
     let mut meshes = Vec::new();
-    for sm in &scene.meshes {
-        meshes.push(b.mesh(sm)?);
+    for (sm, q) in scene.meshes.iter().zip(&plan) {
+        meshes.push(b.mesh_with(sm, *q)?);
     }
     for c in &scene.cameras {
         let cam = match c.projection {
@@ -238,27 +283,46 @@ pub fn write_glb(scene: &Scene) -> Result<Vec<u8>> {
             skeleton: None,
         });
     }
-    for n in &scene.nodes {
+    // Quantized meshes under a TRS-animated node go on a new child carrying the
+    // dequantization (appended after the scene's nodes, so channel targets keep their index).
+    let mut extra = Vec::new();
+    for (i, n) in scene.nodes.iter().enumerate() {
         let t = n.transform;
+        let q = n.mesh.and_then(|m| plan[m]);
+        let (translation, rotation, scale, mesh, mut children) = match q {
+            Some(q) if animated[i] => {
+                extra.push((n.mesh.map(|m| meshes[m]), q, n.name.clone()));
+                let child = json::Index::new((scene.nodes.len() + extra.len() - 1) as u32);
+                (t.translation, t.rotation, t.scale, None, vec![child])
+            }
+            Some(q) => {
+                let (tt, r, s) = q.fold(t.translation, t.rotation, t.scale);
+                (tt, r, s, n.mesh.map(|m| meshes[m]), Vec::new())
+            }
+            None => (
+                t.translation,
+                t.rotation,
+                t.scale,
+                n.mesh.map(|m| meshes[m]),
+                Vec::new(),
+            ),
+        };
+        children.splice(0..0, n.children.iter().map(|&c| json::Index::new(c as u32)));
         b.root.push(json::Node {
             camera: n.camera.map(|c| json::Index::new(c as u32)),
-            children: (!n.children.is_empty()).then(|| {
-                n.children
-                    .iter()
-                    .map(|&c| json::Index::new(c as u32))
-                    .collect()
-            }),
-            extensions: None,
-            extras: Default::default(),
-            matrix: None,
-            mesh: n.mesh.map(|m| meshes[m]),
+            children: (!children.is_empty()).then_some(children),
+            mesh,
             name: (!n.name.is_empty()).then(|| n.name.clone()),
-            rotation: (t.rotation != Quat::IDENTITY)
-                .then(|| json::scene::UnitQuaternion(t.rotation.normalize().to_array())),
-            scale: (t.scale != Vec3::ONE).then(|| t.scale.to_array()),
-            translation: (t.translation != Vec3::ZERO).then(|| t.translation.to_array()),
             skin: n.skin.map(|s| json::Index::new(s as u32)),
             weights: n.weights.clone(),
+            ..trs_node(translation, rotation, scale)
+        });
+    }
+    for (mesh, q, name) in extra {
+        b.root.push(json::Node {
+            mesh,
+            name: (!name.is_empty()).then(|| format!("{name}_quantized")),
+            ..trs_node(q.center, Quat::IDENTITY, Vec3::splat(q.scale))
         });
     }
     let roots = (0..scene.nodes.len()).filter(|&i| scene.nodes[i].parent.is_none());
@@ -273,6 +337,25 @@ pub fn write_glb(scene: &Scene) -> Result<Vec<u8>> {
         write_clip(&mut b, clip);
     }
     b.finish()
+}
+
+/// A node with only a translation, rotation and scale (each omitted when it is the identity).
+pub(crate) fn trs_node(translation: Vec3, rotation: Quat, scale: Vec3) -> json::Node {
+    json::Node {
+        camera: None,
+        children: None,
+        extensions: None,
+        extras: Default::default(),
+        matrix: None,
+        mesh: None,
+        name: None,
+        rotation: (rotation != Quat::IDENTITY)
+            .then(|| json::scene::UnitQuaternion(rotation.normalize().to_array())),
+        scale: (scale != Vec3::ONE).then(|| scale.to_array()),
+        translation: (translation != Vec3::ZERO).then(|| translation.to_array()),
+        skin: None,
+        weights: None,
+    }
 }
 
 pub(crate) fn write_clip(b: &mut Builder, clip: &anim::Clip) {

@@ -1,6 +1,8 @@
 //! # toonkit-io
 //!
-//! Reading and writing animation files: glTF 2.0 (`.gltf`/`.glb`), OBJ and OBJ sequences, PC2
+//! Reading and writing animation files: glTF 2.0 (`.gltf`/`.glb`, with the extensions
+//! animators' files carry: quantized and meshopt-compressed geometry, lights, materials),
+//! FBX (read, through ufbx), OBJ and OBJ sequences, PC2
 //! and MDD point caches, binary STL, BVH motion capture, and NPY arrays; scene caches are
 //! written only: USD layers (`.usda` text, `.usdc` binary, `.usdz` package) and Alembic
 //! archives (`.abc`, with a reader for checking them). Formats are detected by content. Every reader returns [`IoError`] on bad
@@ -28,22 +30,34 @@ pub mod usdc;
 
 pub use atomic::{read_file, remove_stale_temps, write_atomic};
 pub use error::{FilePath, IoError, Result};
-pub use save::{save, Layout, Output};
+pub use save::{save, save_with, Layout, Output, SaveOptions};
 
 mod detect;
 mod flipbook;
 mod gltf_accessors;
 mod gltf_attributes;
+mod gltf_draco;
 mod gltf_flipbook;
+mod gltf_meshopt;
 mod gltf_precheck;
+mod gltf_prepare;
+mod gltf_quantize;
 mod gltf_read;
+mod gltf_scenes;
+mod gltf_values;
 mod gltf_write;
+
+#[cfg(feature = "fbx")]
+pub mod fbx;
 
 /// glTF 2.0: read `.gltf`/`.glb` into a scene, write scenes and point caches as `.glb`.
 pub mod gltf {
-    pub use crate::gltf_flipbook::{write_animation, write_animations, AnimationLayout};
+    pub use crate::gltf_flipbook::{
+        write_animation, write_animations, write_animations_with, AnimationLayout,
+    };
+    pub use crate::gltf_quantize::GlbOptions;
     pub use crate::gltf_read::{read, read_bytes};
-    pub use crate::gltf_write::write_glb;
+    pub use crate::gltf_write::{write_glb, write_glb_with};
 }
 
-pub use detect::{detect, load, Format, LoadOptions, Loaded};
+pub use detect::{detect, load, load_with_notes, Format, LoadOptions, Loaded};

@@ -178,7 +178,7 @@ pub(crate) fn animate(
         CharacterArg::Path(path) => {
             let load = tkio::LoadOptions {
                 fps: fps as f32,
-                rest: None,
+                ..Default::default()
             };
             let source = path.display().to_string();
             match py.detach(|| tkio::load(&path, &load)).map_err(io_error)? {

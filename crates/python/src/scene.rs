@@ -88,7 +88,14 @@ fn load_sampled(
     clip: Option<&str>,
     fps: f32,
 ) -> Result<(SampledScene, Option<Arc<anim::Scene>>), PyErrLater> {
-    let loaded = tkio::load(path, &LoadOptions { fps, rest: None }).map_err(PyErrLater::Io)?;
+    let loaded = tkio::load(
+        path,
+        &LoadOptions {
+            fps,
+            ..Default::default()
+        },
+    )
+    .map_err(PyErrLater::Io)?;
     let at = |e| PyErrLater::Anim(path.display().to_string(), e);
     match loaded {
         Loaded::Scene(scene) => {

@@ -53,7 +53,7 @@ pub fn run(ctx: &Context, args: ConvertArgs) -> Result<()> {
     }
     let sampled = input::sample(&args.input, &loaded, &args.input_args)?;
     let merged = input::merged(&args.input, &sampled)?;
-    let written = output::write_animation(&args.output, &merged, args.layout, None)?;
+    let written = output::write_animation(&args.output, &merged, args.layout, None, ctx.save)?;
     spinner.finish_and_clear();
     let summary = json!({
         "input": args.input,

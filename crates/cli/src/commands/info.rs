@@ -14,7 +14,7 @@ use crate::input::{self, InputArgs};
 /// Arguments of `toonkit info`.
 #[derive(Debug, Args)]
 pub struct InfoArgs {
-    /// The file to describe (glTF, GLB, OBJ, PC2, MDD, BVH, STL).
+    /// The file to describe (glTF, GLB, FBX, OBJ, PC2, MDD, BVH, STL).
     pub file: PathBuf,
     #[command(flatten)]
     pub input: InputArgs,
@@ -22,9 +22,9 @@ pub struct InfoArgs {
 
 /// Runs `toonkit info`.
 pub fn run(ctx: &Context, args: InfoArgs) -> Result<()> {
-    let loaded = input::load(&args.file, &args.input)?;
+    let (loaded, notes) = input::load_with_notes(&args.file, &args.input)?;
     let fps = args.input.fps;
-    let summary = match &loaded {
+    let mut summary = match &loaded {
         Loaded::Scene(scene) => scene_summary(scene, fps)?,
         Loaded::Cache(c) => json!({
             "meshes": [mesh_json(&c.mesh.name, c.vertex_count(), c.mesh.triangle_count(), 0)],
@@ -39,6 +39,7 @@ pub fn run(ctx: &Context, args: InfoArgs) -> Result<()> {
             "bbox": bbox_json(m.bbox()),
         }),
     };
+    summary["notes"] = json!(notes);
     ctx.report(&summary, || human(&args.file, &summary, fps));
     Ok(())
 }
@@ -143,5 +144,8 @@ fn human(path: &std::path::Path, s: &serde_json::Value, fps: f32) -> String {
         }
     }
     out += &format!("  bbox: {} .. {}", s["bbox"][0], s["bbox"][1]);
+    for note in s["notes"].as_array().into_iter().flatten() {
+        out += &format!("\n  note: {}", note.as_str().unwrap_or(""));
+    }
     out
 }

@@ -17,6 +17,8 @@ pub struct Context {
     /// Print no summary at all (the caller reports: steps of `toonkit demo`, shots of
     /// `toonkit batch`).
     pub quiet: bool,
+    /// How results are written (`--no-quantize`: float glTF geometry).
+    pub save: tkio::SaveOptions,
 }
 
 impl Context {

@@ -41,7 +41,7 @@ pub fn character(rel: &str, pose: &str) -> (anim::Scene, loa::animate::Character
         &path,
         &tkio::LoadOptions {
             fps: 24.0,
-            rest: None,
+            ..Default::default()
         },
     )
     .unwrap_or_else(|e| panic!("{}: {e}", path.display()))

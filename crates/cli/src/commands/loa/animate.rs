@@ -141,7 +141,7 @@ pub fn run(ctx: &Context, args: AnimateArgs) -> Result<()> {
     let cpath = args.character.display().to_string();
     let load = tkio::LoadOptions {
         fps: fps as f32,
-        rest: None,
+        ..Default::default()
     };
     let tkio::Loaded::Scene(scene) =
         tkio::load(&args.character, &load).with_context(|| cpath.clone())?

@@ -214,7 +214,7 @@ pub fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
     let out = run_style(&args.io, &p, &style)?;
     let t = Instant::now();
     let body = part(&out, 0)?;
-    let written = output::write_animation(&args.io.output, body, args.layout, None)?;
+    let written = output::write_animation(&args.io.output, body, args.layout, None, ctx.save)?;
     spinner.finish_and_clear();
     let stats = &out.report.objects[0];
     let summary = json!({
@@ -291,12 +291,13 @@ pub fn multiples(ctx: &Context, args: MultiplesArgs) -> Result<()> {
             FlipbookPart::Frames { .. } => None,
         })
         .collect();
-    tkio::save(
+    tkio::save_with(
         &args.io.output,
         &Output::Parts {
             parts: &parts,
             layout: tkio::Layout::Flipbook,
         },
+        ctx.save,
     )?;
     spinner.finish_and_clear();
     let body = part(&out, 0)?;
@@ -410,12 +411,13 @@ pub fn lines(ctx: &Context, args: LinesArgs) -> Result<()> {
     else {
         bail!("internal: the result has no motion lines");
     };
-    tkio::save(
+    tkio::save_with(
         &args.io.output,
         &Output::MotionLines {
             body,
             lines: meshes,
         },
+        ctx.save,
     )?;
     spinner.finish_and_clear();
     let stats = &out.report.objects[0];

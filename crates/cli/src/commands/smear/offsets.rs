@@ -56,7 +56,13 @@ pub fn run(ctx: &Context, args: OffsetsArgs) -> Result<()> {
     } else {
         let anim = input::merged(&args.input, &sampled)?;
         let colors = render::offset_colors(merged.values());
-        output::write_animation(&args.output, &anim, Layout::Flipbook, Some(&colors))?;
+        output::write_animation(
+            &args.output,
+            &anim,
+            Layout::Flipbook,
+            Some(&colors),
+            ctx.save,
+        )?;
     }
     spinner.finish_and_clear();
     let report = &result.report;

@@ -78,7 +78,7 @@ pub fn run(ctx: &Context, args: StyleArgs) -> Result<()> {
     let prepared = smear::prepare(sampled, &options).map_err(with_input)?;
     let styled = smear::stylize(&prepared, &style).map_err(with_input)?;
     let t = Instant::now();
-    tkio::save(output, &Output::Flipbook(&styled.flipbook))?;
+    tkio::save_with(output, &Output::Flipbook(&styled.flipbook), ctx.save)?;
     let write_seconds = t.elapsed().as_secs_f64();
     let mut outputs = vec![output.clone()];
     if let Some(gif) = &args.gif {

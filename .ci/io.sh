@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# CI for issue 24 (reading the files animators have), called by .ci/run after the Rust tests:
+# 1. Blender 4.2 (bpy, headless; the venv .ci/caches.sh makes) exports the bundled characters
+#    (RobotExpressive, CesiumMan, AnimatedMorphSphere) as plain glTF, glTF with a light
+#    (KHR_lights_punctual) and binary FBX with baked animation and shape keys (.ci/io_export.py);
+# 2. glTF-Transform (npm @gltf-transform/cli) compresses each plain glTF with Draco (the bpy
+#    wheel has no Draco library), gltfpack (npm) with meshopt + quantization;
+# 3. the Rust test crates/io/tests/exporters.rs reads every file with tkio::load and compares
+#    clips (frame counts) and positions with the plain glTF (Draco ≤ 1e-3 of the diagonal,
+#    gltfpack ≤ 2/16384, the others ≤ 1e-5);
+# 4. the Khronos validator checks the quantized flipbook `toonkit smear style` writes of the
+#    robot's Dance clip (Fig. 16 style), and its size is printed next to the float one.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ROOT="$PWD"
+VENV="$ROOT/target/caches-venv"
+PY=python3.11
+command -v "$PY" >/dev/null || PY=python3
+test -x "$VENV/bin/python" || "$PY" -m venv "$VENV"
+"$VENV/bin/pip" install --quiet --disable-pip-version-check "bpy==4.2.0" "numpy<2"
+
+OUT="$ROOT/target/io-exports"
+rm -rf "$OUT"
+mkdir -p "$OUT"
+echo "== Blender exports"
+"$VENV/bin/python" .ci/io_export.py "$OUT" assets/characters/RobotExpressive.glb \
+    assets/characters/CesiumMan.glb assets/morph/AnimatedMorphSphere/AnimatedMorphSphere.gltf \
+    > "$OUT/blender.log" 2>&1 || { tail -20 "$OUT/blender.log"; exit 1; }
+grep '^exported' "$OUT/blender.log"
+
+echo "== glTF-Transform (Draco), gltfpack (meshopt + quantization)"
+NPM="$ROOT/target/io-npm"
+mkdir -p "$NPM"
+cp .ci/io/package.json .ci/io/package-lock.json "$NPM/"
+(cd "$NPM" && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
+BIN="$NPM/node_modules/.bin"
+for name in RobotExpressive CesiumMan AnimatedMorphSphere; do
+    "$BIN/gltf-transform" draco "$OUT/$name.glb" "$OUT/${name}_draco.glb" | tail -1
+    "$BIN/gltfpack" -i "$OUT/$name.glb" -o "$OUT/${name}_gltfpack.glb" -c -kn -km | tail -1
+done
+
+echo "== toonkit reads them like the plain glTF"
+TOONKIT_IO_EXPORTS="$OUT" cargo test --quiet --workspace --test exporters -- --nocapture
+
+echo "== the Fig. 16 style on the robot's Dance clip: quantized and float"
+cargo build --quiet --workspace --bins
+TK="$ROOT/target/debug/toonkit"
+"$TK" smear style assets/characters/RobotExpressive.glb --clip Dance \
+    --style examples/smear/fig16_combined.toml -o "$OUT/dance_fig16.glb"
+"$TK" --no-quantize smear style assets/characters/RobotExpressive.glb --clip Dance \
+    --style examples/smear/fig16_combined.toml -o "$OUT/dance_fig16_float.glb"
+ls -l "$OUT/dance_fig16.glb" "$OUT/dance_fig16_float.glb" | awk '{print $5, $9}'
+"$TK" info "$OUT/dance_fig16.glb" | tail -3
+node .ci/validator/validate.mjs "$OUT/dance_fig16.glb"

@@ -1,0 +1,247 @@
+//! Turns the glTF files animators have into what the `gltf` crate validates: required
+//! extensions that do not change geometry or animation are accepted (and noted),
+//! `EXT_meshopt_compression` buffer views are decoded into plain buffers,
+//! `KHR_draco_mesh_compression` primitives are decoded (`gltf_draco`), `KHR_mesh_quantization`
+//! integer attributes are left for `gltf_values` to read as floats, and what cannot be read
+//! (an unknown extension that replaces the geometry) is refused in one line naming the
+//! extension and how to convert the file.
+//!
+//! The rule for an extension toonkit does not know is general: if every primitive's
+//! `POSITION` (and its indices) still lies in a buffer view or a sparse accessor, the
+//! geometry is present and the extension is ignored with a note; otherwise the file is
+//! refused naming the extension.
+
+use std::path::Path;
+
+use serde_json::{Map, Value};
+
+use crate::{IoError, Result};
+
+/// A document ready for the `gltf` crate, its buffers, and what was accepted on the way.
+pub(crate) struct Prepared {
+    /// The JSON root, without materials, textures and the extension lists.
+    pub root: gltf_json::Root,
+    /// One byte vector per buffer of `root` (decoded meshopt buffers appended).
+    pub buffers: Vec<Vec<u8>>,
+    /// One line per extension the file uses and what toonkit did with it.
+    pub notes: Vec<String>,
+}
+
+fn bad(message: impl Into<String>) -> IoError {
+    IoError::malformed("glTF", message)
+}
+
+/// Extensions whose data is decoded here or read by the accessor readers.
+const DECODED: &[(&str, &str)] = &[
+    (
+        "KHR_mesh_quantization",
+        "quantized vertex data read as floats",
+    ),
+    ("EXT_meshopt_compression", "compressed buffer views decoded"),
+    ("KHR_meshopt_compression", "compressed buffer views decoded"),
+    (
+        "KHR_draco_mesh_compression",
+        "Draco-compressed geometry decoded",
+    ),
+];
+
+/// Prefixes of extensions that only touch shading, lights or metadata.
+const HARMLESS_PREFIXES: &[&str] = &[
+    "KHR_materials_",
+    "KHR_texture_",
+    "EXT_texture_",
+    "MSFT_texture_",
+    "KHR_lights_",
+    "EXT_lights_",
+    "KHR_xmp",
+    "EXT_materials_",
+    "ADOBE_materials_",
+];
+
+/// How to get a file toonkit reads when `ext` replaces its geometry.
+fn how_to_convert(ext: &str) -> String {
+    format!(
+        "toonkit cannot decode it; re-export the file without {ext} (e.g. Blender's glTF \
+         export, or `gltfpack -i IN -o OUT`, whose meshopt compression toonkit reads)"
+    )
+}
+
+/// Splits `.glb` bytes into JSON and binary chunk; `.gltf` is all JSON.
+fn split(bytes: &[u8]) -> Result<(Vec<u8>, Option<Vec<u8>>)> {
+    if bytes.starts_with(b"glTF") {
+        let glb = gltf::binary::Glb::from_slice(bytes).map_err(|e| bad(e.to_string()))?;
+        Ok((glb.json.into_owned(), glb.bin.map(|b| b.into_owned())))
+    } else {
+        Ok((bytes.to_vec(), None))
+    }
+}
+
+fn names(v: &Value, key: &str) -> Vec<String> {
+    v.get(key)
+        .and_then(Value::as_array)
+        .map(|a| {
+            a.iter()
+                .filter_map(Value::as_str)
+                .map(str::to_string)
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Whether every triangle primitive's POSITION and indices are readable without `ext`.
+fn geometry_present(root: &Value, ext: &str) -> bool {
+    let accessors = root.get("accessors").and_then(Value::as_array);
+    let readable = |i: &Value| {
+        i.as_u64()
+            .and_then(|i| accessors.and_then(|a| a.get(i as usize)))
+            .is_some_and(|a| a.get("bufferView").is_some() || a.get("sparse").is_some())
+    };
+    let meshes = root.get("meshes").and_then(Value::as_array);
+    meshes.into_iter().flatten().all(|m| {
+        let prims = m.get("primitives").and_then(Value::as_array);
+        prims.into_iter().flatten().all(|p| {
+            let uses = p.get("extensions").and_then(|e| e.get(ext)).is_some();
+            let pos = p.get("attributes").and_then(|a| a.get("POSITION"));
+            let idx_ok = p.get("indices").is_none_or(readable);
+            !uses && pos.is_none_or(readable) && idx_ok
+        })
+    })
+}
+
+/// What toonkit does with extension `ext` (required or not), or the one-line refusal.
+fn classify(root: &Value, ext: &str, required: bool) -> Result<String> {
+    if let Some((_, what)) = DECODED.iter().find(|(n, _)| *n == ext) {
+        return Ok(format!("{ext}: {what}"));
+    }
+    if HARMLESS_PREFIXES.iter().any(|p| ext.starts_with(p)) {
+        return Ok(format!(
+            "{ext}: ignored (shading, lights or metadata; geometry and animation unchanged)"
+        ));
+    }
+    if geometry_present(root, ext) {
+        let kind = if required { "required" } else { "used" };
+        return Ok(format!(
+            "{ext}: {kind} but not read by toonkit; geometry and animation read without it"
+        ));
+    }
+    Err(IoError::unsupported(format!(
+        "the file needs glTF extension {ext} for its geometry: {}",
+        how_to_convert(ext)
+    )))
+}
+
+/// Removes what toonkit never reads (materials, textures, images, samplers, the
+/// extension lists, animation channels that target a JSON pointer) so that their
+/// extensions cannot make the `gltf` crate refuse the file.
+fn strip(root: &mut Map<String, Value>, notes: &mut Vec<String>) {
+    for key in [
+        "materials",
+        "textures",
+        "images",
+        "samplers",
+        "extensionsRequired",
+        "extensionsUsed",
+        "extensions",
+    ] {
+        root.remove(key);
+    }
+    if let Some(meshes) = root.get_mut("meshes").and_then(Value::as_array_mut) {
+        for m in meshes {
+            if let Some(prims) = m.get_mut("primitives").and_then(Value::as_array_mut) {
+                for p in prims.iter_mut().filter_map(Value::as_object_mut) {
+                    p.remove("material");
+                }
+            }
+        }
+    }
+    let mut dropped = 0;
+    if let Some(anims) = root.get_mut("animations").and_then(Value::as_array_mut) {
+        for a in anims {
+            if let Some(ch) = a.get_mut("channels").and_then(Value::as_array_mut) {
+                let before = ch.len();
+                ch.retain(|c| {
+                    c.get("target")
+                        .and_then(|t| t.get("path"))
+                        .and_then(Value::as_str)
+                        != Some("pointer")
+                });
+                dropped += before - ch.len();
+            }
+        }
+    }
+    if dropped > 0 {
+        notes.push(format!(
+            "KHR_animation_pointer: {dropped} channel(s) animating material or camera \
+             properties ignored"
+        ));
+    }
+}
+
+/// Reads buffer `i`'s bytes: the GLB chunk, a `data:` URI, or a file beside the document.
+/// A meshopt fallback buffer (no URI, no data) is empty.
+fn load_buffer(
+    i: usize,
+    buffer: &Value,
+    bin: &mut Option<Vec<u8>>,
+    base: Option<&Path>,
+) -> Result<Vec<u8>> {
+    if let Some(uri) = buffer.get("uri").and_then(Value::as_str) {
+        let data = gltf::buffer::Data::from_source(gltf::buffer::Source::Uri(uri), base)
+            .map_err(|e| bad(format!("buffer {i}: {e}")))?;
+        return Ok(data.0);
+    }
+    let fallback = buffer
+        .get("extensions")
+        .and_then(|e| e.get("EXT_meshopt_compression"))
+        .and_then(|m| m.get("fallback"))
+        .and_then(Value::as_bool)
+        .unwrap_or(false);
+    if fallback {
+        return Ok(Vec::new());
+    }
+    match (i, bin.take()) {
+        (0, Some(b)) => Ok(b),
+        _ => Err(bad(format!(
+            "buffer {i} has no uri and is not the GLB binary chunk"
+        ))),
+    }
+}
+
+/// Prepares `bytes` (a `.glb`, or `.gltf` whose external buffers are found in `base`).
+pub(crate) fn prepare(bytes: &[u8], base: Option<&Path>) -> Result<Prepared> {
+    let (json, mut bin) = split(bytes)?;
+    let mut value: Value = serde_json::from_slice(&json).map_err(|e| bad(e.to_string()))?;
+    if !value.is_object() {
+        return Err(bad("the document is not a JSON object"));
+    }
+    let required = names(&value, "extensionsRequired");
+    let mut notes = Vec::new();
+    let mut listed = required.clone();
+    for used in names(&value, "extensionsUsed") {
+        if !listed.contains(&used) {
+            listed.push(used);
+        }
+    }
+    for ext in &listed {
+        let note = classify(&value, ext, required.contains(ext))?;
+        notes.push(note);
+    }
+    let mut buffers = Vec::new();
+    if let Some(list) = value.get("buffers").and_then(Value::as_array) {
+        for (i, b) in list.iter().enumerate() {
+            buffers.push(load_buffer(i, b, &mut bin, base)?);
+        }
+    }
+    let Value::Object(map) = &mut value else {
+        unreachable!("checked above")
+    };
+    strip(map, &mut notes);
+    crate::gltf_meshopt::decode(map, &mut buffers)?;
+    crate::gltf_draco::decode(map, &mut buffers)?;
+    let root: gltf_json::Root = serde_json::from_value(value).map_err(|e| bad(e.to_string()))?;
+    Ok(Prepared {
+        root,
+        buffers,
+        notes,
+    })
+}

@@ -1,0 +1,179 @@
+//! Files written by real exporters (made by `.ci/io.sh`: Blender 4.2 for glTF, glTF with a
+//! light, FBX; glTF-Transform for Draco; gltfpack for meshopt + quantization) read like the
+//! plain glTF Blender wrote of the same scene: same clips with the same frame counts, and
+//! positions within the compression's error at the first, middle and last frame.
+//!
+//! Vertex order and splitting differ between exporters (Draco reorders, FBX keeps Blender's
+//! vertices), so positions are compared as point sets: the largest distance from a vertex of
+//! one file to the nearest vertex of the other, both ways, relative to the bounding-box
+//! diagonal. Runs when `TOONKIT_IO_EXPORTS` names the folder; `.ci/io.sh` sets it.
+
+use std::path::{Path, PathBuf};
+
+use anim::glam::Vec3;
+use anim::{SampleOptions, Scene};
+
+const FPS: f32 = 24.0;
+
+fn exports() -> Option<PathBuf> {
+    std::env::var_os("TOONKIT_IO_EXPORTS").map(PathBuf::from)
+}
+
+fn load(path: &Path) -> (Scene, Vec<String>) {
+    let (loaded, notes) = tkio::load_with_notes(path, &tkio::LoadOptions::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    match loaded {
+        tkio::Loaded::Scene(s) => (*s, notes),
+        _ => panic!("{}: not a scene", path.display()),
+    }
+}
+
+/// All vertices of every object at frames first, middle, last of `clip` (rest pose: None).
+fn frames(scene: &Scene, clip: Option<usize>) -> Vec<Vec<Vec3>> {
+    let s = anim::sample(
+        scene,
+        &SampleOptions {
+            fps: FPS,
+            clip,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let n = s
+        .objects
+        .iter()
+        .map(|o| o.animation.frame_count())
+        .max()
+        .unwrap_or(1);
+    let picks = if clip.is_some() {
+        vec![0, n / 2, n - 1]
+    } else {
+        vec![0]
+    };
+    picks
+        .into_iter()
+        .map(|f| {
+            s.objects
+                .iter()
+                .flat_map(|o| {
+                    o.animation
+                        .frame(f.min(o.animation.frame_count() - 1))
+                        .to_vec()
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Largest distance from a point of `a` to its nearest point of `b` (points sorted by x).
+fn directed(a: &[Vec3], b: &[Vec3]) -> f32 {
+    let mut b: Vec<Vec3> = b.to_vec();
+    b.sort_by(|p, q| p.x.total_cmp(&q.x));
+    let mut worst = 0.0f32;
+    for p in a {
+        let k = b.partition_point(|q| q.x < p.x);
+        let mut best = f32::MAX;
+        for q in b[k..].iter() {
+            if q.x - p.x > best {
+                break;
+            }
+            best = best.min(p.distance(*q));
+        }
+        for q in b[..k].iter().rev() {
+            if p.x - q.x > best {
+                break;
+            }
+            best = best.min(p.distance(*q));
+        }
+        worst = worst.max(best);
+    }
+    worst
+}
+
+fn diagonal(points: &[Vec3]) -> f32 {
+    let lo = points.iter().fold(Vec3::splat(f32::MAX), |a, p| a.min(*p));
+    let hi = points.iter().fold(Vec3::splat(f32::MIN), |a, p| a.max(*p));
+    (hi - lo).length()
+}
+
+/// Compares `other` with the reference; `tolerance` relative to the diagonal; `animated`:
+/// also every clip's frame count and its first, middle and last frames.
+fn compare(reference: &Path, other: &Path, tolerance: f32, animated: bool) -> f32 {
+    let (a, _) = load(reference);
+    let (b, notes) = load(other);
+    println!("{}: {}", other.display(), notes.join("; "));
+    let mut pairs = vec![(None, None)];
+    if animated {
+        assert_eq!(
+            a.clips.len(),
+            b.clips.len(),
+            "{}: clip count",
+            other.display()
+        );
+        for (i, c) in a.clips.iter().enumerate() {
+            // Blender's FBX exporter names a stack `Armature|Dance`.
+            let j = b
+                .clips
+                .iter()
+                .position(|d| d.name == c.name || d.name.ends_with(&format!("|{}", c.name)))
+                .unwrap_or_else(|| panic!("{}: no clip {}", other.display(), c.name));
+            assert_eq!(
+                c.frame_count(FPS),
+                b.clips[j].frame_count(FPS),
+                "{}: frames of clip {}",
+                other.display(),
+                c.name
+            );
+            pairs.push((Some(i), Some(j)));
+        }
+        pairs.truncate(4); // rest pose and three clips: enough, and quick
+    }
+    let mut worst = 0.0f32;
+    for (ca, cb) in pairs {
+        let (fa, fb) = (frames(&a, ca), frames(&b, cb));
+        for (pa, pb) in fa.iter().zip(&fb) {
+            let d = directed(pa, pb).max(directed(pb, pa)) / diagonal(pa);
+            worst = worst.max(d);
+        }
+    }
+    println!(
+        "{}: largest distance {worst:.2e} of the diagonal (tolerance {tolerance:.0e})",
+        other.display()
+    );
+    assert!(
+        worst <= tolerance,
+        "{}: {worst} > {tolerance}",
+        other.display()
+    );
+    worst
+}
+
+#[test]
+fn files_of_real_exporters_read_like_the_plain_gltf() {
+    let Some(dir) = exports() else {
+        println!("TOONKIT_IO_EXPORTS is not set (.ci/io.sh sets it): nothing to compare");
+        return;
+    };
+    let mut checked = 0;
+    for name in ["RobotExpressive", "CesiumMan", "AnimatedMorphSphere"] {
+        let reference = dir.join(format!("{name}.glb"));
+        if !reference.exists() {
+            continue;
+        }
+        // gltfpack resamples animation and quantizes keys: its rest pose is compared, its clip
+        // frame counts in `compare`'s first step.
+        let cases = [
+            (format!("{name}_lights.glb"), 1e-5, true),
+            (format!("{name}_draco.glb"), 1e-3, true),
+            (format!("{name}.fbx"), 1e-5, true),
+            (format!("{name}_gltfpack.glb"), 2.0 / 16384.0, false),
+        ];
+        for (file, tolerance, animated) in cases {
+            let path = dir.join(&file);
+            assert!(path.exists(), "{} is missing", path.display());
+            compare(&reference, &path, tolerance, animated);
+            checked += 1;
+        }
+    }
+    assert!(checked >= 4, "no exported file found in {}", dir.display());
+}
