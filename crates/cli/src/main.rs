@@ -41,6 +41,8 @@ enum Command {
     Smear(Box<commands::smear::SmearArgs>),
     /// Replacement libraries for 3D-printed stop-motion (StopShop).
     Stopmo(Box<commands::stopmo::StopmoArgs>),
+    /// A local web page to tune smears, sketch lines of action and segment faces (127.0.0.1).
+    Studio(commands::studio::StudioArgs),
     /// Many shots from a manifest: in parallel here, or as an Open Job Description farm job.
     Batch(commands::batch::BatchArgs),
 }
@@ -118,5 +120,6 @@ fn run(ctx: &commands::Context, command: Command) -> anyhow::Result<()> {
         Command::Smear(a) => commands::smear::run(ctx, *a),
         Command::Stopmo(a) => commands::stopmo::run(ctx, *a),
         Command::Batch(a) => commands::batch::run(ctx, a),
+        Command::Studio(a) => commands::studio::run(ctx, a),
     }
 }

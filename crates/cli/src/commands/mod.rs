@@ -8,6 +8,7 @@ pub mod loa;
 pub mod render;
 pub mod smear;
 pub mod stopmo;
+pub mod studio;
 
 /// Options every command sees.
 #[derive(Debug, Clone, Copy)]

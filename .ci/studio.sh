@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Browser tests of `toonkit studio` (issue #18): Debian's chromium headless driven by
+# playwright-core (npm) against the studio on the bundled robot and face. Installs what it
+# needs; screenshots go to target/studio-shots/, latency figures to the output.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+command -v chromium >/dev/null || { apt-get update -qq && apt-get install -y -qq chromium; }
+command -v node >/dev/null || { apt-get update -qq && apt-get install -y -qq nodejs npm; }
+npm ci --prefix crates/studio/web --no-audit --no-fund --loglevel=error
+npm ci --prefix .ci/studio --no-audit --no-fund --loglevel=error
+
+# The test-profile binary `cargo test --workspace` built (no new profile, no rebuild).
+cargo test --workspace --no-run -q 2>/dev/null || cargo test --workspace --no-run
+BIN=target/debug/toonkit
+PORT=${STUDIO_PORT:-18765}
+OUT=target/studio-out
+rm -rf "$OUT"
+"$BIN" studio assets/characters/RobotExpressive.glb assets/face/ict-face-talk.glb \
+    --no-open --port "$PORT" --out "$OUT" >target/studio-server.log 2>&1 &
+SERVER=$!
+trap 'kill $SERVER 2>/dev/null || true' EXIT
+for _ in $(seq 1 100); do
+    curl -sf "http://127.0.0.1:$PORT/api/info" >/dev/null && break
+    sleep 0.2
+done
+node .ci/studio/test.mjs "http://127.0.0.1:$PORT/" target/studio-shots

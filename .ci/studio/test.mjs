@@ -1,0 +1,175 @@
+// Browser test of toonkit studio: Debian's chromium (headless) driven by playwright-core
+// against a running `toonkit studio` (URL in argv[2]); screenshots into argv[3].
+// Prints the latency figures and a closing "N passed, N failed" line; exit 1 on any failure.
+import { chromium } from 'playwright-core';
+import { mkdirSync, mkdtempSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+
+const url = process.argv[2];
+const shots = process.argv[3] || 'target/studio-shots';
+mkdirSync(shots, { recursive: true });
+let passed = 0, failed = 0;
+const check = (name, ok, detail = '') => {
+  if (ok) passed++; else failed++;
+  console.log(`${ok ? 'ok  ' : 'FAIL'} ${name}${detail ? ': ' + detail : ''}`);
+};
+const median = (xs) => { const s = [...xs].sort((a, b) => a - b); return s[Math.floor(s.length / 2)]; };
+
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
+  args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+    '--disable-background-networking', '--disable-component-update', '--disable-sync',
+    '--use-gl=angle', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
+    `--user-data-dir=${mkdtempSync(join(tmpdir(), 'studio-chromium-'))}`],
+});
+try {
+  const page = await browser.newPage({ viewport: { width: 1280, height: 760 } });
+  const consoleErrors = [];
+  page.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
+  page.on('pageerror', (e) => consoleErrors.push(e.message));
+  await page.goto(url);
+  await page.waitForFunction(() => window.studio && window.studio.ready && window.studio.stats.smear.length > 0, null, { timeout: 120000 });
+
+  // Canvas not blank: pixels differ from the background somewhere.
+  const pixels = () => page.evaluate(() => {
+    const src = document.getElementById('gl');
+    const c = document.createElement('canvas');
+    c.width = src.width; c.height = src.height;
+    const ctx = c.getContext('2d');
+    ctx.drawImage(src, 0, 0);
+    return Array.from(ctx.getImageData(0, 0, c.width, c.height).data);
+  });
+  const before = await pixels();
+  const bg = [before[0], before[1], before[2]];
+  let lit = 0;
+  for (let i = 0; i < before.length; i += 4) if (Math.abs(before[i] - bg[0]) + Math.abs(before[i + 1] - bg[1]) + Math.abs(before[i + 2] - bg[2]) > 30) lit++;
+  check('canvas is not blank', lit > 2000, `${lit} pixels differ from the background`);
+
+  // β max slider: pixels change; latency slider → geometry drawn.
+  const setSlider = (v) => page.evaluate((v) => {
+    const s = document.getElementById('beta-max');
+    s.value = v; s.dispatchEvent(new Event('input'));
+  }, v);
+  await page.evaluate(() => { window.studio.setFrame(40); });
+  await page.waitForTimeout(200);
+  const n0 = await page.evaluate(() => window.studio.stats.smear.length);
+  const atRest = await pixels();
+  await setSlider(20);
+  await page.waitForFunction((n) => window.studio.stats.smear.length > n, n0, { timeout: 60000 });
+  await page.waitForTimeout(100);
+  const stretched = await pixels();
+  let changed = 0;
+  for (let i = 0; i < atRest.length; i += 4) if (Math.abs(atRest[i] - stretched[i]) + Math.abs(atRest[i + 1] - stretched[i + 1]) + Math.abs(atRest[i + 2] - stretched[i + 2]) > 30) changed++;
+  check('moving the β-max slider changes the rendered pixels', changed > 200, `${changed} pixels changed`);
+  await page.screenshot({ path: join(shots, 'smear.png') });
+  // Latency: ten slider moves, each waited for.
+  const lat = [];
+  for (let k = 0; k < 10; k++) {
+    const n = await page.evaluate(() => window.studio.stats.smear.length);
+    await setSlider(2 + k * 1.5);
+    await page.waitForFunction((n) => window.studio.stats.smear.length > n, n, { timeout: 60000 });
+    lat.push(await page.evaluate(() => window.studio.stats.smear.at(-1)));
+  }
+  const smearMs = median(lat.map((l) => l.ms));
+  console.log(`latency smear slider → new geometry drawn (robot Dance): median ${smearMs.toFixed(1)} ms, max ${Math.max(...lat.map((l) => l.ms)).toFixed(1)} ms, server median ${median(lat.map((l) => l.server_ms)).toFixed(1)} ms`);
+  await page.evaluate(() => { const c = document.getElementById('show-offsets'); c.checked = true; c.dispatchEvent(new Event('change')); });
+  await page.waitForTimeout(1500);
+  await page.screenshot({ path: join(shots, 'smear-offsets.png') });
+
+  // loa: three strokes at three frames by mouse.
+  await page.evaluate(() => window.studio.activate('loa'));
+  await page.waitForFunction(() => window.studio.panels.loa.view, null, { timeout: 60000 });
+  const box = await page.locator('#overlay').boundingBox();
+  const strokes = [[0, -0.12], [12, 0], [24, 0.12]];
+  const drawn = [];
+  for (const [frame, bend] of strokes) {
+    await page.evaluate((f) => window.studio.setFrame(f), frame);
+    const pts = [];
+    for (let i = 0; i <= 24; i++) {
+      const t = i / 24;
+      pts.push([box.width * (0.5 + bend * Math.sin(Math.PI * t)), box.height * (0.25 + 0.5 * t)]);
+    }
+    drawn.push({ frame, pts });
+    const n = await page.evaluate(() => window.studio.stats.loa.length);
+    await page.mouse.move(box.x + pts[0][0], box.y + pts[0][1]);
+    await page.mouse.down();
+    for (const p of pts.slice(1)) await page.mouse.move(box.x + p[0], box.y + p[1]);
+    await page.mouse.up();
+    if (frame > 0) await page.waitForFunction((n) => window.studio.stats.loa.length > n, n, { timeout: 120000 });
+  }
+  const loaErr = await page.evaluate(() => document.getElementById('error').hidden ? '' : document.getElementById('error').textContent);
+  check('three strokes give a line and a motion without error', loaErr === '', loaErr);
+  const line = await page.evaluate(async () => (await fetch('/api/loa/line')).json());
+  let worst = 0;
+  for (const d of drawn) {
+    const f = line.frames.find((x) => x.frame === d.frame);
+    if (!f) { worst = Infinity; continue; }
+    for (const p of d.pts) worst = Math.max(worst, Math.min(...f.points.map((q) => Math.hypot(p[0] - q[0], p[1] - q[1]))));
+  }
+  check('the line passes through the three strokes (API query)', worst < 0.05 * box.height, `farthest stroke point ${worst.toFixed(1)} px from the line`);
+  const moved = await page.evaluate(() => {
+    const r = window.studio.panels.loa.result;
+    const n = r.header.motion.vertices * 3, f = r.header.motion.frames;
+    const a = r.buffers.positions.subarray(0, n), b = r.buffers.positions.subarray((f - 1) * n, f * n);
+    let m = 0; for (let i = 0; i < n; i++) m = Math.max(m, Math.abs(a[i] - b[i]));
+    return m;
+  });
+  check('the character moves', moved > 0.01, `largest vertex displacement ${moved.toFixed(3)}`);
+  await page.evaluate(() => window.studio.setFrame(6));
+  await page.waitForTimeout(300);
+  await page.screenshot({ path: join(shots, 'loa.png') });
+  // Latency: redraw the middle stroke five times.
+  const loaLat = [];
+  for (let k = 0; k < 5; k++) {
+    const n = await page.evaluate(() => window.studio.stats.loa.length);
+    await page.evaluate(({ pts }) => window.studio.setFrame(12), drawn[1]);
+    const pts = drawn[1].pts.map(([x, y]) => [x + (k - 2) * 4, y]);
+    await page.mouse.move(box.x + pts[0][0], box.y + pts[0][1]);
+    await page.mouse.down();
+    for (const p of pts.slice(1)) await page.mouse.move(box.x + p[0], box.y + p[1]);
+    await page.mouse.up();
+    await page.waitForFunction((n) => window.studio.stats.loa.length > n, n, { timeout: 120000 });
+    loaLat.push(await page.evaluate(() => window.studio.stats.loa.at(-1)));
+  }
+  console.log(`latency new stroke → line + character drawn: median ${median(loaLat.map((l) => l.ms)).toFixed(1)} ms, max ${Math.max(...loaLat.map((l) => l.ms)).toFixed(1)} ms, server median ${median(loaLat.map((l) => l.server_ms)).toFixed(1)} ms`);
+
+  // stopmo: two seed clicks on the face + run → two parts.
+  await page.evaluate(() => window.studio.activate('stopmo'));
+  await page.waitForFunction(() => window.studio.panels.stopmo.anim && window.studio.panels.stopmo.anim.name === 'ict-face-talk.glb', null, { timeout: 120000 });
+  await page.waitForTimeout(300);
+  const gl = await page.locator('#gl').boundingBox();
+  // Forehead and chin: scan up/down the middle column for the first/last hits.
+  const hits = await page.evaluate(({ w, h }) => {
+    const ys = [];
+    for (let y = 0; y < h; y += 4) if (window.studio.view.pick(w / 2, y) !== -1) ys.push(y);
+    return ys.length ? [ys[0] + (ys.at(-1) - ys[0]) * 0.15, ys[0] + (ys.at(-1) - ys[0]) * 0.85] : null;
+  }, { w: gl.width, h: gl.height });
+  check('the face is under the camera', hits !== null);
+  if (hits) {
+    await page.selectOption('#stopmo-part', '1');
+    await page.mouse.click(gl.x + gl.width / 2, gl.y + hits[0]);
+    await page.selectOption('#stopmo-part', '2');
+    await page.mouse.click(gl.x + gl.width / 2, gl.y + hits[1]);
+    const seeds = await page.evaluate(() => window.studio.panels.stopmo.seeds.map((s) => s.length));
+    check('two seed clicks place two seeds', seeds[0] === 1 && seeds[1] === 1, JSON.stringify(seeds));
+    await page.click('#stopmo-run');
+    await page.waitForFunction(() => window.studio.panels.stopmo.result || !document.getElementById('error').hidden, null, { timeout: 600000 });
+    const parts = await page.evaluate(() => {
+      const r = window.studio.panels.stopmo.result;
+      return r ? [...new Set(r.triangle_part)].length : 0;
+    });
+    check('run gives two parts', parts === 2, `${parts} parts`);
+    await page.waitForTimeout(300);
+    await page.screenshot({ path: join(shots, 'stopmo.png') });
+  }
+  check('no console errors', consoleErrors.length === 0, consoleErrors.join(' | '));
+  console.log(`screenshots in ${shots}`);
+} catch (e) {
+  failed++;
+  console.log(`FAIL ${e.stack || e}`);
+} finally {
+  await browser.close();
+}
+console.log(`${passed} passed, ${failed} failed`);
+process.exit(failed ? 1 : 0);

@@ -1,0 +1,310 @@
+//! The loa panel: strokes drawn over the viewport become keystrokes; `loa::line` gives the
+//! dynamic line of action (LoA Section 3) and `loa::animate` the character motion that
+//! follows it (LoA Section 4).
+//!
+//! The page draws through the action camera of [`view`] (the glTF front view fitted to the
+//! character, orthographic, as `loa animate` uses by default), so a stroke's pixels map onto
+//! the image plane with a [`ScreenMap`] from the canvas size: the character follows the line
+//! where it was drawn.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use anim::glam::DVec2;
+use axum::body::Bytes;
+use axum::extract::rejection::BytesRejection;
+use axum::extract::{Query, State};
+use axum::response::{IntoResponse, Response};
+use axum::Json;
+use loa::animate::{ActionCamera, AnimateOptions, Character, InitialPose, Preset, ScreenMap};
+use serde::Deserialize;
+use serde_json::{json, Value};
+
+use super::{blocking, body};
+use crate::error::{ApiError, ApiResult};
+use crate::files::{merged, output_path};
+use crate::pack::Pack;
+use crate::state::{lock, LoaSession, Studio};
+
+/// A file index (query string).
+#[derive(Debug, Deserialize)]
+pub(crate) struct FileQuery {
+    #[serde(default)]
+    file: usize,
+}
+
+fn character(studio: &Studio, file: usize, fps: f64) -> ApiResult<(Character, String)> {
+    let f = studio.file(file)?;
+    let label = f.label();
+    let scene = f.scene().ok_or_else(|| {
+        ApiError::bad(format!(
+            "{label}: not a character (open a skinned glTF/GLB or a BVH file)"
+        ))
+    })?;
+    let c = Character::from_scene(scene, &InitialPose::Rest, fps)
+        .map_err(|e| ApiError::bad(format!("{label}: {e}")))?;
+    Ok((c, label))
+}
+
+fn camera(c: &Character) -> ActionCamera {
+    let (lo, hi) = c.bounds();
+    ActionCamera::front_fitted(lo, hi)
+}
+
+/// `GET /api/loa/view?file=`: the action camera (`center`, `right`, `up`, `forward`,
+/// `half_height`), the bone-set presets, the joints and the rest pose's mesh (buffers
+/// `triangles`, `positions`: one frame).
+pub(crate) async fn view(
+    State(studio): State<Arc<Studio>>,
+    Query(q): Query<FileQuery>,
+) -> ApiResult<Json<Value>> {
+    blocking(move || {
+        let (c, _) = character(&studio, q.file, loa::DEFAULT_FPS)?;
+        let presets: Vec<&str> = Preset::ALL.iter().map(|(_, n)| *n).collect();
+        Ok(Json(json!({
+            "camera": camera(&c),
+            "presets": presets,
+            "joints": c.joint_names(),
+        })))
+    })
+    .await
+}
+
+/// One keystroke as the page sends it.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct PageKeystroke {
+    frame: i64,
+    /// Canvas pixels (y down).
+    points: Vec<[f64; 2]>,
+    #[serde(default)]
+    stiffness: Option<f64>,
+    #[serde(default)]
+    damping: Option<f64>,
+    /// Bone-set preset (or joint list) the character follows from this keystroke on.
+    #[serde(default)]
+    bones: Option<String>,
+}
+
+/// `POST /api/loa/animate` body.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct AnimateRequest {
+    #[serde(default)]
+    file: usize,
+    keystrokes: Vec<PageKeystroke>,
+    /// Canvas size in pixels (the strokes' screen).
+    width: f64,
+    height: f64,
+    #[serde(default)]
+    fps: Option<f64>,
+    /// Drag-to-wobble impulses (`loa::Wobble`).
+    #[serde(default)]
+    wobbles: Vec<loa::Wobble>,
+}
+
+/// The keystroke JSON of `loa line` (what the page's strokes export as).
+fn keystrokes_json(r: &AnimateRequest, fps: f64) -> Value {
+    let keys: Vec<Value> = r
+        .keystrokes
+        .iter()
+        .map(|k| {
+            let mut v = json!({"frame": k.frame, "points": k.points});
+            if let Some(s) = k.stiffness {
+                v["stiffness"] = json!(s);
+            }
+            if let Some(d) = k.damping {
+                v["damping"] = json!(d);
+            }
+            v
+        })
+        .collect();
+    json!({"fps": fps, "keystrokes": keys})
+}
+
+/// `POST /api/loa/animate`: buffers `line` (f32, line frames × joints × 2, canvas pixels),
+/// `positions` (f32, motion frames × vertices × 3), `triangles` (u32).
+pub(crate) async fn animate(
+    State(studio): State<Arc<Studio>>,
+    request: Result<Bytes, BytesRejection>,
+) -> ApiResult<Response> {
+    let r: AnimateRequest = body(request)?;
+    if !(r.width > 0.0 && r.height > 0.0 && r.width.is_finite() && r.height.is_finite()) {
+        return Err(ApiError::bad("width and height must be positive"));
+    }
+    blocking(move || {
+        let start = Instant::now();
+        let fps = r.fps.unwrap_or(loa::DEFAULT_FPS);
+        let keys_json = keystrokes_json(&r, fps);
+        let keys = loa::Keystrokes::from_json_str(&keys_json.to_string())
+            .map_err(|e| ApiError::bad(format!("keystrokes: {e}")))?;
+        let mut options = loa::LineOptions::default();
+        options.physics.fps = fps;
+        options.wobbles = r.wobbles.clone();
+        let line = loa::line(&keys, &options).map_err(|e| ApiError::bad(format!("line: {e}")))?;
+        let line_seconds = start.elapsed().as_secs_f64();
+
+        let (c, label) = character(&studio, r.file, fps)?;
+        let cam = camera(&c);
+        let mut bone_sets = Vec::new();
+        for k in &r.keystrokes {
+            if let Some(b) = k.bones.as_deref().filter(|b| !b.is_empty()) {
+                let key = format!("{b}@{}", k.frame);
+                bone_sets.push(key.parse().map_err(|e| ApiError::bad(format!("bones {b}: {e}")))?);
+            }
+        }
+        let animate_options = AnimateOptions {
+            bone_sets,
+            camera: Some(cam),
+            screen: Some(ScreenMap {
+                anchor: DVec2::new(r.width / 2.0, r.height / 2.0),
+                origin: DVec2::ZERO,
+                scale: 2.0 * cam.half_height / r.height,
+            }),
+            ..Default::default()
+        };
+        let motion = loa::animate(&c, &line, &animate_options)
+            .map_err(|e| ApiError::bad(format!("{label}: {e}")))?;
+        let scene = studio
+            .file(r.file)?
+            .scene()
+            .ok_or_else(|| ApiError::bad("not a character"))?;
+        let out = motion.to_scene(scene);
+        let clip = out
+            .find_clip(loa::animate::CLIP_NAME)
+            .map_err(|e| ApiError::internal(e.to_string()))?;
+        let sampled = anim::sample(
+            &out,
+            &anim::SampleOptions {
+                fps: fps as f32,
+                clip: Some(clip),
+                meshes: Vec::new(),
+            },
+        )
+        .map_err(|e| ApiError::internal(format!("{label}: {e}")))?;
+        let m = merged(&label, &sampled)?;
+        let animate_seconds = start.elapsed().as_secs_f64() - line_seconds;
+
+        let frames = &line.animation.frames;
+        let joints = frames.first().map_or(0, |f| f.chain.joints().len());
+        let mut pack = Pack::new();
+        pack.f32(
+            "line",
+            frames
+                .iter()
+                .flat_map(|f| f.chain.joints().into_iter().flat_map(|p| [p.x as f32, p.y as f32])),
+        );
+        pack.u32("triangles", m.mesh.triangles.iter().flatten().copied());
+        pack.f32("positions", m.positions().iter().flat_map(|p| p.to_array()));
+        let rep = &motion.report;
+        let header = json!({
+            "line": {
+                "first_frame": frames.first().map_or(0, |f| f.frame),
+                "frames": frames.len(),
+                "joints": joints,
+                "keystroke_frames": line.animation.keystroke_frames,
+            },
+            "motion": {
+                "first_frame": motion.first_frame,
+                "frames": m.frame_count(),
+                "vertices": m.vertex_count(),
+                "fps": motion.fps,
+            },
+            "warnings": line.warnings,
+            "report": {
+                "line_distance_mean": rep.line_distance_mean,
+                "line_distance_max": rep.line_distance_max,
+                "max_rotation_step": rep.max_rotation_step,
+                "height": rep.height,
+            },
+            "keystrokes": keys_json,
+            "seconds": {"line": line_seconds, "animate": animate_seconds, "total": start.elapsed().as_secs_f64()},
+        });
+        *lock(&studio.loa) = Some(LoaSession {
+            file: r.file,
+            keys,
+            keys_json: keys_json.to_string(),
+            line,
+            scene: out,
+            motion,
+        });
+        Ok(pack.response(header))
+    })
+    .await
+}
+
+/// `GET /api/loa/line`: the last line in the CLI's JSON layout (`toonkit loa line -o x.json`).
+pub(crate) async fn line(State(studio): State<Arc<Studio>>) -> ApiResult<Response> {
+    let guard = lock(&studio.loa);
+    let s = guard
+        .as_ref()
+        .ok_or_else(|| ApiError::conflict("no line yet: draw keystrokes first"))?;
+    let text = s.line.animation.to_json_string();
+    Ok((
+        [(axum::http::header::CONTENT_TYPE, "application/json")],
+        text,
+    )
+        .into_response())
+}
+
+/// `POST /api/loa/export` body.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct ExportRequest {
+    /// File name in the output folder: `.json` with `what = "keystrokes"` or `"line"`,
+    /// `.svg` (line onion skin), `.glb` / `.bvh` (the motion).
+    name: String,
+    #[serde(default)]
+    what: Option<String>,
+}
+
+/// `POST /api/loa/export`.
+pub(crate) async fn export(
+    State(studio): State<Arc<Studio>>,
+    request: Result<Bytes, BytesRejection>,
+) -> ApiResult<Json<Value>> {
+    let r: ExportRequest = body(request)?;
+    let path = output_path(&studio.out_dir, &r.name)?;
+    blocking(move || {
+        let guard = lock(&studio.loa);
+        let s = guard
+            .as_ref()
+            .ok_or_else(|| ApiError::conflict("no line yet: draw keystrokes first"))?;
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .unwrap_or_default();
+        let io = |e: String| ApiError::internal(format!("{}: {e}", r.name));
+        let text =
+            |t: &str| tkio::save(&path, &tkio::Output::Text(t)).map_err(|e| io(e.to_string()));
+        match (ext.as_str(), r.what.as_deref()) {
+            ("json", Some("keystrokes")) => text(&s.keys_json)?,
+            ("json", _) => text(&s.line.animation.to_json_string())?,
+            ("svg", _) => text(&loa::to_svg_string(&s.line.animation, Some(&s.keys)))?,
+            ("glb", _) => {
+                let bytes = tkio::gltf::write_glb(&s.scene).map_err(|e| io(e.to_string()))?;
+                tkio::save(&path, &tkio::Output::Bytes(&bytes)).map_err(|e| io(e.to_string()))?;
+            }
+            ("bvh", _) => {
+                let scene = studio
+                    .file(s.file)?
+                    .scene()
+                    .ok_or_else(|| ApiError::bad("not a character"))?;
+                let (skeleton, _) = scene.skeleton();
+                let skeletal = s
+                    .motion
+                    .skeletal_animation(&skeleton)
+                    .map_err(|e| io(e.to_string()))?;
+                let t = tkio::bvh::write(&skeleton, &skeletal).map_err(|e| io(e.to_string()))?;
+                text(&t)?;
+            }
+            _ => return Err(ApiError::bad(format!(
+                "{}: export keystrokes/line as .json, the line as .svg, the motion as .glb or .bvh",
+                r.name
+            ))),
+        }
+        Ok(Json(json!({ "written": path.display().to_string() })))
+    })
+    .await
+}

@@ -1,0 +1,91 @@
+//! The API under `/api`: JSON in, JSON or packed float32 buffers ([`crate::pack`]) out.
+//!
+//! | route | what |
+//! |---|---|
+//! | `GET /api/info` | opened files, clips, output folder, whether three.js is installed |
+//! | `GET /api/scene?file=&clip=` | the clip's merged mesh: triangles + positions per frame |
+//! | `GET /api/smear/presets` | the example styles (SMEAR Figs. 11–16) |
+//! | `GET /api/smear/offsets?file=&clip=` | motion offsets per frame and vertex (prepared once) |
+//! | `POST /api/smear/stylize` | a style → elongated body, multiples, lines |
+//! | `POST /api/smear/export` | writes the result (glb/usda/usdc/abc) or the style (toml) |
+//! | `GET /api/loa/view?file=` | the action camera the strokes are drawn through |
+//! | `POST /api/loa/animate` | keystrokes → line of action + character motion |
+//! | `GET /api/loa/line` | the last line in the CLI's JSON layout |
+//! | `POST /api/loa/export` | keystrokes / line (json, svg) / motion (glb, bvh) |
+//! | `POST /api/stopmo/segment` | part seeds → a segmentation job |
+//! | `GET /api/jobs/{id}`, `POST /api/jobs/{id}/cancel` | progress, result, cancel |
+
+mod loa_api;
+mod scene;
+mod smear_api;
+mod stopmo_api;
+
+use std::sync::Arc;
+
+use axum::body::Bytes;
+use axum::extract::rejection::BytesRejection;
+use axum::extract::{Path, State};
+use axum::routing::{get, post};
+use axum::{Json, Router};
+use serde::de::DeserializeOwned;
+use serde_json::Value;
+
+use crate::error::{ApiError, ApiResult};
+use crate::jobs::JobStatus;
+use crate::state::Studio;
+
+/// The API routes.
+pub fn routes() -> Router<Arc<Studio>> {
+    Router::new()
+        .route("/api/info", get(scene::info))
+        .route("/api/scene", get(scene::scene))
+        .route("/api/smear/presets", get(smear_api::presets))
+        .route("/api/smear/offsets", get(smear_api::offsets))
+        .route("/api/smear/stylize", post(smear_api::stylize))
+        .route("/api/smear/export", post(smear_api::export))
+        .route("/api/loa/view", get(loa_api::view))
+        .route("/api/loa/animate", post(loa_api::animate))
+        .route("/api/loa/line", get(loa_api::line))
+        .route("/api/loa/export", post(loa_api::export))
+        .route("/api/stopmo/segment", post(stopmo_api::segment))
+        .route("/api/jobs/{id}", get(job))
+        .route("/api/jobs/{id}/cancel", post(cancel))
+}
+
+/// A JSON request body; a body too large, not JSON, or of the wrong shape is a JSON error.
+pub(crate) fn body<T: DeserializeOwned>(body: Result<Bytes, BytesRejection>) -> ApiResult<T> {
+    let bytes = body.map_err(|r| ApiError {
+        status: r.status(),
+        message: format!("request body: {}", r.body_text()),
+    })?;
+    serde_json::from_slice(&bytes).map_err(|e| ApiError::bad(format!("request body: {e}")))
+}
+
+/// Runs `work` on the blocking pool, so the server keeps answering meanwhile.
+pub(crate) async fn blocking<T, F>(work: F) -> ApiResult<T>
+where
+    T: Send + 'static,
+    F: FnOnce() -> ApiResult<T> + Send + 'static,
+{
+    tokio::task::spawn_blocking(work)
+        .await
+        .map_err(|_| ApiError::internal("the request stopped on an internal error"))?
+}
+
+/// `GET /api/jobs/{id}`.
+async fn job(State(studio): State<Arc<Studio>>, Path(id): Path<u64>) -> ApiResult<Json<JobStatus>> {
+    studio
+        .jobs
+        .status(id)
+        .map(Json)
+        .ok_or_else(|| ApiError::not_found(format!("job {id}: no such job")))
+}
+
+/// `POST /api/jobs/{id}/cancel`.
+async fn cancel(State(studio): State<Arc<Studio>>, Path(id): Path<u64>) -> ApiResult<Json<Value>> {
+    if studio.jobs.cancel(id) {
+        Ok(Json(serde_json::json!({ "cancelled": id })))
+    } else {
+        Err(ApiError::not_found(format!("job {id}: no such job")))
+    }
+}

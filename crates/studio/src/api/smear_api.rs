@@ -1,0 +1,277 @@
+//! The smear panel: offsets prepared once per file and clip ([`Studio::prepared`]), then
+//! `smear::stylize` per change — elongated in-betweens (SMEAR Eq. 10), multiples (SMEAR
+//! Eqs. 11–12) and motion lines (SMEAR Eq. 13) back as float32 buffers.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use axum::body::Bytes;
+use axum::extract::rejection::BytesRejection;
+use axum::extract::{Query, State};
+use axum::response::Response;
+use axum::Json;
+use serde::Deserialize;
+use serde_json::{json, Value};
+use smear::{OffsetOptions, Style};
+
+use super::scene::ClipQuery;
+use super::{blocking, body};
+use crate::error::{ApiError, ApiResult};
+use crate::files::output_path;
+use crate::pack::Pack;
+use crate::state::Studio;
+
+/// The example styles of `examples/smear/` (SMEAR Figs. 11, 12, 15, 16).
+pub(crate) const PRESETS: &[(&str, &str)] = &[
+    (
+        "fig11b_linear",
+        include_str!("../../../../examples/smear/fig11b_linear.toml"),
+    ),
+    (
+        "fig11c_speed",
+        include_str!("../../../../examples/smear/fig11c_speed.toml"),
+    ),
+    (
+        "fig11d_noise",
+        include_str!("../../../../examples/smear/fig11d_noise.toml"),
+    ),
+    (
+        "fig12_warp",
+        include_str!("../../../../examples/smear/fig12_warp.toml"),
+    ),
+    (
+        "fig15_sword",
+        include_str!("../../../../examples/smear/fig15_sword.toml"),
+    ),
+    (
+        "fig15b_punch_arm",
+        include_str!("../../../../examples/smear/fig15b_punch_arm.toml"),
+    ),
+    (
+        "fig16_combined",
+        include_str!("../../../../examples/smear/fig16_combined.toml"),
+    ),
+];
+
+/// `GET /api/smear/presets`: `{"presets": [{"name", "style", "toml"}]}`.
+pub(crate) async fn presets() -> ApiResult<Json<Value>> {
+    let mut out = Vec::new();
+    for (name, text) in PRESETS {
+        let style = Style::from_toml_str(text)
+            .map_err(|e| ApiError::internal(format!("preset {name}: {e}")))?;
+        out.push(json!({"name": name, "style": style, "toml": text}));
+    }
+    Ok(Json(json!({ "presets": out })))
+}
+
+/// `GET /api/smear/offsets?file=&clip=`: `offsets` (f32, frames × vertices, δ ∈ [−1, 1]).
+pub(crate) async fn offsets(
+    State(studio): State<Arc<Studio>>,
+    Query(q): Query<ClipQuery>,
+) -> ApiResult<Response> {
+    blocking(move || {
+        let start = Instant::now();
+        let p = studio.prepared(q.file, &q.clip)?;
+        let pr: &smear::Prepared = &p;
+        let frames = pr.scene().frame_count;
+        let mut pack = Pack::new();
+        pack.f32(
+            "offsets",
+            (0..frames).flat_map(move |f| {
+                (0..pr.object_count()).flat_map(move |i| pr.offsets(i).frame(f).iter().copied())
+            }),
+        );
+        Ok(pack.response(json!({
+            "frames": frames,
+            "report": p.report(),
+            "seconds": start.elapsed().as_secs_f64(),
+        })))
+    })
+    .await
+}
+
+/// A stylize or export request.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct StyleRequest {
+    #[serde(default)]
+    file: usize,
+    #[serde(default)]
+    clip: String,
+    /// The style as JSON (the TOML's structure).
+    #[serde(default)]
+    style: Option<Value>,
+    /// Or the style as TOML text (the expression editor).
+    #[serde(default)]
+    toml: Option<String>,
+    /// Export file name inside the output folder.
+    #[serde(default)]
+    name: Option<String>,
+}
+
+fn read_style(r: &StyleRequest, prepared: &OffsetOptions) -> ApiResult<Style> {
+    let mut style = match (&r.toml, &r.style) {
+        (Some(text), _) => {
+            Style::from_toml_str(text).map_err(|e| ApiError::bad(format!("style: {e}")))?
+        }
+        (None, Some(v)) => {
+            let s: Style = serde_json::from_value(v.clone())
+                .map_err(|e| ApiError::bad(format!("style: {e}")))?;
+            s.validate()
+                .map_err(|e| ApiError::bad(format!("style: {e}")))?;
+            s
+        }
+        (None, None) => return Err(ApiError::bad("style: give \"style\" (JSON) or \"toml\"")),
+    };
+    if style.offsets == OffsetOptions::default() {
+        style.offsets = prepared.clone();
+    }
+    Ok(style)
+}
+
+fn stylized(studio: &Studio, r: &StyleRequest) -> ApiResult<(Style, smear::Stylized)> {
+    let p = studio.prepared(r.file, &r.clip)?;
+    let style = read_style(r, &p.options().offsets)?;
+    let label = studio.file(r.file)?.label();
+    let s = smear::stylize(&p, &style).map_err(|e| ApiError::bad(format!("{label}: {e}")))?;
+    Ok((style, s))
+}
+
+/// `POST /api/smear/stylize`: buffers `body` (f32, frames × vertices × 3, every object's
+/// elongated in-betweens merged in object order), per copy `copyN.positions`,
+/// `copyN.alpha` (frames × copy vertices), `copyN.triangles`; per line set
+/// `linesN.counts` (u32 per frame: vertices, triangles), `linesN.positions`,
+/// `linesN.triangles`, `linesN.alpha`.
+pub(crate) async fn stylize(
+    State(studio): State<Arc<Studio>>,
+    request: Result<Bytes, BytesRejection>,
+) -> ApiResult<Response> {
+    let r: StyleRequest = body(request)?;
+    blocking(move || {
+        let start = Instant::now();
+        let (style, s) = stylized(&studio, &r)?;
+        let toml = style.to_toml_string().unwrap_or_default();
+        let mut pack = Pack::new();
+        let frames = s.flipbook.frames;
+        let bodies: Vec<&anim::MeshAnimation> = s
+            .objects
+            .iter()
+            .filter_map(|o| s.animation(o.body))
+            .collect();
+        let bodies = &bodies;
+        pack.f32(
+            "body",
+            (0..frames).flat_map(move |f| {
+                bodies
+                    .iter()
+                    .flat_map(move |a| a.frame(f).iter().flat_map(|p| p.to_array()))
+            }),
+        );
+        let mut copies = Vec::new();
+        let mut lines = Vec::new();
+        for o in &s.objects {
+            for i in o.copies.clone() {
+                if let Some(anim::FlipbookPart::Animation { animation, colors }) =
+                    s.flipbook.parts.get(i)
+                {
+                    let n = copies.len();
+                    pack.f32(
+                        &format!("copy{n}.positions"),
+                        animation.positions().iter().flat_map(|p| p.to_array()),
+                    );
+                    pack.u32(
+                        &format!("copy{n}.triangles"),
+                        animation.mesh.triangles.iter().flatten().copied(),
+                    );
+                    let count = animation.positions().len();
+                    match colors {
+                        Some(c) => pack.f32(&format!("copy{n}.alpha"), c.iter().map(|c| c[3])),
+                        None => {
+                            pack.f32(&format!("copy{n}.alpha"), std::iter::repeat_n(1.0, count))
+                        }
+                    };
+                    copies.push(
+                        json!({"name": animation.mesh.name, "vertices": animation.vertex_count()}),
+                    );
+                }
+            }
+            if let Some(anim::FlipbookPart::Frames { name, meshes }) =
+                o.lines.and_then(|i| s.flipbook.parts.get(i))
+            {
+                let n = lines.len();
+                pack.u32(
+                    &format!("lines{n}.counts"),
+                    meshes
+                        .iter()
+                        .flat_map(|m| [m.positions.len() as u32, m.triangles.len() as u32]),
+                );
+                pack.f32(
+                    &format!("lines{n}.positions"),
+                    meshes
+                        .iter()
+                        .flat_map(|m| m.positions.iter().flat_map(|p| p.to_array())),
+                );
+                pack.u32(
+                    &format!("lines{n}.triangles"),
+                    meshes
+                        .iter()
+                        .flat_map(|m| m.triangles.iter().flatten().copied()),
+                );
+                pack.f32(
+                    &format!("lines{n}.alpha"),
+                    meshes.iter().flat_map(|m| match &m.colors {
+                        Some(c) => c.iter().map(|c| c[3]).collect::<Vec<_>>(),
+                        None => vec![1.0; m.positions.len()],
+                    }),
+                );
+                lines.push(json!({"name": name}));
+            }
+        }
+        Ok(pack.response(json!({
+            "frames": frames,
+            "style": style,
+            "toml": toml,
+            "copies": copies,
+            "lines": lines,
+            "report": s.report,
+            "seconds": start.elapsed().as_secs_f64(),
+        })))
+    })
+    .await
+}
+
+/// `POST /api/smear/export`: `name` ending in `.toml` writes the style (as the CLI and the
+/// Blender extension read it); `.glb`, `.usda`, `.usdc`, `.usdz`, `.abc` write the result as
+/// `toonkit smear IN --style S -o NAME` does. Always inside the output folder, atomically.
+pub(crate) async fn export(
+    State(studio): State<Arc<Studio>>,
+    request: Result<Bytes, BytesRejection>,
+) -> ApiResult<Json<Value>> {
+    let r: StyleRequest = body(request)?;
+    let name = r
+        .name
+        .clone()
+        .ok_or_else(|| ApiError::bad("export: give \"name\" (a file name in the output folder)"))?;
+    let path = output_path(&studio.out_dir, &name)?;
+    blocking(move || {
+        let io = |e: tkio::IoError| ApiError::internal(e.to_string());
+        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) {
+            let p = studio.prepared(r.file, &r.clip)?;
+            let style = read_style(&r, &p.options().offsets)?;
+            let text = style
+                .to_toml_string()
+                .map_err(|e| ApiError::bad(format!("style: {e}")))?;
+            tkio::save(&path, &tkio::Output::Text(&text)).map_err(io)?;
+        } else {
+            if !tkio::Format::from_extension(&path).is_some_and(tkio::Format::holds_scenes) {
+                return Err(ApiError::bad(format!(
+                    "{name}: a styled smear is written as .glb, .usda, .usdc, .usdz or .abc (a style as .toml)"
+                )));
+            }
+            let (_, s) = stylized(&studio, &r)?;
+            tkio::save(&path, &tkio::Output::Flipbook(&s.flipbook)).map_err(io)?;
+        }
+        Ok(Json(json!({ "written": path.display().to_string() })))
+    })
+    .await
+}

@@ -1,0 +1,97 @@
+//! The stopmo panel: part seeds clicked on the mesh → `stopmo::segment` (StopShop Section 4:
+//! multi-label graph cut, StopShop Eqs. 1–3) on a worker thread; the page polls
+//! `/api/jobs/{id}` and colours the input triangles by `triangle_part`.
+
+use std::sync::Arc;
+
+use axum::body::Bytes;
+use axum::extract::rejection::BytesRejection;
+use axum::extract::State;
+use axum::Json;
+use serde::Deserialize;
+use serde_json::{json, Value};
+use stopmo::segment::{PartSpec, Seed};
+use stopmo::SegmentJobOptions;
+
+use super::body;
+use crate::error::{ApiError, ApiResult};
+use crate::files::merged;
+use crate::state::Studio;
+
+/// Most parts a segmentation request may ask for.
+pub(crate) const MAX_PARTS: usize = 16;
+
+/// `POST /api/stopmo/segment` body.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct SegmentRequest {
+    #[serde(default)]
+    file: usize,
+    #[serde(default)]
+    clip: String,
+    /// Per part, the seed triangles (indices into `/api/scene`'s triangles).
+    seeds: Vec<Vec<u32>>,
+    /// Part names (default `part1`, `part2`, ...).
+    #[serde(default)]
+    names: Vec<String>,
+}
+
+/// `POST /api/stopmo/segment`: `{"job": id}` at once; the job's result is
+/// `{"summary", "triangle_part" (per input triangle), "parts"}`.
+pub(crate) async fn segment(
+    State(studio): State<Arc<Studio>>,
+    request: Result<Bytes, BytesRejection>,
+) -> ApiResult<Json<Value>> {
+    let r: SegmentRequest = body(request)?;
+    if r.seeds.len() < 2 || r.seeds.len() > MAX_PARTS {
+        return Err(ApiError::bad(format!(
+            "seeds: give 2 to {MAX_PARTS} parts, each with at least one seed triangle"
+        )));
+    }
+    if let Some(i) = r.seeds.iter().position(Vec::is_empty) {
+        return Err(ApiError::bad(format!("seeds: part {} has no seed", i + 1)));
+    }
+    let label = studio.file(r.file)?.label();
+    let job_studio = studio.clone();
+    let id = studio.jobs.start("stopmo.segment", move |progress| {
+        let cancelled = |e: crate::jobs::Cancelled| e.to_string();
+        progress.stage("sampling", 0.05).map_err(cancelled)?;
+        let sampled = job_studio.sampled(r.file, &r.clip).map_err(|e| e.message)?;
+        let anim = merged(&label, &sampled).map_err(|e| e.message)?;
+        let triangles = anim.mesh.triangles.len() as u32;
+        let mut parts = Vec::new();
+        for (i, seeds) in r.seeds.iter().enumerate() {
+            if let Some(t) = seeds.iter().find(|&&t| t >= triangles) {
+                return Err(format!(
+                    "seeds: triangle {t} of part {} is past the mesh's {triangles}",
+                    i + 1
+                ));
+            }
+            let name = r
+                .names
+                .get(i)
+                .cloned()
+                .unwrap_or_else(|| format!("part{}", i + 1));
+            parts.push(PartSpec::new(
+                name,
+                seeds.iter().map(|&t| Seed::Triangle(t)).collect(),
+            ));
+        }
+        let options = SegmentJobOptions {
+            parts,
+            ..Default::default()
+        };
+        progress
+            .stage("graph cut and homogenization", 0.2)
+            .map_err(cancelled)?;
+        let s = stopmo::segment(&anim, &options).map_err(|e| format!("{label}: {e}"))?;
+        progress.stage("done", 1.0).map_err(cancelled)?;
+        Ok(json!({
+            "summary": s.summary(),
+            "triangle_part": s.segmentation.input_triangle_part,
+            "parts": s.segmentation.part_names,
+            "seconds": s.seconds,
+        }))
+    });
+    Ok(Json(json!({ "job": id })))
+}

@@ -1,0 +1,187 @@
+//! The files the studio was opened with (the only files it reads) and the output folder (the
+//! only place it writes).
+
+use std::path::{Component, Path, PathBuf};
+
+use anim::{MeshAnimation, SampleOptions, SampledScene};
+use tkio::{LoadOptions, Loaded};
+
+use crate::error::{ApiError, ApiResult, StudioError};
+
+/// Frames per second the studio samples clips at (the CLI's default).
+pub const FPS: f32 = 24.0;
+
+/// Longest file name accepted for an export.
+pub const MAX_NAME_LEN: usize = 200;
+
+/// One opened file.
+#[derive(Debug)]
+pub struct OpenedFile {
+    /// The path given on the command line.
+    pub path: PathBuf,
+    /// What was read.
+    pub loaded: Loaded,
+}
+
+impl OpenedFile {
+    /// Reads `path` with `tkio::load`.
+    pub fn open(path: &Path) -> Result<OpenedFile, StudioError> {
+        let options = LoadOptions {
+            fps: FPS,
+            rest: None,
+        };
+        let loaded = tkio::load(path, &options).map_err(|e| StudioError::Open(e.to_string()))?;
+        Ok(OpenedFile {
+            path: path.to_path_buf(),
+            loaded,
+        })
+    }
+
+    /// The file name shown in the page.
+    pub fn label(&self) -> String {
+        self.path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| self.path.display().to_string())
+    }
+
+    /// Clip names (empty for point caches and still meshes).
+    pub fn clips(&self) -> Vec<String> {
+        match &self.loaded {
+            Loaded::Scene(s) => s.clips.iter().map(|c| c.name.clone()).collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// The scene as read, when the file is a glTF/BVH scene (a loa character).
+    pub fn scene(&self) -> Option<&anim::Scene> {
+        match &self.loaded {
+            Loaded::Scene(s) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// Samples `clip` (the first clip when `None`) at [`FPS`].
+    pub fn sample(&self, clip: Option<&str>) -> ApiResult<SampledScene> {
+        let at = |e: anim::AnimError| ApiError::bad(format!("{}: {e}", self.label()));
+        match &self.loaded {
+            Loaded::Scene(scene) => {
+                let clip = match clip {
+                    Some(name) if !name.is_empty() => Some(scene.find_clip(name).map_err(at)?),
+                    _ => None,
+                };
+                let options = SampleOptions {
+                    fps: FPS,
+                    clip,
+                    meshes: Vec::new(),
+                };
+                anim::sample(scene, &options).map_err(at)
+            }
+            Loaded::Cache(cache) => Ok(SampledScene::from_animation(cache.clone())),
+            Loaded::Mesh(mesh) => Ok(SampledScene::from_animation(MeshAnimation::still(
+                mesh.clone(),
+            ))),
+        }
+    }
+}
+
+/// All mesh objects of a sampled scene as one point cache (the vertex order of every
+/// per-vertex buffer the page gets).
+pub fn merged(label: &str, sampled: &SampledScene) -> ApiResult<MeshAnimation> {
+    if sampled.objects.is_empty() {
+        return Err(ApiError::bad(format!("{label}: the file has no mesh")));
+    }
+    sampled
+        .merged(label)
+        .map_err(|e| ApiError::bad(format!("{label}: {e}")))
+}
+
+/// Makes (if needed) and canonicalizes the output folder.
+pub fn output_folder(path: &Path) -> Result<PathBuf, StudioError> {
+    let err = |source| StudioError::OutputFolder {
+        path: path.display().to_string(),
+        source,
+    };
+    std::fs::create_dir_all(path).map_err(err)?;
+    path.canonicalize().map_err(err)
+}
+
+/// Where an export named `name` goes: `name` must be a relative path of plain components
+/// (no `..`, no root, no drive, no hidden `.` segments), and the result stays inside
+/// `folder` (the canonical output folder) even through symbolic links. Parent folders are
+/// made.
+pub fn output_path(folder: &Path, name: &str) -> ApiResult<PathBuf> {
+    let refuse = |why: &str| ApiError::forbidden(format!("{name}: {why}"));
+    if name.is_empty() || name.len() > MAX_NAME_LEN {
+        return Err(refuse("give a file name (1 to 200 characters)"));
+    }
+    if name.contains('\\') || name.contains('\0') || name.contains(':') {
+        return Err(refuse("names may not contain '\\', ':' or NUL"));
+    }
+    let rel = Path::new(name);
+    let mut parts = 0;
+    for c in rel.components() {
+        match c {
+            Component::Normal(s) if !s.to_string_lossy().starts_with('.') => parts += 1,
+            _ => {
+                return Err(refuse(
+                    "outside the output folder (use a plain relative name)",
+                ))
+            }
+        }
+    }
+    if parts == 0 {
+        return Err(refuse("give a file name"));
+    }
+    let path = folder.join(rel);
+    let parent = path
+        .parent()
+        .ok_or_else(|| refuse("outside the output folder"))?;
+    std::fs::create_dir_all(parent)
+        .map_err(|e| ApiError::internal(format!("{}: {e}", parent.display())))?;
+    let real = parent
+        .canonicalize()
+        .map_err(|e| ApiError::internal(format!("{}: {e}", parent.display())))?;
+    if !real.starts_with(folder) {
+        return Err(refuse("outside the output folder"));
+    }
+    if path.is_symlink() {
+        return Err(refuse("is a symbolic link"));
+    }
+    Ok(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn export_names_stay_inside_the_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let folder = output_folder(dir.path()).unwrap();
+        let ok = output_path(&folder, "shots/a.glb").unwrap();
+        assert!(ok.starts_with(&folder) && ok.ends_with("shots/a.glb"));
+        for bad in [
+            "../a.glb",
+            "/etc/passwd",
+            "a/../../b",
+            "",
+            ".hidden",
+            "a\\..\\b",
+            "C:x",
+        ] {
+            let e = output_path(&folder, bad).unwrap_err();
+            assert_eq!(e.status, axum::http::StatusCode::FORBIDDEN, "{bad}");
+        }
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_symbolic_link_out_of_the_folder_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let outside = tempfile::tempdir().unwrap();
+        let folder = output_folder(dir.path()).unwrap();
+        std::os::unix::fs::symlink(outside.path(), folder.join("link")).unwrap();
+        assert!(output_path(&folder, "link/x.glb").is_err());
+    }
+}

@@ -1,0 +1,111 @@
+//! What the server keeps between requests: the opened files, sampled clips, prepared smear
+//! offsets (solved once per file and clip), the last line of action, and the jobs.
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex, MutexGuard};
+
+use anim::SampledScene;
+
+use crate::error::{ApiError, ApiResult};
+use crate::files::OpenedFile;
+use crate::jobs::Jobs;
+
+/// A file index and clip name.
+pub type ClipKey = (usize, String);
+
+/// The last line of action and the motion that follows it (for queries and exports).
+#[derive(Debug)]
+pub struct LoaSession {
+    /// The file the character came from.
+    pub file: usize,
+    /// The keystrokes.
+    pub keys: loa::Keystrokes,
+    /// The keystrokes in `loa line`'s JSON layout (as exported).
+    pub keys_json: String,
+    /// The line (LoA Section 3).
+    pub line: loa::Line,
+    /// The character with the synthesized clip (LoA Section 4).
+    pub scene: anim::Scene,
+    /// The synthesized joint motion.
+    pub motion: loa::animate::Motion,
+}
+
+/// The server's state, shared by every request.
+#[derive(Debug)]
+pub struct Studio {
+    /// The files the studio reads (and no other).
+    pub files: Vec<OpenedFile>,
+    /// The canonical output folder (the only place it writes).
+    pub out_dir: PathBuf,
+    /// Where the page's npm packages are installed (`web/node_modules`).
+    pub node_modules: PathBuf,
+    sampled: Mutex<HashMap<ClipKey, Arc<SampledScene>>>,
+    prepared: Mutex<HashMap<ClipKey, Arc<smear::Prepared>>>,
+    preparing: Mutex<()>,
+    /// The last line of action.
+    pub loa: Mutex<Option<LoaSession>>,
+    /// Long jobs (stopmo).
+    pub jobs: Jobs,
+}
+
+/// Locks a mutex, recovering from a panicked holder (the data stays usable: every writer
+/// replaces whole values).
+pub fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+impl Studio {
+    /// A studio over opened files.
+    pub fn new(files: Vec<OpenedFile>, out_dir: PathBuf, node_modules: PathBuf) -> Studio {
+        Studio {
+            files,
+            out_dir,
+            node_modules,
+            sampled: Mutex::default(),
+            prepared: Mutex::default(),
+            preparing: Mutex::default(),
+            loa: Mutex::default(),
+            jobs: Jobs::default(),
+        }
+    }
+
+    /// The opened file at `index`.
+    pub fn file(&self, index: usize) -> ApiResult<&OpenedFile> {
+        self.files.get(index).ok_or_else(|| {
+            ApiError::not_found(format!(
+                "file {index}: the studio opened {} file(s) and reads no other",
+                self.files.len()
+            ))
+        })
+    }
+
+    /// The clip `clip` of file `index`, sampled once.
+    pub fn sampled(&self, index: usize, clip: &str) -> ApiResult<Arc<SampledScene>> {
+        let key = (index, clip.to_string());
+        if let Some(s) = lock(&self.sampled).get(&key) {
+            return Ok(s.clone());
+        }
+        let file = self.file(index)?;
+        let s = Arc::new(file.sample(Some(clip))?);
+        lock(&self.sampled).insert(key, s.clone());
+        Ok(s)
+    }
+
+    /// The smear offsets of file `index`, clip `clip`: `smear::prepare` runs once per file
+    /// and clip; every later call returns the same prepared offsets.
+    pub fn prepared(&self, index: usize, clip: &str) -> ApiResult<Arc<smear::Prepared>> {
+        let key = (index, clip.to_string());
+        let _one_at_a_time = lock(&self.preparing);
+        if let Some(p) = lock(&self.prepared).get(&key) {
+            return Ok(p.clone());
+        }
+        let sampled = self.sampled(index, clip)?;
+        let label = self.file(index)?.label();
+        let p = smear::prepare((*sampled).clone(), &smear::PrepareOptions::default())
+            .map_err(|e| ApiError::bad(format!("{label}: {e}")))?;
+        let p = Arc::new(p);
+        lock(&self.prepared).insert(key, p.clone());
+        Ok(p)
+    }
+}

@@ -1,0 +1,37 @@
+// Talking to the studio server: JSON, and packed float32/uint32 buffers (see crates/studio/src/pack.rs).
+
+async function check(response) {
+  if (response.ok) return response;
+  let message = `${response.status} ${response.statusText}`;
+  try { message = (await response.json()).error || message; } catch (_) { /* not JSON */ }
+  throw new Error(message);
+}
+
+export async function getJSON(url) {
+  return (await check(await fetch(url))).json();
+}
+
+export async function postJSON(url, body) {
+  const r = await fetch(url, { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body) });
+  return (await check(r)).json();
+}
+
+/** A packed response: `header` and typed views of its buffers by name. */
+export function parsePack(buffer) {
+  const view = new DataView(buffer);
+  const length = view.getUint32(0, true);
+  const header = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 4, length)));
+  const base = 4 + length;
+  const buffers = {};
+  for (const b of header.buffers) {
+    const Kind = b.type === 'u32' ? Uint32Array : Float32Array;
+    buffers[b.name] = new Kind(buffer, base + b.offset, b.count);
+  }
+  return { header, buffers };
+}
+
+export async function getPack(url, body) {
+  const init = body === undefined ? {} : { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body) };
+  const r = await check(await fetch(url, init));
+  return parsePack(await r.arrayBuffer());
+}

@@ -1,0 +1,220 @@
+// The 3D viewport: the animation (one frame of a frames × vertices × 3 buffer at a time),
+// multiples (alpha-blended copies), motion lines, offsets colouring, part colouring,
+// an orbit camera, and an orthographic action camera for drawing lines of action.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+
+const BASE = new THREE.Color(0.78, 0.78, 0.8);
+
+export class Viewport {
+  constructor(canvas) {
+    this.canvas = canvas;
+    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+    this.renderer.setPixelRatio(1);
+    this.scene = new THREE.Scene();
+    this.scene.background = new THREE.Color(0x33363b);
+    this.scene.add(new THREE.HemisphereLight(0xffffff, 0x444455, 2.2));
+    const sun = new THREE.DirectionalLight(0xffffff, 1.6);
+    sun.position.set(2, 4, 3);
+    this.scene.add(sun);
+    this.perspective = new THREE.PerspectiveCamera(40, 1, 0.01, 1000);
+    this.ortho = new THREE.OrthographicCamera(-1, 1, 1, -1, -1000, 1000);
+    this.camera = this.perspective;
+    this.controls = new OrbitControls(this.perspective, canvas);
+    this.material = new THREE.MeshStandardMaterial({ color: 0xffffff, vertexColors: true, roughness: 0.7, side: THREE.DoubleSide });
+    this.mesh = null;
+    this.anim = null;
+    this.frame = 0;
+    this.copies = [];
+    this.lines = [];
+    this.offsets = null;
+    this.vertexColors = null;
+    this.onRendered = [];
+    this.resize();
+    new ResizeObserver(() => this.resize()).observe(canvas);
+  }
+
+  resize() {
+    const w = this.canvas.clientWidth || 1, h = this.canvas.clientHeight || 1;
+    this.renderer.setSize(w, h, false);
+    this.perspective.aspect = w / h;
+    this.perspective.updateProjectionMatrix();
+    if (this.action) this.setActionCamera(this.action);
+    this.dirty = true;
+  }
+
+  /** Shows an animation: {triangles: Uint32Array, positions: Float32Array, frames, vertices}. */
+  setAnimation(anim, { frame = true } = {}) {
+    const reuse = this.mesh && this.anim && this.anim.vertices === anim.vertices && this.anim.triangles === anim.triangles;
+    this.anim = anim;
+    if (!reuse) {
+      if (this.mesh) { this.scene.remove(this.mesh); this.mesh.geometry.dispose(); }
+      const g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(anim.vertices * 3), 3));
+      g.setAttribute('color', new THREE.BufferAttribute(new Float32Array(anim.vertices * 3).fill(0.78), 3));
+      g.setIndex(new THREE.BufferAttribute(anim.triangles, 1));
+      this.mesh = new THREE.Mesh(g, this.material);
+      this.mesh.frustumCulled = false;
+      this.scene.add(this.mesh);
+      if (frame) this.frameCamera(anim);
+    }
+    this.setFrame(Math.min(this.frame, anim.frames - 1));
+  }
+
+  frameCamera(anim) {
+    const n = anim.vertices;
+    const box = new THREE.Box3();
+    const p = new THREE.Vector3();
+    for (let i = 0; i < n; i++) box.expandByPoint(p.fromArray(anim.positions, i * 3));
+    const c = box.getCenter(new THREE.Vector3());
+    const r = box.getSize(new THREE.Vector3()).length() / 2 || 1;
+    this.perspective.near = r / 100; this.perspective.far = r * 100;
+    this.perspective.position.set(c.x, c.y + r * 0.2, c.z + r * 2.6);
+    this.perspective.updateProjectionMatrix();
+    this.controls.target.copy(c);
+    this.controls.update();
+  }
+
+  /** The orthographic action camera of /api/loa/view (or null for the orbit camera). */
+  setActionCamera(action) {
+    this.action = action;
+    if (!action) { this.camera = this.perspective; this.controls.enabled = true; this.dirty = true; return; }
+    const w = this.canvas.clientWidth || 1, h = this.canvas.clientHeight || 1;
+    const hh = action.half_height, hw = hh * w / h;
+    const o = this.ortho;
+    o.left = -hw; o.right = hw; o.top = hh; o.bottom = -hh;
+    const c = new THREE.Vector3(...action.center), f = new THREE.Vector3(...action.forward);
+    o.position.copy(c).addScaledVector(f, -hh * 10);
+    o.up.set(...action.up);
+    o.lookAt(c);
+    o.near = -hh * 100; o.far = hh * 100;
+    o.updateProjectionMatrix();
+    this.camera = o;
+    this.controls.enabled = false;
+    this.dirty = true;
+  }
+
+  setFrame(f) {
+    if (!this.anim) return;
+    this.frame = Math.max(0, Math.min(f, this.anim.frames - 1));
+    const n = this.anim.vertices * 3;
+    const pos = this.mesh.geometry.attributes.position;
+    pos.array.set(this.anim.positions.subarray(this.frame * n, (this.frame + 1) * n));
+    pos.needsUpdate = true;
+    this.mesh.geometry.computeVertexNormals();
+    this.mesh.geometry.computeBoundingSphere();
+    this.updateColors();
+    for (const c of this.copies) this.copyFrame(c);
+    for (const l of this.lines) this.lineFrame(l);
+    this.dirty = true;
+  }
+
+  /** Per-frame offsets (frames × vertices) to colour red (leading) / blue (trailing), or null. */
+  setOffsets(offsets) { this.offsets = offsets; this.updateColors(); this.dirty = true; }
+
+  /** Fixed per-vertex colours (Float32Array vertices × 3), or null. */
+  setVertexColors(colors) { this.vertexColors = colors; this.updateColors(); this.dirty = true; }
+
+  updateColors() {
+    if (!this.mesh) return;
+    const col = this.mesh.geometry.attributes.color;
+    const n = this.anim.vertices;
+    if (this.vertexColors && this.vertexColors.length === n * 3) {
+      col.array.set(this.vertexColors);
+    } else if (this.offsets && this.offsets.length >= (this.frame + 1) * n) {
+      const d = this.offsets.subarray(this.frame * n, (this.frame + 1) * n);
+      for (let i = 0; i < n; i++) {
+        const v = Math.max(-1, Math.min(1, d[i]));
+        const a = Math.abs(v);
+        const [r, g, b] = v >= 0 ? [1, 1 - a, 1 - a] : [1 - a, 1 - a, 1];
+        col.array[i * 3] = r * 0.9; col.array[i * 3 + 1] = g * 0.9; col.array[i * 3 + 2] = b * 0.9;
+      }
+    } else {
+      for (let i = 0; i < n; i++) { col.array[i * 3] = BASE.r; col.array[i * 3 + 1] = BASE.g; col.array[i * 3 + 2] = BASE.b; }
+    }
+    col.needsUpdate = true;
+  }
+
+  clearEffects() {
+    for (const o of [...this.copies, ...this.lines]) { this.scene.remove(o.mesh); o.mesh.geometry.dispose(); o.mesh.material.dispose(); }
+    this.copies = []; this.lines = [];
+  }
+
+  /** Multiples: [{positions (frames × v × 3), alpha (frames × v), triangles, vertices}]. */
+  setCopies(copies) {
+    for (const c of this.copies) { this.scene.remove(c.mesh); c.mesh.geometry.dispose(); c.mesh.material.dispose(); }
+    this.copies = copies.map((c) => {
+      const g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(c.vertices * 3), 3));
+      g.setAttribute('color', new THREE.BufferAttribute(new Float32Array(c.vertices * 4), 4));
+      g.setIndex(new THREE.BufferAttribute(c.triangles, 1));
+      const m = new THREE.MeshStandardMaterial({ vertexColors: true, transparent: true, depthWrite: false, side: THREE.DoubleSide });
+      const mesh = new THREE.Mesh(g, m);
+      mesh.frustumCulled = false;
+      this.scene.add(mesh);
+      const o = { ...c, mesh };
+      this.copyFrame(o);
+      return o;
+    });
+    this.dirty = true;
+  }
+
+  copyFrame(c) {
+    const n = c.vertices, f = Math.min(this.frame, c.positions.length / (n * 3) - 1);
+    const g = c.mesh.geometry;
+    g.attributes.position.array.set(c.positions.subarray(f * n * 3, (f + 1) * n * 3));
+    const col = g.attributes.color.array;
+    for (let i = 0; i < n; i++) { col[i * 4] = 0.8; col[i * 4 + 1] = 0.8; col[i * 4 + 2] = 0.8; col[i * 4 + 3] = c.alpha[f * n + i]; }
+    g.attributes.position.needsUpdate = true; g.attributes.color.needsUpdate = true;
+    g.computeVertexNormals();
+  }
+
+  /** Motion lines: [{counts (frames × 2), positions, triangles, alpha}] — one mesh per frame. */
+  setLines(lines) {
+    for (const l of this.lines) { this.scene.remove(l.mesh); l.mesh.geometry.dispose(); l.mesh.material.dispose(); }
+    this.lines = lines.map((l) => {
+      const frames = l.counts.length / 2;
+      const vstart = [0], tstart = [0];
+      for (let f = 0; f < frames; f++) { vstart.push(vstart[f] + l.counts[2 * f]); tstart.push(tstart[f] + l.counts[2 * f + 1]); }
+      const m = new THREE.MeshBasicMaterial({ color: 0x111111, transparent: true, opacity: 0.9, side: THREE.DoubleSide });
+      const mesh = new THREE.Mesh(new THREE.BufferGeometry(), m);
+      mesh.frustumCulled = false;
+      this.scene.add(mesh);
+      const o = { ...l, vstart, tstart, mesh };
+      this.lineFrame(o);
+      return o;
+    });
+    this.dirty = true;
+  }
+
+  lineFrame(l) {
+    const f = Math.min(this.frame, l.vstart.length - 2);
+    const v0 = l.vstart[f], v1 = l.vstart[f + 1], t0 = l.tstart[f], t1 = l.tstart[f + 1];
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.BufferAttribute(l.positions.slice(v0 * 3, v1 * 3), 3));
+    const idx = l.triangles.slice(t0 * 3, t1 * 3);
+    g.setIndex(new THREE.BufferAttribute(idx, 1));
+    l.mesh.geometry.dispose();
+    l.mesh.geometry = g;
+  }
+
+  /** The triangle under a canvas pixel, or -1. */
+  pick(x, y) {
+    if (!this.mesh) return -1;
+    const w = this.canvas.clientWidth, h = this.canvas.clientHeight;
+    const ray = new THREE.Raycaster();
+    ray.setFromCamera(new THREE.Vector2((x / w) * 2 - 1, -(y / h) * 2 + 1), this.camera);
+    const hit = ray.intersectObject(this.mesh, false)[0];
+    return hit ? { triangle: hit.faceIndex, point: hit.point } : -1;
+  }
+
+  render() {
+    this.renderer.render(this.scene, this.camera);
+    this.dirty = false;
+    const done = this.onRendered; this.onRendered = [];
+    for (const f of done) f();
+  }
+
+  /** Resolves after the next render. */
+  rendered() { this.dirty = true; return new Promise((resolve) => this.onRendered.push(resolve)); }
+}
