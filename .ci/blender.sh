@@ -4,7 +4,8 @@
 # target/pywheels/ when it is there), then on real Blender through `bpy` from PyPI -- 4.2.0
 # LTS (reusing caches.sh's target/caches-venv) and 5.0.1 (own venv), each with numpy<2 --
 # installs the zip with bpy.ops.extensions.package_install_files and runs
-# blender/tests/test_smear.py (one PASS/FAIL line per test, non-zero exit on a failure).
+# blender/tests/test_smear.py and test_stopmo.py (one PASS/FAIL line per test, non-zero exit
+# on a failure).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT="$PWD"
@@ -32,7 +33,10 @@ for spec in "4.2.0:target/caches-venv" "5.0.1:target/blender-venv-5.0"; do
     out="target/blender-out-$version"
     rm -rf "$out" "target/blender-user-$version"
     echo "== Blender $version"
-    BLENDER_USER_RESOURCES="$ROOT/target/blender-user-$version" \
-        "$dir/bin/python" blender/tests/test_smear.py "$zip" "$out" || status=1
+    for t in smear stopmo; do
+        rm -rf "target/blender-user-$version"
+        BLENDER_USER_RESOURCES="$ROOT/target/blender-user-$version" \
+            "$dir/bin/python" "blender/tests/test_$t.py" "$zip" "$out/$t" || status=1
+    done
 done
 exit $status

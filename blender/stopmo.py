@@ -63,9 +63,10 @@ def parts_of(obj, triangles):
 
 
 def options(s):
-    count = {"EACH": {"each": s.pieces}, "BUDGET": {"budget": s.budget},
+    """Keyword arguments of `toonkit.stopmo.run` from the panel."""
+    count = {"EACH": {"pieces": s.pieces}, "BUDGET": {"budget": s.budget},
              "MAX_ERROR": {"max_error_mm": s.max_error_mm}}[s.count]
-    opts = {"pieces": count, "lambda": s.lam, "restarts": s.restarts, "seed": s.seed,
+    opts = {**count, "lambda": s.lam, "restarts": s.restarts, "seed": s.seed,
             "print_height_mm": s.print_height_mm}
     if s.plugs:
         opts["plugs"] = {}

@@ -52,6 +52,9 @@ def world_positions(obj, frame=None):
 
 
 def run(tests):
+    only = os.environ.get("TOONKIT_TESTS")  # comma-separated names: run only those
+    if only:
+        tests = [t for t in tests if t.__name__ in only.split(",")]
     failed = 0
     for t in tests:
         start = time.perf_counter()

@@ -118,4 +118,5 @@ def test_stopmo_errors():
 
 
 if __name__ == "__main__":
-    sys.exit(run([test_stopmo_errors, test_stopmo_run_matches_the_module]))
+    code = run([test_stopmo_errors, test_stopmo_run_matches_the_module])
+    os._exit(code)  # bpy's interpreter teardown can crash after a headless run

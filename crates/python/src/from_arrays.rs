@@ -21,6 +21,7 @@ pub(crate) fn sampled(
     fps: f32,
     skin: Option<&Bound<'_, PyDict>>,
     objects: Option<Vec<(String, usize, usize)>>,
+    attributes: Vec<(String, Vec<f32>)>,
 ) -> PyResult<SampledScene> {
     if !(fps.is_finite() && fps > 0.0) {
         return Err(value_error(format!(
@@ -50,7 +51,16 @@ pub(crate) fn sampled(
         }
         tris.push(tri);
     }
-    let mesh = Mesh::new("arrays", points[..vertices].to_vec(), tris);
+    let mut mesh = Mesh::new("arrays", points[..vertices].to_vec(), tris);
+    for (name, values) in attributes {
+        if values.len() != vertices {
+            return Err(value_error(format!(
+                "attributes[{name:?}] has {} values for {vertices} vertices",
+                values.len()
+            )));
+        }
+        mesh.attributes.insert(name, values);
+    }
     let animation =
         MeshAnimation::new(mesh, fps, points).map_err(|e| value_error(at(SOURCE, e)))?;
     let mut scene = SampledScene::from_animation(animation);
@@ -117,7 +127,11 @@ fn split_objects(
         for f in 0..frames {
             positions.extend_from_slice(&whole.animation.frame(f)[*a..*b]);
         }
-        let mesh = Mesh::new(name.clone(), positions[..b - a].to_vec(), tris);
+        let mut mesh = Mesh::new(name.clone(), positions[..b - a].to_vec(), tris);
+        for (attribute, values) in &whole.animation.mesh.attributes {
+            mesh.attributes
+                .insert(attribute.clone(), values[*a..*b].to_vec());
+        }
         let animation = MeshAnimation::new(mesh, whole.animation.fps, positions)
             .map_err(|e| value_error(at(SOURCE, e)))?;
         let skin = whole.skin.as_ref().and_then(|s| {

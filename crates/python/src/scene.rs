@@ -187,6 +187,9 @@ impl Scene {
     /// ``Scene.objects`` returns them) splits the mesh into objects: an object without skin
     /// weights is a simple object (SMEAR Eq. 1), carried by ``skin["object_parents"][i]``.
     ///
+    /// ``attributes`` (``{name: (vertices,) float32}``) are scalar per-vertex attributes, e.g.
+    /// painted weights for a style's ``weights = { attribute = "name" }``.
+    ///
     /// Arrays are read in place when they are C-contiguous float32 (int for indices).
     ///
     /// >>> s = toonkit.load("assets/characters/RobotExpressive.glb", clip="Dance")
@@ -194,7 +197,7 @@ impl Scene {
     /// >>> t.positions.shape == s.positions.shape
     /// True
     #[staticmethod]
-    #[pyo3(signature = (positions, triangles, fps=24.0, skin=None, objects=None))]
+    #[pyo3(signature = (positions, triangles, fps=24.0, skin=None, objects=None, attributes=None))]
     fn from_arrays(
         py: Python<'_>,
         positions: crate::arrays::ArrayIn<'_, f32>,
@@ -202,7 +205,16 @@ impl Scene {
         fps: f32,
         skin: Option<&Bound<'_, PyDict>>,
         objects: Option<Vec<(String, Bound<'_, PyAny>)>>,
+        attributes: Option<std::collections::BTreeMap<String, crate::arrays::ArrayIn<'_, f32>>>,
     ) -> PyResult<Scene> {
+        let attributes = attributes
+            .unwrap_or_default()
+            .into_iter()
+            .map(|(name, a)| {
+                crate::arrays::shape(&a, &format!("attributes[{name:?}]"), &[None])?;
+                Ok((name, crate::arrays::values(&a).into_owned()))
+            })
+            .collect::<PyResult<Vec<_>>>()?;
         let objects = objects
             .map(|list| {
                 list.into_iter()
@@ -214,7 +226,8 @@ impl Scene {
                     .collect::<PyResult<Vec<_>>>()
             })
             .transpose()?;
-        let sampled = crate::from_arrays::sampled(&positions, &triangles, fps, skin, objects)?;
+        let sampled =
+            crate::from_arrays::sampled(&positions, &triangles, fps, skin, objects, attributes)?;
         Scene::new(py, sampled, "<arrays>".to_string(), None)
     }
 

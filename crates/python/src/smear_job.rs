@@ -240,28 +240,31 @@ impl Stylized {
         output(py, &[frames, vertices, 3], data)
     }
 
-    /// The multiple in-betweens: one dict per copy, ``{"name", "positions" (frames, v, 3),
-    /// "triangles" (t, 3), "alpha" (frames, v)}`` (per-vertex opacity, SMEAR Eq. 12).
+    /// The multiple in-betweens: one dict per copy, ``{"name", "object" (index into
+    /// ``scene.objects``), "positions" (frames, v, 3), "triangles" (t, 3), "alpha" (frames,
+    /// v)}`` (per-vertex opacity, SMEAR Eq. 12).
     #[getter]
     fn multiples<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         let mut out = Vec::new();
-        for o in &self.stylized.objects {
+        for (k, o) in self.stylized.objects.iter().enumerate() {
             for i in o.copies.clone() {
                 if let Some((a, c)) = self.animation_part(i) {
-                    out.push(animation_dict(py, a, c)?);
+                    let d = animation_dict(py, a, c)?;
+                    d.set_item("object", k)?;
+                    out.push(d);
                 }
             }
         }
         Ok(out)
     }
 
-    /// The motion lines: one dict per object with lines, ``{"name", "frames": [{"positions"
-    /// (n, 3), "triangles" (t, 3), "alpha" (n,)}, ...]}`` (one tube mesh per frame; empty
-    /// where no line shows).
+    /// The motion lines: one dict per object with lines, ``{"name", "object" (index into
+    /// ``scene.objects``), "frames": [{"positions" (n, 3), "triangles" (t, 3), "alpha" (n,)},
+    /// ...]}`` (one tube mesh per frame; empty where no line shows).
     #[getter]
     fn lines<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         let mut out = Vec::new();
-        for o in &self.stylized.objects {
+        for (k, o) in self.stylized.objects.iter().enumerate() {
             let Some(i) = o.lines else { continue };
             let Some(anim::FlipbookPart::Frames { name, meshes }) =
                 self.stylized.flipbook.parts.get(i)
@@ -287,6 +290,7 @@ impl Stylized {
                 .collect::<PyResult<Vec<_>>>()?;
             let d = PyDict::new(py);
             d.set_item("name", name)?;
+            d.set_item("object", k)?;
             d.set_item("frames", frames)?;
             out.push(d);
         }

@@ -1,6 +1,7 @@
 """toonkit.load and toonkit.Scene against the CLI's reading of the same files."""
 
 import numpy as np
+import pytest
 
 import toonkit
 from conftest import ROBOT, asset, cli_json, read_pc2, run_cli
@@ -74,3 +75,24 @@ def test_from_arrays_without_skin(robot):
     np.testing.assert_array_equal(s.triangles, robot.triangles)
     assert s.fps == 30.0 and s.skin is None and s.joint_names == []
     assert [r for _, r in s.objects] == [range(0, robot.vertex_count)]
+
+
+def test_from_arrays_attributes_are_painted_weights(robot):
+    # A painted attribute (e.g. a Blender vertex group) drives `weights = { attribute }`:
+    # weight 0 everywhere leaves the input untouched, weight 1 equals no weights at all.
+    scene = lambda w: toonkit.Scene.from_arrays(  # noqa: E731
+        robot.positions, robot.triangles, fps=robot.fps, skin=robot.skin,
+        objects=robot.objects, attributes={"paint": w},
+    )
+    n = robot.vertex_count
+    style = {"elongate": {"function": {"stages": [{"op": "weight"}, {"op": "scale", "by": 3}]}},
+             "weights": {"attribute": "paint"}}
+    zero = toonkit.smear.stylize(toonkit.smear.prepare(scene(np.zeros(n, np.float32))), style)
+    np.testing.assert_array_equal(zero.elongated, robot.positions)
+    one = toonkit.smear.stylize(toonkit.smear.prepare(scene(np.ones(n, np.float32))), style)
+    plain = toonkit.smear.stylize(toonkit.smear.prepare(robot), {
+        "elongate": {"function": {"stages": [{"op": "scale", "by": 3}]}}})
+    np.testing.assert_allclose(one.elongated, plain.elongated, atol=1e-5)
+    assert np.abs(one.elongated - robot.positions).max() > 1e-3
+    with pytest.raises(ValueError, match="attributes"):
+        scene(np.ones(n + 1, np.float32))

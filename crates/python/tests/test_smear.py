@@ -130,6 +130,18 @@ def test_restyling_reuses_the_offsets(prepared):
         f, v, _ = c["positions"].shape
         assert c["alpha"].shape == (f, v) and c["triangles"].shape[1] == 3
         assert 0.0 <= c["alpha"].min() and c["alpha"].max() <= 1.0
+        # "object" indexes scene.objects: the copy has that object's vertices.
+        name, r = prepared_objects(prepared)[c["object"]]
+        assert v == len(r) and c["name"].startswith(name)
+
+
+def prepared_objects(prepared):
+    """`(name, range)` per object of a prepared scene, from its report."""
+    out, start = [], 0
+    for o in prepared.report["objects"]:
+        out.append((o["name"], range(start, start + o["vertices"])))
+        start += o["vertices"]
+    return out
 
 
 def test_multiples_only_style_keeps_the_body(robot, prepared):
@@ -143,6 +155,7 @@ def test_motion_lines(robot, prepared):
     shown = []
     for obj in look.lines:
         assert len(obj["frames"]) == robot.frame_count
+        assert obj["name"] == robot.objects[obj["object"]][0] + "_lines"
         shown += [m for m in obj["frames"] if len(m["triangles"])]
     assert shown
     for m in shown:

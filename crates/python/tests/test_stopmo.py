@@ -56,3 +56,11 @@ def test_bad_parts_raise(face):
         toonkit.stopmo.segment(face, parts={"a": [(0, 0)]})
     with pytest.raises(ValueError, match="options"):
         toonkit.stopmo.library(toonkit.stopmo.segment(face, parts=PARTS), pieces=-1)
+
+
+def test_budget_replaces_the_piece_count(face):
+    lib = toonkit.stopmo.run(face, parts=PARTS, budget=5, restarts=1)
+    assert len(lib.pieces) == 5
+    with pytest.raises(ValueError, match="budget"):
+        toonkit.stopmo.library(toonkit.stopmo.segment(face, parts=PARTS), budget=4,
+                               max_error_mm=1.0)

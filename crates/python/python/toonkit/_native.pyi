@@ -21,6 +21,7 @@ class Scene:
         fps: float = 24.0,
         skin: Optional[Mapping[str, Any]] = None,
         objects: Optional[Sequence[tuple[str, range]]] = None,
+        attributes: Optional[Mapping[str, npt.ArrayLike]] = None,
     ) -> Scene: ...
     @property
     def positions(self) -> npt.NDArray[np.float32]: ...

@@ -54,7 +54,15 @@ def _segment_options(parts, gamma, homogenize, options) -> dict:
 
 
 def _library_options(pieces, options) -> dict:
-    if isinstance(pieces, Mapping):
+    options = dict(options)
+    budget, max_error = options.pop("budget", None), options.pop("max_error_mm", None)
+    if budget is not None and max_error is not None:
+        raise ValueError("pieces: give budget or max_error_mm, not both")
+    if budget is not None:
+        count: Any = {"budget": int(budget)}
+    elif max_error is not None:
+        count = {"max_error_mm": float(max_error)}
+    elif isinstance(pieces, Mapping):
         count: Any = {"per_part": {str(k): int(v) for k, v in pieces.items()}}
     else:
         count = {"each": int(pieces)}
@@ -91,7 +99,9 @@ def library(
     """Builds the replacement library of each part and labels every frame (StopShop
     Eqs. 10-16), as ``toonkit stopmo library``.
 
-    ``pieces`` is a count for every part or a dict per part; other ``options`` are the stopmo
+    ``pieces`` is a count for every part or a dict per part; ``budget=N`` (a total over all
+    parts) or ``max_error_mm=E`` (the smallest library within that error) replace it; other
+    ``options`` are the stopmo
     crate's ``LibraryJobOptions`` (``restarts``, ``seed``, ``method``, ``print_height_mm``,
     ``plugs``, ...). Returns a :class:`Library` with ``.labels`` ``(frames, parts)``,
     ``.pieces``, ``.assembly``, ``.report`` and ``.save(dir)`` (the CLI's layout).
