@@ -53,7 +53,7 @@ fn push_view(
     bytes: &[u8],
     stride: Option<usize>,
 ) -> usize {
-    while out.len() % 4 != 0 {
+    while !out.len().is_multiple_of(4) {
         out.push(0);
     }
     let mut v = json!({"buffer": buffer, "byteOffset": out.len(), "byteLength": bytes.len()});

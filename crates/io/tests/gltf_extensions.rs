@@ -28,7 +28,7 @@ fn split(bytes: &[u8]) -> (Value, Vec<u8>) {
 /// A GLB from JSON and binary chunk.
 fn join(json: &Value, bin: Vec<u8>) -> Vec<u8> {
     let mut bin = bin;
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let mut json = json.clone();
@@ -298,7 +298,7 @@ fn meshopt_compressed_views_decode_to_the_original_data() {
             &mut ws,
         )
         .unwrap();
-        while compressed.len() % 4 != 0 {
+        while !compressed.len().is_multiple_of(4) {
             compressed.push(0);
         }
         view["extensions"] = json!({"EXT_meshopt_compression": {
