@@ -61,7 +61,10 @@ pub(crate) fn smear_error(source: &str, e: smear::SmearError) -> PyErr {
         | E::PruneWithoutAncestor { .. }
         | E::UnknownAttribute { .. }
         | E::UnknownCamera { .. }
-        | E::UnknownObject { .. } => value_error(msg),
+        | E::UnknownObject { .. }
+        | E::InvalidParameter {
+            name: "revolve", ..
+        } => value_error(msg),
         _ => toonkit_error(msg),
     }
 }

@@ -20,6 +20,7 @@ mod progress;
 mod scene;
 mod smear_job;
 mod smear_py;
+mod smear_stream;
 mod stopmo_py;
 
 use pyo3::prelude::*;
@@ -35,6 +36,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(smear_py::offsets, m)?)?;
     m.add_class::<smear_job::Prepared>()?;
     m.add_class::<smear_job::Stylized>()?;
+    m.add_class::<smear_stream::Stream>()?;
     m.add_function(wrap_pyfunction!(smear_job::prepare, m)?)?;
     m.add_function(wrap_pyfunction!(smear_job::stylize, m)?)?;
     m.add_class::<loa_py::Line>()?;

@@ -74,7 +74,7 @@ impl Prepared {
 /// The native half of `toonkit.smear.prepare`; `options_json` holds the other
 /// `PrepareOptions` fields (`weights`, `merge`) as JSON.
 #[pyfunction(name = "smear_prepare")]
-#[pyo3(signature = (scene, smooth=smear::DEFAULT_SMOOTH, whole_body=false, prune=Vec::new(), camera=None, options_json=None, progress=None))]
+#[pyo3(signature = (scene, smooth=smear::DEFAULT_SMOOTH, whole_body=false, prune=Vec::new(), camera=None, options_json=None, progress=None, causal=false, revolve=Vec::new()))]
 pub(crate) fn prepare(
     py: Python<'_>,
     scene: &Bound<'_, Scene>,
@@ -84,6 +84,8 @@ pub(crate) fn prepare(
     camera: Option<CameraArg>,
     options_json: Option<&str>,
     progress: Option<Py<PyAny>>,
+    causal: bool,
+    revolve: Vec<String>,
 ) -> PyResult<Prepared> {
     let scene = scene.get();
     scene.merged_check()?;
@@ -93,7 +95,7 @@ pub(crate) fn prepare(
         }
         None => PrepareOptions::default(),
     };
-    options.offsets = offset_options(smooth, whole_body, prune, camera);
+    options.offsets = offset_options(smooth, whole_body, prune, camera, (causal, revolve));
     report(py, progress.as_ref(), "prepare", 0.0)?;
     let sampled = scene.sampled.clone();
     let prepared = py

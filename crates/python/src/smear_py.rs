@@ -23,8 +23,11 @@ pub(crate) fn offset_options(
     whole_body: bool,
     prune: Vec<String>,
     camera: Option<CameraArg>,
+    (causal, revolve): (bool, Vec<String>),
 ) -> OffsetOptions {
     OffsetOptions {
+        causal,
+        revolve,
         smooth,
         whole_body,
         prune,
@@ -51,7 +54,7 @@ pub(crate) fn offset_options(
 /// >>> delta.shape == scene.positions.shape[:2]
 /// True
 #[pyfunction(name = "smear_offsets")]
-#[pyo3(signature = (scene, smooth=smear::DEFAULT_SMOOTH, whole_body=false, prune=Vec::new(), camera=None, progress=None))]
+#[pyo3(signature = (scene, smooth=smear::DEFAULT_SMOOTH, whole_body=false, prune=Vec::new(), camera=None, progress=None, causal=false, revolve=Vec::new()))]
 pub(crate) fn offsets<'py>(
     py: Python<'py>,
     scene: &Bound<'py, Scene>,
@@ -60,10 +63,12 @@ pub(crate) fn offsets<'py>(
     prune: Vec<String>,
     camera: Option<CameraArg>,
     progress: Option<Py<PyAny>>,
+    causal: bool,
+    revolve: Vec<String>,
 ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
     let scene = scene.get();
     scene.merged_check()?;
-    let options = offset_options(smooth, whole_body, prune, camera);
+    let options = offset_options(smooth, whole_body, prune, camera, (causal, revolve));
     report(py, progress.as_ref(), "offsets", 0.0)?;
     let sampled = scene.sampled.clone();
     let merged = py

@@ -35,6 +35,8 @@ pub(crate) struct RibbonField {
 pub(crate) struct Tolerances {
     pub(crate) still: f32,
     pub(crate) zero_length: f32,
+    /// Past-only velocities (causal mode, issue #22): backward differences.
+    pub(crate) causal: bool,
 }
 
 impl Field {
@@ -51,9 +53,7 @@ impl Field {
         space: Option<&CameraSpace>,
     ) -> (Field, Vec<f32>) {
         let mut raw = vec![0.0f32; frames * vertices];
-        let planes = plane_frames(
-            positions, frames, vertices, triangles, tol.still, space, &mut raw,
-        );
+        let planes = plane_frames(positions, frames, vertices, triangles, tol, space, &mut raw);
         (Field::Plane(planes), raw)
     }
 
@@ -107,8 +107,11 @@ impl Field {
             .for_each(|(f, out)| {
                 for (k, r) in out.iter_mut().enumerate() {
                     let bone = bones[f * joints + k];
-                    let vr = track_velocity(f, frames, space, |g| bones[g * joints + k].root);
-                    let vt = track_velocity(f, frames, space, |g| bones[g * joints + k].tip);
+                    let vr = track_velocity(f, frames, space, tol.causal, |g| {
+                        bones[g * joints + k].root
+                    });
+                    let vt =
+                        track_velocity(f, frames, space, tol.causal, |g| bones[g * joints + k].tip);
                     *r = Ribbon::new(bone.root, bone.tip, vr, vt, tol.still, tol.zero_length);
                 }
             });

@@ -52,6 +52,28 @@
 //! | SMEAR Eq. 13 (motion lines) | [`motion_lines`], [`motion_lines_frame`], [`LinesStyle`] |
 //! | Section 5 (stylization functions) | [`FunctionSpec`], [`Stage`], [`Expression`], [`warp_offset`], [`voronoi_f1`] |
 //!
+//! # Beyond the paper (issue #22)
+//! * **Adaptive subdivision** ([`Style::subdivide`], [`subdivide_frame`]): output edges longer
+//!   than TOL × their rest length are split, crack-free; a new vertex is a blend of the input
+//!   vertices of its triangle and follows the same blend of their trajectories, displaced by
+//!   the blend of their β (Catmull-Rom is linear in its control points), so it lies on the
+//!   smear. Results then have one mesh per frame (`anim::FlipbookPart::Frames`).
+//! * **Revolving parts** ([`OffsetOptions::revolve`], [`Arcs`], [`fit_screw`]): the paper's
+//!   Fig. 19 limitation. Per frame interval the rigid motion is fitted as a screw; offsets are
+//!   SMEAR Eq. 1 with the plane replaced by the half-plane through the axis (signed arc length
+//!   ahead of each piece's angular centre) and trajectories follow the screw arcs, so
+//!   elongated blades stay on their circles. The construction is documented in `revolve`.
+//! * **Contact** ([`Style::contact`], [`ContactStyle`]): a displacement that would end below
+//!   the ground plane stops where its trajectory reaches it ([`Trajectories::displaced`]);
+//!   optional volume-preserving squash on impact ([`squash_frames`]).
+//! * **Causal mode** ([`OffsetOptions::causal`]) and **streaming** ([`Stream`]): backward
+//!   velocity differences, the past half of SMEAR Eq. 2's window
+//!   ([`causal_smoothing_weights`]) and trajectories that extrapolate past the current frame
+//!   ([`Trajectories::seen_from`]): frame f's result reads frames ≤ f only. Visual
+//!   difference from the offline mode: the smear lags (smoothed offsets by about N/3 frames,
+//!   velocities by half a frame) and the leading half of an elongation is a straight
+//!   extrapolation of the last motion, so it overshoots when the motion stops or turns.
+//!
 //! # Building blocks
 //! * Simple objects (SMEAR Eq. 1): signed distance to the plane through the area-weighted
 //!   surface centroid ([`surface_centroid`]) with the direction of motion as normal,
@@ -91,10 +113,12 @@ mod job;
 mod offsets;
 mod options;
 mod plane;
+mod revolve;
 mod ribbon;
 mod rig;
 mod smooth;
 mod solver;
+mod stream;
 mod stylize;
 mod surface;
 mod velocity;
@@ -102,10 +126,11 @@ mod velocity;
 pub use effects::{
     attribute_weights, elongate, elongate_frame, eq12_opacity, group_weights, held_frame,
     motion_lines, motion_lines_frame, multiple_opacity, multiples, multiples_frame,
-    overlap_spacing, sample_surface, surface_point_weights, EffectInputs, ElongateOptions,
-    LineFrame, LineOptions, LineStyle, MultipleCopy, MultiplesOptions, Spacing, StyleInput,
-    Stylize, Trajectories, DEFAULT_FRAME_STEP, DEFAULT_LINE_SAMPLES, DEFAULT_LINE_SIDES,
-    DEFAULT_SEED, DEFAULT_SPACING,
+    overlap_spacing, sample_surface, squash_frames, subdivide_frame, surface_point_weights,
+    ContactStyle, EffectInputs, ElongateOptions, LineFrame, LineOptions, LineStyle, MultipleCopy,
+    MultiplesOptions, Spacing, Squash, StyleInput, Stylize, SubdivisionStats, Trajectories,
+    DEFAULT_FRAME_STEP, DEFAULT_LINE_SAMPLES, DEFAULT_LINE_SIDES, DEFAULT_SEED, DEFAULT_SPACING,
+    DEFAULT_SQUASH_FRAMES, MAX_SQUASH, MAX_SUBDIVISION_LEVELS,
 };
 pub use error::{Result, SmearError};
 pub use job::{
@@ -118,9 +143,13 @@ pub use options::{
     DEFAULT_ZERO_LENGTH, STILL_ROUNDING_FACTOR,
 };
 pub use plane::surface_centroid;
+pub use revolve::{fit_screw, object_screws, revolving_offsets, Arcs, Screw, REVOLVE_AUTO};
 pub use ribbon::smoothstep;
-pub use smooth::{smooth_in_time, smoothing_weights};
+pub use smooth::{
+    causal_smoothing_weights, smooth_in_time, smooth_in_time_causal, smoothing_weights,
+};
 pub use solver::{mesh_offsets, offset_solves, scene_offsets, OffsetMode, OffsetSolver};
+pub use stream::{Stream, StreamOptions, DEFAULT_STREAM_HISTORY};
 pub use stylize::{
     apply_stages, hise_curve, voronoi_f1, warp_offset, CompiledEffects, CompiledLines,
     ElongateStyle, Expression, FunctionSpec, LinesStyle, MultiplesStyle, ObjectEffects,
@@ -129,4 +158,4 @@ pub use stylize::{
     EXPRESSION_INPUTS, MAX_EXPRESSION_VARIABLES,
 };
 pub use surface::SurfacePoint;
-pub use velocity::{camera_vertex_velocities, speeds, vertex_velocities};
+pub use velocity::{camera_vertex_velocities, causal_vertex_velocities, speeds, vertex_velocities};

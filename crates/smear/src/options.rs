@@ -47,6 +47,16 @@ pub struct OffsetOptions {
     /// Apply the collinear weight w_coll of SMEAR Eqs. 6/8 (paper Fig. 7); turning it off shows the
     /// shearing it prevents.
     pub collinear_weight: bool,
+    /// Past-only mode (issue #22): velocities by backward differences, SMEAR Eq. 2 smoothing
+    /// over past frames only, and trajectories that extrapolate instead of reading later
+    /// frames — frame f's result uses frames ≤ f only (real-time previews, games).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub causal: bool,
+    /// Objects (mesh names) that revolve about an axis (a wheel, a propeller): their offsets
+    /// and trajectories follow arcs about the fitted axis instead of SMEAR Eq. 1's plane
+    /// (issue #22; the paper's Fig. 19 limitation). `"auto"` detects them.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub revolve: Vec<String>,
 }
 
 impl Default for OffsetOptions {
@@ -57,6 +67,8 @@ impl Default for OffsetOptions {
             prune: Vec::new(),
             camera: None,
             collinear_weight: true,
+            causal: false,
+            revolve: Vec::new(),
         }
     }
 }

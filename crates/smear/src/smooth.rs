@@ -21,17 +21,34 @@ pub fn smoothing_weights(n: usize) -> Vec<f32> {
     raw.iter().map(|w| (w / sum) as f32).collect()
 }
 
+/// The past half of SMEAR Eq. 2's window for the causal mode (issue #22): w_n for
+/// n = −N..=0, renormalized to sum 1 (index `n + N` holds w_n). Frame f then reads no frame
+/// after f; the smoothed offsets lag the offline ones by about N/3 frames.
+pub fn causal_smoothing_weights(n: usize) -> Vec<f32> {
+    let w = smoothing_weights(n);
+    let past = &w[..=n];
+    let sum: f32 = past.iter().sum();
+    past.iter().map(|x| x / sum).collect()
+}
+
+/// [`smooth_in_time`] with the past-only window of [`causal_smoothing_weights`] (frames
+/// before the first clamp to it).
+pub fn smooth_in_time_causal(values: &[f32], frames: usize, vertices: usize, n: usize) -> Vec<f32> {
+    smooth_columns(values, frames, vertices, 0..vertices, n, true)
+}
+
 /// Smooths a frame-major `frames × vertices` buffer in time with SMEAR Eq. 2; frames outside the
 /// animation are clamped to the first/last frame (SPEC.md).
 ///
 /// # Performance
 /// Parallel over frames; `(2N + 1) × frames × vertices` multiply-adds.
 pub fn smooth_in_time(values: &[f32], frames: usize, vertices: usize, n: usize) -> Vec<f32> {
-    smooth_columns(values, frames, vertices, 0..vertices, n)
+    smooth_columns(values, frames, vertices, 0..vertices, n, false)
 }
 
 /// SMEAR Eq. 2 on the columns `cols` of a frame-major `frames × stride` buffer (one object's
-/// vertices inside a group), into a new frame-major `frames × cols.len()` buffer.
+/// vertices inside a group), into a new frame-major `frames × cols.len()` buffer; with
+/// `causal`, only the past half of the window ([`causal_smoothing_weights`]).
 ///
 /// # Panics
 /// If `values` is shorter than `frames × stride` or `cols` is not inside `0..stride`.
@@ -45,8 +62,14 @@ pub(crate) fn smooth_columns(
     stride: usize,
     cols: std::ops::Range<usize>,
     n: usize,
+    causal: bool,
 ) -> Vec<f32> {
     let width = cols.len();
+    let w = if causal {
+        causal_smoothing_weights(n)
+    } else {
+        smoothing_weights(n)
+    };
     let column = |g: usize| &values[g * stride + cols.start..g * stride + cols.end];
     if n == 0 || frames <= 1 || width == 0 {
         let mut out = Vec::with_capacity(frames * width);
@@ -55,7 +78,6 @@ pub(crate) fn smooth_columns(
         }
         return out;
     }
-    let w = smoothing_weights(n);
     let mut out = vec![0.0f32; frames * width];
     out.par_chunks_mut(width).enumerate().for_each(|(f, dst)| {
         for (k, &wk) in w.iter().enumerate() {
@@ -107,6 +129,20 @@ mod tests {
         for x in smooth_in_time(&c, 5, 3, 2) {
             assert!((x - 0.7).abs() < 1e-6);
         }
+    }
+
+    #[test]
+    fn causal_smoothing_reads_only_the_past() {
+        let w = causal_smoothing_weights(2);
+        assert_eq!(w.len(), 3);
+        assert!((w.iter().sum::<f32>() - 1.0).abs() < 1e-6);
+        // A step at frame 3: frames 0..=2 stay 0 in causal mode (offline, frame 2 sees it).
+        let v = [0.0, 0.0, 0.0, 1.0, 1.0, 1.0];
+        let c = smooth_in_time_causal(&v, 6, 1, 2);
+        assert_eq!(&c[..3], &[0.0, 0.0, 0.0]);
+        assert!((c[3] - w[2]).abs() < 1e-6 && (c[5] - 1.0).abs() < 1e-6);
+        assert!(smooth_in_time(&v, 6, 1, 2)[2] > 0.0);
+        assert_eq!(smooth_in_time_causal(&v, 6, 1, 0), v);
     }
 
     #[test]

@@ -78,6 +78,8 @@ struct Group {
 pub(crate) struct SolvedField {
     frames: usize,
     smooth: usize,
+    /// Past-only smoothing window (causal mode).
+    causal: bool,
     slots: Vec<Slot>,
     groups: Vec<Group>,
 }
@@ -143,10 +145,17 @@ fn tolerances(
     frames: usize,
     vertices: usize,
     space: Option<&CameraSpace>,
+    causal: bool,
 ) -> Tolerances {
     let mut b = Aabb::EMPTY;
     if vertices > 0 {
-        for f in [0, frames / 2, frames.saturating_sub(1)] {
+        // Causal mode: frame 0 only, so no threshold depends on later frames.
+        let probes = if causal {
+            [0, 0, 0]
+        } else {
+            [0, frames / 2, frames.saturating_sub(1)]
+        };
+        for f in probes {
             b = b.union(Aabb::from_points(
                 &positions[f * vertices..(f + 1) * vertices],
             ));
@@ -164,6 +173,7 @@ fn tolerances(
     Tolerances {
         still: (DEFAULT_STILL_TOLERANCE * diag).max(STILL_ROUNDING_FACTOR * scale),
         zero_length: DEFAULT_ZERO_LENGTH * diag,
+        causal,
     }
 }
 
@@ -270,7 +280,7 @@ impl SolvedField {
             let merged = merged_positions(&parts, frames);
             let positions: &[Vec3] = merged.as_deref().unwrap_or_else(|| parts[0].positions());
             let vertices: usize = parts.iter().map(|a| a.vertex_count()).sum();
-            let tol = tolerances(positions, frames, vertices, space.as_ref());
+            let tol = tolerances(positions, frames, vertices, space.as_ref(), options.causal);
             let mode = match key {
                 None => OffsetMode::Simple,
                 Some(_) if options.whole_body => OffsetMode::WholeBody,
@@ -318,6 +328,7 @@ impl SolvedField {
         Ok(SolvedField {
             frames,
             smooth: options.smooth,
+            causal: options.causal,
             slots: slots.into_iter().flatten().collect(),
             groups,
         })
@@ -344,6 +355,7 @@ impl SolvedField {
             frames,
             anim.vertex_count(),
             space.as_ref(),
+            options.causal,
         );
         let (field, raw) = Field::plane(
             anim.positions(),
@@ -356,6 +368,7 @@ impl SolvedField {
         Ok(SolvedField {
             frames,
             smooth: options.smooth,
+            causal: options.causal,
             slots: vec![Slot {
                 group: 0,
                 base: 0,
@@ -397,6 +410,7 @@ impl SolvedField {
             grp.vertices,
             slot.base..slot.base + slot.vertices,
             self.smooth,
+            self.causal,
         );
         MotionOffsets::new(self.frames, slot.vertices, values).expect("frames × vertices")
     }
@@ -461,7 +475,8 @@ impl SolvedField {
                 }
             });
         }
-        let values = crate::smooth_in_time(&raw, self.frames, np, self.smooth);
+        let values =
+            crate::smooth::smooth_columns(&raw, self.frames, np, 0..np, self.smooth, self.causal);
         MotionOffsets::new(self.frames, np, values)
     }
 }

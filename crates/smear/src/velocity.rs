@@ -6,8 +6,17 @@ use rayon::prelude::*;
 
 /// Frames `(prev, next)` and scale of the velocity difference at frame `f` of `frames`:
 /// central `(p(f+1) − p(f−1))/2` inside, one-sided at the ends, zero for one-frame clips.
+/// `causal` (past-only mode, issue #22): the backward difference `p(f) − p(f−1)` (forward
+/// at frame 0 would read the future, so frame 0 is still).
 #[inline]
-pub(crate) fn difference_frames(f: usize, frames: usize) -> (usize, usize, f32) {
+pub(crate) fn difference_frames(f: usize, frames: usize, causal: bool) -> (usize, usize, f32) {
+    if causal {
+        return if f == 0 || frames < 2 {
+            (0, 0, 0.0)
+        } else {
+            (f - 1, f, 1.0)
+        };
+    }
     if frames < 2 {
         (0, 0, 0.0)
     } else if f == 0 {
@@ -58,9 +67,10 @@ impl CameraSpace {
         &self,
         f: usize,
         frames: usize,
+        causal: bool,
         track: impl Fn(usize) -> Vec3,
     ) -> Vec3 {
-        let (a, b, s) = difference_frames(f, frames);
+        let (a, b, s) = difference_frames(f, frames, causal);
         let pa = self.view[a].transform_point3(track(a));
         let pb = self.view[b].transform_point3(track(b));
         (pb - pa) * s
@@ -74,9 +84,10 @@ impl CameraSpace {
         &self,
         f: usize,
         frames: usize,
+        causal: bool,
         track: impl Fn(usize) -> Vec3,
     ) -> Vec3 {
-        self.world[f].transform_vector3(self.camera_velocity(f, frames, track))
+        self.world[f].transform_vector3(self.camera_velocity(f, frames, causal, track))
     }
 }
 
@@ -86,12 +97,13 @@ pub(crate) fn track_velocity(
     f: usize,
     frames: usize,
     space: Option<&CameraSpace>,
+    causal: bool,
     track: impl Fn(usize) -> Vec3,
 ) -> Vec3 {
     match space {
-        Some(c) => c.relative_velocity(f, frames, track),
+        Some(c) => c.relative_velocity(f, frames, causal, track),
         None => {
-            let (a, b, s) = difference_frames(f, frames);
+            let (a, b, s) = difference_frames(f, frames, causal);
             (track(b) - track(a)) * s
         }
     }
@@ -109,6 +121,17 @@ pub fn vertex_velocities(anim: &MeshAnimation) -> Vec<Vec3> {
     velocities_impl(anim, None)
 }
 
+/// Past-only per-vertex velocities (causal mode, issue #22): `p(f) − p(f−1)`, zero at the
+/// first frame; frame `f` reads no frame after `f`.
+pub fn causal_vertex_velocities(anim: &MeshAnimation) -> Vec<Vec3> {
+    buffer_velocities(
+        anim.positions(),
+        anim.frame_count(),
+        anim.vertex_count(),
+        true,
+    )
+}
+
 /// Per-vertex velocities relative to a (moving, rotating) camera, in camera coordinates:
 /// every frame's positions are first transformed by the inverse of that frame's camera world
 /// matrix, then differenced as in [`vertex_velocities`].
@@ -118,9 +141,14 @@ pub fn camera_vertex_velocities(anim: &MeshAnimation, camera: &Camera) -> Vec<Ve
 }
 
 /// Central-difference velocities of a frame-major buffer of `frames × points` positions
-/// (world space), as [`vertex_velocities`].
-pub(crate) fn buffer_velocities(positions: &[Vec3], frames: usize, points: usize) -> Vec<Vec3> {
-    differences(positions, frames, points, None)
+/// (world space), as [`vertex_velocities`]; backward differences when `causal`.
+pub(crate) fn buffer_velocities(
+    positions: &[Vec3],
+    frames: usize,
+    points: usize,
+    causal: bool,
+) -> Vec<Vec3> {
+    differences(positions, frames, points, None, causal)
 }
 
 /// [`buffer_velocities`] relative to a camera (as [`camera_vertex_velocities`]).
@@ -129,8 +157,9 @@ pub(crate) fn camera_buffer_velocities(
     frames: usize,
     points: usize,
     space: &CameraSpace,
+    causal: bool,
 ) -> Vec<Vec3> {
-    differences(positions, frames, points, Some(space))
+    differences(positions, frames, points, Some(space), causal)
 }
 
 fn velocities_impl(anim: &MeshAnimation, space: Option<&CameraSpace>) -> Vec<Vec3> {
@@ -139,6 +168,7 @@ fn velocities_impl(anim: &MeshAnimation, space: Option<&CameraSpace>) -> Vec<Vec
         anim.frame_count(),
         anim.vertex_count(),
         space,
+        false,
     )
 }
 
@@ -147,13 +177,14 @@ fn differences(
     frames: usize,
     n: usize,
     space: Option<&CameraSpace>,
+    causal: bool,
 ) -> Vec<Vec3> {
     let mut out = vec![Vec3::ZERO; frames * n];
     if n == 0 || positions.len() < frames * n {
         return out;
     }
     out.par_chunks_mut(n).enumerate().for_each(|(f, dst)| {
-        let (a, b, s) = difference_frames(f, frames);
+        let (a, b, s) = difference_frames(f, frames, causal);
         let (pa, pb) = (
             &positions[a * n..(a + 1) * n],
             &positions[b * n..(b + 1) * n],

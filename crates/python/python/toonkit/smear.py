@@ -22,9 +22,9 @@ from typing import Any, Callable, Iterable, Mapping, Optional, Union
 import numpy as np
 
 from . import _native
-from ._native import Prepared, Stylized
+from ._native import Prepared, Stream, Stylized
 
-__all__ = ["Prepared", "Stylized", "offsets", "prepare", "stylize"]
+__all__ = ["Prepared", "Stream", "Stylized", "offsets", "prepare", "stream", "stylize"]
 
 
 def _prune_list(prune: Iterable[str]) -> list:
@@ -40,6 +40,8 @@ def offsets(
     prune: Iterable[str] = (),
     camera: Optional[Union[str, int]] = None,
     progress: Optional[Callable[[str, float], None]] = None,
+    causal: bool = False,
+    revolve: Iterable[str] = (),
 ) -> np.ndarray:
     """Motion offsets per frame and vertex (SMEAR Eqs. 1-9).
 
@@ -49,7 +51,9 @@ def offsets(
     ``smooth`` is the half-window N of SMEAR Eq. 2 (0 = off); ``whole_body`` treats each
     skinned character as one object (Fig. 14); ``prune`` names joints whose vertices follow
     their nearest kept ancestor; ``camera`` (name or index) measures motion relative to a
-    camera. The GIL is released while computing. ``progress(stage, fraction)`` is called
+    camera. ``causal`` uses past frames only (backward differences, past-half smoothing);
+    ``revolve`` names objects (or ``"auto"``) whose offsets follow arcs about their rotation
+    axis. The GIL is released while computing. ``progress(stage, fraction)`` is called
     before and after.
 
     >>> scene = toonkit.load("assets/characters/RobotExpressive.glb", clip="Dance")
@@ -57,7 +61,14 @@ def offsets(
     True
     """
     return _native.smear_offsets(
-        scene, int(smooth), bool(whole_body), _prune_list(prune), camera, progress
+        scene,
+        int(smooth),
+        bool(whole_body),
+        _prune_list(prune),
+        camera,
+        progress,
+        bool(causal),
+        _prune_list(revolve),
     )
 
 
@@ -70,6 +81,8 @@ def prepare(
     weights: Optional[Mapping[str, Any]] = None,
     merge: Optional[str] = None,
     progress: Optional[Callable[[str, float], None]] = None,
+    causal: bool = False,
+    revolve: Iterable[str] = (),
 ) -> Prepared:
     """Everything a style does not change, computed once: offsets, camera, weights, velocities.
 
@@ -95,7 +108,36 @@ def prepare(
         camera,
         json.dumps(extra) if extra else None,
         progress,
+        bool(causal),
+        _prune_list(revolve),
     )
+
+
+def stream(
+    triangles: Any,
+    vertices: int,
+    smooth: int = 2,
+    elongate: Optional[Mapping[str, Any]] = None,
+    history: int = 6,
+    ground: Optional[float] = None,
+) -> Stream:
+    """A streaming smear (past-only): ``s.push(positions)`` returns that frame's elongated
+    in-between at once, from the frames pushed so far -- for games and live previews.
+
+    ``triangles`` is ``(T, 3)`` ints, ``vertices`` the points per frame; ``smooth`` the
+    past half-window of SMEAR Eq. 2; ``elongate`` a stylization function as in a style's
+    ``[elongate] function`` table (default ``{"stages": [{"op": "scale", "by": 1}]}``);
+    ``history`` the past frames kept; ``ground`` a plane y = ground never crossed.
+
+    >>> s = toonkit.smear.stream(scene.triangles, scene.positions.shape[1])
+    >>> out = s.push(scene.positions[0])
+    """
+    options: dict = {"smooth": int(smooth), "history": int(history)}
+    if elongate is not None:
+        options["elongate"] = dict(elongate)
+    if ground is not None:
+        options["ground"] = float(ground)
+    return _native.Stream(np.asarray(triangles), int(vertices), json.dumps(options))
 
 
 def stylize(

@@ -6,7 +6,7 @@ from typing import Any, Callable, Iterable, Mapping, Optional, Union
 import numpy as np
 import numpy.typing as npt
 
-from ._native import Prepared as Prepared, Scene, Stylized as Stylized
+from ._native import Prepared as Prepared, Scene, Stream as Stream, Stylized as Stylized
 
 def offsets(
     scene: Scene,
@@ -15,6 +15,8 @@ def offsets(
     prune: Iterable[str] = (),
     camera: Optional[Union[str, int]] = None,
     progress: Optional[Callable[[str, float], Any]] = None,
+    causal: bool = False,
+    revolve: Iterable[str] = (),
 ) -> npt.NDArray[np.float32]: ...
 def prepare(
     scene: Scene,
@@ -25,7 +27,17 @@ def prepare(
     weights: Optional[Mapping[str, Any]] = None,
     merge: Optional[str] = None,
     progress: Optional[Callable[[str, float], Any]] = None,
+    causal: bool = False,
+    revolve: Iterable[str] = (),
 ) -> Prepared: ...
+def stream(
+    triangles: Any,
+    vertices: int,
+    smooth: int = 2,
+    elongate: Optional[Mapping[str, Any]] = None,
+    history: int = 6,
+    ground: Optional[float] = None,
+) -> Stream: ...
 def stylize(
     prepared: Prepared,
     style: Union[Mapping[str, Any], str, os.PathLike[str]],

@@ -9,6 +9,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::{StyleInput, Trajectories};
+use crate::revolve::Arcs;
 use crate::{MotionOffsets, Result, SmearError, SurfacePoint};
 
 /// Default frame step: every frame is its own drawing ("on ones").
@@ -29,6 +30,12 @@ pub struct EffectInputs<'a> {
     weights: Option<Vec<f32>>,
     /// The point cache the points are the vertices of (`None` for surface points).
     source: Option<&'a MeshAnimation>,
+    /// Past-only trajectories and velocities (issue #22).
+    causal: bool,
+    /// Ground plane height the displaced points never go below.
+    ground: Option<f32>,
+    /// Revolving parts: their points move along arcs.
+    arcs: Option<Cow<'a, Arcs>>,
 }
 
 fn mismatch(name: &'static str, expected: usize, found: usize) -> SmearError {
@@ -68,6 +75,9 @@ impl<'a> EffectInputs<'a> {
             velocities: Cow::Borrowed(velocities),
             weights,
             source: Some(anim),
+            causal: false,
+            ground: None,
+            arcs: None,
         }
     }
 
@@ -138,7 +148,7 @@ impl<'a> EffectInputs<'a> {
                 offsets.vertex_count(),
             ));
         }
-        let velocities = crate::velocity::buffer_velocities(&positions, frames, points);
+        let velocities = crate::velocity::buffer_velocities(&positions, frames, points, false);
         Ok(EffectInputs {
             positions,
             frames,
@@ -147,7 +157,61 @@ impl<'a> EffectInputs<'a> {
             velocities: Cow::Owned(velocities),
             weights: None,
             source: None,
+            causal: false,
+            ground: None,
+            arcs: None,
         })
+    }
+
+    /// Past-only mode (issue #22): trajectories read no frame after the one they displace,
+    /// and velocities computed here from the positions become backward differences
+    /// (velocities given by [`prepare`](crate::prepare) are causal already when asked).
+    pub fn with_causal(mut self, causal: bool) -> Self {
+        if causal && !self.causal && matches!(self.velocities, Cow::Owned(_)) {
+            self.velocities = Cow::Owned(crate::velocity::buffer_velocities(
+                &self.positions,
+                self.frames,
+                self.points,
+                true,
+            ));
+        }
+        self.causal = causal;
+        self
+    }
+
+    /// A ground plane `y = ground` that displaced points never go below (issue #22).
+    pub fn with_ground(mut self, ground: Option<f32>) -> Self {
+        self.ground = ground;
+        self
+    }
+
+    /// Arcs of revolving parts, one entry per point (issue #22; see `crate::revolve`).
+    ///
+    /// # Errors
+    /// [`SmearError::InvalidParameter`] when `arcs` do not have one entry per point.
+    pub fn with_arcs(mut self, arcs: Option<Cow<'a, Arcs>>) -> Result<Self> {
+        if let Some(a) = &arcs {
+            if a.point_count() != self.points {
+                return Err(mismatch("arcs", self.points, a.point_count()));
+            }
+        }
+        self.arcs = arcs;
+        Ok(self)
+    }
+
+    /// The arcs of revolving parts, if any.
+    pub fn arcs(&self) -> Option<&Arcs> {
+        self.arcs.as_deref()
+    }
+
+    /// Whether trajectories are evaluated past-only.
+    pub fn is_causal(&self) -> bool {
+        self.causal
+    }
+
+    /// The ground plane height, if any.
+    pub fn ground(&self) -> Option<f32> {
+        self.ground
     }
 
     /// Sets painted weights ω_i ∈ [0, 1] (one per point; default 1).
@@ -197,6 +261,7 @@ impl<'a> EffectInputs<'a> {
             self.frames,
             self.points,
             &space,
+            self.causal,
         ));
         self
     }
@@ -230,6 +295,7 @@ impl<'a> EffectInputs<'a> {
     pub fn trajectories(&self) -> Trajectories<'_> {
         Trajectories::new(&self.positions, self.frames, self.points)
             .expect("length checked on construction")
+            .shaped(self.causal, self.ground, self.arcs.as_deref())
     }
 
     /// The stylization inputs of point `i` at frame `f` (`m` and `t` left 0). `f` and `i`

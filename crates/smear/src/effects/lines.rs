@@ -191,7 +191,7 @@ fn trace(
         let n = options.samples;
         for j in 0..n {
             let t = j as f32 / (n - 1) as f32;
-            let center = tr.at(l, start + (end - start) * t);
+            let center = tr.seen_from(h, l, start + (end - start) * t);
             // Beyond the clip the trajectory clamps: drop repeated points.
             if out
                 .rings

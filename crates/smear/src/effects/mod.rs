@@ -1,18 +1,21 @@
 //! Smear effects driven by motion offsets (Section 4): trajectories, elongated in-betweens,
 //! multiple in-betweens and motion lines.
 
+mod contact;
 mod elongate;
 mod inputs;
 mod lines;
 mod multiples;
 mod seeds;
 mod stylization;
+mod subdivide;
 #[cfg(test)]
 mod test_util;
 mod trajectory;
 mod tube;
 mod weights;
 
+pub use contact::{squash_frames, ContactStyle, Squash, DEFAULT_SQUASH_FRAMES, MAX_SQUASH};
 pub use elongate::{elongate, elongate_frame, ElongateOptions};
 pub use inputs::{held_frame, EffectInputs, DEFAULT_FRAME_STEP};
 pub use lines::{
@@ -25,5 +28,6 @@ pub use multiples::{
 };
 pub use seeds::{sample_surface, DEFAULT_SEED};
 pub use stylization::{StyleInput, Stylize};
+pub use subdivide::{subdivide_frame, SubdivisionStats, MAX_SUBDIVISION_LEVELS};
 pub use trajectory::Trajectories;
 pub use weights::{attribute_weights, group_weights, surface_point_weights};

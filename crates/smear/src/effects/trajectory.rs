@@ -1,9 +1,14 @@
 //! Vertex trajectories (Section 4.1): one uniform Catmull-Rom segment Q_{i,f}(t) per pair of
-//! contiguous frames, C1 across frames.
+//! contiguous frames, C1 across frames; beyond the paper (issue #22): arcs for revolving
+//! parts, past-only evaluation (causal mode) and a ground plane they never cross.
 
 use glam::Vec3;
 
+use crate::revolve::Arcs;
 use crate::{Result, SmearError};
+
+/// Bisection steps when a displacement is shortened to stop at the ground.
+const GROUND_STEPS: usize = 16;
 
 /// The trajectories of a frame-major `frames × points` position buffer (mesh vertices, or
 /// surface points after barycentric interpolation — Catmull-Rom is linear in its control
@@ -14,11 +19,23 @@ use crate::{Result, SmearError};
 /// `(p(f+1) − p(f−1))/2`, end frames duplicated (`p(−1) = p(0)`, `p(F) = p(F−1)`); times before
 /// the first or after the last frame clamp to those frames. Nothing is precomputed: a point is
 /// four loads and a cubic, so evaluation is allocation-free.
+///
+/// Beyond the paper (issue #22), set by [`Trajectories::shaped`]:
+/// * **causal** — seen from frame `now`, frames after `now` are extrapolated at constant
+///   velocity `p(now) − p(now−1)` (the last screw keeps turning for revolving parts), so
+///   [`Trajectories::displaced`] at frame f reads no frame after f;
+/// * **arcs** — points of revolving parts move along screw arcs (see `crate::revolve`);
+/// * **ground** — [`Trajectories::displaced`] shortens a displacement that would end below
+///   the plane `y = ground` to where the trajectory reaches it (and lifts what is below
+///   already), so elongated and multiple in-betweens never cross it.
 #[derive(Debug, Clone, Copy)]
 pub struct Trajectories<'a> {
     positions: &'a [Vec3],
     frames: usize,
     points: usize,
+    causal: bool,
+    ground: Option<f32>,
+    arcs: Option<&'a Arcs>,
 }
 
 impl<'a> Trajectories<'a> {
@@ -37,7 +54,21 @@ impl<'a> Trajectories<'a> {
             positions,
             frames,
             points,
+            causal: false,
+            ground: None,
+            arcs: None,
         })
+    }
+
+    /// The same trajectories evaluated past-only (`causal`), along the `arcs` of revolving
+    /// parts (one entry per point, ignored otherwise) and stopped at the plane `y = ground`.
+    pub fn shaped(self, causal: bool, ground: Option<f32>, arcs: Option<&'a Arcs>) -> Self {
+        Trajectories {
+            causal,
+            ground: ground.filter(|g| g.is_finite()),
+            arcs: arcs.filter(|a| !a.is_empty() && a.point_count() == self.points),
+            ..self
+        }
     }
 
     /// The trajectories of a point cache's vertices.
@@ -46,7 +77,20 @@ impl<'a> Trajectories<'a> {
             positions: anim.positions(),
             frames: anim.frame_count(),
             points: anim.vertex_count(),
+            causal: false,
+            ground: None,
+            arcs: None,
         }
+    }
+
+    /// The ground plane height displacements stop at, if any.
+    pub fn ground(&self) -> Option<f32> {
+        self.ground
+    }
+
+    /// Whether frames after the displaced one are extrapolated (causal mode).
+    pub fn is_causal(&self) -> bool {
+        self.causal
     }
 
     /// Number of frames.
@@ -74,35 +118,116 @@ impl<'a> Trajectories<'a> {
     /// `Q_{i,k}(t)` — the floor rule of Section 4.1 (e.g. time 6.4 → segment 6, t = 0.4).
     ///
     /// Times outside `[0, F − 1]` clamp to the first/last frame; a non-finite time reads
-    /// frame 0 (NaN) or clamps (±∞). `i` must be below the point count.
+    /// frame 0 (NaN) or clamps (±∞). `i` must be below the point count. This is the offline
+    /// trajectory (arcs apply, causal mode does not: see [`Trajectories::seen_from`]).
     ///
     /// # Performance
     /// Four loads and a cubic; no allocation.
     #[inline]
     pub fn at(&self, i: usize, time: f32) -> Vec3 {
+        self.sample(None, i, time)
+    }
+
+    /// Point `i` at time `time` as seen from frame `now`: [`Trajectories::at`] offline; in
+    /// causal mode frames after `now` are extrapolated (never read) and times past `now` are
+    /// not clamped to the clip.
+    #[inline]
+    pub fn seen_from(&self, now: usize, i: usize, time: f32) -> Vec3 {
+        self.sample(self.causal.then_some(now), i, time)
+    }
+
+    #[inline]
+    fn sample(&self, now: Option<usize>, i: usize, time: f32) -> Vec3 {
         let last = self.frames.saturating_sub(1);
+        let now = now.map(|n| n.min(last));
         if last == 0 || time.is_nan() || time <= 0.0 {
             return self.positions[i];
         }
-        if time >= last as f32 {
+        let arcs = self.arcs.and_then(|a| a.screws_of(i));
+        if let Some(n) = now {
+            if time >= n as f32 {
+                return self.extrapolate(n, i, time - n as f32, arcs);
+            }
+        } else if time >= last as f32 {
             return self.positions[last * self.points + i];
         }
         let k = (time.floor() as usize).min(last - 1);
         let t = time - k as f32;
+        if let Some(screws) = arcs {
+            let (p1, p2) = (
+                self.at_frame(k as isize, i),
+                self.at_frame(k as isize + 1, i),
+            );
+            let s = screws[k.min(screws.len() - 1)];
+            return s.apply(p1, t) + (p2 - s.apply(p1, 1.0)) * t;
+        }
         let k = k as isize;
-        let p0 = self.at_frame(k - 1, i);
-        let p1 = self.at_frame(k, i);
-        let p2 = self.at_frame(k + 1, i);
-        let p3 = self.at_frame(k + 2, i);
+        let fetch = |g: isize| match now {
+            Some(n) if g > n as isize => self.extrapolate(n, i, (g - n as isize) as f32, None),
+            _ => self.at_frame(g, i),
+        };
+        let p0 = fetch(k - 1);
+        let p1 = fetch(k);
+        let p2 = fetch(k + 1);
+        let p3 = fetch(k + 2);
         hermite(p1, p2, (p2 - p0) * 0.5, (p3 - p1) * 0.5, t)
+    }
+
+    /// Point `i`, `dt ≥ 0` frames after frame `now`, extrapolated from frames `now − 1` and
+    /// `now`: constant velocity, or the last screw turning on for a revolving part.
+    #[inline]
+    fn extrapolate(
+        &self,
+        now: usize,
+        i: usize,
+        dt: f32,
+        arcs: Option<&[crate::revolve::Screw]>,
+    ) -> Vec3 {
+        let p = self.at_frame(now as isize, i);
+        if now == 0 {
+            return p;
+        }
+        match arcs {
+            Some(screws) => screws[(now - 1).min(screws.len() - 1)].apply(p, dt),
+            None => p + (p - self.at_frame(now as isize - 1, i)) * dt,
+        }
     }
 
     /// Point `i` of frame `f` displaced by `beta` frames along its trajectory:
     /// `p′_i(f) = Q_{i, f+⌊β⌋}(β − ⌊β⌋)` (Section 4.1). A non-finite `beta` counts as 0.
+    /// With a ground plane, a displacement that would end below it stops where the trajectory
+    /// reaches it (bisection on β), and a point already below is lifted onto it.
     #[inline]
     pub fn displaced(&self, f: usize, i: usize, beta: f32) -> Vec3 {
         let beta = if beta.is_finite() { beta } else { 0.0 };
-        self.at(i, f as f32 + beta)
+        let q = self.seen_from(f, i, f as f32 + beta);
+        match self.ground {
+            Some(g) if q.y < g => self.grounded(f, i, beta, g),
+            _ => q,
+        }
+    }
+
+    /// [`Trajectories::displaced`] when the full displacement ends below the ground `g`: the
+    /// largest fraction of β whose point stays above (the trajectory may dip and return, so
+    /// this finds one crossing, not necessarily the first), lifted onto the plane if needed.
+    #[cold]
+    fn grounded(&self, f: usize, i: usize, beta: f32, g: f32) -> Vec3 {
+        let at = |s: f32| self.seen_from(f, i, f as f32 + beta * s);
+        let mut q = at(0.0);
+        if q.y >= g {
+            let (mut lo, mut hi) = (0.0f32, 1.0f32);
+            for _ in 0..GROUND_STEPS {
+                let mid = 0.5 * (lo + hi);
+                if at(mid).y >= g {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            q = at(lo);
+        }
+        q.y = q.y.max(g);
+        q
     }
 }
 

@@ -8,6 +8,7 @@ use anim::{Camera, MeshAnimation, SampledScene};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+use crate::revolve::{replace_offsets, revolving_objects, target_arcs, Arcs};
 use crate::solver::SolvedField;
 use crate::velocity::{buffer_velocities, camera_buffer_velocities, CameraSpace};
 use crate::{
@@ -76,6 +77,8 @@ struct Target {
     offsets: MotionOffsets,
     velocities: Vec<Vec3>,
     weights: Option<Vec<f32>>,
+    /// Revolving parts (issue #22).
+    arcs: Option<Arcs>,
 }
 
 /// A scene with its motion offsets solved, ready to be stylized any number of times
@@ -148,7 +151,8 @@ pub struct SceneOffsets {
 pub fn offsets(scene: &SampledScene, options: &OffsetOptions) -> Result<SceneOffsets> {
     let start = Instant::now();
     let field = SolvedField::new(scene, options)?;
-    let per_object = field.all();
+    let revolving = revolving_objects(scene, &options.revolve)?;
+    let per_object = replace_offsets(scene, options, &revolving, field.all());
     let solve_seconds = start.elapsed().as_secs_f64();
     let objects = object_reports(scene, &field, &per_object);
     let offsets = if per_object.len() == 1 {
@@ -185,14 +189,16 @@ pub fn prepare(scene: SampledScene, options: &PrepareOptions) -> Result<Prepared
     let start = Instant::now();
     let camera = options.offsets.selected_camera(&scene.cameras)?.cloned();
     let field = SolvedField::new(&scene, &options.offsets)?;
-    let per_object = field.all();
+    let revolving = revolving_objects(&scene, &options.offsets.revolve)?;
+    let per_object = replace_offsets(&scene, &options.offsets, &revolving, field.all());
     let solve_seconds = start.elapsed().as_secs_f64();
     let objects = object_reports(&scene, &field, &per_object);
+    let causal = options.offsets.causal;
     let velocities = |anim: &MeshAnimation| {
         let (p, f, n) = (anim.positions(), anim.frame_count(), anim.vertex_count());
         match &camera {
-            Some(c) => camera_buffer_velocities(p, f, n, &CameraSpace::new(c, f)),
-            None => buffer_velocities(p, f, n),
+            Some(c) => camera_buffer_velocities(p, f, n, &CameraSpace::new(c, f), causal),
+            None => buffer_velocities(p, f, n, causal),
         }
     };
     let resolve = |w: &WeightSource, i: usize| w.vertex_weights(&scene, i);
@@ -224,6 +230,7 @@ pub fn prepare(scene: SampledScene, options: &PrepareOptions) -> Result<Prepared
                 offsets,
                 velocities: velocities(&anim),
                 weights,
+                arcs: target_arcs(&scene, &revolving, None),
             };
             (Some(anim), vec![target])
         }
@@ -238,6 +245,7 @@ pub fn prepare(scene: SampledScene, options: &PrepareOptions) -> Result<Prepared
                         Some(w) => Some(resolve(w, i)?),
                         None => None,
                     },
+                    arcs: target_arcs(&scene, &revolving, Some(i)),
                 });
             }
             (None, targets)
@@ -316,6 +324,14 @@ impl Prepared {
         &self.targets[i].offsets
     }
 
+    /// Arcs of object `i`'s revolving parts (issue #22), if it has any.
+    ///
+    /// # Panics
+    /// If `i >= object_count()`.
+    pub fn arcs(&self, i: usize) -> Option<&Arcs> {
+        self.targets[i].arcs.as_ref()
+    }
+
     /// Painted weights of object `i`'s vertices (from [`PrepareOptions::weights`]).
     ///
     /// # Panics
@@ -350,7 +366,9 @@ impl Prepared {
             count: self.targets.len(),
         })?;
         let inputs =
-            EffectInputs::from_prepared(self.animation(i), &t.offsets, &t.velocities, None);
+            EffectInputs::from_prepared(self.animation(i), &t.offsets, &t.velocities, None)
+                .with_causal(self.options.offsets.causal)
+                .with_arcs(t.arcs.as_ref().map(std::borrow::Cow::Borrowed))?;
         match weights {
             Some(w) => inputs.with_weights(w),
             None => Ok(inputs),

@@ -8,7 +8,7 @@ use anim::{Aabb, Flipbook, FlipbookPart, MeshAnimation};
 use serde::Serialize;
 
 use super::prepare::Prepared;
-use crate::{CompiledEffects, EffectInputs, LineStyle, Result, SmearError, Style};
+use crate::{CompiledEffects, EffectInputs, LineStyle, Result, SmearError, Style, Stylize};
 
 /// One copy of the multiple in-betweens in a [`StylizeReport`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -58,6 +58,15 @@ pub struct ObjectReport {
     /// Most lines drawn in one frame.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lines_max: Option<usize>,
+    /// With subdivision: the largest output edge length over its rest length (issue #22).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub subdivision_max_stretch: Option<f32>,
+    /// With subdivision: the most triangles of the body in one frame.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub subdivision_max_triangles: Option<usize>,
+    /// Frames squashed on impact with the ground.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub squashed_frames: Option<usize>,
 }
 
 /// Seconds per phase of [`stylize`].
@@ -129,6 +138,67 @@ fn displacement(a: &MeshAnimation, b: &MeshAnimation) -> (f32, f64) {
     (max, sum / a.positions().len().max(1) as f64)
 }
 
+/// Squashes the frames of `anim` that land on the ground (see [`crate::squash_frames`]).
+fn squash_animation(
+    anim: &mut MeshAnimation,
+    squash: &[Option<crate::Squash>],
+    ground: Option<f32>,
+) {
+    let (Some(g), n) = (ground, anim.vertex_count()) else {
+        return;
+    };
+    if squash.iter().all(Option::is_none) || n == 0 {
+        return;
+    }
+    let mut p = anim.positions().to_vec();
+    for (f, s) in squash.iter().enumerate() {
+        if let Some(s) = s {
+            s.apply(g, &mut p[f * n..(f + 1) * n]);
+        }
+    }
+    if let Ok(a) = MeshAnimation::new(anim.mesh.clone(), anim.fps, p) {
+        let start = anim.start_time;
+        *anim = a;
+        anim.start_time = start;
+    }
+}
+
+/// One multiple in-between, adaptively subdivided per frame (issue #22): every vertex of
+/// copy m moves by β_m(f) = step · m · Δf(f) (Section 4.2); opacities are blended into the
+/// colours' alpha.
+fn subdivided_copy(
+    inputs: &EffectInputs<'_>,
+    options: &crate::MultiplesOptions,
+    copy: &crate::MultipleCopy,
+    rgb: [f32; 3],
+    tol: f32,
+) -> Result<Vec<anim::Mesh>> {
+    let tr = inputs.trajectories();
+    let anim = &copy.animation;
+    let (frames, n) = (anim.frame_count(), anim.vertex_count());
+    let step = options.step.max(1);
+    let mut meshes = Vec::with_capacity(frames);
+    for f in 0..frames {
+        let h = crate::held_frame(f, step);
+        let (past, future) = options.counts_at(h as f32);
+        let shown = if copy.m < 0 {
+            copy.m.unsigned_abs() as usize <= past
+        } else {
+            copy.m as usize <= future
+        };
+        let b = if shown {
+            step as f32 * copy.m as f32 * options.spacing_at(h as f32)?
+        } else {
+            0.0
+        };
+        let beta = vec![b; n];
+        let alpha = &copy.alpha[f * n..(f + 1) * n];
+        let (mesh, _) = crate::subdivide_frame(&tr, &anim.mesh, h, &beta, Some((alpha, rgb)), tol);
+        meshes.push(mesh);
+    }
+    Ok(meshes)
+}
+
 /// Applies `style` to every object of `prepared`: per object, the elongated in-betweens (or
 /// the input when the style has none), the multiple in-betweens as alpha-coloured copies and
 /// the motion lines as per-frame tube meshes.
@@ -170,19 +240,28 @@ pub fn stylize(prepared: &Prepared, style: &Style) -> Result<Stylized> {
             Some(w) => Some(prepared.resolve_weights(w, i)?),
             None => prepared.weights(i).map(<[f32]>::to_vec),
         };
-        let inputs = prepared.inputs(i, weights.clone())?;
         let mut stats = ObjectReport {
             name: name.to_string(),
             vertices: anim.vertex_count(),
             ..ObjectReport::default()
         };
+        let ground = style.contact.as_ref().map(|c| c.ground);
+        let inputs = prepared.inputs(i, weights.clone())?.with_ground(ground);
+        let squash = match &style.contact {
+            Some(c) => crate::squash_frames(anim, c),
+            None => Vec::new(),
+        };
+        let squashed = squash.iter().filter(|s| s.is_some()).count();
+        if style.contact.as_ref().is_some_and(|c| c.squash > 0.0) {
+            stats.squashed_frames = Some(squashed);
+        }
         let mut parts = ObjectParts {
             body: book.parts.len(),
             ..ObjectParts::default()
         };
 
         let t = Instant::now();
-        let body = match &fx.elongate {
+        let mut body = match &fx.elongate {
             Some((f, options)) => {
                 let e = crate::elongate(&inputs, f, options)?;
                 let (max, mean) = displacement(&e, anim);
@@ -192,11 +271,44 @@ pub fn stylize(prepared: &Prepared, style: &Style) -> Result<Stylized> {
             }
             None => anim.clone(),
         };
+        match (style.subdivide, &fx.elongate) {
+            (Some(tol), Some((f, options))) => {
+                let tr = inputs.trajectories();
+                let step = options.step.max(1);
+                let n = anim.vertex_count();
+                let mut beta = vec![0.0f32; n];
+                let mut meshes = Vec::with_capacity(anim.frame_count());
+                let (mut stretch, mut most) = (0.0f32, 0usize);
+                for frame in 0..anim.frame_count() {
+                    let h = crate::held_frame(frame, step);
+                    for (k, b) in beta.iter_mut().enumerate() {
+                        *b = step as f32 * f.eval(&inputs.style_input(h, k));
+                    }
+                    let (mut mesh, st) =
+                        crate::subdivide_frame(&tr, &anim.mesh, h, &beta, None, tol);
+                    if let (Some(Some(sq)), Some(g)) = (squash.get(frame), ground) {
+                        sq.apply(g, &mut mesh.positions);
+                    }
+                    stretch = stretch.max(st.max_stretch);
+                    most = most.max(st.triangles);
+                    meshes.push(mesh);
+                }
+                stats.subdivision_max_stretch = Some(stretch);
+                stats.subdivision_max_triangles = Some(most);
+                book.parts.push(FlipbookPart::Frames {
+                    name: anim.mesh.name.clone(),
+                    meshes,
+                });
+            }
+            _ => {
+                squash_animation(&mut body, &squash, ground);
+                book.parts.push(FlipbookPart::Animation {
+                    animation: body,
+                    colors: None,
+                });
+            }
+        }
         report.seconds.elongate += t.elapsed().as_secs_f64();
-        book.parts.push(FlipbookPart::Animation {
-            animation: body,
-            colors: None,
-        });
 
         let t = Instant::now();
         let first_copy = book.parts.len();
@@ -207,7 +319,7 @@ pub fn stylize(prepared: &Prepared, style: &Style) -> Result<Stylized> {
                 .map_or(crate::DEFAULT_MULTIPLE_COLOR, |m| m.color);
             let copies = crate::multiples(&inputs, f, options)?;
             let mut visible = 0usize;
-            for c in copies {
+            for mut c in copies {
                 let shown = c.alpha.iter().filter(|a| **a > 0.0).count();
                 visible += shown;
                 stats.copies.push(CopyReport {
@@ -216,6 +328,15 @@ pub fn stylize(prepared: &Prepared, style: &Style) -> Result<Stylized> {
                     visible: shown,
                     total: c.alpha.len(),
                 });
+                if let Some(tol) = style.subdivide {
+                    let meshes = subdivided_copy(&inputs, options, &c, [r, g, b], tol)?;
+                    book.parts.push(FlipbookPart::Frames {
+                        name: c.animation.mesh.name.clone(),
+                        meshes,
+                    });
+                    continue;
+                }
+                squash_animation(&mut c.animation, &squash, ground);
                 let colors = c.alpha.iter().map(|&a| [r, g, b, a]).collect();
                 book.parts.push(FlipbookPart::Animation {
                     animation: c.animation,
@@ -237,7 +358,15 @@ pub fn stylize(prepared: &Prepared, style: &Style) -> Result<Stylized> {
                 points.sort_by_key(|s| s.triangle);
             }
             let seed_offsets = prepared.surface_offsets(i, &points)?;
+            let seed_arcs = prepared.arcs(i).map(|a| {
+                std::borrow::Cow::Owned(a.remap(points.len(), |k| {
+                    tris.get(points[k].triangle as usize)
+                        .map_or(usize::MAX, |t| t[0] as usize)
+                }))
+            });
             let mut seeds = EffectInputs::at_surface_points(anim, &points, seed_offsets)?
+                .with_causal(prepared.options().offsets.causal)
+                .with_arcs(seed_arcs)?
                 .relative_to_camera(camera);
             if let Some(w) = &weights {
                 seeds = seeds.with_weights(crate::surface_point_weights(w, tris, &points)?)?;

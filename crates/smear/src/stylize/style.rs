@@ -11,8 +11,8 @@ use super::param::Param;
 use super::stage::Stage;
 use super::weights::WeightSource;
 use crate::{
-    ElongateOptions, LineOptions, MultiplesOptions, OffsetOptions, Spacing, DEFAULT_FRAME_STEP,
-    DEFAULT_LINE_SAMPLES, DEFAULT_LINE_SIDES, DEFAULT_SEED, DEFAULT_SPACING,
+    ContactStyle, ElongateOptions, LineOptions, MultiplesOptions, OffsetOptions, Spacing,
+    DEFAULT_FRAME_STEP, DEFAULT_LINE_SAMPLES, DEFAULT_LINE_SIDES, DEFAULT_SEED, DEFAULT_SPACING,
 };
 
 /// Default number of motion-line seeds.
@@ -293,6 +293,14 @@ pub struct Style {
     /// Motion lines.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lines: Option<LinesStyle>,
+    /// Adaptive subdivision (issue #22): output edges of the elongated and multiple
+    /// in-betweens longer than this × their rest length are split (≥ 1; e.g. 2). The results
+    /// then have one mesh per frame.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub subdivide: Option<f32>,
+    /// A ground plane the in-betweens never cross, with optional squash on impact (issue #22).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact: Option<ContactStyle>,
     /// Per-object overrides keyed by mesh name.
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub objects: BTreeMap<String, ObjectStyle>,
@@ -331,6 +339,27 @@ impl Style {
 
     /// Compiles every function and checks every option.
     pub fn validate(&self) -> Result<(), StyleError> {
+        if let Some(t) = self.subdivide {
+            if !(t.is_finite() && t >= 1.0) {
+                return Err(StyleError::Parameter {
+                    name: "subdivide".into(),
+                    problem: format!("the tolerance must be a number ≥ 1 (e.g. 2), got {t}"),
+                });
+            }
+        }
+        if let Some(c) = &self.contact {
+            if !c.ground.is_finite() || !(0.0..=crate::MAX_SQUASH).contains(&c.squash) {
+                return Err(StyleError::Parameter {
+                    name: "contact".into(),
+                    problem: format!(
+                        "ground must be finite and squash in [0, {}], got {} and {}",
+                        crate::MAX_SQUASH,
+                        c.ground,
+                        c.squash
+                    ),
+                });
+            }
+        }
         let sections = std::iter::once((
             "",
             ObjectStyle {

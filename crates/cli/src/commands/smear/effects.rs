@@ -164,12 +164,28 @@ fn require_scene_output(path: &Path, what: &str) -> Result<()> {
     Ok(())
 }
 
-/// A style with only the offsets `p` was prepared with (effects are added by the caller).
-fn base_style(p: &Prepared) -> Style {
-    Style {
+/// A style with only the offsets `p` was prepared with and the subdivision and contact
+/// settings of the flags (effects are added by the caller).
+fn base_style(p: &Prepared, a: &EffectArgs) -> Result<Style> {
+    let (subdivide, contact) = a.shaping()?;
+    Ok(Style {
         offsets: p.options().offsets.clone(),
+        subdivide,
+        contact,
         ..Style::default()
+    })
+}
+
+/// Refuses an output format that cannot hold a mesh whose topology changes per frame.
+fn require_per_frame_topology(path: &Path) -> Result<()> {
+    if !Format::from_extension(path).is_some_and(Format::holds_scenes) {
+        bail!(
+            "{}: --subdivide changes the mesh per frame, which .pc2/.mdd/.obj point caches cannot \
+             store (one vertex count for all frames); write .glb, .usda, .usdc, .usdz or .abc",
+            path.display()
+        );
     }
+    Ok(())
 }
 
 /// Runs the style on the prepared input, naming the input in errors.
@@ -201,6 +217,10 @@ pub fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
         }),
     };
     check(&spec, "--expr")?;
+    args.offsets.shaping()?;
+    if args.offsets.subdivide.is_some() {
+        require_per_frame_topology(&args.io.output)?;
+    }
     let spinner = crate::progress::spinner("elongating", ctx.json);
     let p = prepare(&args.io, &args.offsets)?;
     let style = Style {
@@ -209,17 +229,27 @@ pub fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
             step: args.offsets.step,
             function: spec,
         }),
-        ..base_style(&p)
+        ..base_style(&p, &args.offsets)?
     };
     let out = run_style(&args.io, &p, &style)?;
     let t = Instant::now();
-    let body = part(&out, 0)?;
-    let written = output::write_animation(&args.io.output, body, args.layout, None, ctx.save)?;
+    let input = p.animation(0);
+    let written = match out.animation(0) {
+        Some(body) => output::write_animation(&args.io.output, body, args.layout, None, ctx.save)?,
+        None => {
+            tkio::save_with(&args.io.output, &Output::Flipbook(&out.flipbook), ctx.save)?;
+            vec![args.io.output.clone()]
+        }
+    };
     spinner.finish_and_clear();
     let stats = &out.report.objects[0];
+    let body = input;
     let summary = json!({
         "input": args.io.input, "output": args.io.output, "files": written,
         "frames": body.frame_count(), "vertices": body.vertex_count(),
+        "subdivision_max_stretch": stats.subdivision_max_stretch,
+        "subdivision_max_triangles": stats.subdivision_max_triangles,
+        "squashed_frames": stats.squashed_frames, "causal": args.offsets.offsets.causal,
         "objects": p.scene().objects.len(), "step": args.offsets.step,
         "weighted": p.weights(0).is_some(), "camera_speed": p.camera().is_some(),
         "max_displacement": stats.elongation_max, "mean_displacement": stats.elongation_mean,
@@ -278,10 +308,13 @@ pub fn multiples(ctx: &Context, args: MultiplesArgs) -> Result<()> {
             opacity: Some(spec),
             color: [1.0; 3],
         }),
-        ..base_style(&p)
+        ..base_style(&p, &args.offsets)?
     };
     let out = run_style(&args.io, &p, &style)?;
     let t = Instant::now();
+    if args.offsets.subdivide.is_some() {
+        tkio::save_with(&args.io.output, &Output::Flipbook(&out.flipbook), ctx.save)?;
+    }
     let parts: Vec<(&MeshAnimation, Option<&[[f32; 4]]>)> = out
         .flipbook
         .parts
@@ -291,16 +324,18 @@ pub fn multiples(ctx: &Context, args: MultiplesArgs) -> Result<()> {
             FlipbookPart::Frames { .. } => None,
         })
         .collect();
-    tkio::save_with(
-        &args.io.output,
-        &Output::Parts {
-            parts: &parts,
-            layout: tkio::Layout::Flipbook,
-        },
-        ctx.save,
-    )?;
+    if args.offsets.subdivide.is_none() {
+        tkio::save_with(
+            &args.io.output,
+            &Output::Parts {
+                parts: &parts,
+                layout: tkio::Layout::Flipbook,
+            },
+            ctx.save,
+        )?;
+    }
     spinner.finish_and_clear();
-    let body = part(&out, 0)?;
+    let body = p.animation(0);
     let copies_json: Vec<_> = out.report.objects[0]
         .copies
         .iter()
@@ -401,7 +436,7 @@ pub fn lines(ctx: &Context, args: LinesArgs) -> Result<()> {
             thickness: Some(thickness),
             opacity,
         }),
-        ..base_style(&p)
+        ..base_style(&p, &args.offsets)?
     };
     let out = run_style(&args.io, &p, &style)?;
     let t = Instant::now();

@@ -19,8 +19,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Result};
 use clap::{Args, Subcommand};
 use smear::{
-    CameraSelect, FunctionSpec, OffsetOptions, PrepareOptions, Prepared, Stage, WeightAttribute,
-    WeightGroup, WeightSource,
+    CameraSelect, ContactStyle, FunctionSpec, OffsetOptions, PrepareOptions, Prepared, Stage,
+    WeightAttribute, WeightGroup, WeightSource,
 };
 
 use super::Context;
@@ -79,6 +79,14 @@ pub struct OffsetArgs {
     /// prevents).
     #[arg(long)]
     pub no_collinear: bool,
+    /// Past-only mode: velocities, smoothing and trajectories of frame f read frames ≤ f only
+    /// (as a game or live preview would); the smear lags slightly behind the offline one.
+    #[arg(long)]
+    pub causal: bool,
+    /// Objects that revolve about an axis (wheels, propellers; comma-separated mesh names, or
+    /// `auto` to detect them): offsets and trajectories follow arcs about the fitted axis.
+    #[arg(long, value_delimiter = ',')]
+    pub revolve: Vec<String>,
 }
 
 impl OffsetArgs {
@@ -95,6 +103,8 @@ impl OffsetArgs {
             prune: self.prune.clone(),
             camera,
             collinear_weight: !self.no_collinear,
+            causal: self.causal,
+            revolve: self.revolve.clone(),
         }
     }
 }
@@ -137,9 +147,49 @@ pub struct EffectArgs {
     /// e.g. "clamp01(y / 2)".
     #[arg(long)]
     pub weight_expr: Option<String>,
+    /// Adaptive subdivision: split output edges longer than TOL × their rest length (TOL ≥ 1,
+    /// e.g. 2). The mesh then changes per frame: write .glb, .usda, .usdc, .usdz or .abc.
+    #[arg(long, value_name = "TOL")]
+    pub subdivide: Option<f32>,
+    /// A ground plane y = Y that the in-betweens never cross.
+    #[arg(long, value_name = "Y", allow_negative_numbers = true)]
+    pub ground: Option<f32>,
+    /// With --ground: squash on impact, the height scaled by 1 − AMOUNT (volume kept),
+    /// easing back over --squash-frames.
+    #[arg(long, value_name = "AMOUNT", requires = "ground")]
+    pub squash: Option<f32>,
+    /// Frames a squash lasts.
+    #[arg(long, default_value_t = smear::DEFAULT_SQUASH_FRAMES, requires = "squash")]
+    pub squash_frames: usize,
 }
 
 impl EffectArgs {
+    /// The style's subdivision and contact settings (issue #22), checked.
+    ///
+    /// # Errors
+    /// A tolerance below 1, a non-finite ground or a squash outside [0, 0.9].
+    pub fn shaping(&self) -> Result<(Option<f32>, Option<ContactStyle>)> {
+        let contact = self.ground.map(|g| ContactStyle {
+            ground: g,
+            squash: self.squash.unwrap_or(0.0),
+            squash_frames: self.squash_frames,
+        });
+        let probe = smear::Style {
+            subdivide: self.subdivide,
+            contact: contact.clone(),
+            ..smear::Style::default()
+        };
+        if let Err(e) = probe.validate() {
+            bail!(
+                "{}",
+                e.to_string()
+                    .replace("subdivide", "--subdivide")
+                    .replace("contact", "--ground/--squash")
+            );
+        }
+        Ok((self.subdivide, contact))
+    }
+
     /// The painted-weight source the flags ask for, if any.
     pub fn weight_source(&self) -> Option<WeightSource> {
         if !self.weight_group.is_empty() {

@@ -1,0 +1,145 @@
+//! `toonkit smear elongate | multiples` with the flags of issue #22: `--subdivide`,
+//! `--ground`/`--squash`, `--causal`, `--revolve`.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use anim::glam::Vec3;
+use anim::{Mesh, MeshAnimation};
+use common::*;
+
+/// A low-poly ball (4 rings × 6 segments, 36 triangles) dropping onto y = 0 while moving
+/// along +X, written as `dir/drop.pc2` + `dir/drop.obj`.
+fn write_drop(dir: &Path) -> PathBuf {
+    let (rings, segments) = (4usize, 6usize);
+    let mut p = vec![Vec3::Y, -Vec3::Y];
+    for a in 1..rings {
+        let th = std::f32::consts::PI * a as f32 / rings as f32;
+        for b in 0..segments {
+            let ph = std::f32::consts::TAU * b as f32 / segments as f32;
+            p.push(Vec3::new(
+                th.sin() * ph.cos(),
+                th.cos(),
+                th.sin() * ph.sin(),
+            ));
+        }
+    }
+    let idx = |a: usize, b: usize| (2 + (a - 1) * segments + b % segments) as u32;
+    let mut t = Vec::new();
+    for b in 0..segments {
+        t.push([0, idx(1, b + 1), idx(1, b)]);
+        t.push([1, idx(rings - 1, b), idx(rings - 1, b + 1)]);
+        for a in 1..rings - 1 {
+            t.push([idx(a, b), idx(a, b + 1), idx(a + 1, b)]);
+            t.push([idx(a + 1, b), idx(a, b + 1), idx(a + 1, b + 1)]);
+        }
+    }
+    let mesh = Mesh::new("drop", p, t);
+    let height = |f: f32| 1.0 + (4.0 - 0.5 * f).max(0.0);
+    let pos = (0..16)
+        .flat_map(|f| {
+            let c = Vec3::new(0.5 * f as f32, height(f as f32), 0.0);
+            mesh.positions
+                .iter()
+                .map(move |q| *q + c)
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let anim = MeshAnimation::new(mesh, 24.0, pos).unwrap();
+    let pc2 = dir.join("drop.pc2");
+    std::fs::write(&pc2, tkio::pc2::write(&anim)).unwrap();
+    std::fs::write(dir.join("drop.obj"), tkio::obj::write(&anim.mesh)).unwrap();
+    pc2
+}
+
+#[test]
+fn elongate_subdivides_grounds_and_refuses_point_caches() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = write_drop(dir.path());
+    let out = dir.path().join("drop_smear.glb");
+    let v = json(&[
+        "smear",
+        "elongate",
+        s(&input),
+        "--beta-max",
+        "4",
+        "--subdivide",
+        "2",
+        "--ground",
+        "0",
+        "--squash",
+        "0.3",
+        "-o",
+        s(&out),
+    ]);
+    let stretch = v["subdivision_max_stretch"].as_f64().unwrap();
+    assert!(stretch <= 2.0, "{v}");
+    assert!(v["subdivision_max_triangles"].as_u64().unwrap() > 36, "{v}");
+    assert!(v["squashed_frames"].as_u64().unwrap() > 0, "{v}");
+    let tkio::Loaded::Scene(scene) = tkio::load(&out, &tkio::LoadOptions::default()).unwrap()
+    else {
+        panic!("a glb is a scene");
+    };
+    assert!(scene.meshes.len() > 1, "a flipbook with one mesh per frame");
+    keep_for_validation(dir.path(), "smear_subdivide");
+
+    // Point caches hold one vertex count: a one-line refusal, exit code 2.
+    let pc2 = dir.path().join("drop_smear.pc2");
+    let bad = toonkit(&[
+        "smear",
+        "elongate",
+        s(&input),
+        "--subdivide",
+        "2",
+        "-o",
+        s(&pc2),
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+    let msg = String::from_utf8_lossy(&bad.stderr);
+    assert!(msg.contains("--subdivide") && msg.contains(".abc"), "{msg}");
+    assert_eq!(msg.trim().lines().count(), 1, "{msg}");
+    assert!(!pc2.exists());
+    let bad = toonkit(&[
+        "smear",
+        "elongate",
+        s(&input),
+        "--subdivide",
+        "0.5",
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+
+    // Causal mode and multiples with subdivision and the ground plane.
+    let causal = dir.path().join("drop_causal.pc2");
+    ok(&["smear", "elongate", s(&input), "--causal", "-o", s(&causal)]);
+    let m = dir.path().join("drop_copies.usda");
+    ok(&[
+        "smear",
+        "multiples",
+        s(&input),
+        "--past",
+        "2",
+        "--future",
+        "1",
+        "--subdivide",
+        "2",
+        "--ground",
+        "0",
+        "-o",
+        s(&m),
+    ]);
+    let bad = toonkit(&[
+        "smear",
+        "elongate",
+        s(&input),
+        "--revolve",
+        "wheel",
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+    let msg = String::from_utf8_lossy(&bad.stderr);
+    assert!(msg.contains("wheel") && msg.contains("drop"), "{msg}");
+}

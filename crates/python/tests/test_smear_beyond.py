@@ -1,0 +1,78 @@
+"""toonkit.smear beyond the paper (issue #22): causal mode, revolving objects, streaming."""
+
+import numpy as np
+import pytest
+
+import toonkit
+from conftest import ROBOT, asset, run_cli
+
+LINEAR = {"elongate": {"function": {"stages": [{"op": "scale", "by": 1}]}}}
+
+
+def hopping_box(frames=20):
+    """A box hopping along +X (float32 positions (frames, 8, 3), triangles (12, 3))."""
+    corners = np.array(
+        [[x, y, z] for y in (0, 1) for z in (-0.5, 0.5) for x in (-0.5, 0.5)], dtype=np.float32
+    )
+    tris = np.array(
+        [[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
+         [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]],
+        dtype=np.int32,
+    )
+    t = np.arange(frames, dtype=np.float32)
+    shift = np.stack([0.3 * t, 2.0 * np.abs(np.sin(t * np.pi / 8)), 0 * t], axis=1)
+    return (corners[None] + shift[:, None]).astype(np.float32), tris
+
+
+def test_causal_offsets_equal_cli(tmp_path):
+    robot = toonkit.load(asset(ROBOT), clip="Dance")
+    out = tmp_path / "causal.npy"
+    run_cli("smear", "offsets", asset(ROBOT), "--clip", "Dance", "--causal", "-o", out)
+    causal = toonkit.smear.offsets(robot, causal=True)
+    assert np.abs(causal - np.load(out)).max() <= 1e-6
+    assert np.abs(causal - toonkit.smear.offsets(robot)).max() > 1e-3  # the option acts
+
+
+def test_causal_frames_ignore_the_future():
+    pos, tris = hopping_box()
+    other = pos.copy()
+    other[11:] += np.float32([0.0, 3.0, 1.0])
+    a = toonkit.smear.stylize(
+        toonkit.smear.prepare(toonkit.Scene.from_arrays(pos, tris), causal=True), LINEAR
+    ).elongated
+    b = toonkit.smear.stylize(
+        toonkit.smear.prepare(toonkit.Scene.from_arrays(other, tris), causal=True), LINEAR
+    ).elongated
+    np.testing.assert_array_equal(a[:11], b[:11])
+    assert np.abs(a[11:] - b[11:]).max() > 0.1
+
+
+def test_stream_matches_causal_stylize():
+    pos, tris = hopping_box()
+    prepared = toonkit.smear.prepare(toonkit.Scene.from_arrays(pos, tris), causal=True)
+    offline = toonkit.smear.stylize(prepared, LINEAR).elongated
+    s = toonkit.smear.stream(tris, pos.shape[1])
+    for f in range(pos.shape[0]):
+        out = s.push(pos[f])
+        assert out.shape == (8, 3) and out.dtype == np.float32
+        assert np.abs(out - offline[f]).max() <= 1e-4, f
+    assert s.frames_pushed == pos.shape[0]
+    np.testing.assert_allclose(s.offsets, prepared.offsets[-1], atol=1e-5)
+    with pytest.raises(ValueError, match="positions"):
+        s.push(pos[0][:3])
+    with pytest.raises(ValueError, match="triangles"):
+        toonkit.smear.stream(tris + 100, 8)
+
+
+def test_stream_ground_keeps_points_above():
+    pos, tris = hopping_box()
+    s = toonkit.smear.stream(tris, 8, elongate={"stages": [{"op": "scale", "by": 3}]}, ground=0.0)
+    low = min(s.push(p)[:, 1].min() for p in pos)
+    assert low >= 0.0
+
+
+def test_revolve_names_unknown_objects():
+    pos, tris = hopping_box()
+    scene = toonkit.Scene.from_arrays(pos, tris)
+    with pytest.raises(ValueError, match="wheel"):
+        toonkit.smear.prepare(scene, revolve=["wheel"])

@@ -1,0 +1,293 @@
+//! Adaptive subdivision of smeared frames (issue #22; the paper's limitation "adaptive
+//! subdivision where the displacement gradient is high"): a triangle of a low-poly mesh that
+//! elongation stretches into a long shard is split until no edge is longer than `tolerance`
+//! times its rest length.
+//!
+//! Every vertex of the subdivided mesh is a blend of at most three input vertices (the
+//! corners of the input triangle it lies in). Catmull-Rom is linear in its control points, so
+//! its trajectory is the same blend of its parents' trajectories, and it is displaced by the
+//! blend of their β: new vertices lie on the smear, not on the straight chord between the
+//! displaced parents. Attributes (normals, UVs, colours, scalar attributes, multiples'
+//! opacities) are blended with the same weights.
+//!
+//! The rest length of an edge is measured on the input frame (the un-smeared drawing): for an
+//! edge lying on an input edge, that edge's length; for an edge inside an input triangle, the
+//! triangle's longest edge. Decisions are made per edge, so both triangles of an edge split it
+//! the same way: the result is crack-free (a split edge's midpoint is shared).
+
+use std::collections::HashMap;
+
+use anim::Mesh;
+use glam::Vec3;
+use serde::Serialize;
+
+use super::Trajectories;
+
+/// Most rounds of edge splits per frame (each round at most halves every edge).
+pub const MAX_SUBDIVISION_LEVELS: usize = 8;
+
+/// A vertex of the subdivided mesh: weights of up to three input vertices (unused slots 0).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Blend {
+    v: [u32; 3],
+    w: [f32; 3],
+}
+
+impl Blend {
+    fn one(v: u32) -> Blend {
+        Blend {
+            v: [v, v, v],
+            w: [1.0, 0.0, 0.0],
+        }
+    }
+
+    fn support(&self) -> impl Iterator<Item = (u32, f32)> + '_ {
+        self.v
+            .iter()
+            .copied()
+            .zip(self.w.iter().copied())
+            .filter(|e| e.1 > 0.0)
+    }
+
+    /// The midpoint of two blends (supports inside one input triangle: at most three vertices).
+    fn mid(a: &Blend, b: &Blend) -> Blend {
+        let mut out: Vec<(u32, f32)> = Vec::with_capacity(6);
+        for (v, w) in a.support().chain(b.support()) {
+            match out.iter_mut().find(|e| e.0 == v) {
+                Some(e) => e.1 += 0.5 * w,
+                None => out.push((v, 0.5 * w)),
+            }
+        }
+        out.sort_by(|x, y| y.1.total_cmp(&x.1));
+        out.truncate(3);
+        let sum: f32 = out.iter().map(|e| e.1).sum();
+        let mut r = Blend {
+            v: [out[0].0; 3],
+            w: [0.0; 3],
+        };
+        for (k, (v, w)) in out.into_iter().enumerate() {
+            r.v[k] = v;
+            r.w[k] = w / sum;
+        }
+        r
+    }
+
+    fn count(&self) -> usize {
+        self.w.iter().filter(|w| **w > 0.0).count()
+    }
+
+    fn lerp<T: Copy + std::ops::Mul<f32, Output = T> + std::ops::Add<Output = T>>(
+        &self,
+        values: &[T],
+    ) -> T {
+        let mut acc = values[self.v[0] as usize] * self.w[0];
+        for k in 1..3 {
+            if self.w[k] > 0.0 {
+                acc = acc + values[self.v[k] as usize] * self.w[k];
+            }
+        }
+        acc
+    }
+}
+
+/// What subdividing one frame did.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct SubdivisionStats {
+    /// Triangles after subdivision.
+    pub triangles: usize,
+    /// Vertices after subdivision.
+    pub vertices: usize,
+    /// Largest ratio of an output edge's length to its rest length.
+    pub max_stretch: f32,
+}
+
+/// One smeared frame, adaptively subdivided.
+///
+/// # Arguments
+/// * `tr` — the trajectories the frame was displaced along (causal mode, arcs, ground apply).
+/// * `mesh` — the input mesh (triangles and attributes; its positions are not used).
+/// * `h` — the drawing's frame: rest lengths are measured on `tr.frame(h)`.
+/// * `beta` — β of every input vertex at this frame, in frames.
+/// * `alpha` — optional per-vertex opacities, blended into the output's colour alpha with
+///   colour `rgb`.
+/// * `tolerance` — split edges longer than `tolerance ×` their rest length (e.g. 2).
+///
+/// # Performance
+/// One trajectory evaluation per parent of every new vertex; hash map of split edges per round.
+pub fn subdivide_frame(
+    tr: &Trajectories<'_>,
+    mesh: &Mesh,
+    h: usize,
+    beta: &[f32],
+    alpha: Option<(&[f32], [f32; 3])>,
+    tolerance: f32,
+) -> (Mesh, SubdivisionStats) {
+    let rest = tr.frame(h);
+    let ground = tr.ground();
+    let place = |b: &Blend| -> Vec3 {
+        if b.count() == 1 {
+            return tr.displaced(h, b.v[0] as usize, beta[b.v[0] as usize]);
+        }
+        let bb: f32 = b.support().map(|(v, w)| w * beta[v as usize]).sum();
+        let bb = if bb.is_finite() { bb } else { 0.0 };
+        let mut p: Vec3 = b
+            .support()
+            .map(|(v, w)| tr.seen_from(h, v as usize, h as f32 + bb) * w)
+            .sum();
+        if let Some(g) = ground {
+            p.y = p.y.max(g);
+        }
+        p
+    };
+    let mut blends: Vec<Blend> = (0..mesh.vertex_count() as u32).map(Blend::one).collect();
+    let mut pos: Vec<Vec3> = blends.iter().map(place).collect();
+    // Per triangle: its input triangle (for rest lengths).
+    let mut tris: Vec<([u32; 3], u32)> = mesh
+        .triangles
+        .iter()
+        .enumerate()
+        .map(|(k, t)| (*t, k as u32))
+        .collect();
+    let rest_len = |a: u32, b: u32| rest[a as usize].distance(rest[b as usize]);
+    let reference = |blends: &[Blend], a: u32, b: u32, t: u32| -> f32 {
+        let mut s: Vec<u32> = blends[a as usize]
+            .support()
+            .chain(blends[b as usize].support())
+            .map(|e| e.0)
+            .collect();
+        s.sort_unstable();
+        s.dedup();
+        match s.as_slice() {
+            [u, v] => rest_len(*u, *v),
+            _ => {
+                let [x, y, z] = mesh.triangles[t as usize];
+                rest_len(x, y).max(rest_len(y, z)).max(rest_len(z, x))
+            }
+        }
+    };
+    let mut mids: HashMap<(u32, u32), u32> = HashMap::new();
+    for _ in 0..MAX_SUBDIVISION_LEVELS {
+        let mut split: HashMap<(u32, u32), bool> = HashMap::new();
+        let mut any = false;
+        for &(t, orig) in &tris {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let key = (a.min(b), a.max(b));
+                if split.contains_key(&key) {
+                    continue;
+                }
+                let r = reference(&blends, a, b, orig);
+                let long = r > 0.0 && pos[a as usize].distance(pos[b as usize]) > tolerance * r;
+                any |= long;
+                split.insert(key, long);
+            }
+        }
+        if !any {
+            break;
+        }
+        let mut next = Vec::with_capacity(tris.len() * 2);
+        for &(t, orig) in &tris {
+            let mut m = [u32::MAX; 3];
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let key = (a.min(b), a.max(b));
+                if split[&key] {
+                    m[k] = *mids.entry(key).or_insert_with(|| {
+                        let nb = Blend::mid(&blends[a as usize], &blends[b as usize]);
+                        blends.push(nb);
+                        pos.push(place(&nb));
+                        (blends.len() - 1) as u32
+                    });
+                }
+            }
+            split_triangle(t, m, orig, &mut next);
+        }
+        tris = next;
+    }
+    let mut max_stretch = 0.0f32;
+    for &(t, orig) in &tris {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let r = reference(&blends, a, b, orig);
+            if r > 0.0 {
+                max_stretch = max_stretch.max(pos[a as usize].distance(pos[b as usize]) / r);
+            }
+        }
+    }
+    let mut out = Mesh::new(mesh.name.clone(), pos, tris.iter().map(|t| t.0).collect());
+    out.normals = mesh.normals.as_ref().map(|n| {
+        blends
+            .iter()
+            .map(|b| b.lerp(n).try_normalize().unwrap_or(Vec3::Y))
+            .collect()
+    });
+    out.uvs = mesh.uvs.as_ref().map(|uv| {
+        blends
+            .iter()
+            .map(|b| {
+                let u: [f32; 2] =
+                    [0, 1].map(|c| b.support().map(|(v, w)| w * uv[v as usize][c]).sum::<f32>());
+                u
+            })
+            .collect()
+    });
+    out.colors = match alpha {
+        Some((a, [r, g, bl])) => Some(blends.iter().map(|b| [r, g, bl, b.lerp(a)]).collect()),
+        None => mesh.colors.as_ref().map(|c| {
+            blends
+                .iter()
+                .map(|b| {
+                    [0, 1, 2, 3]
+                        .map(|k| b.support().map(|(v, w)| w * c[v as usize][k]).sum::<f32>())
+                })
+                .collect()
+        }),
+    };
+    out.attributes = mesh
+        .attributes
+        .iter()
+        .map(|(k, vals)| (k.clone(), blends.iter().map(|b| b.lerp(vals)).collect()))
+        .collect();
+    let stats = SubdivisionStats {
+        triangles: out.triangle_count(),
+        vertices: out.vertex_count(),
+        max_stretch,
+    };
+    (out, stats)
+}
+
+/// Splits triangle `t` (its input triangle `orig`) at the midpoints `m` of its edges
+/// (`m[k]` on edge `t[k] → t[k+1]`, `u32::MAX` when not split), keeping the winding.
+fn split_triangle(t: [u32; 3], m: [u32; 3], orig: u32, out: &mut Vec<([u32; 3], u32)>) {
+    let on = |k: usize| m[k] != u32::MAX;
+    let n = (0..3).filter(|&k| on(k)).count();
+    // Rotate so the split edges come first (one: edge 0; two: edges 0 and 1).
+    let r = (0..3)
+        .find(|&r| match n {
+            1 => on(r),
+            2 => on(r) && on((r + 1) % 3),
+            _ => true,
+        })
+        .unwrap_or(0);
+    let [a, b, c] = [t[r], t[(r + 1) % 3], t[(r + 2) % 3]];
+    let [m0, m1, m2] = [m[r], m[(r + 1) % 3], m[(r + 2) % 3]];
+    let mut push = |x: [u32; 3]| out.push((x, orig));
+    match n {
+        0 => push(t),
+        1 => {
+            push([a, m0, c]);
+            push([m0, b, c]);
+        }
+        2 => {
+            push([m0, b, m1]);
+            push([a, m0, m1]);
+            push([a, m1, c]);
+        }
+        _ => {
+            push([a, m0, m2]);
+            push([m0, b, m1]);
+            push([m2, m1, c]);
+            push([m0, m1, m2]);
+        }
+    }
+}

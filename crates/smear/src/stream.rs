@@ -1,0 +1,254 @@
+//! Streaming smears (issue #22): push a frame, get its elongated in-between at once — for
+//! games and real-time previews. Everything is causal: frame f's result reads frames ≤ f only.
+//!
+//! Per pushed frame: SMEAR Eq. 1 offsets with the centroid velocity differenced backward
+//! (`c(f) − c(f−1)`), SMEAR Eq. 2 smoothing over the past half-window only
+//! ([`causal_smoothing_weights`](crate::causal_smoothing_weights)), speeds by backward
+//! differences, and SMEAR Eq. 10 along trajectories through the last frames kept, extrapolated
+//! at constant velocity beyond the current frame (see [`Trajectories`]).
+//!
+//! Compared with the offline mode the smear lags: smoothed offsets trail the offline ones by
+//! about N/3 frames, velocities by half a frame, and the future half of an elongation
+//! (β > 0) is a straight extrapolation of the last motion, so it overshoots when the motion
+//! stops or turns (an arm that stops still smears one frame past its stop).
+//!
+//! The stream treats the pushed points as one simple object (SMEAR Eq. 1, or the whole-body
+//! mode of Fig. 14 for a skinned character); the per-bone offsets of SMEAR Eqs. 3–9 need the
+//! skeleton and are offline only.
+
+use anim::Mesh;
+use glam::Vec3;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::field::Tolerances;
+use crate::plane::plane_frames;
+use crate::{
+    causal_smoothing_weights, FunctionSpec, Result, SmearError, StyleFunction, StyleInput, Stylize,
+    Trajectories, DEFAULT_SMOOTH, DEFAULT_STILL_TOLERANCE, STILL_ROUNDING_FACTOR,
+};
+
+/// Default number of past frames a [`Stream`] keeps for its trajectories.
+pub const DEFAULT_STREAM_HISTORY: usize = 6;
+
+/// Vertices per parallel task.
+const CHUNK: usize = 1024;
+
+/// Options of a [`Stream`] (deserializes with every field optional).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StreamOptions {
+    /// Half-window N of SMEAR Eq. 2 (past half only).
+    pub smooth: usize,
+    /// S_E of SMEAR Eq. 10: β in frames (default S_E(δ; 1) = δ).
+    pub elongate: FunctionSpec,
+    /// Past frames kept: β below −(history − 1) clamps to the oldest kept frame.
+    pub history: usize,
+    /// A ground plane `y = ground` the result never goes below.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ground: Option<f32>,
+}
+
+impl Default for StreamOptions {
+    fn default() -> Self {
+        StreamOptions {
+            smooth: DEFAULT_SMOOTH,
+            elongate: FunctionSpec::linear(1.0),
+            history: DEFAULT_STREAM_HISTORY,
+            ground: None,
+        }
+    }
+}
+
+/// A streaming smear: [`Stream::push`] one frame's positions, get its elongated in-between.
+///
+/// ```
+/// use anim::Mesh;
+/// use glam::Vec3;
+/// use smear::{Stream, StreamOptions};
+///
+/// let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+/// let mesh = Mesh::new("tet", p.clone(), vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]);
+/// let mut stream = Stream::new(&mesh, &StreamOptions::default())?;
+/// for f in 0..5 {
+///     let frame: Vec<Vec3> = p.iter().map(|q| *q + Vec3::X * f as f32).collect();
+///     let out = stream.push(&frame)?;
+///     if f == 4 {
+///         assert!(out[1].x > 5.0 - 1e-3); // the leading vertex reaches ahead
+///     }
+/// }
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug)]
+pub struct Stream {
+    triangles: Vec<[u32; 3]>,
+    n: usize,
+    function: StyleFunction,
+    weights: Vec<f32>,
+    ground: Option<f32>,
+    /// The last `kept` frames, oldest first, frame-major (capacity `history` frames).
+    positions: Vec<Vec3>,
+    kept: usize,
+    history: usize,
+    /// Raw offsets of the last N + 1 frames, oldest first.
+    raw: Vec<f32>,
+    /// Smoothed offsets of the current frame.
+    delta: Vec<f32>,
+    rest: Vec<Vec3>,
+    out: Vec<Vec3>,
+    pushed: usize,
+    still: Option<Tolerances>,
+}
+
+impl Stream {
+    /// A stream for `mesh`'s topology (its positions are not used).
+    ///
+    /// # Errors
+    /// A style function that does not compile; `history` below 2.
+    pub fn new(mesh: &Mesh, options: &StreamOptions) -> Result<Stream> {
+        let function = options
+            .elongate
+            .compile()
+            .map_err(|e| SmearError::InvalidParameter {
+                name: "elongate",
+                reason: e.to_string(),
+            })?;
+        if options.history < 2 {
+            return Err(SmearError::InvalidParameter {
+                name: "history",
+                reason: format!("keep at least 2 frames, got {}", options.history),
+            });
+        }
+        let n = mesh.vertex_count();
+        Ok(Stream {
+            triangles: mesh.triangles.clone(),
+            n,
+            function,
+            weights: causal_smoothing_weights(options.smooth),
+            ground: options.ground.filter(|g| g.is_finite()),
+            positions: Vec::with_capacity(options.history * n),
+            kept: 0,
+            history: options.history,
+            raw: Vec::with_capacity((options.smooth + 1) * n),
+            delta: vec![0.0; n],
+            rest: Vec::new(),
+            out: vec![Vec3::ZERO; n],
+            pushed: 0,
+            still: None,
+        })
+    }
+
+    /// Frames pushed so far.
+    pub fn frames_pushed(&self) -> usize {
+        self.pushed
+    }
+
+    /// Smoothed motion offsets of the last pushed frame.
+    pub fn offsets(&self) -> &[f32] {
+        &self.delta
+    }
+
+    /// Pushes the positions of the next frame and returns its elongated in-between.
+    ///
+    /// # Errors
+    /// [`SmearError::InvalidParameter`] when `positions` does not have one point per vertex.
+    ///
+    /// # Performance
+    /// O(vertices × (history + N)) memory moves, SMEAR Eq. 1 on two frames, and one S_E
+    /// evaluation and Catmull-Rom point per vertex (parallel over vertices).
+    pub fn push(&mut self, positions: &[Vec3]) -> Result<&[Vec3]> {
+        let n = self.n;
+        if positions.len() != n {
+            return Err(SmearError::InvalidParameter {
+                name: "positions",
+                reason: format!("expected {n} points, got {}", positions.len()),
+            });
+        }
+        if self.pushed == 0 {
+            self.rest = positions.to_vec();
+            self.still = Some(still_tolerance(positions));
+        }
+        if self.kept == self.history {
+            self.positions.copy_within(n.., 0);
+            self.positions.truncate((self.kept - 1) * n);
+            self.kept -= 1;
+        }
+        self.positions.extend_from_slice(positions);
+        self.kept += 1;
+        let now = self.kept - 1;
+        // SMEAR Eq. 1 on the last two frames, differenced backward.
+        let mut two = Vec::new();
+        let tol = self.still.expect("set on the first push");
+        let frame_raw = if now == 0 {
+            vec![0.0; n]
+        } else {
+            two.resize(2 * n, 0.0);
+            let pair = &self.positions[(now - 1) * n..(now + 1) * n];
+            plane_frames(pair, 2, n, &self.triangles, tol, None, &mut two);
+            two.split_off(n)
+        };
+        let taps = self.weights.len();
+        if self.raw.len() == taps * n {
+            self.raw.copy_within(n.., 0);
+            self.raw.truncate((taps - 1) * n);
+        }
+        self.raw.extend_from_slice(&frame_raw);
+        // SMEAR Eq. 2, past half: frames before the first clamp to it.
+        let have = self.raw.len() / n.max(1);
+        for (i, d) in self.delta.iter_mut().enumerate() {
+            let mut acc = 0.0f32;
+            for (k, w) in self.weights.iter().enumerate() {
+                let back = taps - 1 - k;
+                let row = have.saturating_sub(1 + back);
+                acc += w * self.raw[row * n + i];
+            }
+            *d = acc;
+        }
+        let tr = Trajectories::new(&self.positions, self.kept, n)?.shaped(true, self.ground, None);
+        let (delta, rest, frame) = (&self.delta, &self.rest, self.pushed as f32);
+        let function = &self.function;
+        let current = &self.positions[now * n..];
+        let previous = &self.positions[now.saturating_sub(1) * n..];
+        self.out
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(c, dst)| {
+                for (k, o) in dst.iter_mut().enumerate() {
+                    let i = c * CHUNK + k;
+                    let velocity = if now == 0 {
+                        Vec3::ZERO
+                    } else {
+                        current[i] - previous[i]
+                    };
+                    let x = StyleInput {
+                        delta: delta[i],
+                        speed: velocity.length(),
+                        velocity,
+                        weight: 1.0,
+                        rest: rest[i],
+                        frame,
+                        m: 0.0,
+                        t: 0.0,
+                    };
+                    *o = tr.displaced(now, i, function.eval(&x));
+                }
+            });
+        self.pushed += 1;
+        Ok(&self.out)
+    }
+}
+
+/// The still threshold of the solver (SPEC.md) for a stream, from its first frame.
+fn still_tolerance(p: &[Vec3]) -> Tolerances {
+    let b = anim::Aabb::from_points(p);
+    let scale = if b.is_empty() {
+        0.0
+    } else {
+        b.min.abs().max(b.max.abs()).max_element()
+    };
+    Tolerances {
+        still: (DEFAULT_STILL_TOLERANCE * b.diagonal()).max(STILL_ROUNDING_FACTOR * scale),
+        zero_length: 0.0,
+        causal: true,
+    }
+}
