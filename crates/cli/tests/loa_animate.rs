@@ -38,8 +38,9 @@ fn robot_jump_writes_glb_bvh_and_gif() {
         gif.to_str().unwrap(),
     ]);
     println!("{report:#}");
+    // Keystrokes 0..=46, then the default `--settle`: one key interval (46 - 34 = 12 frames).
     let frames = report["frames"].as_u64().unwrap();
-    assert_eq!(frames, 47);
+    assert_eq!(frames, 47 + 12);
     assert_eq!(report["joints"].as_u64().unwrap(), 43);
     let dist = report["line_distance_mean_percent"].as_f64().unwrap();
     let step = report["max_rotation_step_degrees"].as_f64().unwrap();
@@ -54,7 +55,7 @@ fn robot_jump_writes_glb_bvh_and_gif() {
     assert_eq!(scene.clips[0].name, "loa");
     assert!(!scene.meshes.is_empty());
     let duration = scene.clips[0].duration();
-    assert!((duration - 46.0 / 24.0).abs() < 1e-3, "{duration}");
+    assert!((duration - 58.0 / 24.0).abs() < 1e-3, "{duration}");
     let motion = tkio::bvh::read(&std::fs::read(&bvh).unwrap()).unwrap();
     assert_eq!(motion.clips.len(), 1);
     assert!(std::fs::read(&gif).unwrap().starts_with(b"GIF8"));
@@ -150,6 +151,25 @@ fn settle_wobble_and_reversed_strokes_from_the_command_line() {
         "key",
     ]);
     assert_eq!(keyed["frames"].as_u64().unwrap(), 41 + 20);
+    // `key` is the default; `--settle 0` ends on the last keystroke.
+    let default = json(&[
+        "loa",
+        "line",
+        &examples("whip.json"),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(default["frames"], keyed["frames"]);
+    let none = json(&[
+        "loa",
+        "line",
+        &examples("whip.json"),
+        "-o",
+        out.to_str().unwrap(),
+        "--settle",
+        "0",
+    ]);
+    assert_eq!(none["frames"].as_u64().unwrap(), 41);
     assert_bad_input(
         &[
             "loa",

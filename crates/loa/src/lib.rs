@@ -41,8 +41,8 @@
 //!   the next pose (whip, k = 120: overshoot strictly smaller at ζ = 0.1 < 0.25 < 0.5 < 1).
 //!   Damping above 0.5 is accepted but slows the approach past `t*`, and the sped-up replay
 //!   can then exceed the motion cap.
-//! * **settle** ([`PhysicsOptions::settle`]): follow-through frames after the last keystroke,
-//!   ending on it at rest. A keystroke repeated at a later frame is a moving hold.
+//! * **settle** ([`PhysicsOptions::settle`], default one key interval): follow-through frames
+//!   after the last keystroke, ending on it at rest. A keystroke repeated at a later frame is a moving hold.
 //! * No setting in those ranges moves any chain point more than 15 % of the line's length in
 //!   one frame on `whip.json` or `jump.json` (the approach is slowed down as needed,
 //!   [`MAX_FRAME_MOTION`]; measured worst 14.4 %, the spacing of jump.json's own keystrokes).
@@ -89,7 +89,8 @@
 //!     {"frame": 24, "points": [[0, 0], [50, 30], [100, 0]], "damping": 0.2}
 //! ]}"#)?;
 //! let line = loa::line(&keys, &LineOptions::default())?;
-//! assert_eq!(line.animation.frames.len(), 25);
+//! // Frames 0..=24, then the default settle: one key interval (24 frames) ending at rest.
+//! assert_eq!(line.animation.frames.len(), 25 + 24);
 //! // The line lands on the second keystroke exactly.
 //! let last = line.animation.chain_at(24).unwrap().joints();
 //! let key = line.keys[1].chain.joints();
@@ -113,7 +114,7 @@
 //! let options: AnimateOptions =
 //!     serde_json::from_str(r#"{"bone_sets": [{"frame": 0, "set": "hips,head"}]}"#)?;
 //! let motion = loa::animate(&character, &hermite, &options)?;
-//! assert_eq!(motion.frames(), 25);
+//! assert_eq!(motion.frames(), 25 + 24);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
@@ -151,7 +152,7 @@ pub use keystroke::{
 };
 pub use onion::{to_svg_string, DEFAULT_SVG_WIDTH};
 pub use physics::{
-    simulate, PhysicsAnimation, PhysicsOptions, Retarget, SimulatedFrames, Simulation,
+    simulate, PhysicsAnimation, PhysicsOptions, Retarget, Settle, SimulatedFrames, Simulation,
     DEFAULT_SIMULATED_FRAMES, DEFAULT_SUBSTEPS, MAX_SIMULATED_STEPS,
 };
 pub use retarget::{closest_frame, Blend};

@@ -95,7 +95,8 @@ pub fn line(keys: &Keystrokes, options: &LineOptions) -> Result<Line, LoaError> 
             check_positive("fps", options.physics.fps)?;
             let mut a = interpolate_hermite(&poses, options.physics.fps);
             if let Some(last) = a.frames.last().cloned() {
-                for k in 1..=i64::from(options.physics.settle) {
+                let tail = options.physics.settle.frames(&keys.frames());
+                for k in 1..=i64::from(tail) {
                     a.frames.push(AnimationFrame {
                         frame: last.frame + k,
                         chain: last.chain.clone(),

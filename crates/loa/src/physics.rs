@@ -49,6 +49,29 @@ impl Default for SimulatedFrames {
     }
 }
 
+/// Follow-through after the last keystroke ([`PhysicsOptions::settle`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Settle {
+    /// This many frames (0 = the clip ends on the last keystroke).
+    Frames(u32),
+    /// One key interval: as many frames as between the last two keystrokes (none with a
+    /// single keystroke). The default, so the line does not stop dead on the last key.
+    #[default]
+    KeyInterval,
+}
+
+impl Settle {
+    /// Frames added after the last of the keystrokes at `key_frames` (increasing).
+    pub fn frames(self, key_frames: &[i64]) -> u32 {
+        match (self, key_frames) {
+            (Settle::Frames(n), _) => n,
+            (Settle::KeyInterval, [.., a, b]) => u32::try_from(b - a).unwrap_or(u32::MAX),
+            (Settle::KeyInterval, _) => 0,
+        }
+    }
+}
+
 /// Options of the physically-based interpolation.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -61,9 +84,9 @@ pub struct PhysicsOptions {
     pub simulated_frames: SimulatedFrames,
     /// Blend of the re-targeting correction.
     pub blend: Blend,
-    /// Frames of follow-through added after the last keystroke (0 = end on it); they end on
-    /// the last keystroke, at rest.
-    pub settle: u32,
+    /// Frames of follow-through added after the last keystroke (default one key interval;
+    /// `Frames(0)` ends on it); they end on the last keystroke, at rest.
+    pub settle: Settle,
 }
 
 impl Default for PhysicsOptions {
@@ -73,7 +96,7 @@ impl Default for PhysicsOptions {
             substeps: DEFAULT_SUBSTEPS,
             simulated_frames: SimulatedFrames::default(),
             blend: Blend::default(),
-            settle: 0,
+            settle: Settle::default(),
         }
     }
 }

@@ -94,7 +94,9 @@ pub fn interpolate_physics(
         });
     }
     let last = &keys[keys.len() - 1];
-    for (f, chain) in (last.frame + 1..).zip(settle(last, &velocity, options.settle, options)?) {
+    let key_frames: Vec<i64> = keys.iter().map(|k| k.frame).collect();
+    let tail = options.settle.frames(&key_frames);
+    for (f, chain) in (last.frame + 1..).zip(settle(last, &velocity, tail, options)?) {
         frames.push(AnimationFrame { frame: f, chain });
     }
     Ok(PhysicsAnimation {

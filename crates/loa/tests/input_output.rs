@@ -132,7 +132,8 @@ fn json_output_follows_the_spec_layout_and_is_deterministic() {
         serde_json::json!([0, 10, 22, 34, 46])
     );
     let frames = v["frames"].as_array().unwrap();
-    assert_eq!(frames.len(), 47);
+    // Keystrokes 0..=46 plus the default settle: one key interval (46 - 34 = 12 frames).
+    assert_eq!(frames.len(), 47 + 12);
     for (i, f) in frames.iter().enumerate() {
         assert_eq!(f["frame"], i as i64);
         assert_eq!(f["points"].as_array().unwrap().len(), DEFAULT_ELEMENTS + 1);

@@ -6,7 +6,7 @@ mod common;
 
 use common::{example, with_params};
 use glam::DVec2;
-use loa::{Animation, Keystrokes, LineOptions, PhysicsOptions};
+use loa::{Animation, Keystrokes, LineOptions, PhysicsOptions, Settle};
 
 /// Documented ranges (crate docs, "Parameters").
 const STIFFNESS_RANGE: [f64; 2] = [5.0, 100.0];
@@ -15,7 +15,7 @@ const DAMPING_RANGE: [f64; 2] = [0.05, 0.5];
 fn physics_line(keys: &Keystrokes, settle: u32) -> loa::Line {
     let options = LineOptions {
         physics: PhysicsOptions {
-            settle,
+            settle: Settle::Frames(settle),
             fps: keys.fps().unwrap_or(24.0),
             ..Default::default()
         },

@@ -1,8 +1,8 @@
 //! Previews of a character following a line of action: the skinned meshes (or only the
 //! bones, for a BVH skeleton), the bones in grey, the line in red and the constrained joints in
 //! blue, seen through an orthographic view along the action camera that follows the
-//! character (the same scale on every frame, centred on its smoothed centroid), or through a
-//! scene camera.
+//! character (the same scale on every frame, centred on its meshes' smoothed bounding-box
+//! centre), or through a scene camera.
 
 use anim::{Camera, MeshAnimation};
 use glam::{Mat4, Vec3};
@@ -66,20 +66,38 @@ impl RigPreview<'_> {
     fn joints_at(&self, f: usize) -> &[Vec3] {
         &self.positions[f * self.joints..(f + 1) * self.joints]
     }
+
+    /// Centre of what is drawn of the character at frame `f`: the midpoint of its meshes'
+    /// bounding box (of the joints' when it has no meshes). Joints bunch up in the spine and
+    /// hands, so their centroid sits away from the middle of the body.
+    fn subject_centre(&self, f: usize) -> Vec3 {
+        let mut points = self
+            .meshes
+            .iter()
+            .filter(|m| f < m.frame_count())
+            .flat_map(|m| m.frame(f).iter())
+            .filter(|q| q.is_finite())
+            .peekable();
+        if points.peek().is_none() {
+            let j = self.joints_at(f);
+            return j.iter().copied().sum::<Vec3>() / j.len().max(1) as f32;
+        }
+        let (min, max) = points.fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(a, b), &q| (a.min(q), b.max(q)),
+        );
+        0.5 * (min + max)
+    }
 }
 
-/// One orthographic view per frame along `axes`, centred on the joints' centroid smoothed
+/// One orthographic view per frame along `axes`, centred on the character (its meshes'
+/// bounding-box centre, else the joints' centroid; see [`RigPreview::subject_centre`]) smoothed
 /// over `±DEFAULT_FOLLOW_SMOOTHING` frames, with one scale for the whole clip: the largest
 /// distance of any joint, mesh vertex or line point from its frame's centre (plus a
 /// margin).
 fn follow(p: &RigPreview<'_>, axes: ViewAxes, aspect: f32) -> Vec<View> {
     let frames = p.frames();
-    let raw: Vec<Vec3> = (0..frames)
-        .map(|f| {
-            let j = p.joints_at(f);
-            j.iter().copied().sum::<Vec3>() / j.len().max(1) as f32
-        })
-        .collect();
+    let raw: Vec<Vec3> = (0..frames).map(|f| p.subject_centre(f)).collect();
     let centres: Vec<Vec3> = (0..frames)
         .map(|f| {
             let k = DEFAULT_FOLLOW_SMOOTHING.min(f).min(frames - 1 - f);
@@ -169,5 +187,63 @@ pub fn rig_preview(preview: &RigPreview<'_>, view: RigView<'_>, gif: bool) -> Re
         encode_gif(&images, preview.fps)
     } else {
         encode_png(&images[0])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn follow_view_centres_the_meshes_not_the_joints() {
+        // Joints bunched at the top of a tall box mesh (as a robot's spine, arms and head).
+        let corners = vec![Vec3::new(-1.0, 0.0, 0.0), Vec3::new(1.0, 4.0, 0.0)];
+        let mesh = anim::Mesh::new("body", corners.clone(), Vec::new());
+        let frames = 3;
+        let shift = |f: usize| Vec3::new(f as f32, 0.0, 0.0);
+        let cache: Vec<Vec3> = (0..frames)
+            .flat_map(|f| corners.iter().map(move |&c| c + shift(f)))
+            .collect();
+        let animation = MeshAnimation::new(mesh, 24.0, cache).unwrap();
+        let positions: Vec<Vec3> = (0..frames)
+            .flat_map(|f| {
+                [
+                    Vec3::new(0.0, 3.5, 0.0) + shift(f),
+                    Vec3::new(0.5, 3.9, 0.0) + shift(f),
+                ]
+            })
+            .collect();
+        let meshes = [&animation];
+        let lines = vec![Vec::new(); frames];
+        let marked = vec![Vec::new(); frames];
+        let preview = RigPreview {
+            meshes: &meshes,
+            joints: 2,
+            positions: &positions,
+            bones: &[(0, 1)],
+            lines: &lines,
+            marked: &marked,
+            fps: 24.0,
+        };
+        let axes = ViewAxes {
+            right: Vec3::X,
+            up: Vec3::Y,
+            forward: Vec3::NEG_Z,
+        };
+        let views = follow(&preview, axes, 1.0);
+        // The middle frame is smoothed symmetrically: the box centre lands mid-image.
+        let c = views[1]
+            .project(Vec3::new(0.0, 2.0, 0.0) + shift(1), 100, 100)
+            .unwrap();
+        assert!((c.x - 50.0).abs() < 0.5 && (c.y - 50.0).abs() < 0.5, "{c}");
+        // Without meshes the joints' centroid is the centre.
+        let bare = RigPreview {
+            meshes: &[],
+            ..preview
+        };
+        let c = follow(&bare, axes, 1.0)[1]
+            .project(Vec3::new(0.25, 3.7, 0.0) + shift(1), 100, 100)
+            .unwrap();
+        assert!((c.x - 50.0).abs() < 0.5 && (c.y - 50.0).abs() < 0.5, "{c}");
     }
 }

@@ -42,7 +42,7 @@
 //! let line = loa::line(&keys, &LineOptions { mode: Mode::Hermite, ..Default::default() })?;
 //! let sets = [BoneSetKey { frame: 0, set: "hips,head".parse()? }];
 //! let motion = animate(&character, &line.animation, &sets, &[], &[], &AnimateOptions::default())?;
-//! assert_eq!(motion.frames(), 13);
+//! assert_eq!(motion.frames(), 13 + 12); // and the default settle: one key interval
 //! assert!(motion.report.line_distance_mean < 0.05); // within 5 % of the line's length
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```

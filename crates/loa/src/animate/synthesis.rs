@@ -176,7 +176,13 @@ pub(crate) fn run(
     for (f, t) in targets.iter_mut().enumerate() {
         line_targets(&keys, &key_offsets, f, &lines[f], t);
     }
-    let reduction = Reduction::new(&line.keystroke_frames);
+    // Settle frames after the last keystroke get their own interval of nodes, ending on the
+    // clip's last frame.
+    let mut node_keys = line.keystroke_frames.clone();
+    if node_keys.last().is_some_and(|&k| k < last) {
+        node_keys.push(last);
+    }
+    let reduction = Reduction::new(&node_keys);
 
     // Planar stage (Section 4).
     let mut dof = vec![false; rig.len()];

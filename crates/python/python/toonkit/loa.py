@@ -66,7 +66,8 @@ def line(
     ``"physics"`` (elastic chain re-targeted onto every keystroke) or ``"hermite"``.
     ``options`` are the fields of the loa crate's ``LineOptions`` (``elements``,
     ``smoothing``, ``orient``, ``wobbles``) and of its ``physics`` options (``substeps``,
-    ``simulated_frames`` -- a count or ``"gap"`` --, ``settle``, ``blend``), as the CLI's
+    ``simulated_frames`` -- a count or ``"gap"`` --, ``settle`` -- a count or ``"key"``, the
+    default, for one key interval --, ``blend``), as the CLI's
     ``toonkit loa line`` flags set them. Returns a :class:`Line` with ``.points``
     ``(frames, joints, 2)``, ``.angles``, ``.lengths`` and ``.save(path)``.
 
@@ -81,6 +82,8 @@ def line(
         if k in _PHYSICS:
             if k == "simulated_frames":
                 v = {"fixed": int(v)} if isinstance(v, int) else ("frame_gap" if v == "gap" else v)
+            if k == "settle":
+                v = {"frames": int(v)} if isinstance(v, int) else ("key_interval" if v == "key" else v)
             physics[k] = v
         else:
             rest[k] = v

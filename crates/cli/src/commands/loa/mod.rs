@@ -63,9 +63,9 @@ pub struct LineFlags {
     /// Rigid elements per chain (even).
     #[arg(long, default_value_t = loa::DEFAULT_ELEMENTS)]
     pub elements: usize,
-    /// Follow-through after the last keystroke, ending on it at rest: a frame count, or `key`
-    /// for one key interval (the last one).
-    #[arg(long, default_value = "0")]
+    /// Follow-through after the last keystroke, ending on it at rest: a frame count (0 = end
+    /// on the last keystroke), or `key` for one key interval (the last one).
+    #[arg(long, default_value = "key")]
     pub settle: String,
     /// Drag-to-wobble `FRAME:S:DX,DY`: hit the line at frame FRAME, at arc-length position
     /// S (0..1), with impulse DX,DY (screen units per second). Repeatable.
@@ -86,15 +86,12 @@ impl LineFlags {
                 format!("--simulated-frames {m}: expected a frame count or \"gap\"")
             })?),
         };
-        let frames = keys.frames();
         let settle = match self.settle.trim() {
-            "key" => match frames[..] {
-                [.., a, b] => u32::try_from(b - a).unwrap_or(u32::MAX),
-                _ => 0,
-            },
-            s => s
-                .parse()
-                .with_context(|| format!("--settle {s}: expected a frame count or \"key\""))?,
+            "key" => loa::Settle::KeyInterval,
+            s => loa::Settle::Frames(
+                s.parse()
+                    .with_context(|| format!("--settle {s}: expected a frame count or \"key\""))?,
+            ),
         };
         let wobbles = self
             .wobbles
