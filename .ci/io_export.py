@@ -6,12 +6,12 @@ Usage: python .ci/io_export.py OUT_DIR ASSET...
 
 For every asset (a .glb/.gltf) it imports the file into an empty scene and writes
 - NAME.glb: plain glTF (the reference every other file is compared with);
-- NAME_draco.glb: glTF with Draco mesh compression (KHR_draco_mesh_compression);
 - NAME_lights.glb: glTF with a point light added (KHR_lights_punctual);
 - NAME.fbx: binary FBX 7.4 with the animation baked per action and shape keys.
 Each export covers the same frame range (the scene's, set by the glTF importer).
 """
 
+import os
 import pathlib
 import sys
 
@@ -51,9 +51,15 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
     for asset in map(pathlib.Path, sys.argv[2:]):
         name = asset.stem
+        # A fresh import before every export: the FBX exporter's baking changes the scene.
         import_gltf(asset)
         export_gltf(out / f"{name}.glb")
-        export_gltf(out / f"{name}_draco.glb", export_draco_mesh_compression_enable=True)
+        import_gltf(asset)
+        light = bpy.data.lights.new("lamp", type="POINT")
+        obj = bpy.data.objects.new("lamp", light)
+        bpy.context.scene.collection.objects.link(obj)
+        export_gltf(out / f"{name}_lights.glb", export_lights=True)
+        import_gltf(asset)
         bpy.ops.export_scene.fbx(
             filepath=str(out / f"{name}.fbx"),
             bake_anim=True,
@@ -65,12 +71,11 @@ def main():
             axis_forward="-Z",
             axis_up="Y",
         )
-        light = bpy.data.lights.new("lamp", type="POINT")
-        obj = bpy.data.objects.new("lamp", light)
-        bpy.context.scene.collection.objects.link(obj)
-        export_gltf(out / f"{name}_lights.glb", export_lights=True)
-        print(f"exported {name}: glb, draco, lights, fbx")
+        print(f"exported {name}: glb, lights, fbx")
 
 
 if __name__ == "__main__":
     main()
+    # bpy 4.2 as a module can crash while the interpreter shuts down; the files are written.
+    sys.stdout.flush()
+    os._exit(0)

@@ -13,7 +13,7 @@
 
 use std::path::Path;
 
-use serde_json::{Map, Value};
+use serde_json::{json, Map, Value};
 
 use crate::{IoError, Result};
 
@@ -207,6 +207,63 @@ fn load_buffer(
     }
 }
 
+/// Accessors without a buffer view or sparse values are zeros (glTF 2.0 §3.6.2.1; exporters
+/// write all-zero morph targets so): they get a zero-filled view, which the `gltf` crate needs.
+fn zero_views(root: &mut Map<String, Value>, buffers: &mut Vec<Vec<u8>>) {
+    let mut zeros: Vec<u8> = Vec::new();
+    let buffer = buffers.len();
+    let mut new_views = Vec::new();
+    let first_view = root
+        .get("bufferViews")
+        .and_then(Value::as_array)
+        .map_or(0, Vec::len);
+    if let Some(accessors) = root.get_mut("accessors").and_then(Value::as_array_mut) {
+        for acc in accessors.iter_mut().filter_map(Value::as_object_mut) {
+            if acc.contains_key("bufferView") || acc.contains_key("sparse") {
+                continue;
+            }
+            let comps = match acc.get("type").and_then(Value::as_str) {
+                Some("SCALAR") => 1,
+                Some("VEC2") => 2,
+                Some("VEC3") => 3,
+                Some("VEC4") | Some("MAT2") => 4,
+                Some("MAT3") => 12,
+                Some("MAT4") => 16,
+                _ => continue,
+            };
+            let size = match acc.get("componentType").and_then(Value::as_u64) {
+                Some(5120 | 5121) => 1,
+                Some(5122 | 5123) => 2,
+                _ => 4,
+            };
+            let count = acc.get("count").and_then(Value::as_u64).unwrap_or(0) as usize;
+            let len = (count * comps * size).div_ceil(4) * 4;
+            acc.insert("bufferView".into(), json!(first_view + new_views.len()));
+            acc.insert("byteOffset".into(), json!(0));
+            new_views.push(json!({"buffer": buffer, "byteOffset": zeros.len(), "byteLength": len}));
+            zeros.resize(zeros.len() + len, 0);
+        }
+    }
+    if new_views.is_empty() {
+        return;
+    }
+    if let Some(views) = root
+        .entry("bufferViews")
+        .or_insert_with(|| Value::Array(Vec::new()))
+        .as_array_mut()
+    {
+        views.extend(new_views);
+    }
+    if let Some(list) = root
+        .entry("buffers")
+        .or_insert_with(|| Value::Array(Vec::new()))
+        .as_array_mut()
+    {
+        list.push(json!({ "byteLength": zeros.len() }));
+    }
+    buffers.push(zeros);
+}
+
 /// Prepares `bytes` (a `.glb`, or `.gltf` whose external buffers are found in `base`).
 pub(crate) fn prepare(bytes: &[u8], base: Option<&Path>) -> Result<Prepared> {
     let (json, mut bin) = split(bytes)?;
@@ -238,6 +295,7 @@ pub(crate) fn prepare(bytes: &[u8], base: Option<&Path>) -> Result<Prepared> {
     strip(map, &mut notes);
     crate::gltf_meshopt::decode(map, &mut buffers)?;
     crate::gltf_draco::decode(map, &mut buffers)?;
+    zero_views(map, &mut buffers);
     let root: gltf_json::Root = serde_json::from_value(value).map_err(|e| bad(e.to_string()))?;
     Ok(Prepared {
         root,

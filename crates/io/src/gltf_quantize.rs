@@ -4,7 +4,8 @@
 //!
 //! Per mesh: `c` = centre of its bounding box, `s` = the largest of |p − c| and |delta| over
 //! every component, so that `(p − c) / s` and `delta / s` lie in [−1, 1]; the position error
-//! is at most `s / 65534` per component (≈ 1.5e-5 of the bounding box). The node above the mesh
+//! is at most `s / 65534` per component (≈ 1.5e-5 of the bounding box; twice that with morph
+//! deltas, which are rounded too). The node above the mesh
 //! gets the transform `x ↦ c + s·x`: folded into the node's own TRS when the node's transform
 //! is not animated (exact: `t' = t + R·S·c`, `S' = S·s`), else on a new child node that
 //! carries the mesh. Skinned meshes (the node transform of a skinned mesh is ignored) and

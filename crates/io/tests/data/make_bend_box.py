@@ -43,5 +43,5 @@ cam = bpy.data.objects.new("cam", cam_data); cam.location = (0, -10, 2); cam.rot
 scene.collection.objects.link(cam)
 import sys
 out = sys.argv[-1]
-bpy.ops.export_scene.fbx(filepath=out, bake_anim=True, bake_anim_use_all_actions=False, add_leaf_bones=False, axis_forward="-Z", axis_up="Y")
+bpy.ops.export_scene.fbx(filepath=out, bake_anim=True, bake_anim_use_all_actions=True, bake_anim_use_nla_strips=False, add_leaf_bones=False, axis_forward="-Z", axis_up="Y")
 bpy.ops.export_scene.gltf(filepath=out.replace(".fbx", ".glb"), export_format="GLB")
