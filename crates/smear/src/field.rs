@@ -53,7 +53,9 @@ impl Field {
         space: Option<&CameraSpace>,
     ) -> (Field, Vec<f32>) {
         let mut raw = vec![0.0f32; frames * vertices];
-        let planes = plane_frames(positions, frames, vertices, triangles, tol, space, &mut raw);
+        let planes = plane_frames(
+            positions, frames, vertices, triangles, tol.still, tol.causal, space, &mut raw,
+        );
         (Field::Plane(planes), raw)
     }
 

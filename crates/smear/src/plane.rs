@@ -66,8 +66,8 @@ impl PlaneFrame {
 /// (unsmoothed) offsets of its vertices.
 ///
 /// # Arguments
-/// * `tol` — velocities at most `tol.still` long give a still frame (offsets 0); `tol.causal`
-///   differences backward (past-only mode).
+/// * `still` — velocities at most this long give a still frame (offsets 0).
+/// * `causal` — difference velocities backward (past-only mode).
 /// * `space` — measure the centroid's velocity relative to this camera.
 /// * `raw` — receives the frame-major `frames × vertices` offsets δ_i(f) of SMEAR Eq. 1.
 ///
@@ -82,7 +82,8 @@ pub(crate) fn plane_frames(
     frames: usize,
     vertices: usize,
     triangles: &[[u32; 3]],
-    tol: crate::field::Tolerances,
+    still: f32,
+    causal: bool,
     space: Option<&CameraSpace>,
     raw: &mut [f32],
 ) -> Vec<PlaneFrame> {
@@ -91,10 +92,9 @@ pub(crate) fn plane_frames(
         .into_par_iter()
         .map(|f| surface_centroid(frame(f), triangles))
         .collect();
-    let still = tol.still;
     let plane = |f: usize| {
         let c = centroids[f];
-        let v = track_velocity(f, frames, space, tol.causal, |g| centroids[g]);
+        let v = track_velocity(f, frames, space, causal, |g| centroids[g]);
         let dir = if v.length() > still {
             v.try_normalize()
         } else {

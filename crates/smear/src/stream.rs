@@ -21,7 +21,6 @@ use glam::Vec3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::field::Tolerances;
 use crate::plane::plane_frames;
 use crate::{
     causal_smoothing_weights, FunctionSpec, Result, SmearError, StyleFunction, StyleInput, Stylize,
@@ -97,7 +96,7 @@ pub struct Stream {
     rest: Vec<Vec3>,
     out: Vec<Vec3>,
     pushed: usize,
-    still: Option<Tolerances>,
+    still: Option<f32>,
 }
 
 impl Stream {
@@ -184,7 +183,7 @@ impl Stream {
         } else {
             two.resize(2 * n, 0.0);
             let pair = &self.positions[(now - 1) * n..(now + 1) * n];
-            plane_frames(pair, 2, n, &self.triangles, tol, None, &mut two);
+            plane_frames(pair, 2, n, &self.triangles, tol, true, None, &mut two);
             two.split_off(n)
         };
         let taps = self.weights.len();
@@ -239,16 +238,12 @@ impl Stream {
 }
 
 /// The still threshold of the solver (SPEC.md) for a stream, from its first frame.
-fn still_tolerance(p: &[Vec3]) -> Tolerances {
+fn still_tolerance(p: &[Vec3]) -> f32 {
     let b = anim::Aabb::from_points(p);
     let scale = if b.is_empty() {
         0.0
     } else {
         b.min.abs().max(b.max.abs()).max_element()
     };
-    Tolerances {
-        still: (DEFAULT_STILL_TOLERANCE * b.diagonal()).max(STILL_ROUNDING_FACTOR * scale),
-        zero_length: 0.0,
-        causal: true,
-    }
+    (DEFAULT_STILL_TOLERANCE * b.diagonal()).max(STILL_ROUNDING_FACTOR * scale)
 }
