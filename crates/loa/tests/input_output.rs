@@ -149,7 +149,7 @@ fn json_output_follows_the_spec_layout_and_is_deterministic() {
     );
     assert_eq!(
         svg.matches("stroke=\"#2a5bd7\"").count(),
-        47 - 5,
+        47 + 12 - 5,
         "in-betweens in blue"
     );
     assert!(roxmltree::Document::parse(&svg).is_ok());

@@ -47,7 +47,11 @@ fn fig3_physics_line_lands_on_every_keystroke() {
             let line = loa::line(&keys, &options).unwrap();
             let a = &line.animation;
             assert_eq!(a.keystroke_frames, keys.frames());
-            let span = keys.frames().last().unwrap() - keys.frames()[0] + 1;
+            // Keystroke span plus the default settle (one key interval).
+            let [.., before, last] = keys.frames()[..] else {
+                panic!("{name}: fewer than two keystrokes")
+            };
+            let span = last - keys.frames()[0] + 1 + (last - before);
             assert_eq!(
                 a.frames.len() as i64,
                 span,
