@@ -2,8 +2,7 @@
 // against a running `toonkit studio` (URL in argv[2]); screenshots into argv[3].
 // Prints the latency figures and a closing "N passed, N failed" line; exit 1 on any failure.
 import { chromium } from 'playwright-core';
-import { mkdirSync, mkdtempSync } from 'node:fs';
-import { tmpdir } from 'node:os';
+import { mkdirSync } from 'node:fs';
 import { join } from 'node:path';
 
 const url = process.argv[2];
@@ -20,8 +19,8 @@ const browser = await chromium.launch({
   executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
   args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
     '--disable-background-networking', '--disable-component-update', '--disable-sync',
-    '--use-gl=angle', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-    `--user-data-dir=${mkdtempSync(join(tmpdir(), 'studio-chromium-'))}`],
+    '--use-gl=angle', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+  // launch() gives every run a fresh temporary user-data-dir.
 });
 try {
   const page = await browser.newPage({ viewport: { width: 1280, height: 760 } });

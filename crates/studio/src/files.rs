@@ -56,7 +56,7 @@ impl OpenedFile {
     /// The scene as read, when the file is a glTF/BVH scene (a loa character).
     pub fn scene(&self) -> Option<&anim::Scene> {
         match &self.loaded {
-            Loaded::Scene(s) => Some(s),
+            Loaded::Scene(s) => Some(&**s),
             _ => None,
         }
     }

@@ -47,13 +47,18 @@ impl Allowed {
 
 /// The middleware: refuses foreign `Host`/`Origin` with 403.
 pub async fn check(State(allowed): State<Allowed>, request: Request, next: Next) -> Response {
-    let value = |name| {
-        request
-            .headers()
-            .get(name)
-            .map(|v| v.to_str().unwrap_or("\u{fffd}").to_string())
+    // Read the headers in a block: a borrow of the request (not `Sync`) must not live across
+    // the `await` below.
+    let (host, origin) = {
+        let value = |name: header::HeaderName| {
+            request
+                .headers()
+                .get(name)
+                .map(|v| v.to_str().unwrap_or("\u{fffd}").to_string())
+        };
+        let host = value(header::HOST).or_else(|| request.uri().authority().map(|a| a.to_string()));
+        (host, value(header::ORIGIN))
     };
-    let host = value(header::HOST).or_else(|| request.uri().authority().map(|a| a.to_string()));
     match host {
         Some(h) if allowed.host(&h) => {}
         Some(h) => {
@@ -62,7 +67,7 @@ pub async fn check(State(allowed): State<Allowed>, request: Request, next: Next)
         }
         None => return ApiError::forbidden("a request without Host is refused").into_response(),
     }
-    if let Some(origin) = value(header::ORIGIN) {
+    if let Some(origin) = origin {
         if !allowed.origin(&origin) {
             return ApiError::forbidden(format!("Origin {origin:?} is not this studio (refused)"))
                 .into_response();

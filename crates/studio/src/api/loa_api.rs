@@ -150,7 +150,10 @@ pub(crate) async fn animate(
         for k in &r.keystrokes {
             if let Some(b) = k.bones.as_deref().filter(|b| !b.is_empty()) {
                 let key = format!("{b}@{}", k.frame);
-                bone_sets.push(key.parse().map_err(|e| ApiError::bad(format!("bones {b}: {e}")))?);
+                let set: loa::animate::BoneSetKey = key
+                    .parse()
+                    .map_err(|e: loa::animate::AnimateError| ApiError::bad(format!("bones {b}: {e}")))?;
+                bone_sets.push(set);
             }
         }
         let animate_options = AnimateOptions {
@@ -276,8 +279,11 @@ pub(crate) async fn export(
             .map(str::to_ascii_lowercase)
             .unwrap_or_default();
         let io = |e: String| ApiError::internal(format!("{}: {e}", r.name));
-        let text =
-            |t: &str| tkio::save(&path, &tkio::Output::Text(t)).map_err(|e| io(e.to_string()));
+        let text = |t: &str| {
+            tkio::save(&path, &tkio::Output::Text(t))
+                .map(|_| ())
+                .map_err(|e| io(e.to_string()))
+        };
         match (ext.as_str(), r.what.as_deref()) {
             ("json", Some("keystrokes")) => text(&s.keys_json)?,
             ("json", _) => text(&s.line.animation.to_json_string())?,
@@ -299,10 +305,12 @@ pub(crate) async fn export(
                 let t = tkio::bvh::write(&skeleton, &skeletal).map_err(|e| io(e.to_string()))?;
                 text(&t)?;
             }
-            _ => return Err(ApiError::bad(format!(
+            _ => {
+                return Err(ApiError::bad(format!(
                 "{}: export keystrokes/line as .json, the line as .svg, the motion as .glb or .bvh",
                 r.name
-            ))),
+            )))
+            }
         }
         Ok(Json(json!({ "written": path.display().to_string() })))
     })
