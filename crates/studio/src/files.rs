@@ -29,6 +29,7 @@ impl OpenedFile {
         let options = LoadOptions {
             fps: FPS,
             rest: None,
+            ..LoadOptions::default()
         };
         let loaded = tkio::load(path, &options).map_err(|e| StudioError::Open(e.to_string()))?;
         Ok(OpenedFile {
