@@ -33,7 +33,7 @@ impl Allowed {
     /// Whether `host` (a `Host` header value) names the server.
     pub fn host(&self, host: &str) -> bool {
         let host = host.trim().to_ascii_lowercase();
-        self.hosts.iter().any(|h| *h == host)
+        self.hosts.contains(&host)
     }
 
     /// Whether `origin` (an `Origin` header value) is a page of the server.

@@ -33,6 +33,7 @@ pub mod error;
 pub mod files;
 pub mod guard;
 pub mod jobs;
+mod lock;
 pub mod pack;
 pub mod server;
 pub mod state;

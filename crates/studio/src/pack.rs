@@ -65,7 +65,7 @@ impl Pack {
         };
         object.insert("buffers".into(), Value::Array(self.entries));
         let mut text = Value::Object(object).to_string().into_bytes();
-        while text.len() % 4 != 0 {
+        while !text.len().is_multiple_of(4) {
             text.push(b' ');
         }
         let mut out = Vec::with_capacity(4 + text.len() + self.data.len());

@@ -3,13 +3,14 @@
 
 use std::collections::HashMap;
 use std::path::PathBuf;
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::{Arc, Mutex};
 
 use anim::SampledScene;
 
 use crate::error::{ApiError, ApiResult};
 use crate::files::OpenedFile;
 use crate::jobs::Jobs;
+pub use crate::lock::lock;
 
 /// A file index and clip name.
 pub type ClipKey = (usize, String);
@@ -47,12 +48,6 @@ pub struct Studio {
     pub loa: Mutex<Option<LoaSession>>,
     /// Long jobs (stopmo).
     pub jobs: Jobs,
-}
-
-/// Locks a mutex, recovering from a panicked holder (the data stays usable: every writer
-/// replaces whole values).
-pub fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|p| p.into_inner())
 }
 
 impl Studio {

@@ -149,8 +149,8 @@ pub(crate) fn revolving_objects(
         .objects
         .iter()
         .map(|o| {
-            let named = names.iter().any(|n| *n == o.name);
-            if !named && !(auto && o.skin.is_none()) {
+            let named = names.contains(&o.name);
+            if !(named || auto && o.skin.is_none()) {
                 return None;
             }
             let a = &o.animation;

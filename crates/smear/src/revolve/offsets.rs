@@ -94,11 +94,7 @@ pub fn revolving_offsets(
     smooth: usize,
     causal: bool,
 ) -> Vec<f32> {
-    let vertices = if frames == 0 {
-        0
-    } else {
-        positions.len() / frames
-    };
+    let vertices = positions.len().checked_div(frames).unwrap_or(0);
     let piece = pieces(vertices, triangles);
     let mut raw = vec![0.0f32; frames * vertices];
     for f in 0..frames {
