@@ -46,9 +46,9 @@ TOONKIT_IO_EXPORTS="$OUT" cargo test --quiet --workspace --test exporters -- --n
 echo "== the Fig. 16 style on the robot's Dance clip: quantized and float"
 cargo build --quiet --workspace --bins
 TK="$ROOT/target/debug/toonkit"
-"$TK" --quantize smear style assets/characters/RobotExpressive.glb --clip Dance \
+"$TK" --quantize smear assets/characters/RobotExpressive.glb --clip Dance \
     --style examples/smear/fig16_combined.toml -o "$OUT/dance_fig16.glb"
-"$TK" smear style assets/characters/RobotExpressive.glb --clip Dance \
+"$TK" smear assets/characters/RobotExpressive.glb --clip Dance \
     --style examples/smear/fig16_combined.toml -o "$OUT/dance_fig16_float.glb"
 ls -l "$OUT/dance_fig16.glb" "$OUT/dance_fig16_float.glb" | awk '{print $5, $9}'
 "$TK" info "$OUT/dance_fig16.glb" | tail -3
