@@ -236,19 +236,7 @@ fn morph(
     Ok(node)
 }
 
+/// A node with no transform (the flipbook roots and frames that need no dequantization).
 fn empty_node() -> json::Node {
-    json::Node {
-        camera: None,
-        children: None,
-        extensions: None,
-        extras: Default::default(),
-        matrix: None,
-        mesh: None,
-        name: None,
-        rotation: None,
-        scale: None,
-        translation: None,
-        skin: None,
-        weights: None,
-    }
+    trs_node(Vec3::ZERO, Quat::IDENTITY, Vec3::ONE)
 }

@@ -91,6 +91,8 @@ pub struct Stream {
     history: usize,
     /// Raw offsets of the last N + 1 frames, oldest first.
     raw: Vec<f32>,
+    /// Raw offsets of the last two frames (SMEAR Eq. 1 scratch, reused every push).
+    pair_raw: Vec<f32>,
     /// Smoothed offsets of the current frame.
     delta: Vec<f32>,
     rest: Vec<Vec3>,
@@ -129,6 +131,7 @@ impl Stream {
             kept: 0,
             history: options.history,
             raw: Vec::with_capacity((options.smooth + 1) * n),
+            pair_raw: vec![0.0; 2 * n],
             delta: vec![0.0; n],
             rest: Vec::new(),
             out: vec![Vec3::ZERO; n],
@@ -176,22 +179,27 @@ impl Stream {
         self.kept += 1;
         let now = self.kept - 1;
         // SMEAR Eq. 1 on the last two frames, differenced backward.
-        let mut two = Vec::new();
         let tol = self.still.expect("set on the first push");
-        let frame_raw = if now == 0 {
-            vec![0.0; n]
-        } else {
-            two.resize(2 * n, 0.0);
+        self.pair_raw.fill(0.0);
+        if now > 0 {
             let pair = &self.positions[(now - 1) * n..(now + 1) * n];
-            plane_frames(pair, 2, n, &self.triangles, tol, true, None, &mut two);
-            two.split_off(n)
-        };
+            plane_frames(
+                pair,
+                2,
+                n,
+                &self.triangles,
+                tol,
+                true,
+                None,
+                &mut self.pair_raw,
+            );
+        }
         let taps = self.weights.len();
         if self.raw.len() == taps * n {
             self.raw.copy_within(n.., 0);
             self.raw.truncate((taps - 1) * n);
         }
-        self.raw.extend_from_slice(&frame_raw);
+        self.raw.extend_from_slice(&self.pair_raw[n..]);
         // SMEAR Eq. 2, past half: frames before the first clamp to it.
         let have = self.raw.len() / n.max(1);
         for (i, d) in self.delta.iter_mut().enumerate() {

@@ -233,7 +233,6 @@ pub fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
     };
     let out = run_style(&args.io, &p, &style)?;
     let t = Instant::now();
-    let input = p.animation(0);
     let written = match out.animation(0) {
         Some(body) => output::write_animation(&args.io.output, body, args.layout, None, ctx.save)?,
         None => {
@@ -243,7 +242,7 @@ pub fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
     };
     spinner.finish_and_clear();
     let stats = &out.report.objects[0];
-    let body = input;
+    let body = p.animation(0);
     let summary = json!({
         "input": args.io.input, "output": args.io.output, "files": written,
         "frames": body.frame_count(), "vertices": body.vertex_count(),
