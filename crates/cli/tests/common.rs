@@ -97,4 +97,32 @@ pub fn assert_bad_input(args: &[&str], needle: &str) {
         err.contains(needle),
         "stderr {err:?} does not mention {needle:?}"
     );
+    assert_readable(&err);
+}
+
+/// The rules of every error message (issue #23): no `Debug` output, no OS error codes, no
+/// text said twice, numbers written for people.
+pub fn assert_readable(message: &str) {
+    let m = message.trim_end();
+    for leak in [
+        "Constant(",
+        "Curve(",
+        "Some(",
+        "None",
+        "Error {",
+        "kind: ",
+        "os error",
+    ] {
+        assert!(!m.contains(leak), "{m:?} leaks {leak:?}");
+    }
+    let digits = m
+        .split(|c: char| !c.is_ascii_digit())
+        .map(str::len)
+        .max()
+        .unwrap_or(0);
+    assert!(digits <= 12, "{m:?} spells out a {digits}-digit number");
+    let parts: Vec<&str> = m.split(": ").map(str::trim).collect();
+    for w in parts.windows(2) {
+        assert!(!w[0].eq_ignore_ascii_case(w[1]), "{m:?} repeats {:?}", w[0]);
+    }
 }
