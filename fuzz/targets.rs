@@ -7,13 +7,13 @@
 
 /// Alembic (Ogawa) archives from bytes: any bytes give Ok or Err; an archive that reads
 /// gives every mesh's samples without panicking.
-pub fn abc(data: &[u8]) {
+pub(crate) fn abc(data: &[u8]) {
     let _ = tkio::abc::read(data);
 }
 
 /// BVH: any bytes give Ok or Err; a scene that reads samples without NaN (when short enough)
 /// and its BVH export reads back.
-pub fn bvh(data: &[u8]) {
+pub(crate) fn bvh(data: &[u8]) {
     use anim::{sample, SampleOptions};
     use tkio::bvh;
     let Ok(scene) = bvh::read(data) else { return };
@@ -48,7 +48,7 @@ pub fn bvh(data: &[u8]) {
 
 /// Stylization expressions: any text gives Ok or Err; an expression that compiles evaluates
 /// (to any number, NaN included) on ordinary and extreme inputs without panicking.
-pub fn expr(data: &[u8]) {
+pub(crate) fn expr(data: &[u8]) {
     use smear::{Expression, Param, StyleInput, Stylize};
     use std::collections::BTreeMap;
     let Ok(text) = std::str::from_utf8(data) else {
@@ -91,12 +91,12 @@ pub fn expr(data: &[u8]) {
 }
 
 /// glTF/GLB from bytes: any bytes give Ok or Err.
-pub fn gltf(data: &[u8]) {
+pub(crate) fn gltf(data: &[u8]) {
     let _ = tkio::gltf::read_bytes(data);
 }
 
 /// Keystrokes from JSON or SVG text (`loa::Keystrokes::parse`): any text gives Ok or Err.
-pub fn keystrokes(data: &[u8]) {
+pub(crate) fn keystrokes(data: &[u8]) {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
@@ -107,7 +107,7 @@ pub fn keystrokes(data: &[u8]) {
 }
 
 /// MDD: any bytes give Ok or Err; a valid file re-encodes to the same positions.
-pub fn mdd(data: &[u8]) {
+pub(crate) fn mdd(data: &[u8]) {
     use anim::glam::Vec3;
     use anim::Mesh;
     use tkio::mdd;
@@ -123,7 +123,7 @@ pub fn mdd(data: &[u8]) {
 }
 
 /// NPY: any bytes give Ok or Err; an array that reads writes back to the same bits.
-pub fn npy(data: &[u8]) {
+pub(crate) fn npy(data: &[u8]) {
     use tkio::npy;
     if let Ok((shape, values)) = npy::read_f32(data) {
         let bytes = npy::write_f32(&shape, &values).expect("write of a read array");
@@ -135,7 +135,7 @@ pub fn npy(data: &[u8]) {
 }
 
 /// OBJ: any bytes give Ok or Err; a mesh that reads writes back to exactly the same mesh.
-pub fn obj(data: &[u8]) {
+pub(crate) fn obj(data: &[u8]) {
     use tkio::obj;
     if let Ok(m) = obj::read(data) {
         let again = obj::read(obj::write(&m).as_bytes()).expect("re-read of written OBJ");
@@ -144,7 +144,7 @@ pub fn obj(data: &[u8]) {
 }
 
 /// PC2: any bytes give Ok or Err; a valid file re-encodes to the same positions.
-pub fn pc2(data: &[u8]) {
+pub(crate) fn pc2(data: &[u8]) {
     use anim::glam::Vec3;
     use anim::Mesh;
     use tkio::pc2;
@@ -160,7 +160,7 @@ pub fn pc2(data: &[u8]) {
 }
 
 /// STL: any bytes give Ok or Err; a mesh that reads writes back to the same welded mesh.
-pub fn stl(data: &[u8]) {
+pub(crate) fn stl(data: &[u8]) {
     use tkio::stl;
     if let Ok(m) = stl::read(data) {
         let again = stl::read(&stl::write_binary(&m)).expect("re-read of written STL");
@@ -171,7 +171,7 @@ pub fn stl(data: &[u8]) {
 
 /// Smear style files (TOML): any text gives Ok or Err; a style that parses compiles for a
 /// unit-size scene without panicking.
-pub fn style(data: &[u8]) {
+pub(crate) fn style(data: &[u8]) {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };

@@ -175,9 +175,13 @@ pub(crate) fn tool_output(words: &[&str]) -> ToolOutput {
             None => return ToolOutput::Unknown,
         }
     }
-    match command.get_arguments().find(|a| a.get_id() == "output") {
-        Some(a) if a.is_positional() => ToolOutput::Positional,
-        Some(_) => ToolOutput::Option,
+    let output = command
+        .get_arguments()
+        .find(|a| a.get_id() == "output")
+        .map(|a| a.is_positional());
+    match output {
+        Some(true) => ToolOutput::Positional,
+        Some(false) => ToolOutput::Option,
         None => ToolOutput::NoOutput,
     }
 }
