@@ -98,6 +98,20 @@ struct Measured {
     min_key_spread: f64,
 }
 
+/// Every piece of every part scaled to millimetres.
+fn in_mm(lib: &stopmo::library::Library, mm: f32) -> Vec<Vec<Vec<Vec3>>> {
+    lib.parts
+        .iter()
+        .map(|part| {
+            part.solution
+                .pieces
+                .iter()
+                .map(|piece| piece.iter().map(|x| *x * mm).collect())
+                .collect()
+        })
+        .collect()
+}
+
 /// The shells of every part, seam walls shared, with keys on every seam.
 fn shells(
     anims: &[MeshAnimation],
@@ -155,17 +169,7 @@ fn close_pieces(pieces: usize) -> Measured {
     };
     let lib = build_library(&inputs, &opts).expect("library");
     let mm = print_scale(&refs, HEIGHT_MM) as f32;
-    let pieces_mm: Vec<Vec<Vec<Vec3>>> = lib
-        .parts
-        .iter()
-        .map(|part| {
-            part.solution
-                .pieces
-                .iter()
-                .map(|piece| piece.iter().map(|x| *x * mm).collect())
-                .collect()
-        })
-        .collect();
+    let pieces_mm = in_mm(&lib, mm);
     let mut m = Measured {
         min_wall: f64::INFINITY,
         min_keys_per_seam: usize::MAX,
@@ -472,17 +476,7 @@ fn diagnose_crossings() {
     )
     .expect("library");
     let mm = print_scale(&refs, HEIGHT_MM) as f32;
-    let all_mm: Vec<Vec<Vec<Vec3>>> = lib
-        .parts
-        .iter()
-        .map(|part| {
-            part.solution
-                .pieces
-                .iter()
-                .map(|piece| piece.iter().map(|x| *x * mm).collect())
-                .collect()
-        })
-        .collect();
+    let all_mm = in_mm(&lib, mm);
     for (p, (shell, keys, _)) in shells(&anims, &all_mm, mm).into_iter().enumerate() {
         let a = &anims[p];
         let pieces_mm = &all_mm[p];

@@ -21,6 +21,7 @@ use super::error::{LibraryError, Result};
 use super::fabricate::{check_solid, split_fans, DEFAULT_THICKNESS_MM};
 use super::intersect::self_intersecting_triangles;
 
+mod caps;
 mod envelope;
 mod seams;
 mod untangle;
@@ -124,43 +125,6 @@ fn front_positions(source: &[u32], caps: &[Vec<u32>], piece: &[Vec3]) -> Vec<Vec
         out.push(c);
     }
     out
-}
-
-/// Splits the directed boundary edges into loops, removes the loops shorter than
-/// `fraction` of the longest one from `boundary` and returns them (vertices in edge order).
-fn cap_loops(front: &[Vec3], boundary: &mut Vec<(u32, u32)>, fraction: f64) -> Vec<Vec<u32>> {
-    let next: HashMap<u32, u32> = boundary.iter().copied().collect();
-    let mut seen: HashMap<u32, ()> = HashMap::new();
-    let mut loops: Vec<(Vec<u32>, f64)> = Vec::new();
-    for &(start, _) in boundary.iter() {
-        if seen.contains_key(&start) {
-            continue;
-        }
-        let (mut lp, mut len, mut v) = (Vec::new(), 0.0f64, start);
-        let mut closed = false;
-        while seen.insert(v, ()).is_none() {
-            lp.push(v);
-            let Some(&w) = next.get(&v) else { break };
-            len += f64::from(front[v as usize].distance(front[w as usize]));
-            if w == start {
-                closed = true;
-                break;
-            }
-            v = w;
-        }
-        if closed && lp.len() >= 3 {
-            loops.push((lp, len));
-        }
-    }
-    let longest = loops.iter().map(|l| l.1).fold(0.0, f64::max);
-    let caps: Vec<Vec<u32>> = loops
-        .into_iter()
-        .filter(|l| l.1 < fraction * longest)
-        .map(|l| l.0)
-        .collect();
-    let capped: std::collections::HashSet<u32> = caps.iter().flatten().copied().collect();
-    boundary.retain(|(a, _)| !capped.contains(a));
-    caps
 }
 
 /// Vertex adjacency (sorted, deduplicated) of a triangle list.
@@ -305,7 +269,7 @@ impl PartShell {
         // Cap the small boundary loops (eye and mouth openings): a fan from the loop's
         // centroid, so only the outer boundary (seams, neck, scalp) needs a wall.
         let (mut front, mut tris) = (front, tris);
-        let caps = cap_loops(&front, &mut boundary, opts.cap_fraction);
+        let caps = caps::cap_loops(&front, &mut boundary, opts.cap_fraction);
         let regular = front.len();
         for (i, lp) in caps.iter().enumerate() {
             let c = (regular + i) as u32;
