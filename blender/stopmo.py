@@ -33,7 +33,7 @@ class StopmoSettings(bpy.types.PropertyGroup):
                        description="Temporal smoothness weight (StopShop Eq. 10)")
     restarts: IntProperty(name="Restarts", default=4, min=1, max=100)
     seed: IntProperty(name="Seed", default=1, min=0)
-    print_height_mm: FloatProperty(name="Print height (mm)", default=25.0, min=1.0)
+    print_height_mm: FloatProperty(name="Print height (mm)", default=60.0, min=1.0)
     plugs: BoolProperty(name="Plugs", default=False,
                         description="Registration plugs between parts")
     directory: StringProperty(name="Directory", default="//stopmo", subtype="DIR_PATH")

@@ -83,7 +83,7 @@ fn segment_then_library_on_a_tube_gives_the_spec_layout() {
             assert_eq!(recon.frame(f), &sol.pieces[sol.labels[f] as usize][..]);
         }
     }
-    // The report's errors are the library's, in mm at the default 25 mm print height.
+    // The report's errors are the library's, in mm at the default print height.
     assert_eq!(lib.report.errors_mm, lib.library.errors_mm);
     assert!(lib.report.errors_mm.position_mean > 0.0);
     assert!(lib.report.errors_mm.position_mean < lib.report.errors_mm.position_max);

@@ -36,7 +36,8 @@ pub struct OutputFile<'a> {
 }
 
 impl LibraryResult {
-    /// Every file of the output layout: `pieces/<part>_<NN>.obj` and `.stl`, `assembly.csv`,
+    /// Every file of the output layout: `pieces/<part>_<NN>.obj` and `.stl`,
+    /// `pieces/<part>_back.obj` (the shared back surface, mm), `assembly.csv`,
     /// `assembly.md`, `catalogue.png`, `assembly_shotNN.png` (one per shot),
     /// `shooting_order.csv`, `report.json`, `reconstruction.glb`,
     /// `reconstruction.pc2` + `rest.obj`, `error_curve.csv` / `.png` after a size search and,
@@ -66,6 +67,9 @@ impl LibraryResult {
                 format!("pieces/{}.stl", p.id),
                 FileData::Mesh(&p.solid),
             ));
+        }
+        for b in &self.backs {
+            out.push(file(format!("pieces/{}.obj", b.name), FileData::Mesh(b)));
         }
         out.push(file("assembly.csv", FileData::Text(self.assembly_csv())));
         out.push(file(

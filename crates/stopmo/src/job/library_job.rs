@@ -290,7 +290,7 @@ fn build(
     };
     let segments = opts.plugs.map(|p| p.segments);
     let errors = input_errors(&lib, anims, inputs, &opts.cuts)?;
-    let (pieces, printing, warnings) = print_pieces(
+    let printed = print_pieces(
         &lib,
         anims,
         &PrintSettings {
@@ -301,6 +301,7 @@ fn build(
             ids: opts.ids,
             plugs: &plugs,
             plug_segments: segments.unwrap_or(crate::library::DEFAULT_PLUG_SEGMENTS),
+            backs: &opts.backs,
         },
     )?;
     let catalogue = catalogue_png(&lib, anims)?;
@@ -331,8 +332,8 @@ fn build(
             thickness_mm: opts.thickness_mm,
             restarts: opts.solve.restarts,
             errors,
-            printing,
-            warnings,
+            printing: printed.report,
+            warnings: printed.warnings,
             sheets: sheets.iter().map(|(n, _)| n.clone()).collect(),
         },
     );
@@ -341,7 +342,8 @@ fn build(
         segmented: None,
         part_names: names.to_vec(),
         library: lib,
-        pieces,
+        pieces: printed.pieces,
+        backs: printed.backs,
         assembly,
         shooting_order: order,
         plugs,

@@ -83,6 +83,10 @@ pub struct LibraryJobOptions {
     /// Pre-made pieces per part name (model units, one position per vertex of the part):
     /// they are kept and new pieces are added up to the library size.
     pub fixed: BTreeMap<String, Vec<Vec<Vec3>>>,
+    /// Printed back surfaces per part name (millimetres, in the shell's vertex order: the
+    /// `pieces/<part>_back.obj` of an earlier run): the new pieces seat on them instead of
+    /// a back surface made for this clip, so they fit the printed library's head.
+    pub backs: BTreeMap<String, Vec<Vec3>>,
     /// Printer resolution in millimetres: pieces that differ from a sibling by less are
     /// reported (a warning and `printing.parts[].below_resolution`).
     pub resolution_mm: f64,
@@ -105,6 +109,7 @@ impl Default for LibraryJobOptions {
             saliency: None,
             cuts: Vec::new(),
             fixed: BTreeMap::new(),
+            backs: BTreeMap::new(),
             resolution_mm: DEFAULT_RESOLUTION_MM,
             keys: true,
             ids: true,

@@ -41,6 +41,20 @@ pub(crate) struct PrintSettings<'a> {
     pub(crate) ids: bool,
     pub(crate) plugs: &'a [Plug],
     pub(crate) plug_segments: usize,
+    /// Printed back surfaces by part name (see [`crate::LibraryJobOptions::backs`]).
+    pub(crate) backs: &'a std::collections::BTreeMap<String, Vec<Vec3>>,
+}
+
+/// What [`print_pieces`] makes.
+pub(crate) struct Printed {
+    /// Every piece, part by part.
+    pub(crate) pieces: Vec<Piece>,
+    /// `report.json` `"printing"`.
+    pub(crate) report: PrintReport,
+    /// Warnings (pieces below the printer resolution, thin walls on a printed back).
+    pub(crate) warnings: Vec<String>,
+    /// The back surface of every part before keys and IDs (`pieces/<part>_back.obj`).
+    pub(crate) backs: Vec<Mesh>,
 }
 
 /// One part in [`PrintReport`].
@@ -111,6 +125,15 @@ pub struct Piece {
     pub solid: Mesh,
 }
 
+/// A part's back surface with what it was built from (millimetres).
+struct BuiltShell {
+    shell: PartShell,
+    average: Vec<Vec3>,
+    pieces_mm: Vec<Vec<Vec3>>,
+    /// `(average, back)` of its boundary vertices ([`PartShell::boundary_pairs`]).
+    boundary: Vec<(Vec3, Vec3)>,
+}
+
 /// Renders `text` with the built-in font into a bitmap (one font pixel per bitmap pixel).
 fn text_bitmap(text: &str) -> Result<Bitmap> {
     let (w, h) = render::text_size(text, 1);
@@ -129,16 +152,18 @@ pub(crate) fn print_pieces(
     lib: &Library,
     anims: &[&MeshAnimation],
     s: &PrintSettings<'_>,
-) -> Result<(Vec<Piece>, PrintReport, Vec<String>)> {
+) -> Result<Printed> {
     let mm = lib.mm_per_unit as f32;
     let mut parts_report = Vec::new();
     let mut warnings = Vec::new();
     let mut pieces_out: Vec<Piece> = Vec::new();
+    // One back surface per part, seam walls shared with the parts built before.
     let mut shared: Vec<(Vec3, Vec3)> = Vec::new();
+    let mut shells: Vec<BuiltShell> = Vec::new();
+    let mut backs: Vec<Mesh> = Vec::new();
     for (p, a) in anims.iter().enumerate() {
-        let part = &lib.parts[p];
         let avg: Vec<Vec3> = a.average_positions().iter().map(|x| *x * mm).collect();
-        let pieces_mm: Vec<Vec<Vec3>> = part
+        let pieces_mm: Vec<Vec<Vec3>> = lib.parts[p]
             .solution
             .pieces
             .iter()
@@ -150,9 +175,52 @@ pub(crate) fn print_pieces(
             ..ShellOptions::default()
         };
         let mut shell = PartShell::new_sharing(&a.mesh, &avg, &refs, &shell_opts, &shared)?;
-        shared.extend(shell.boundary_pairs(&avg));
+        if let Some(back) = s.backs.get(&lib.parts[p].name) {
+            shell.use_back(back, &refs).map_err(|e| {
+                Error::option_error("fixed", format!("part {}: {e}", lib.parts[p].name))
+            })?;
+            if shell.stats.min_wall_mm < s.thickness_mm * 0.99
+                || shell.stats.self_intersecting_triangles > 0
+            {
+                warnings.push(format!(
+                    "part {}: the new pieces come within {:.2} mm of the printed back surface ({} crossing triangles); the wall is {} mm",
+                    lib.parts[p].name,
+                    shell.stats.min_wall_mm,
+                    shell.stats.self_intersecting_triangles,
+                    s.thickness_mm
+                ));
+            }
+        }
+        backs.push(shell.back_mesh(&format!("{}_back", lib.parts[p].name)));
+        let pairs = shell.boundary_pairs(&avg);
+        shared.extend(pairs.iter().copied());
+        shells.push(BuiltShell {
+            shell,
+            average: avg,
+            pieces_mm,
+            boundary: pairs,
+        });
+    }
+    let boundaries: Vec<Vec<(Vec3, Vec3)>> = shells.iter().map(|b| b.boundary.clone()).collect();
+    for (p, built) in shells.into_iter().enumerate() {
+        let BuiltShell {
+            mut shell,
+            average: avg,
+            pieces_mm,
+            ..
+        } = built;
+        let part = &lib.parts[p];
+        let a = anims[p];
+        // The seams this part shares with every other part (in part order).
+        let seams: Vec<Vec<u32>> = boundaries
+            .iter()
+            .enumerate()
+            .filter(|(q, _)| *q != p)
+            .map(|(_, other)| shell.seam_vertices(&avg, other))
+            .filter(|v| !v.is_empty())
+            .collect();
         let keys = if s.keys {
-            shell.add_keys(&KeyOptions::for_print_height(s.print_height_mm))?
+            shell.add_seam_keys(&KeyOptions::for_print_height(s.print_height_mm), &seams)?
         } else {
             Vec::new()
         };
@@ -215,7 +283,12 @@ pub(crate) fn print_pieces(
         ids: s.ids,
         parts: parts_report,
     };
-    Ok((pieces_out, report, warnings))
+    Ok(Printed {
+        pieces: pieces_out,
+        report,
+        warnings,
+        backs,
+    })
 }
 
 /// Pieces closer to a sibling than `resolution_mm` (largest vertex distance), and the

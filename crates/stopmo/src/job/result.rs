@@ -18,6 +18,9 @@ pub struct LibraryResult {
     pub library: Library,
     /// Every piece, part by part.
     pub pieces: Vec<Piece>,
+    /// The back surface every piece of a part seats on (millimetres, before keys and IDs;
+    /// `pieces/<part>_back.obj`, read back by `--fixed`).
+    pub backs: Vec<anim::Mesh>,
     /// Which piece of each part goes on each frame.
     pub assembly: Assembly,
     /// A proposed order to shoot the frames with few piece swaps.

@@ -242,6 +242,22 @@ fn pair_intersects(tris: &[[u32; 3]], snapped: &[P], i: usize, j: usize) -> bool
 /// One uniform grid (cell ≈ mean triangle size), exact tests only for pairs whose bounding
 /// boxes overlap, in parallel over cells.
 pub fn self_intersecting_triangles(positions: &[Vec3], tris: &[[u32; 3]]) -> Option<Vec<u32>> {
+    let mut hits: Vec<u32> = intersecting_pairs(positions, tris)?
+        .into_iter()
+        .flat_map(|(i, j)| [i, j])
+        .collect();
+    hits.sort_unstable();
+    hits.dedup();
+    Some(hits)
+}
+
+/// The pairs `(i, j)`, `i ≤ j`, of triangles of `tris` that intersect anywhere but in the
+/// vertices and edges they share; a degenerate triangle `t` is reported as `(t, t)`. Where
+/// [`self_intersecting_triangles`] counts, this tells which parts of a solid cross.
+///
+/// # Returns
+/// Sorted pairs; `None` as for [`self_intersecting_triangles`].
+pub fn intersecting_pairs(positions: &[Vec3], tris: &[[u32; 3]]) -> Option<Vec<(u32, u32)>> {
     if positions
         .iter()
         .any(|p| !p.is_finite() || p.abs().max_element() > MAX_EXACT_COORDINATE)
@@ -295,7 +311,7 @@ pub fn self_intersecting_triangles(positions: &[Vec3], tris: &[[u32; 3]]) -> Opt
         .map(|(t, _)| t as u32)
         .collect();
     let cells: Vec<(&[i32; 3], &Vec<u32>)> = grid.iter().collect();
-    let mut hits: Vec<u32> = cells
+    let mut hits: Vec<(u32, u32)> = cells
         .par_iter()
         .flat_map_iter(|(cell_key, list)| {
             let mut out = Vec::new();
@@ -310,15 +326,14 @@ pub fn self_intersecting_triangles(positions: &[Vec3], tris: &[[u32; 3]]) -> Opt
                         continue;
                     }
                     if pair_intersects(tris, &snapped, i as usize, j as usize) {
-                        out.push(i);
-                        out.push(j);
+                        out.push((i.min(j), i.max(j)));
                     }
                 }
             }
             out
         })
         .collect();
-    hits.extend(degenerate);
+    hits.extend(degenerate.into_iter().map(|t| (t, t)));
     hits.sort_unstable();
     hits.dedup();
     Some(hits)

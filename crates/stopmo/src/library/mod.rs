@@ -37,7 +37,7 @@
 //!     .unwrap();
 //! assert_eq!(lib.parts[0].solution.pieces.len(), 4);
 //! assert_eq!(lib.parts[0].solution.labels.len(), 40);
-//! assert!(lib.errors_mm.position_mean < 2.0); // millimetres at a 25 mm print height
+//! assert!(lib.errors_mm.position_mean < 4.8); // millimetres at a 60 mm print height
 //! let order = shooting_order(&lib.assembly());
 //! assert!(order.swaps <= order.sequential_swaps);
 //! ```
@@ -77,12 +77,13 @@ pub use fabricate::{
 };
 pub use input_errors::compare_frames;
 pub use intersect::{
-    closest_point_on_triangle, self_intersecting_triangles, TriangleGrid, MAX_EXACT_COORDINATE,
+    closest_point_on_triangle, intersecting_pairs, self_intersecting_triangles, TriangleGrid,
+    MAX_EXACT_COORDINATE,
 };
 pub use metrics::{ErrorSummary, FrameErrors};
 pub use piece_id::{
-    Bitmap, Key, KeyOptions, DEFAULT_ID_RELIEF_MM, DEFAULT_KEY_COUNT, KEY_HEIGHT_PER_RADIUS,
-    KEY_RADIUS_PER_HEIGHT,
+    Bitmap, Key, KeyOptions, DEFAULT_ID_RELIEF_MM, DEFAULT_KEYS_PER_SEAM, DEFAULT_KEY_COUNT,
+    KEY_HEIGHT_PER_RADIUS, KEY_RADIUS_PER_HEIGHT,
 };
 pub use plugs::{
     add_plugs, components, plan_plugs, Plug, PlugOptions, DEFAULT_PLUG_CLEARANCE_MM,

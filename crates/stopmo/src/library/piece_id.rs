@@ -1,12 +1,16 @@
 //! Registration keys and embossed piece IDs on the shared back surface.
 //!
 //! Keys: smooth domes raised out of the back surface (into the armature/head the pieces seat
-//! on), at least three, far apart and away from the part boundary, so a piece pressed onto
-//! its seat cannot slide or turn (all six degrees of freedom fixed); every piece of a part has
-//! the same keys. IDs: the piece's ID raised out of the back surface as a height field of a
-//! text bitmap (the caller renders the glyphs), at the back vertex farthest from the boundary
-//! and the keys, readable from behind. Both only move back-surface vertices along the smoothed
-//! inward direction, outward from the solid, so the wall never gets thinner.
+//! on, which carries the matching dimples). Every seam the part shares with a neighbour gets
+//! [`KeyOptions::per_seam`] keys (default 2) just inside it, as far apart along it as the
+//! back allows, so the two sides of a seam are held where they meet; farthest-point sampling
+//! then adds keys up to [`KeyOptions::count`] (at least three, not collinear: a piece pressed
+//! onto its seat can neither slide nor turn, all six degrees of freedom fixed). Every piece of
+//! a part has the same keys. IDs: the piece's ID raised out of the back surface as a height
+//! field of a text bitmap (the caller renders the glyphs), at the back vertex farthest from
+//! the boundary and the keys, readable from behind. Both only move back-surface vertices
+//! along the smoothed inward direction, outward from the solid, so the wall never gets
+//! thinner.
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -14,8 +18,10 @@ use serde::{Deserialize, Serialize};
 use super::back_surface::PartShell;
 use super::error::{LibraryError, Result};
 
-/// Keys per part.
+/// Keys per part (at least; seam keys may add more).
 pub const DEFAULT_KEY_COUNT: usize = 3;
+/// Keys along every seam, on each side.
+pub const DEFAULT_KEYS_PER_SEAM: usize = 2;
 /// Key radius as a fraction of the print height (clamped to 0.75–4 mm).
 pub const KEY_RADIUS_PER_HEIGHT: f64 = 0.035;
 /// Key height as a fraction of its radius.
@@ -27,8 +33,11 @@ pub const DEFAULT_ID_RELIEF_MM: f64 = 0.4;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct KeyOptions {
-    /// Number of keys (0 disables them; 3 fix all six degrees of freedom).
+    /// Number of keys per part at least (0 disables them; 3 not collinear fix all six
+    /// degrees of freedom).
     pub count: usize,
+    /// Keys just inside every seam shared with another part (on each side of the seam).
+    pub per_seam: usize,
     /// Dome radius.
     pub radius_mm: f64,
     /// Dome height.
@@ -47,6 +56,7 @@ impl KeyOptions {
         let r = (height_mm * KEY_RADIUS_PER_HEIGHT).clamp(0.75, 4.0);
         KeyOptions {
             count: DEFAULT_KEY_COUNT,
+            per_seam: DEFAULT_KEYS_PER_SEAM,
             radius_mm: r,
             height_mm: r * KEY_HEIGHT_PER_RADIUS,
         }
@@ -64,6 +74,9 @@ pub struct Key {
     pub radius_mm: f32,
     /// Height.
     pub height_mm: f32,
+    /// The seam it registers (index into the `seams` given to [`PartShell::add_seam_keys`]),
+    /// `None` for the keys that only complete the part's registration.
+    pub seam: Option<usize>,
 }
 
 /// A text bitmap: `pixels[row * width + column]`, row 0 at the top.
@@ -122,11 +135,23 @@ impl PartShell {
 
     /// Raises the registration keys on the back surface (shared by every piece of the part):
     /// farthest-point sampling among back vertices at least a key diameter from the
-    /// boundary, starting from the one farthest from it.
+    /// boundary, starting from the one farthest from it. A part with seams uses
+    /// [`PartShell::add_seam_keys`].
     ///
     /// # Errors
     /// [`LibraryError::InvalidParameter`] for non-finite or negative sizes.
     pub fn add_keys(&mut self, opts: &KeyOptions) -> Result<Vec<Key>> {
+        self.add_seam_keys(opts, &[])
+    }
+
+    /// Raises the registration keys: [`KeyOptions::per_seam`] keys just inside every seam
+    /// (`seams[i]` lists the shell vertices of seam `i`, see [`PartShell::seam_vertices`]),
+    /// spread along it, then farthest-point samples up to [`KeyOptions::count`]. Keys stay
+    /// 1.5 radii from the boundary and 2.5 radii from each other.
+    ///
+    /// # Errors
+    /// [`LibraryError::InvalidParameter`] for non-finite or negative sizes.
+    pub fn add_seam_keys(&mut self, opts: &KeyOptions, seams: &[Vec<u32>]) -> Result<Vec<Key>> {
         if !(opts.radius_mm.is_finite()
             && opts.radius_mm > 0.0
             && opts.height_mm.is_finite()
@@ -138,30 +163,71 @@ impl PartShell {
             )));
         }
         let (r, h) = (opts.radius_mm as f32, opts.height_mm as f32);
+        let n = self.back().len();
         let from_boundary = distances(self.back(), &self.boundary_points());
+        let allowed: Vec<bool> = (0..n).map(|v| from_boundary[v] >= 1.5 * r).collect();
         let mut keys: Vec<Key> = Vec::new();
         let mut centres: Vec<Vec3> = Vec::new();
-        for _ in 0..opts.count {
+        let key_at = |v: usize, seam: Option<usize>| Key {
+            center: self.back()[v].to_array(),
+            direction: (-self.direction(v)).to_array(),
+            radius_mm: r,
+            height_mm: h,
+            seam,
+        };
+        if opts.count > 0 {
+            for (i, seam) in seams.iter().enumerate() {
+                let pts: Vec<Vec3> = seam
+                    .iter()
+                    .filter_map(|&v| self.back().get(v as usize).copied())
+                    .collect();
+                if pts.is_empty() {
+                    continue;
+                }
+                // A band just inside the seam: the seam is the nearest boundary.
+                let from_seam = distances(self.back(), &pts);
+                let band: Vec<usize> = (0..n)
+                    .filter(|&v| allowed[v] && from_seam[v] <= from_boundary[v] + 0.25 * r)
+                    .filter(|&v| from_seam[v] <= 3.0 * r)
+                    .collect();
+                for _ in 0..opts.per_seam {
+                    let near = distances(self.back(), &centres);
+                    // Farthest from the keys already placed (the first: from the seam's
+                    // centroid, i.e. towards one end), preferring the inner edge of the band.
+                    let anchor = pts.iter().copied().sum::<Vec3>() / pts.len() as f32;
+                    let best =
+                        band.iter()
+                            .copied()
+                            .filter(|&v| near[v] >= 2.5 * r)
+                            .max_by(|&a, &b| {
+                                let s = |v: usize| {
+                                    let d = if centres.is_empty() {
+                                        self.back()[v].distance(anchor)
+                                    } else {
+                                        near[v]
+                                    };
+                                    d - (from_seam[v] - 2.0 * r).abs()
+                                };
+                                s(a).total_cmp(&s(b))
+                            });
+                    let Some(v) = best else { break };
+                    keys.push(key_at(v, Some(i)));
+                    centres.push(self.back()[v]);
+                }
+            }
+        }
+        while keys.len() < opts.count {
             let from_keys = distances(self.back(), &centres);
-            let best = (0..self.back().len())
-                .filter(|&v| from_boundary[v] >= 1.5 * r)
-                .max_by(|&a, &b| {
-                    let s = |v: usize| from_keys[v].min(4.0 * from_boundary[v]);
-                    s(a).total_cmp(&s(b))
-                });
+            let best = (0..n).filter(|&v| allowed[v]).max_by(|&a, &b| {
+                let s = |v: usize| from_keys[v].min(4.0 * from_boundary[v]);
+                s(a).total_cmp(&s(b))
+            });
             let Some(v) = best else { break };
             if from_keys[v] < 2.5 * r {
                 break;
             }
-            let c = self.back()[v];
-            let dir = -self.direction(v);
-            centres.push(c);
-            keys.push(Key {
-                center: c.to_array(),
-                direction: dir.to_array(),
-                radius_mm: r,
-                height_mm: h,
-            });
+            keys.push(key_at(v, None));
+            centres.push(self.back()[v]);
         }
         for key in &keys {
             let c = Vec3::from_array(key.center);

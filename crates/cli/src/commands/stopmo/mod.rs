@@ -211,7 +211,8 @@ pub(crate) struct LibraryOptionsArgs {
     #[arg(long, value_delimiter = ',')]
     pub(crate) cuts: Vec<usize>,
     /// Directory of pre-made pieces `<part>_<NN>.obj` (e.g. `OLD/pieces` of an earlier run);
-    /// they are kept and new pieces are added up to the library size.
+    /// they are kept and new pieces are added up to the library size. The printed back
+    /// surfaces `<part>_back.obj` there are reused, so the new pieces seat on the same head.
     #[arg(long, value_name = "DIR")]
     pub(crate) fixed: Option<PathBuf>,
     /// Algorithm.
@@ -276,9 +277,9 @@ impl LibraryOptionsArgs {
             Some(p) => Some(read_saliency(p)?),
             None => None,
         };
-        let fixed = match &self.fixed {
-            Some(dir) => read_fixed(dir, names)?,
-            None => BTreeMap::new(),
+        let (fixed, backs) = match &self.fixed {
+            Some(dir) => (read_fixed(dir, names)?, read_backs(dir, names)?),
+            None => (BTreeMap::new(), BTreeMap::new()),
         };
         Ok(LibraryJobOptions {
             pieces,
@@ -300,6 +301,7 @@ impl LibraryOptionsArgs {
             saliency,
             cuts: self.cuts.clone(),
             fixed,
+            backs,
             resolution_mm: self.resolution,
             keys: !self.no_keys,
             ids: !self.no_ids,
@@ -380,6 +382,19 @@ fn read_fixed(dir: &Path, names: &[String]) -> Result<BTreeMap<String, Vec<Vec<V
             .collect::<Result<Vec<_>>>()?;
         if !pieces.is_empty() {
             out.insert(name.clone(), pieces);
+        }
+    }
+    Ok(out)
+}
+
+/// The printed back surfaces `<part>_back.obj` in `dir` of the parts in `names` (those present).
+fn read_backs(dir: &Path, names: &[String]) -> Result<BTreeMap<String, Vec<Vec3>>> {
+    let mut out = BTreeMap::new();
+    for name in names {
+        let f = dir.join(format!("{name}_back.obj"));
+        if f.is_file() {
+            let mesh = tkio::obj::read(&tkio::read_file(&f)?).map_err(|e| e.at(&f))?;
+            out.insert(name.clone(), mesh.positions);
         }
     }
     Ok(out)

@@ -21,6 +21,11 @@ use super::error::{LibraryError, Result};
 use super::fabricate::{check_solid, split_fans, DEFAULT_THICKNESS_MM};
 use super::intersect::self_intersecting_triangles;
 
+mod caps;
+mod envelope;
+mod seams;
+mod untangle;
+
 /// Radius over which the offset direction field is smoothed, in millimetres.
 pub const DEFAULT_NORMAL_SMOOTHING_MM: f64 = 8.0;
 /// Laplacian smoothing steps of the back surface.
@@ -29,6 +34,11 @@ pub const DEFAULT_BACK_SMOOTHING_ITERATIONS: usize = 300;
 pub const DEFAULT_CAP_FRACTION: f64 = 0.5;
 /// Rounds of local repair where the exact test still finds crossings.
 pub const DEFAULT_REPAIR_ROUNDS: usize = 0;
+
+/// Radius of the column under a front vertex the back must stay behind, in walls.
+const ENVELOPE_LATERAL_WALLS: f64 = 2.0;
+/// How far behind a front vertex the column reaches, in walls.
+const ENVELOPE_REACH_WALLS: f64 = 3.0;
 
 /// Options of the shared back surface (millimetres, like the printable pieces).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -93,6 +103,8 @@ pub struct PartShell {
     normals: Vec<Vec3>,
     /// Whether a shell vertex lies on the part boundary.
     on_boundary: Vec<bool>,
+    /// Vertex adjacency of the front triangles.
+    adjacency: Vec<Vec<u32>>,
     /// Measurements.
     pub stats: ShellStats,
 }
@@ -113,43 +125,6 @@ fn front_positions(source: &[u32], caps: &[Vec<u32>], piece: &[Vec3]) -> Vec<Vec
         out.push(c);
     }
     out
-}
-
-/// Splits the directed boundary edges into loops, removes the loops shorter than
-/// `fraction` of the longest one from `boundary` and returns them (vertices in edge order).
-fn cap_loops(front: &[Vec3], boundary: &mut Vec<(u32, u32)>, fraction: f64) -> Vec<Vec<u32>> {
-    let next: HashMap<u32, u32> = boundary.iter().copied().collect();
-    let mut seen: HashMap<u32, ()> = HashMap::new();
-    let mut loops: Vec<(Vec<u32>, f64)> = Vec::new();
-    for &(start, _) in boundary.iter() {
-        if seen.contains_key(&start) {
-            continue;
-        }
-        let (mut lp, mut len, mut v) = (Vec::new(), 0.0f64, start);
-        let mut closed = false;
-        while seen.insert(v, ()).is_none() {
-            lp.push(v);
-            let Some(&w) = next.get(&v) else { break };
-            len += f64::from(front[v as usize].distance(front[w as usize]));
-            if w == start {
-                closed = true;
-                break;
-            }
-            v = w;
-        }
-        if closed && lp.len() >= 3 {
-            loops.push((lp, len));
-        }
-    }
-    let longest = loops.iter().map(|l| l.1).fold(0.0, f64::max);
-    let caps: Vec<Vec<u32>> = loops
-        .into_iter()
-        .filter(|l| l.1 < fraction * longest)
-        .map(|l| l.0)
-        .collect();
-    let capped: std::collections::HashSet<u32> = caps.iter().flatten().copied().collect();
-    boundary.retain(|(a, _)| !capped.contains(a));
-    caps
 }
 
 /// Vertex adjacency (sorted, deduplicated) of a triangle list.
@@ -294,7 +269,7 @@ impl PartShell {
         // Cap the small boundary loops (eye and mouth openings): a fan from the loop's
         // centroid, so only the outer boundary (seams, neck, scalp) needs a wall.
         let (mut front, mut tris) = (front, tris);
-        let caps = cap_loops(&front, &mut boundary, opts.cap_fraction);
+        let caps = caps::cap_loops(&front, &mut boundary, opts.cap_fraction);
         let regular = front.len();
         for (i, lp) in caps.iter().enumerate() {
             let c = (regular + i) as u32;
@@ -340,21 +315,23 @@ impl PartShell {
         }
         let fronts: Vec<Vec<Vec3>> = pieces
             .iter()
-            .map(|p| front_positions(&src, &caps, p))
-            .collect();
-        let piece_at = |k: usize, v: usize| fronts[k][v];
-        // Deepest point any piece reaches along the direction field, per vertex.
-        let wall = opts.wall_mm as f32;
-        let limit: Vec<f32> = (0..n)
-            .map(|v| {
-                let d = pieces
-                    .iter()
-                    .enumerate()
-                    .map(|(k, _)| piece_at(k, v).dot(normals[v]))
-                    .fold(front[v].dot(normals[v]), f32::min);
-                d - wall
+            .map(|p| {
+                let mut f = front_positions(&src, &caps, p);
+                untangle::untangle(&mut f, &tris, &adj);
+                f
             })
             .collect();
+        // Deepest point any piece reaches in a column around the direction field, per
+        // vertex, minus the wall.
+        let wall = opts.wall_mm as f32;
+        let limit = envelope::envelope_limits(
+            &front,
+            &fronts,
+            &normals,
+            wall,
+            (ENVELOPE_LATERAL_WALLS * opts.wall_mm) as f32,
+            (ENVELOPE_REACH_WALLS * opts.wall_mm) as f32,
+        );
         let shared_at: HashMap<[u32; 3], Vec3> = shared
             .iter()
             .map(|(a, b)| (a.to_array().map(f32::to_bits), *b))
@@ -386,10 +363,31 @@ impl PartShell {
         let mut back: Vec<Vec3> = (0..n).map(|v| front[v] - normals[v] * wall).collect();
         let mut extra = vec![0.0f32; n];
         enforce(&mut back, &extra);
+        // Neighbours along the boundary loops: the wall's depth is smoothed along them so
+        // the wall strip does not zigzag where the depth needed changes.
+        let mut along: Vec<[u32; 2]> = vec![[u32::MAX; 2]; n];
+        for &(a, b) in &boundary {
+            along[a as usize][1] = b;
+            along[b as usize][0] = a;
+        }
         let smooth = |back: &mut Vec<Vec3>, mask: Option<&[bool]>| {
+            let depth = |back: &[Vec3], u: usize| (front[u] - back[u]).dot(normals[u]);
             let next: Vec<Vec3> = (0..n)
                 .map(|v| {
-                    if (on_boundary[v] && !opts.smooth_boundary)
+                    if on_boundary[v] && !opts.smooth_boundary {
+                        let [p, q] = along[v];
+                        if fixed[v].is_some()
+                            || p == u32::MAX
+                            || q == u32::MAX
+                            || mask.is_some_and(|m| !m[v])
+                        {
+                            return back[v];
+                        }
+                        let d = 0.5 * depth(back, v)
+                            + 0.25 * (depth(back, p as usize) + depth(back, q as usize));
+                        return front[v] - normals[v] * d;
+                    }
+                    if mask.is_some_and(|m| !m[v])
                         || mask.is_some_and(|m| !m[v])
                         || adj[v].is_empty()
                     {
@@ -414,6 +412,7 @@ impl PartShell {
             back,
             normals: normals.clone(),
             on_boundary: on_boundary.clone(),
+            adjacency: adj.clone(),
             stats: ShellStats::default(),
         };
         // Repair: smooth and push back around crossings found by the exact test.
@@ -480,21 +479,6 @@ impl PartShell {
         &self.back
     }
 
-    /// `(average front position, back position)` of every boundary vertex, to share the seam
-    /// walls with the next part ([`PartShell::new_sharing`]).
-    pub fn boundary_pairs(&self, average: &[Vec3]) -> Vec<(Vec3, Vec3)> {
-        let mut out: Vec<(Vec3, Vec3)> = (0..self.back.len())
-            .filter(|&v| self.on_boundary[v])
-            .filter_map(|v| {
-                average
-                    .get(self.source[v] as usize)
-                    .map(|a| (*a, self.back[v]))
-            })
-            .collect();
-        out.dedup();
-        out
-    }
-
     /// Directed boundary edges `a → b` of the front (shell vertices).
     pub fn boundary_edges(&self) -> &[(u32, u32)] {
         &self.boundary
@@ -519,6 +503,11 @@ impl PartShell {
         }
     }
 
+    /// Triangles of the front that cap openings (the last ones of [`PartShell::triangles`]).
+    pub fn cap_triangle_count(&self) -> usize {
+        self.caps.iter().map(Vec::len).sum()
+    }
+
     /// Front triangles over the shell vertices.
     pub fn triangles(&self) -> &[[u32; 3]] {
         &self.triangles
@@ -529,9 +518,17 @@ impl PartShell {
         &self.source
     }
 
+    /// Front of `piece` over the shell vertices (caps included), untangled where it
+    /// crosses itself.
+    fn front(&self, piece: &[Vec3]) -> Vec<Vec3> {
+        let mut f = front_positions(&self.source, &self.caps, piece);
+        untangle::untangle(&mut f, &self.triangles, &self.adjacency);
+        f
+    }
+
     fn solid_unchecked(&self, piece: &[Vec3], name: &str) -> Mesh {
         let m = self.back.len() as u32;
-        let mut positions = front_positions(&self.source, &self.caps, piece);
+        let mut positions = self.front(piece);
         positions.extend_from_slice(&self.back);
         let mut tris = self.triangles.clone();
         tris.extend(
@@ -575,7 +572,7 @@ impl PartShell {
     /// Smallest distance (mm) from a front vertex of `piece` to the back surface's triangles.
     pub fn min_wall(&self, piece: &[Vec3]) -> f64 {
         let grid = super::intersect::TriangleGrid::new(&self.back, &self.triangles);
-        front_positions(&self.source, &self.caps, piece)
+        self.front(piece)
             .iter()
             .map(|&p| grid.distance(p))
             .fold(f64::INFINITY, f64::min)
