@@ -49,6 +49,7 @@
 
 mod bones;
 mod camera;
+mod contacts;
 mod error;
 mod keys;
 mod reduction;
@@ -61,6 +62,7 @@ mod terms;
 
 pub use bones::{BoneSet, Preset};
 pub use camera::{ActionCamera, ActionPlane, ScreenMap, DEFAULT_CAMERA_MARGIN};
+pub use contacts::{CONTACT_RELEASE_MAX_TURN, MAX_CONTACT_RELEASE};
 pub use error::AnimateError;
 pub use keys::{BoneSetKey, ContactKey, TwistKey};
 pub use reduction::Reduction;
@@ -77,8 +79,13 @@ use rig::Rig;
 /// Default weight of E_x (projected positions on the line; distances relative to the longest
 /// bone set's length).
 pub const DEFAULT_POSITION_WEIGHT: f64 = 1.0;
-/// Default weight of E_∂ (projected bone directions along the line's tangent).
-pub const DEFAULT_TANGENT_WEIGHT: f64 = 0.5;
+/// Default weight of E_∂ (projected bone directions along the line's tangent). E_x is
+/// measured in fractions of the line's length and E_∂ in radians (roughly): a bone a fraction
+/// `ℓ` of the line long turned by `θ` moves its end by `ℓ θ`, so the two terms weigh alike
+/// at `w_∂ ≈ ℓ²`; 0.05 is a bone of about a fifth of the line. Heavier tangents keep bones
+/// parallel to the line at the cost of their positions (at 0.5, RobotExpressive's legs hung
+/// 12 % of the line beside it).
+pub const DEFAULT_TANGENT_WEIGHT: f64 = 0.05;
 /// Default weight of LoA Eq. 3's rotation term for constrained bones (radians per frame).
 pub const DEFAULT_SMOOTHNESS_WEIGHT: f64 = 1.0;
 /// Fraction of the smoothness weight applied to unconstrained degrees of freedom, so that
@@ -166,9 +173,11 @@ pub struct AnimateOptions {
     pub weights: Weights,
     /// Cap on accepted iterations per stage (0 = [`DEFAULT_MAX_ITERATIONS`]).
     pub max_iterations: usize,
-    /// Planar stage continuation that frees the pelvis/chest after a first solve with them
-    /// held (experimental, off by default; see the crate docs' SPEC decisions).
-    pub free_pelvis: bool,
+    /// Keep the turn joints (pelvis, chest: where a bone set's path turns from climbing the
+    /// tree to descending it) and their ancestors at their initial orientation in the planar
+    /// stage, instead of freeing them after a first solve with them held (the default; see
+    /// the crate docs' SPEC decisions).
+    pub hold_pelvis: bool,
 }
 
 /// A character: skeleton plus initial pose.
