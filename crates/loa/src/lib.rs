@@ -82,9 +82,15 @@
 //!   body leans with the line ([`animate::AnimateOptions::hold_pelvis`] stops after the
 //!   first). The solver iterates until an accepted step gains less than
 //!   [`animate::DEFAULT_TOLERANCE`] (cap [`animate::DEFAULT_MAX_ITERATIONS`]).
-//! * **Contacts** (LoA §4.1, E_⊥): eased in before the first key and out after the last over
-//!   [`animate::DEFAULT_CONTACT_RELEASE`] frames (the target slides between the planar pose
-//!   and the contact), so a released foot does not snap.
+//! * **Contacts** (LoA §4.1, E_⊥): eased in before the first key and out after the last (the
+//!   target turns about the limb's root between the planar pose and the contact, over
+//!   [`animate::DEFAULT_CONTACT_RELEASE`]..=[`animate::MAX_CONTACT_RELEASE`] frames so that
+//!   it turns at most [`animate::CONTACT_RELEASE_MAX_TURN`] per frame), so a released foot
+//!   does not snap; a limb held or easing gets LoA Eq. 3's smoothness of constrained bones.
+//!   The 3D stage's pull toward the planar solution is its own weight
+//!   ([`animate::Weights::spatial_regularization`]). Known limit: a contact the line pulls
+//!   out of reach (`FootL@0..10` under `jump.json`, whose body rises 1.5 leg lengths by frame
+//!   10) still turns the freed leg up to 42° per frame after the release.
 //! * **Cameras**: a scene camera may be perspective ([`animate::ActionCamera::from_scene`]);
 //!   E_∂ then uses the projection's derivative at each segment's midpoint.
 //!

@@ -186,3 +186,22 @@ fn ease_length(
     }
     MAX_CONTACT_RELEASE
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_ease_turns_about_the_limb_root_keeping_its_reach() {
+        let pivot = DVec3::new(0.0, 1.0, 0.0);
+        let held = DVec3::new(0.0, -1.0, 0.0); // 2 below the pivot
+        let free = DVec3::new(2.0, 1.0, 0.0); // 2 beside it
+        assert!((turn_about(pivot, held, free, 1.0) - held).length() < 1e-12);
+        assert!((turn_about(pivot, held, free, 0.0) - free).length() < 1e-12);
+        let mid = turn_about(pivot, held, free, 0.5);
+        // A straight slide would pass 1.41 from the pivot; the turn keeps the reach of 2.
+        assert!(((mid - pivot).length() - 2.0).abs() < 1e-12);
+        let d = (mid - pivot).normalize();
+        assert!((d.angle_between(DVec3::NEG_Y) - std::f64::consts::FRAC_PI_4).abs() < 1e-9);
+    }
+}

@@ -102,6 +102,10 @@ pub const DEFAULT_TWIST_WEIGHT: f64 = 1.0;
 /// Default weight pulling the accumulated increments toward the initial pose (keeps
 /// redundant joints well-posed).
 pub const DEFAULT_REGULARIZATION: f64 = 1e-2;
+/// Default pull of the 3D stage (Section 4.1) toward the planar solution it starts from: the
+/// 3D stage refines the planar motion for contacts and twists, so it bends the limbs they
+/// concern instead of re-staging the whole body in depth, which the view cannot show.
+pub const DEFAULT_SPATIAL_REGULARIZATION: f64 = 1e-2;
 /// Default cap on accepted Levenberg–Marquardt iterations per stage: a safety net; the
 /// solver stops earlier, when an accepted step lowers the energy by less than
 /// [`DEFAULT_TOLERANCE`].
@@ -132,6 +136,8 @@ pub struct Weights {
     pub twist: f64,
     /// Pull toward the initial pose.
     pub regularization: f64,
+    /// Pull of the 3D stage's increments toward the planar solution.
+    pub spatial_regularization: f64,
 }
 
 impl Default for Weights {
@@ -146,6 +152,7 @@ impl Default for Weights {
             contact_orientation: DEFAULT_CONTACT_ORIENTATION_WEIGHT,
             twist: DEFAULT_TWIST_WEIGHT,
             regularization: DEFAULT_REGULARIZATION,
+            spatial_regularization: DEFAULT_SPATIAL_REGULARIZATION,
         }
     }
 }

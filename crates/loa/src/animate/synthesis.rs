@@ -293,6 +293,10 @@ pub(crate) fn run(
                 mark_ancestors(rig, ChainPoint::Tip(o.joint), &mut dof);
             }
         }
+        let weights3 = super::Weights {
+            regularization: weights.spatial_regularization,
+            ..*weights
+        };
         let stage = Stage {
             rig,
             camera: &camera,
@@ -304,7 +308,7 @@ pub(crate) fn run(
             ),
             targets: &targets3,
             reduction: &reduction,
-            weights,
+            weights: &weights3,
             ref_length,
             height,
         };

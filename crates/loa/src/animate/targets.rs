@@ -333,3 +333,25 @@ pub(crate) fn bone_direction(rig: &Rig, w: &WorldPose, j: usize) -> DVec3 {
 pub(crate) fn twist_target(rig: &Rig, w: &WorldPose, j: usize, angle: f64) -> DQuat {
     exp(bone_direction(rig, w, j) * angle) * w.rotation[j]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quadrature_weights_are_arc_shares_with_mean_one() {
+        // Points at u = 0, 0.1, 0.5, 1: trapezoid shares 0.05, 0.25, 0.45, 0.25.
+        let mut u = [0.0, 0.1, 0.5, 1.0];
+        quadrature(u.iter_mut(), true);
+        for (w, e) in u.iter().zip([0.2, 1.0, 1.8, 1.0]) {
+            assert!((w - e).abs() < 1e-12, "{u:?}");
+        }
+        // Segments spanning 0.1 and 0.3 of the arc.
+        let mut s = [0.1, 0.3];
+        quadrature(s.iter_mut(), false);
+        assert!(
+            (s[0] - 0.5).abs() < 1e-12 && (s[1] - 1.5).abs() < 1e-12,
+            "{s:?}"
+        );
+    }
+}
