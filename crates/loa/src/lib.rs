@@ -66,15 +66,31 @@
 //!   oriented like the previous one and a reversed one is reported ([`Line::warnings`]).
 //! * **Screen map** (LoA §4): one scale for all keystrokes (least squares over the keystrokes'
 //!   lengths against their bone sets' lengths), not the first keystroke's alone.
-//! * **Planar stage** (LoA §4): the pelvis and chest (turn joints carrying a sideways branch)
-//!   keep their initial orientation by default (the root translates); the opt-in
-//!   [`animate::AnimateOptions::free_pelvis`] continuation frees them from that solution,
-//!   but it still turns joints by up to 38° per frame at Fig. 5's bone-set switch, so it is
-//!   off. The solver iterates until an accepted step gains less than
+//! * **Matching a chain to the line** (LoA §4, E_loa): arc lengths along a bone set are
+//!   measured in the image of the initial pose (what the planar stage can show: a bone
+//!   leaning toward the camera, or RobotExpressive's short `Body → Hips` bone doubling back,
+//!   covers only its image length), the screen scale is fitted to those lengths, and E_x and
+//!   E_∂ are quadratures of the paper's integrals over `s` (each point and segment weighted by
+//!   its share of the arc, so a short bone weighs little). A segment hanging from a branch
+//!   connector's lower end (the thigh below the hip joint beside the pelvis) has no E_∂: it
+//!   cannot be parallel to the line while its leg is on it. E_∂ weighs 0.05 by default
+//!   ([`animate::DEFAULT_TANGENT_WEIGHT`]; at 0.5 the tangents outweighed the positions and
+//!   RobotExpressive's legs hung 12 % of the line beside it).
+//! * **Planar stage** (LoA §4): a continuation — a first solve holds the pelvis and chest
+//!   (turn joints carrying a sideways branch) at their initial orientation (the root
+//!   translates), a second frees them from that solution, so the pelvis tilts and the whole
+//!   body leans with the line ([`animate::AnimateOptions::hold_pelvis`] stops after the
+//!   first). The solver iterates until an accepted step gains less than
 //!   [`animate::DEFAULT_TOLERANCE`] (cap [`animate::DEFAULT_MAX_ITERATIONS`]).
-//! * **Contacts** (LoA §4.1, E_⊥): eased in before the first key and out after the last over
-//!   [`animate::DEFAULT_CONTACT_RELEASE`] frames (the target slides between the planar pose
-//!   and the contact), so a released foot does not snap.
+//! * **Contacts** (LoA §4.1, E_⊥): eased in before the first key and out after the last (the
+//!   target turns about the limb's root between the planar pose and the contact, over
+//!   [`animate::DEFAULT_CONTACT_RELEASE`]..=[`animate::MAX_CONTACT_RELEASE`] frames so that
+//!   it turns at most [`animate::CONTACT_RELEASE_MAX_TURN`] per frame), so a released foot
+//!   does not snap; a limb held or easing gets LoA Eq. 3's smoothness of constrained bones.
+//!   The 3D stage's pull toward the planar solution is its own weight
+//!   ([`animate::Weights::spatial_regularization`]). Known limit: a contact the line pulls
+//!   out of reach (`FootL@0..10` under `jump.json`, whose body rises 1.5 leg lengths by frame
+//!   10) still turns the freed leg up to 42° per frame after the release.
 //! * **Cameras**: a scene camera may be perspective ([`animate::ActionCamera::from_scene`]);
 //!   E_∂ then uses the projection's derivative at each segment's midpoint.
 //!

@@ -49,6 +49,7 @@
 
 mod bones;
 mod camera;
+mod contacts;
 mod error;
 mod keys;
 mod reduction;
@@ -61,6 +62,7 @@ mod terms;
 
 pub use bones::{BoneSet, Preset};
 pub use camera::{ActionCamera, ActionPlane, ScreenMap, DEFAULT_CAMERA_MARGIN};
+pub use contacts::{CONTACT_RELEASE_MAX_TURN, MAX_CONTACT_RELEASE};
 pub use error::AnimateError;
 pub use keys::{BoneSetKey, ContactKey, TwistKey};
 pub use reduction::Reduction;
@@ -77,8 +79,13 @@ use rig::Rig;
 /// Default weight of E_x (projected positions on the line; distances relative to the longest
 /// bone set's length).
 pub const DEFAULT_POSITION_WEIGHT: f64 = 1.0;
-/// Default weight of E_∂ (projected bone directions along the line's tangent).
-pub const DEFAULT_TANGENT_WEIGHT: f64 = 0.5;
+/// Default weight of E_∂ (projected bone directions along the line's tangent). E_x is
+/// measured in fractions of the line's length and E_∂ in radians (roughly): a bone a fraction
+/// `ℓ` of the line long turned by `θ` moves its end by `ℓ θ`, so the two terms weigh alike
+/// at `w_∂ ≈ ℓ²`; 0.05 is a bone of about a fifth of the line. Heavier tangents keep bones
+/// parallel to the line at the cost of their positions (at 0.5, RobotExpressive's legs hung
+/// 12 % of the line beside it).
+pub const DEFAULT_TANGENT_WEIGHT: f64 = 0.05;
 /// Default weight of LoA Eq. 3's rotation term for constrained bones (radians per frame).
 pub const DEFAULT_SMOOTHNESS_WEIGHT: f64 = 1.0;
 /// Fraction of the smoothness weight applied to unconstrained degrees of freedom, so that
@@ -95,6 +102,10 @@ pub const DEFAULT_TWIST_WEIGHT: f64 = 1.0;
 /// Default weight pulling the accumulated increments toward the initial pose (keeps
 /// redundant joints well-posed).
 pub const DEFAULT_REGULARIZATION: f64 = 1e-2;
+/// Default pull of the 3D stage (Section 4.1) toward the planar solution it starts from: the
+/// 3D stage refines the planar motion for contacts and twists, so it bends the limbs they
+/// concern instead of re-staging the whole body in depth, which the view cannot show.
+pub const DEFAULT_SPATIAL_REGULARIZATION: f64 = 1e-2;
 /// Default cap on accepted Levenberg–Marquardt iterations per stage: a safety net; the
 /// solver stops earlier, when an accepted step lowers the energy by less than
 /// [`DEFAULT_TOLERANCE`].
@@ -125,6 +136,8 @@ pub struct Weights {
     pub twist: f64,
     /// Pull toward the initial pose.
     pub regularization: f64,
+    /// Pull of the 3D stage's increments toward the planar solution.
+    pub spatial_regularization: f64,
 }
 
 impl Default for Weights {
@@ -139,6 +152,7 @@ impl Default for Weights {
             contact_orientation: DEFAULT_CONTACT_ORIENTATION_WEIGHT,
             twist: DEFAULT_TWIST_WEIGHT,
             regularization: DEFAULT_REGULARIZATION,
+            spatial_regularization: DEFAULT_SPATIAL_REGULARIZATION,
         }
     }
 }
@@ -166,9 +180,11 @@ pub struct AnimateOptions {
     pub weights: Weights,
     /// Cap on accepted iterations per stage (0 = [`DEFAULT_MAX_ITERATIONS`]).
     pub max_iterations: usize,
-    /// Planar stage continuation that frees the pelvis/chest after a first solve with them
-    /// held (experimental, off by default; see the crate docs' SPEC decisions).
-    pub free_pelvis: bool,
+    /// Keep the turn joints (pelvis, chest: where a bone set's path turns from climbing the
+    /// tree to descending it) and their ancestors at their initial orientation in the planar
+    /// stage, instead of freeing them after a first solve with them held (the default; see
+    /// the crate docs' SPEC decisions).
+    pub hold_pelvis: bool,
 }
 
 /// A character: skeleton plus initial pose.

@@ -103,7 +103,7 @@ impl Stage<'_> {
                 point_jacobian(rig, cols, w, p.point, 1.0, &mut s.j3);
                 project_jacobian(cam, x, &s.j3, &mut s.j2);
             }
-            add(b, &s.j2, r, sx, jac);
+            add(b, &s.j2, r, sx * p.weight.sqrt(), jac);
         }
         let st = self.weights.tangent.sqrt();
         for g in &t.segments {
@@ -118,7 +118,7 @@ impl Stage<'_> {
                 point_jacobian(rig, cols, w, g.a, -g.inv_length, &mut s.j3);
                 project_jacobian(cam, mid, &s.j3, &mut s.j2);
             }
-            add(b, &s.j2, r, st, jac);
+            add(b, &s.j2, r, st * g.weight.sqrt(), jac);
         }
         let sq = self.weights.twist.sqrt();
         for o in &t.twists {

@@ -6,6 +6,7 @@ use glam::{DQuat, DVec2, DVec3};
 
 use super::bones::{self, BoneSet, ChainPoint, Preset};
 use super::camera::{ActionCamera, ActionPlane, ScreenMap};
+use super::contacts::contact_trajectories;
 use super::error::AnimateError;
 use super::keys::{BoneSetKey, ContactKey, TwistKey};
 use super::reduction::Reduction;
@@ -16,11 +17,7 @@ use super::targets::{
     OrientTarget,
 };
 use super::terms::{log, point_position, Columns};
-use super::{
-    AnimateOptions, AnimateReport, Character, Motion, DEFAULT_CONTACT_RELEASE,
-    DEFAULT_MAX_ITERATIONS,
-};
-use crate::retarget::Blend;
+use super::{AnimateOptions, AnimateReport, Character, Motion, DEFAULT_MAX_ITERATIONS};
 use crate::Animation;
 
 fn joint_index(rig: &Rig, name: &str) -> Result<usize, AnimateError> {
@@ -156,7 +153,7 @@ pub(crate) fn run(
         .collect::<Result<_, _>>()?;
     let keys: Vec<KeyChain> = chains
         .iter()
-        .map(|c| KeyChain::new(rig, &initial, c))
+        .map(|c| KeyChain::new(rig, &initial, &camera, c))
         .collect();
     let ref_length = keys
         .iter()
@@ -194,10 +191,11 @@ pub(crate) fn run(
     // The turn joint of a chain (pelvis, chest) carries a sideways branch connector: turning
     // it, or any of its ancestors, swaps the connector's side — a discrete flip the solver
     // takes mid-clip (the children counter-rotating) when it starts from the initial pose.
-    // The turn joints and their ancestors keep their initial orientation (limbs and spine
-    // turn, the root translates). With `free_pelvis`, a continuation then frees them,
-    // starting from that solution (opt-in: it still lets Fig. 5's bone-set switch turn joints
-    // by up to 38° in a frame).
+    // So the planar stage is a continuation: a first solve holds the turn joints and their
+    // ancestors at their initial orientation (limbs and spine turn, the root translates),
+    // which stages the pose without any flip; a second solve frees them (the pelvis tilts
+    // and turns the whole body), starting from that solution, so they only refine it.
+    // `hold_pelvis` stops after the first solve.
     let mut held = dof.clone();
     for k in &keys {
         for (i, c) in k.connector.iter().enumerate() {
@@ -228,7 +226,7 @@ pub(crate) fn run(
         height,
     };
     let mut planar = planar_stage(&held).solve(&mut poses, max_iterations);
-    if options.free_pelvis && held != dof {
+    if !options.hold_pelvis && held != dof {
         let free = planar_stage(&dof).solve(&mut poses, max_iterations);
         planar = StageReport {
             unknowns: free.unknowns,
@@ -241,7 +239,6 @@ pub(crate) fn run(
     // 3D stage (Section 4.1).
     let mut spatial = None;
     let mut contact_targets: Vec<Vec<ContactTarget>> = vec![Vec::new(); frames];
-    let mut easing: Vec<Vec<ContactTarget>> = vec![Vec::new(); frames];
     if !contacts.is_empty() || !twists.is_empty() {
         let worlds = poses.worlds(rig);
         let frame_index = |what: &'static str, f: i64| -> Result<usize, AnimateError> {
@@ -254,70 +251,14 @@ pub(crate) fn run(
             }
             Ok((f - first) as usize)
         };
-        let mut by_joint: BTreeMap<usize, Vec<(usize, Option<DVec3>)>> = BTreeMap::new();
-        for c in contacts {
-            let j = joint_index(rig, &c.joint)?;
-            by_joint
-                .entry(j)
-                .or_default()
-                .push((frame_index("contact", c.frame)?, c.position));
-        }
-        for (j, mut ks) in by_joint {
-            ks.sort_by_key(|k| k.0);
-            let rotation = worlds[ks[0].0].rotation[j];
-            let mut resolved: Vec<(usize, DVec3)> = Vec::with_capacity(ks.len());
-            for (f, p) in ks {
-                let p = p.unwrap_or_else(|| {
-                    resolved
-                        .last()
-                        .map_or(worlds[f].position[j], |&(_, prev)| prev)
-                });
-                resolved.push((f, p));
-            }
-            for w in 0..resolved.len() {
-                let (f0, p0) = resolved[w];
-                let (f1, p1) = resolved.get(w + 1).copied().unwrap_or((f0, p0));
-                for f in f0..=f1 {
-                    let t = if f1 > f0 {
-                        (f - f0) as f64 / (f1 - f0) as f64
-                    } else {
-                        0.0
-                    };
-                    let t_ = &mut contact_targets[f];
-                    t_.retain(|c| c.joint != j);
-                    t_.push(ContactTarget {
-                        joint: j,
-                        position: p0.lerp(p1, t),
-                        rotation,
-                    });
-                }
-            }
-            // Ease in and out over DEFAULT_CONTACT_RELEASE frames: the target slides from the
-            // planar stage's pose onto the contact before its first key and back after its
-            // last, so the limb does not snap free.
-            let (first_key, last_key) = (resolved[0], resolved[resolved.len() - 1]);
-            for i in 1..=DEFAULT_CONTACT_RELEASE {
-                let w =
-                    1.0 - Blend::Smoothstep.weight(i as f64 / (DEFAULT_CONTACT_RELEASE + 1) as f64);
-                for (f, held) in [
-                    (first_key.0.checked_sub(i), first_key.1),
-                    (Some(last_key.0 + i), last_key.1),
-                ] {
-                    let Some(f) = f.filter(|&f| f < frames) else {
-                        continue;
-                    };
-                    if contact_targets[f].iter().any(|c| c.joint == j) {
-                        continue;
-                    }
-                    let free = &worlds[f];
-                    easing[f].push(ContactTarget {
-                        joint: j,
-                        position: free.position[j].lerp(held, w),
-                        rotation: free.rotation[j].slerp(rotation, w),
-                    });
-                }
-            }
-        }
+        let trajectories = contact_trajectories(
+            rig,
+            &worlds,
+            contacts,
+            |name| joint_index(rig, name),
+            |f| frame_index("contact", f),
+        )?;
+        contact_targets = trajectories.held;
         let mut twist_by_joint: BTreeMap<usize, Vec<(usize, f64)>> = BTreeMap::new();
         for t in twists {
             let j = joint_index(rig, &t.joint)?;
@@ -329,7 +270,13 @@ pub(crate) fn run(
         let mut targets3 = targets.clone();
         for (f, t) in targets3.iter_mut().enumerate() {
             t.contacts = contact_targets[f].clone();
-            t.contacts.extend_from_slice(&easing[f]);
+            t.contacts.extend_from_slice(&trajectories.easing[f]);
+            // A limb held by a contact is constrained: LoA Eq. 3 smooths it like Ω(t)'s bones.
+            for &k in &trajectories.limbs[f] {
+                if !t.bones.contains(&k) {
+                    t.bones.push(k);
+                }
+            }
             for (&j, ks) in &twist_by_joint {
                 let angle = piecewise_linear(ks, f);
                 t.twists.push(OrientTarget {
@@ -346,6 +293,10 @@ pub(crate) fn run(
                 mark_ancestors(rig, ChainPoint::Tip(o.joint), &mut dof);
             }
         }
+        let weights3 = super::Weights {
+            regularization: weights.spatial_regularization,
+            ..*weights
+        };
         let stage = Stage {
             rig,
             camera: &camera,
@@ -357,7 +308,7 @@ pub(crate) fn run(
             ),
             targets: &targets3,
             reduction: &reduction,
-            weights,
+            weights: &weights3,
             ref_length,
             height,
         };

@@ -5,7 +5,7 @@
 use glam::{DQuat, DVec2, DVec3};
 
 use super::bones::{Chain3, ChainPoint};
-use super::camera::ScreenMap;
+use super::camera::{ActionCamera, ScreenMap};
 use super::rig::{Rig, WorldPose};
 use super::terms::{exp, point_position};
 use crate::Animation;
@@ -15,6 +15,9 @@ use crate::Animation;
 pub(crate) struct PointTarget {
     pub point: ChainPoint,
     pub target: DVec2,
+    /// Quadrature weight of the point in E_loa's integral over `s` (its share of the
+    /// constrained arc length; mean 1 over a frame's points).
+    pub weight: f64,
 }
 
 /// A rigid segment whose projected direction follows the line's tangent (E_∂).
@@ -24,8 +27,13 @@ pub(crate) struct SegmentTarget {
     pub b: ChainPoint,
     /// Unit tangent of the line between the two points' arc lengths.
     pub tangent: DVec2,
-    /// 1 / the segment's 3D length.
+    /// 1 / the segment's image length in the initial pose (invariant under the planar
+    /// stage's rotations about the view axis, so a foreshortened bone can still match the
+    /// tangent exactly).
     pub inv_length: f64,
+    /// Quadrature weight of the segment in E_loa's integral over `s` (its share of the
+    /// constrained arc length; mean 1 over a frame's segments).
+    pub weight: f64,
 }
 
 /// A world orientation target of a joint (twist cans, contact orientations).
@@ -108,7 +116,11 @@ pub(crate) fn image_lines(line: &Animation, map: &ScreenMap) -> Vec<ImageLine> {
         .collect()
 }
 
-/// A resolved chain with its points' normalized arc lengths (from 3D segment lengths).
+/// A resolved chain with its points' normalized arc lengths, measured in the image of the
+/// initial pose: the planar stage turns bones about the view axis, which keeps their image
+/// lengths, so the chain can only ever cover the line with its image lengths (a bone leaning
+/// toward the camera, or a short bone doubling back like RobotExpressive's `Body → Hips`,
+/// counts for what it shows).
 #[derive(Debug, Clone)]
 pub(crate) struct KeyChain {
     pub points: Vec<ChainPoint>,
@@ -124,9 +136,12 @@ pub(crate) struct KeyChain {
 }
 
 impl KeyChain {
-    pub(super) fn new(rig: &Rig, w: &WorldPose, chain: &Chain3) -> KeyChain {
+    pub(super) fn new(rig: &Rig, w: &WorldPose, camera: &ActionCamera, chain: &Chain3) -> KeyChain {
         let points = chain.points();
-        let pos: Vec<DVec3> = points.iter().map(|&p| point_position(rig, w, p)).collect();
+        let pos: Vec<DVec2> = points
+            .iter()
+            .map(|&p| camera.project(point_position(rig, w, p)))
+            .collect();
         let seg_length: Vec<f64> = pos.windows(2).map(|s| (s[1] - s[0]).length()).collect();
         // The branch connector: where the path turns from going up the tree to going down
         // (a pelvis or shoulder girdle), the segment climbing into the turn joint is a
@@ -226,9 +241,11 @@ pub(crate) fn line_targets(
             out.points.push(PointTarget {
                 point: a.points[i],
                 target: line.at(u),
+                weight: u,
             });
         }
     }
+    quadrature(out.points.iter_mut().map(|p| &mut p.weight), true);
     for i in 0..a.points.len().saturating_sub(1) {
         let (p, q) = (a.points[i], a.points[i + 1]);
         // The segment must be consecutive in both chains.
@@ -236,7 +253,14 @@ pub(crate) fn line_targets(
             (Some(x), Some(y)) => x.abs_diff(y) == 1,
             _ => false,
         };
-        if !consecutive || a.seg_length[i] <= 0.0 || a.connector[i] {
+        // A segment ending on a branch connector's lower end (a hip joint beside the
+        // pelvis) hangs off the line by the connector's width: only its points are matched.
+        if !consecutive
+            || a.seg_length[i] <= 1e-6 * a.length
+            || a.connector[i]
+            || !matched(i)
+            || !matched(i + 1)
+        {
             continue;
         }
         let (Some(u0), Some(u1)) = (u_of(i), u_of(i + 1)) else {
@@ -251,10 +275,44 @@ pub(crate) fn line_targets(
             b: q,
             tangent,
             inv_length: 1.0 / a.seg_length[i],
+            weight: (u1 - u0).abs(),
         });
         if !out.bones.contains(&a.seg_bone[i]) {
             out.bones.push(a.seg_bone[i]);
         }
+    }
+    quadrature(out.segments.iter_mut().map(|g| &mut g.weight), false);
+}
+
+/// Turns arc-length positions (`points`: the points' `u`, in chain order) or spans (segments)
+/// into quadrature weights of E_loa's integral over `s` (LoA §4): a point gets half the arc
+/// to each neighbour (trapezoid rule), a segment its own span; scaled to mean 1 so the
+/// weights `w_x`, `w_∂` keep their per-point meaning. Degenerate spans (all zero) give 1.
+fn quadrature<'a>(values: impl Iterator<Item = &'a mut f64>, points: bool) {
+    let mut v: Vec<&mut f64> = values.collect();
+    let n = v.len();
+    if n == 0 {
+        return;
+    }
+    let w: Vec<f64> = if points {
+        let u: Vec<f64> = v.iter().map(|x| **x).collect();
+        (0..n)
+            .map(|i| {
+                let lo = if i > 0 { u[i - 1] } else { u[i] };
+                let hi = if i + 1 < n { u[i + 1] } else { u[i] };
+                0.5 * (hi - lo).abs()
+            })
+            .collect()
+    } else {
+        v.iter().map(|x| **x).collect()
+    };
+    let total: f64 = w.iter().sum();
+    for (x, wi) in v.iter_mut().zip(&w) {
+        **x = if total > 0.0 {
+            wi * n as f64 / total
+        } else {
+            1.0
+        };
     }
 }
 
@@ -274,4 +332,26 @@ pub(crate) fn bone_direction(rig: &Rig, w: &WorldPose, j: usize) -> DVec3 {
 /// Twist "can" target: the stage-1 orientation turned by `angle` about the bone's own axis.
 pub(crate) fn twist_target(rig: &Rig, w: &WorldPose, j: usize, angle: f64) -> DQuat {
     exp(bone_direction(rig, w, j) * angle) * w.rotation[j]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quadrature_weights_are_arc_shares_with_mean_one() {
+        // Points at u = 0, 0.1, 0.5, 1: trapezoid shares 0.05, 0.25, 0.45, 0.25.
+        let mut u = [0.0, 0.1, 0.5, 1.0];
+        quadrature(u.iter_mut(), true);
+        for (w, e) in u.iter().zip([0.2, 1.0, 1.8, 1.0]) {
+            assert!((w - e).abs() < 1e-12, "{u:?}");
+        }
+        // Segments spanning 0.1 and 0.3 of the arc.
+        let mut s = [0.1, 0.3];
+        quadrature(s.iter_mut(), false);
+        assert!(
+            (s[0] - 0.5).abs() < 1e-12 && (s[1] - 1.5).abs() < 1e-12,
+            "{s:?}"
+        );
+    }
 }
