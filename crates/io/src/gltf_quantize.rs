@@ -24,7 +24,7 @@ use anim::{Property, Scene, SceneMesh};
 
 /// Largest position error of quantized output, relative to the diagonal of the bounding box
 /// of everything quantized together; above it the output stays float.
-pub(crate) const MAX_ERROR: f32 = 1e-5;
+pub const MAX_ERROR: f32 = 1e-5;
 
 /// The options of the glTF writers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
