@@ -1,8 +1,7 @@
 //! glTF/GLB from bytes: any bytes give Ok or Err.
 #![no_main]
 
-use libfuzzer_sys::fuzz_target;
+#[path = "../targets.rs"]
+mod targets;
 
-fuzz_target!(|data: &[u8]| {
-    let _ = tkio::gltf::read_bytes(data);
-});
+libfuzzer_sys::fuzz_target!(|data: &[u8]| targets::gltf(data));

@@ -8,50 +8,50 @@ use clap::Args;
 use tkio::{LoadOptions, Loaded};
 
 /// Options shared by every command that reads an animation.
-#[derive(Debug, Clone, Args)]
-pub struct InputArgs {
+#[derive(Debug, Clone, Default, Args)]
+pub(crate) struct InputArgs {
     /// Clip to sample, by name or index (default: the first clip).
     #[arg(long)]
-    pub clip: Option<String>,
-    /// Frames per second to sample at.
-    #[arg(long, default_value_t = DEFAULT_FPS)]
-    pub fps: f32,
+    pub(crate) clip: Option<String>,
+    /// Frames per second to sample at (default: 24).
+    #[arg(long, value_name = "FPS")]
+    pub(crate) fps: Option<f32>,
     /// Only this mesh object (by name; repeat or comma-separate for several).
     #[arg(long, value_delimiter = ',')]
-    pub mesh: Vec<String>,
+    pub(crate) mesh: Vec<String>,
     /// Rest mesh (.obj) for a PC2/MDD point cache (default: same name .obj, or rest.obj).
     #[arg(long)]
-    pub rest: Option<PathBuf>,
+    pub(crate) rest: Option<PathBuf>,
     /// Scene of a multi-scene glTF file, by name or index (default: the file's default scene).
     #[arg(long)]
-    pub scene: Option<String>,
+    pub(crate) scene: Option<String>,
 }
 
-impl Default for InputArgs {
-    fn default() -> Self {
-        InputArgs {
-            clip: None,
-            fps: DEFAULT_FPS,
-            mesh: Vec::new(),
-            rest: None,
-            scene: None,
-        }
+impl InputArgs {
+    /// The sampling rate: `--fps`, or 24.
+    pub(crate) fn fps(&self) -> f32 {
+        self.fps.unwrap_or(DEFAULT_FPS)
     }
 }
 
+/// Checks an `--fps` value: a positive, finite number.
+pub(crate) fn check_fps(fps: f32) -> Result<f32> {
+    if !(fps.is_finite() && fps > 0.0) {
+        anyhow::bail!("--fps: must be a positive number of frames per second, got {fps}");
+    }
+    Ok(fps)
+}
+
 /// Reads a file of any supported format.
-pub fn load(path: &Path, args: &InputArgs) -> Result<Loaded> {
+pub(crate) fn load(path: &Path, args: &InputArgs) -> Result<Loaded> {
     load_with_notes(path, args).map(|(loaded, _)| loaded)
 }
 
 /// Reads a file of any supported format, with the reader's notes (glTF extensions accepted,
 /// scene read, FBX units and axes converted).
-pub fn load_with_notes(path: &Path, args: &InputArgs) -> Result<(Loaded, Vec<String>)> {
-    if !(args.fps.is_finite() && args.fps > 0.0) {
-        anyhow::bail!("--fps must be a positive number, got {}", args.fps);
-    }
+pub(crate) fn load_with_notes(path: &Path, args: &InputArgs) -> Result<(Loaded, Vec<String>)> {
     let options = LoadOptions {
-        fps: args.fps,
+        fps: check_fps(args.fps())?,
         rest: args.rest.clone(),
         scene: args.scene.clone(),
     };
@@ -59,7 +59,7 @@ pub fn load_with_notes(path: &Path, args: &InputArgs) -> Result<(Loaded, Vec<Str
 }
 
 /// Samples what was loaded into per-object point caches (and skeleton, cameras).
-pub fn sample(path: &Path, loaded: &Loaded, args: &InputArgs) -> Result<SampledScene> {
+pub(crate) fn sample(path: &Path, loaded: &Loaded, args: &InputArgs) -> Result<SampledScene> {
     let with_path = |e: anim::AnimError| anyhow::anyhow!("{}: {e}", path.display());
     match loaded {
         Loaded::Scene(scene) => {
@@ -68,7 +68,7 @@ pub fn sample(path: &Path, loaded: &Loaded, args: &InputArgs) -> Result<SampledS
                 None => None,
             };
             let options = SampleOptions {
-                fps: args.fps,
+                fps: args.fps(),
                 clip,
                 meshes: args.mesh.clone(),
             };
@@ -82,14 +82,14 @@ pub fn sample(path: &Path, loaded: &Loaded, args: &InputArgs) -> Result<SampledS
 }
 
 /// Loads and samples in one call.
-pub fn open(path: &Path, args: &InputArgs) -> Result<SampledScene> {
+pub(crate) fn open(path: &Path, args: &InputArgs) -> Result<SampledScene> {
     let loaded = load(path, args)?;
     sample(path, &loaded, args)
 }
 
 /// All mesh objects merged into one point cache (the vertex order every per-vertex output
 /// uses, and that `toonkit convert IN rest.obj` writes).
-pub fn merged(path: &Path, sampled: &SampledScene) -> Result<MeshAnimation> {
+pub(crate) fn merged(path: &Path, sampled: &SampledScene) -> Result<MeshAnimation> {
     if sampled.objects.is_empty() {
         anyhow::bail!("{}: the file has no mesh", path.display());
     }
@@ -99,7 +99,7 @@ pub fn merged(path: &Path, sampled: &SampledScene) -> Result<MeshAnimation> {
 }
 
 /// Name of the merged point cache of an input: its file stem (`mesh` when it has none).
-pub fn merged_name(path: &Path) -> String {
+pub(crate) fn merged_name(path: &Path) -> String {
     path.file_stem()
         .and_then(|s| s.to_str())
         .unwrap_or("mesh")

@@ -5,6 +5,10 @@ mod commands;
 mod input;
 mod output;
 mod progress;
+mod shared;
+
+#[cfg(test)]
+mod help_consistency;
 
 use std::process::ExitCode;
 
@@ -13,7 +17,7 @@ use clap::{Parser, Subcommand};
 /// Stylization tools for 3D animation: smear frames, 3D-printed stop-motion, lines of action.
 #[derive(Debug, Parser)]
 #[command(name = "toonkit", version, about, propagate_version = true)]
-pub struct Cli {
+pub(crate) struct Cli {
     /// Print a machine-readable JSON summary (timings included) on stdout instead of text.
     #[arg(long, global = true)]
     json: bool,
@@ -104,12 +108,29 @@ fn main() -> ExitCode {
             ExitCode::from(failed.map_or(2, |f| f.exit_code()))
         }
         Err(e) => {
-            // One line: the cause chain joined, the file named by the innermost error.
-            let msg = format!("{e:#}").replace('\n', " ");
-            eprintln!("toonkit: error: {msg}");
+            eprintln!("toonkit: error: {}", one_line(&e));
             ExitCode::from(2)
         }
     }
+}
+
+/// An error and its causes as one line, each text once: a cause already said by the message
+/// before it (an OS error its wrapper described in the user's terms, a path the context
+/// repeats) is left out.
+pub(crate) fn one_line(e: &anyhow::Error) -> String {
+    let mut msg = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if msg.is_empty() || text.contains(msg.as_str()) {
+            msg = text;
+        } else if msg.contains(text.as_str()) || cause.is::<std::io::Error>() {
+            continue;
+        } else {
+            msg.push_str(": ");
+            msg.push_str(&text);
+        }
+    }
+    msg.replace('\n', " ")
 }
 
 /// Runs one parsed command (the binary's dispatcher; `toonkit batch` runs its shots through

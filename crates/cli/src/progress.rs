@@ -6,7 +6,7 @@ use std::time::Duration;
 use indicatif::ProgressBar;
 
 /// A spinner for work of unknown length.
-pub fn spinner(message: &str, json: bool) -> ProgressBar {
+pub(crate) fn spinner(message: &str, json: bool) -> ProgressBar {
     if json || !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }

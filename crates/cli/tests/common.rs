@@ -5,23 +5,23 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// Path of a shared test asset; panics (fails loudly) if it is missing.
-pub fn data(rel: &str) -> PathBuf {
+pub(crate) fn data(rel: &str) -> PathBuf {
     testdata::asset(rel)
 }
 
 /// A path as a command-line argument.
-pub fn s(p: &Path) -> &str {
+pub(crate) fn s(p: &Path) -> &str {
     p.to_str().expect("test paths are UTF-8")
 }
 
 /// Reads a `.pc2` written by toonkit with its rest `.obj` beside it (24 fps).
-pub fn read_pc2(path: &Path) -> anim::MeshAnimation {
+pub(crate) fn read_pc2(path: &Path) -> anim::MeshAnimation {
     let rest = tkio::obj::read(&std::fs::read(path.with_extension("obj")).unwrap()).unwrap();
     tkio::pc2::read(&std::fs::read(path).unwrap(), rest, 24.0).unwrap()
 }
 
 /// Runs `toonkit` with arguments.
-pub fn toonkit(args: &[&str]) -> Output {
+pub(crate) fn toonkit(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_toonkit"))
         .args(args)
         .output()
@@ -29,7 +29,7 @@ pub fn toonkit(args: &[&str]) -> Output {
 }
 
 /// Runs `toonkit`, asserting success; returns stdout.
-pub fn ok(args: &[&str]) -> String {
+pub(crate) fn ok(args: &[&str]) -> String {
     let out = toonkit(args);
     assert!(
         out.status.success(),
@@ -40,7 +40,7 @@ pub fn ok(args: &[&str]) -> String {
 }
 
 /// Runs `toonkit --json ...` and parses stdout.
-pub fn json(args: &[&str]) -> serde_json::Value {
+pub(crate) fn json(args: &[&str]) -> serde_json::Value {
     let mut a = vec!["--json"];
     a.extend_from_slice(args);
     serde_json::from_str(&ok(&a)).expect("json stdout")
@@ -49,7 +49,7 @@ pub fn json(args: &[&str]) -> serde_json::Value {
 /// Keeps a copy of every glTF in `dir` for CI's Khronos validation run
 /// (`TOONKIT_VALIDATE_DIR`), under a name prefixed by `tag`; CI runs the Khronos validator
 /// on the glTF files and Pixar's USD (`.ci/validate_usd.py`) on the `.usda` files.
-pub fn keep_for_validation(dir: &Path, tag: &str) {
+pub(crate) fn keep_for_validation(dir: &Path, tag: &str) {
     let Ok(dest) = std::env::var("TOONKIT_VALIDATE_DIR") else {
         return;
     };
@@ -79,7 +79,7 @@ fn walk(dir: &Path) -> Vec<PathBuf> {
 }
 
 /// Asserts a failed run: exit code 2, one line on stderr mentioning `needle`, no panic.
-pub fn assert_bad_input(args: &[&str], needle: &str) {
+pub(crate) fn assert_bad_input(args: &[&str], needle: &str) {
     let out = toonkit(args);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(
@@ -97,4 +97,43 @@ pub fn assert_bad_input(args: &[&str], needle: &str) {
         err.contains(needle),
         "stderr {err:?} does not mention {needle:?}"
     );
+    assert_readable(&err);
+}
+
+/// The rules of every error message (issue #23): no `Debug` output, no OS error codes, no
+/// text said twice, numbers written for people.
+pub(crate) fn assert_readable(message: &str) {
+    let m = message.trim_end();
+    for leak in [
+        "Constant(",
+        "Curve(",
+        "Some(",
+        "None",
+        "Error {",
+        "kind: ",
+        "os error",
+    ] {
+        assert!(!m.contains(leak), "{m:?} leaks {leak:?}");
+    }
+    let digits = m
+        .split(|c: char| !c.is_ascii_digit())
+        .map(str::len)
+        .max()
+        .unwrap_or(0);
+    assert!(digits <= 12, "{m:?} spells out a {digits}-digit number");
+    let parts: Vec<&str> = m.split(": ").map(str::trim).collect();
+    for w in parts.windows(2) {
+        assert!(!w[0].eq_ignore_ascii_case(w[1]), "{m:?} repeats {:?}", w[0]);
+    }
+}
+
+/// Every file name in `dir`, sorted (temporary files included: they start with '.').
+pub(crate) fn file_names(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
 }

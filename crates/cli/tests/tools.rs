@@ -17,7 +17,13 @@ fn smear_offsets_npy_matches_merged_vertex_order() {
         "-o",
         npy.to_str().unwrap(),
     ]);
-    ok(&["convert", cesium.to_str().unwrap(), rest.to_str().unwrap()]);
+    ok(&[
+        "convert",
+        cesium.to_str().unwrap(),
+        rest.to_str().unwrap(),
+        "--frame",
+        "0",
+    ]);
     let (shape, values) = tkio::npy::read_f32(&std::fs::read(&npy).unwrap()).unwrap();
     let mesh = tkio::obj::read(&std::fs::read(&rest).unwrap()).unwrap();
     assert_eq!(shape, vec![48, mesh.vertex_count()]);
@@ -197,6 +203,8 @@ fn stopmo_segment_face_writes_parts_report_and_render() {
     segment_face(
         &out,
         &[
+            "--layout",
+            "morph",
             "--report",
             report.to_str().unwrap(),
             "--render",

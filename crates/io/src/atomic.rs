@@ -9,21 +9,71 @@ use crate::{IoError, Result};
 /// Writes `bytes` to `path` atomically: a reader never sees a half-written file, and a failed
 /// write leaves any previous file untouched. Parent directories are created.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let tmp = stage(path, bytes)?;
+    commit(&tmp, path)
+}
+
+/// Writes several files all or nothing: every file is first written in full to a temporary
+/// file beside its target; only when all of them are written (a full disk, a size limit or an
+/// unwritable folder fails here) are they renamed over their targets. A failure removes the
+/// temporary files and leaves every previous file as it was.
+pub fn write_atomic_all(files: &[(PathBuf, Vec<u8>)]) -> Result<()> {
+    let mut temps = Vec::with_capacity(files.len());
+    for (path, bytes) in files {
+        match stage(path, bytes) {
+            Ok(tmp) => temps.push(tmp),
+            Err(e) => {
+                for t in &temps {
+                    let _ = fs::remove_file(t);
+                }
+                return Err(e);
+            }
+        }
+    }
+    for (k, ((path, _), tmp)) in files.iter().zip(&temps).enumerate() {
+        if let Err(e) = commit(tmp, path) {
+            for t in &temps[k + 1..] {
+                let _ = fs::remove_file(t);
+            }
+            return Err(e);
+        }
+    }
+    Ok(())
+}
+
+/// Writes `bytes` in full to the temporary file of `path` (synced to disk) and returns its
+/// path; on failure nothing is left behind.
+fn stage(path: &Path, bytes: &[u8]) -> Result<PathBuf> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         fs::create_dir_all(dir).map_err(|e| IoError::io(dir, e))?;
+    }
+    if path.is_dir() {
+        return Err(IoError::io(
+            path,
+            std::io::Error::from(std::io::ErrorKind::IsADirectory),
+        ));
     }
     let tmp = temp_path(path);
     let result = (|| {
         let mut f = fs::File::create(&tmp)?;
         f.write_all(bytes)?;
-        f.sync_all()?;
-        fs::rename(&tmp, path)
+        f.sync_all()
     })();
-    if let Err(e) = result {
-        let _ = fs::remove_file(&tmp);
-        return Err(IoError::io(path, e));
+    match result {
+        Ok(()) => Ok(tmp),
+        Err(e) => {
+            let _ = fs::remove_file(&tmp);
+            Err(IoError::io(path, e))
+        }
     }
-    Ok(())
+}
+
+/// Renames a staged temporary file over its target (removing it when that fails).
+fn commit(tmp: &Path, path: &Path) -> Result<()> {
+    fs::rename(tmp, path).map_err(|e| {
+        let _ = fs::remove_file(tmp);
+        IoError::io(path, e)
+    })
 }
 
 /// Removes the temporary files that interrupted [`write_atomic`] calls of `path` left beside

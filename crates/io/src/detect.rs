@@ -47,6 +47,32 @@ impl Format {
         )
     }
 
+    /// Whether a file of the format holds one frame only (`.obj`, `.stl`): several frames are
+    /// written as a numbered sequence ([`Layout::Sequence`](crate::Layout::Sequence)) or
+    /// refused ([`IoError::FramesDoNotFit`](crate::IoError::FramesDoNotFit)).
+    pub fn holds_one_frame(self) -> bool {
+        matches!(self, Format::Obj | Format::Stl)
+    }
+
+    /// The usual lower-case extension of the format, without the dot.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Format::Gltf => "gltf",
+            Format::Glb => "glb",
+            Format::Obj => "obj",
+            Format::Pc2 => "pc2",
+            Format::Mdd => "mdd",
+            Format::Bvh => "bvh",
+            Format::Stl => "stl",
+            Format::Npy => "npy",
+            Format::Usda => "usda",
+            Format::Usdc => "usdc",
+            Format::Usdz => "usdz",
+            Format::Abc => "abc",
+            Format::Fbx => "fbx",
+        }
+    }
+
     /// Format from a file extension (for outputs).
     pub fn from_extension(path: &Path) -> Option<Format> {
         let ext = path.extension()?.to_str()?.to_ascii_lowercase();

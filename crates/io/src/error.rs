@@ -22,7 +22,7 @@ impl fmt::Display for FilePath {
 #[derive(Debug, Error)]
 pub enum IoError {
     /// The file could not be read or written. Check the path and permissions.
-    #[error("{path}: {source}")]
+    #[error("{path}: {}", describe_io(source))]
     Io {
         /// File.
         path: FilePath,
@@ -59,6 +59,28 @@ pub enum IoError {
         format: &'static str,
         /// The library's error.
         source: Box<dyn std::error::Error + Send + Sync + 'static>,
+    },
+    /// Several frames asked to be written to a format that holds one frame (`.obj`, `.stl`)
+    /// without saying how: write the sequence ([`Layout::Sequence`](crate::Layout::Sequence),
+    /// `--layout sequence`) or one frame ([`Layout::Frame`](crate::Layout::Frame), `--frame N`).
+    #[error("{path}: {frames} frames do not fit in one .{extension}: use --layout sequence, or --frame N for one frame")]
+    FramesDoNotFit {
+        /// File.
+        path: FilePath,
+        /// Number of frames of the result.
+        frames: usize,
+        /// Extension of the single-frame format.
+        extension: &'static str,
+    },
+    /// A frame was asked for that the result does not have.
+    #[error("{path}: --frame {frame} is past the last frame ({last}): frames are numbered from 0")]
+    NoSuchFrame {
+        /// File.
+        path: FilePath,
+        /// The frame asked for (0-based).
+        frame: usize,
+        /// The last frame (0-based).
+        last: usize,
     },
     /// The file parsed but its content is inconsistent (e.g. NaN positions, bad indices).
     #[error("{path}: {source}")]
@@ -115,12 +137,47 @@ impl IoError {
             | IoError::Malformed { path, .. }
             | IoError::Unsupported { path, .. }
             | IoError::Encode { path, .. }
+            | IoError::FramesDoNotFit { path, .. }
+            | IoError::NoSuchFrame { path, .. }
             | IoError::Anim { path, .. } => path,
         };
         if slot.0.as_os_str().is_empty() {
             slot.0 = p.to_path_buf();
         }
         self
+    }
+}
+
+/// An operating-system error in the user's terms, with how to fix it: "is a directory: name a
+/// file", not "Is a directory (os error 21)".
+pub fn describe_io(e: &std::io::Error) -> String {
+    use std::io::ErrorKind as K;
+    match e.kind() {
+        K::NotFound => "no such file or directory (check the path)".into(),
+        K::PermissionDenied => {
+            "permission denied (check the file's and folder's permissions)".into()
+        }
+        K::IsADirectory => "is a directory: name a file".into(),
+        K::NotADirectory => "a part of the path is a file, not a folder".into(),
+        K::ReadOnlyFilesystem => "the file system is read-only: write somewhere else".into(),
+        K::StorageFull => "no space left on the device: free some space and run again".into(),
+        K::FileTooLarge => "the file is larger than this system allows".into(),
+        K::QuotaExceeded => "disk quota exceeded: free some space and run again".into(),
+        K::UnexpectedEof => "the file ends early (truncated?)".into(),
+        K::InvalidData => "not valid UTF-8 text".into(),
+        _ => {
+            // The OS text without its "(os error N)" suffix, lower-cased first letter.
+            let text = e.to_string();
+            let text = match text.rfind(" (os error ") {
+                Some(i) => text[..i].to_string(),
+                None => text,
+            };
+            let mut c = text.chars();
+            match c.next() {
+                Some(f) => f.to_lowercase().chain(c).collect(),
+                None => "input/output error".into(),
+            }
+        }
     }
 }
 

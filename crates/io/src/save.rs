@@ -8,18 +8,53 @@ use anim::{Flipbook, Mesh, MeshAnimation};
 
 use crate::usda::{UsdMesh, UsdStage};
 
-use crate::{write_atomic, Format, IoError, Result};
+use crate::{write_atomic_all, Format, IoError, Result};
 
 /// How an animation is laid out in the output file.
+///
+/// The rule for formats that hold one frame (`.obj`, `.stl`, see [`Format::holds_one_frame`]):
+/// an animation of several frames is written as a numbered sequence with [`Layout::Sequence`],
+/// as one frame with [`Layout::Frame`], and refused otherwise
+/// ([`IoError::FramesDoNotFit`]) — never silently cut to its first frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Layout {
-    /// glTF: one node per frame, visibility keyed (vertex colours per frame).
+    /// glTF: one node per frame, visibility keyed (vertex colours per frame). Other formats:
+    /// their natural layout (a point cache, a time-sampled mesh).
     #[default]
     Flipbook,
     /// glTF: one morph target per frame, STEP weights.
     Morph,
-    /// OBJ: one file per frame, `name_0001.obj`, ….
+    /// One file per frame, `name_0001.obj`, … (`.obj`, `.stl`).
     Sequence,
+    /// Only this frame (0-based), in any format.
+    Frame(usize),
+}
+
+impl Layout {
+    /// The layouts a user picks by name (`--layout NAME`); [`Layout::Frame`] is picked by
+    /// number (`--frame N`).
+    pub const NAMED: [Layout; 3] = [Layout::Flipbook, Layout::Morph, Layout::Sequence];
+
+    /// The name of the layout (`flipbook`, `morph`, `sequence`, `frame`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Layout::Flipbook => "flipbook",
+            Layout::Morph => "morph",
+            Layout::Sequence => "sequence",
+            Layout::Frame(_) => "frame",
+        }
+    }
+}
+
+impl std::str::FromStr for Layout {
+    type Err = String;
+
+    fn from_str(s: &str) -> std::result::Result<Layout, String> {
+        Layout::NAMED
+            .into_iter()
+            .find(|l| l.name().eq_ignore_ascii_case(s))
+            .ok_or_else(|| format!("unknown layout '{s}' (use flipbook, morph or sequence)"))
+    }
 }
 
 /// One result to write. The variant says what the data is; the path's extension says how.
@@ -115,10 +150,10 @@ pub fn save_with(path: &Path, output: &Output<'_>, options: SaveOptions) -> Resu
     let glb = crate::gltf::GlbOptions {
         quantize: options.quantize,
     };
-    let mut written = Vec::new();
+    // Every file is encoded first, then all are written together (all or nothing).
+    let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
     let mut put = |p: &Path, bytes: &[u8]| -> Result<()> {
-        write_atomic(p, bytes)?;
-        written.push(p.to_path_buf());
+        files.push((p.to_path_buf(), bytes.to_vec()));
         Ok(())
     };
     match *output {
@@ -157,6 +192,13 @@ pub fn save_with(path: &Path, output: &Output<'_>, options: SaveOptions) -> Resu
         },
         Output::Stage(stage) => put(path, &write_stage(path, stage)?)?,
         Output::Parts { parts, layout } => {
+            if matches!(layout, Layout::Sequence | Layout::Frame(_)) {
+                return Err(IoError::unsupported(format!(
+                    "parts are written whole as .glb or a scene cache: the {} layout does not apply (use flipbook or morph)",
+                    layout.name()
+                ))
+                .at(path));
+            }
             let bytes = if output_format(path)? == Format::Glb {
                 crate::gltf::write_animations_with(parts, gltf_layout(layout), glb)
                     .map_err(|e| e.at(path))?
@@ -190,7 +232,8 @@ pub fn save_with(path: &Path, output: &Output<'_>, options: SaveOptions) -> Resu
             colors,
         } => write_animation(path, animation, layout, colors, glb, &mut put)?,
     }
-    Ok(written)
+    write_atomic_all(&files)?;
+    Ok(files.into_iter().map(|(p, _)| p).collect())
 }
 
 /// The format of an output path, or an error naming the extensions toonkit writes.
@@ -242,7 +285,43 @@ fn write_animation(
     glb: crate::gltf::GlbOptions,
     put: &mut dyn FnMut(&Path, &[u8]) -> Result<()>,
 ) -> Result<()> {
-    match output_format(path)? {
+    let format = output_format(path)?;
+    if let Layout::Frame(frame) = layout {
+        let frames = anim.frame_count();
+        if frame >= frames {
+            return Err(IoError::NoSuchFrame {
+                path: Default::default(),
+                frame,
+                last: frames.saturating_sub(1),
+            }
+            .at(path));
+        }
+        let one = MeshAnimation::new(anim.mesh.clone(), anim.fps, anim.frame(frame).to_vec())
+            .map_err(|e| IoError::from(e).at(path))?;
+        let n = anim.vertex_count();
+        let colors = colors.and_then(|c| c.get(frame * n..(frame + 1) * n));
+        return write_animation(path, &one, Layout::Flipbook, colors, glb, put);
+    }
+    if format.holds_one_frame() {
+        if layout == Layout::Sequence && anim.frame_count() > 1 {
+            return write_sequence(path, format, anim, put);
+        }
+        if anim.frame_count() > 1 {
+            return Err(IoError::FramesDoNotFit {
+                path: Default::default(),
+                frames: anim.frame_count(),
+                extension: format.extension(),
+            }
+            .at(path));
+        }
+    } else if layout == Layout::Sequence {
+        return Err(IoError::unsupported(format!(
+            "the sequence layout writes one file per frame: name the output .obj or .stl (a .{} holds every frame)",
+            format.extension()
+        ))
+        .at(path));
+    }
+    match format {
         Format::Glb => {
             let bytes =
                 crate::gltf::write_animations_with(&[(anim, colors)], gltf_layout(layout), glb)
@@ -262,16 +341,7 @@ fn write_animation(
             rest_mesh(path, anim, put)
         }
         #[cfg(feature = "obj")]
-        Format::Obj => {
-            if layout == Layout::Sequence && anim.frame_count() > 1 {
-                for (p, text) in crate::obj::write_sequence(anim, &sequence_base(path)) {
-                    put(&p, text.as_bytes())?;
-                }
-                Ok(())
-            } else {
-                put(path, crate::obj::write(&anim.mesh_at(0)).as_bytes())
-            }
-        }
+        Format::Obj => put(path, crate::obj::write(&anim.mesh_at(0)).as_bytes()),
         #[cfg(feature = "stl")]
         Format::Stl => put(path, &crate::stl::write_binary(&anim.mesh_at(0))),
         Format::Npy => {
@@ -294,6 +364,41 @@ fn write_animation(
         #[allow(unreachable_patterns)]
         _ => Err(IoError::unsupported("this build of toonkit cannot write that format").at(path)),
     }
+}
+
+/// Every frame as its own file, `name_0001.obj`, … (numbered from 1, as Blender's OBJ
+/// sequences are).
+fn write_sequence(
+    path: &Path,
+    format: Format,
+    anim: &MeshAnimation,
+    put: &mut dyn FnMut(&Path, &[u8]) -> Result<()>,
+) -> Result<()> {
+    let base = sequence_base(path);
+    match format {
+        #[cfg(feature = "obj")]
+        Format::Obj => {
+            for (p, text) in crate::obj::write_sequence(anim, &base) {
+                put(&p, text.as_bytes())?;
+            }
+        }
+        _ => {
+            let stem = base.file_name().map(|s| s.to_string_lossy().into_owned());
+            let stem = stem.unwrap_or_else(|| "frame".into());
+            for f in 0..anim.frame_count() {
+                let p = base.with_file_name(format!("{stem}_{:04}.{}", f + 1, format.extension()));
+                write_animation(
+                    &p,
+                    &MeshAnimation::still(anim.mesh_at(f)),
+                    Layout::Flipbook,
+                    None,
+                    crate::gltf::GlbOptions::default(),
+                    put,
+                )?;
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The rest mesh of a PC2/MDD cache, as a same-name `.obj` beside it.

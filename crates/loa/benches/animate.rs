@@ -4,6 +4,9 @@
 //!
 //! `cargo bench -p toonkit-loa --bench animate`
 
+// `criterion_group!` generates an undocumented `pub fn`.
+#![allow(missing_docs)]
+
 use criterion::{criterion_group, criterion_main, Criterion};
 use loa::animate::{animate, AnimateOptions, BoneSetKey, Character};
 use loa::{Keystrokes, LineOptions};

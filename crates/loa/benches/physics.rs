@@ -1,5 +1,8 @@
 //! Physics interpolation benchmark: 10 keystrokes × 40 frames (Section 3.2).
 
+// `criterion_group!` generates an undocumented `pub fn`.
+#![allow(missing_docs)]
+
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use glam::DVec2;
 use loa::{fit_keystrokes, interpolate_physics, Keystroke, Keystrokes, PhysicsOptions, Stroke};

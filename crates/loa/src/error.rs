@@ -74,7 +74,7 @@ pub enum LoaError {
     #[error("no keystrokes found; provide at least one stroke with a frame number")]
     NoKeystrokes,
     /// A numeric parameter is out of its valid range; the message names the range.
-    #[error("invalid {name} = {value}: {expected}")]
+    #[error("invalid {name} = {}: {expected}", anim::human_number(*.value))]
     InvalidParameter {
         /// Parameter name as in the input format or options.
         name: &'static str,

@@ -96,7 +96,7 @@ impl Segmented {
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<PathBuf> {
         let parts = self.segmented.part_animations();
         let p = path.clone();
-        py.detach(|| save_file(&p, &FileData::Parts(parts)))
+        py.detach(|| FileData::Parts(parts).save(&p))
             .map_err(io_error)?;
         Ok(path)
     }
@@ -186,12 +186,8 @@ impl Library {
             .result
             .files()
             .map_err(|e| toonkit_error(at(&self.source, e)))?;
-        py.detach(|| {
-            files
-                .iter()
-                .try_for_each(|f| save_file(&dir.join(&f.path), &f.data))
-        })
-        .map_err(io_error)?;
+        py.detach(|| stopmo::save_files(&dir, &files))
+            .map_err(io_error)?;
         Ok(files.into_iter().map(|f| f.path).collect())
     }
 
@@ -203,34 +199,6 @@ impl Library {
             self.result.pieces.len()
         )
     }
-}
-
-/// Writes one file of a stopmo layout with `tkio::save` (the format follows the extension).
-fn save_file(path: &std::path::Path, data: &FileData<'_>) -> tkio::Result<()> {
-    let output = match data {
-        FileData::Text(t) => tkio::Output::Text(t),
-        FileData::Bytes(b) => tkio::Output::Bytes(b),
-        FileData::Mesh(m) => tkio::Output::Mesh(m),
-        FileData::OwnedMesh(m) => tkio::Output::Mesh(m),
-        FileData::PointCache(a) => tkio::Output::Animation {
-            animation: a,
-            layout: tkio::Layout::default(),
-            colors: None,
-        },
-        FileData::Parts(parts) => {
-            let layers: Vec<(&anim::MeshAnimation, Option<&[[f32; 4]]>)> =
-                parts.iter().map(|a| (*a, None)).collect();
-            return tkio::save(
-                path,
-                &tkio::Output::Parts {
-                    parts: &layers,
-                    layout: tkio::Layout::Morph,
-                },
-            )
-            .map(drop);
-        }
-    };
-    tkio::save(path, &output).map(drop)
 }
 
 /// The scene's objects merged (the animation the stopmo jobs take).

@@ -2,6 +2,9 @@
 //!
 //! Run: `cargo bench -p toonkit-render --bench raster`.
 
+// `criterion_group!` generates an undocumented `pub fn`.
+#![allow(missing_docs)]
+
 use criterion::{criterion_group, criterion_main, Criterion};
 use glam::Vec3;
 use render::{ColorMap, DrawList, MeshColors, MeshItem, Renderer, View, ViewDirection};

@@ -61,7 +61,7 @@ pub enum RenderError {
     #[error("no frames to encode")]
     NoFrames,
     /// The camera frame rate is not positive. Fix: pass a positive, finite fps.
-    #[error("frame rate must be positive and finite, got {0}")]
+    #[error("frame rate must be positive and finite, got {}", anim::human_number(*.0))]
     InvalidFps(f32),
     /// The requested frame does not exist. Fix: pick a frame below the frame count.
     #[error("frame {frame} is out of range (the clip has {frames} frames)")]

@@ -4,6 +4,9 @@
 //!
 //! Run: `cargo bench -p toonkit-smear --bench effects`.
 
+// `criterion_group!` generates an undocumented `pub fn`.
+#![allow(missing_docs)]
+
 use criterion::{criterion_group, criterion_main, Criterion};
 use glam::Vec3;
 use smear::{

@@ -3,6 +3,9 @@
 //! Run: `cargo bench -p toonkit-smear --bench offsets`; divide the reported time by 40 for
 //! the time per frame.
 
+// `criterion_group!` generates an undocumented `pub fn`.
+#![allow(missing_docs)]
+
 use criterion::{criterion_group, criterion_main, Criterion};
 use smear::{mesh_offsets, OffsetOptions, OffsetSolver};
 

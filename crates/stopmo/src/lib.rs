@@ -98,9 +98,9 @@ pub mod library;
 pub mod segment;
 
 pub use job::{
-    file_safe_name, library, piece_label, run, saved_segmentation, segment, Error, FileData,
-    LibraryJobOptions, LibraryReport, LibraryResult, OrderReport, OutputFile, PartPrintReport,
-    PartReport, PartSummary, Piece, PieceCount, PlugReport, PrintReport, PrintTime, Result,
-    RunOptions, SegmentJobOptions, SegmentSummary, Segmented, DEFAULT_PIECES,
+    file_safe_name, library, piece_label, run, save_files, saved_segmentation, segment, Error,
+    FileData, LibraryJobOptions, LibraryReport, LibraryResult, OrderReport, OutputFile,
+    PartPrintReport, PartReport, PartSummary, Piece, PieceCount, PlugReport, PrintReport,
+    PrintTime, Result, RunOptions, SegmentJobOptions, SegmentSummary, Segmented, DEFAULT_PIECES,
     DEFAULT_RESOLUTION_MM,
 };

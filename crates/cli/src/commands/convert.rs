@@ -1,4 +1,5 @@
-//! `toonkit convert IN OUT [--clip NAME] [--fps F] [--mesh NAME] [--as flipbook|morph|sequence]`.
+//! `toonkit convert IN OUT [--clip NAME] [--fps F] [--mesh NAME] [--layout flipbook|morph|sequence]
+//! [--frame N]`.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -11,24 +12,24 @@ use tkio::{Format, Loaded};
 
 use super::Context;
 use crate::input::{self, InputArgs};
-use crate::output::{self, Layout};
+use crate::output;
+use crate::shared::{self, LayoutArgs};
 
 /// Arguments of `toonkit convert`.
 #[derive(Debug, Args)]
-pub struct ConvertArgs {
+pub(crate) struct ConvertArgs {
     /// Input animation (glTF/GLB, OBJ or OBJ sequence, PC2/MDD + rest OBJ, BVH).
-    pub input: PathBuf,
+    pub(crate) input: PathBuf,
     /// Output file; the extension picks the format (.glb, .usda, .pc2, .mdd, .obj, .stl, .npy).
-    pub output: PathBuf,
+    pub(crate) output: PathBuf,
     #[command(flatten)]
-    pub input_args: InputArgs,
-    /// Layout of the animation in the output.
-    #[arg(long = "as", value_enum, default_value_t = Layout::Flipbook)]
-    pub layout: Layout,
+    pub(crate) input_args: InputArgs,
+    #[command(flatten)]
+    pub(crate) layout: LayoutArgs,
 }
 
 /// Runs `toonkit convert`.
-pub fn run(ctx: &Context, args: ConvertArgs) -> Result<()> {
+pub(crate) fn run(ctx: &Context, args: ConvertArgs) -> Result<()> {
     let start = Instant::now();
     let loaded = input::load(&args.input, &args.input_args)?;
     let spinner = crate::progress::spinner("converting", ctx.json);
@@ -53,7 +54,8 @@ pub fn run(ctx: &Context, args: ConvertArgs) -> Result<()> {
     }
     let sampled = input::sample(&args.input, &loaded, &args.input_args)?;
     let merged = input::merged(&args.input, &sampled)?;
-    let written = output::write_animation(&args.output, &merged, args.layout, None, ctx.save)?;
+    let layout = args.layout.layout();
+    let written = output::write_animation(&args.output, &merged, layout, None, ctx.save)?;
     spinner.finish_and_clear();
     let summary = json!({
         "input": args.input,
@@ -65,13 +67,9 @@ pub fn run(ctx: &Context, args: ConvertArgs) -> Result<()> {
     });
     ctx.report(&summary, || {
         format!(
-            "wrote {} ({} frames × {} vertices at {} fps)",
-            written
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect::<Vec<_>>()
-                .join(", "),
-            merged.frame_count(),
+            "wrote {} ({} × {} vertices at {} fps)",
+            shared::files(&written),
+            shared::frames_written(layout, merged.frame_count()),
             merged.vertex_count(),
             merged.fps
         )

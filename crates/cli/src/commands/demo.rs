@@ -15,26 +15,31 @@ use serde_json::json;
 use super::Context;
 
 /// The bundled 3D sample: RobotExpressive (CC0, see assets/README.md).
-pub const SAMPLE_GLB: &[u8] = include_bytes!("../../../../assets/characters/RobotExpressive.glb");
+pub(crate) const SAMPLE_GLB: &[u8] =
+    include_bytes!("../../../../assets/characters/RobotExpressive.glb");
 /// The bundled face for stop-motion: ICT-FaceKit face with a speech-like animation (MIT).
-pub const SAMPLE_FACE: &[u8] = include_bytes!("../../../../assets/face/ict-face-talk.glb");
+pub(crate) const SAMPLE_FACE: &[u8] = include_bytes!("../../../../assets/face/ict-face-talk.glb");
 /// The bundled smear style: all three effects (paper Fig. 16).
-pub const SAMPLE_STYLE: &str = include_str!("../../../../examples/smear/fig16_combined.toml");
+pub(crate) const SAMPLE_STYLE: &str =
+    include_str!("../../../../examples/smear/fig16_combined.toml");
 /// The bundled keystrokes: a jump-like arc.
-pub const SAMPLE_KEYS: &str = include_str!("../../../../examples/loa/jump.json");
+pub(crate) const SAMPLE_KEYS: &str = include_str!("../../../../examples/loa/jump.json");
+
+/// The robot's clip the demo uses unless `--clip` names another.
+const DEMO_CLIP: &str = "Running";
 
 /// Arguments of `toonkit demo`.
 #[derive(Debug, Args)]
-pub struct DemoArgs {
+pub(crate) struct DemoArgs {
     /// Folder for the results.
     #[arg(short, long, default_value = "out/demo")]
-    pub out: PathBuf,
-    /// Clip of the robot to use.
-    #[arg(long, default_value = "Running")]
-    pub clip: String,
-    /// Frames per second.
-    #[arg(long, default_value_t = anim::DEFAULT_FPS)]
-    pub fps: f32,
+    pub(crate) out: PathBuf,
+    /// Clip of the robot to use (default: Running).
+    #[arg(long)]
+    pub(crate) clip: Option<String>,
+    /// Frames per second (default: 24).
+    #[arg(long, value_name = "FPS")]
+    pub(crate) fps: Option<f32>,
 }
 
 /// One demo step: a command line, what it shows, and the files it makes.
@@ -50,7 +55,7 @@ struct Step {
 }
 
 /// Runs `toonkit demo`.
-pub fn run(ctx: &Context, args: DemoArgs) -> Result<()> {
+pub(crate) fn run(ctx: &Context, args: DemoArgs) -> Result<()> {
     let start = Instant::now();
     let out = &args.out;
     let inputs = out.join("inputs");
@@ -62,7 +67,9 @@ pub fn run(ctx: &Context, args: DemoArgs) -> Result<()> {
     ] {
         tkio::write_atomic(&inputs.join(name), bytes)?;
     }
-    let steps = steps(out, &args.clip, args.fps);
+    let clip = args.clip.as_deref().unwrap_or(DEMO_CLIP);
+    let fps = crate::input::check_fps(args.fps.unwrap_or(anim::DEFAULT_FPS))?;
+    let steps = steps(out, clip, fps);
     let mut timings = Vec::with_capacity(steps.len());
     for (i, step) in steps.iter().enumerate() {
         if !ctx.json && !ctx.quiet {
@@ -86,8 +93,8 @@ pub fn run(ctx: &Context, args: DemoArgs) -> Result<()> {
     let sampled = anim::sample(
         &scene,
         &anim::SampleOptions {
-            fps: args.fps,
-            clip: Some(scene.find_clip(&args.clip)?),
+            fps,
+            clip: Some(scene.find_clip(clip)?),
             meshes: Vec::new(),
         },
     )?;

@@ -13,17 +13,17 @@ use crate::input::{self, InputArgs};
 
 /// Arguments of `toonkit info`.
 #[derive(Debug, Args)]
-pub struct InfoArgs {
+pub(crate) struct InfoArgs {
     /// The file to describe (glTF, GLB, FBX, OBJ, PC2, MDD, BVH, STL).
-    pub file: PathBuf,
+    pub(crate) file: PathBuf,
     #[command(flatten)]
-    pub input: InputArgs,
+    pub(crate) input: InputArgs,
 }
 
 /// Runs `toonkit info`.
-pub fn run(ctx: &Context, args: InfoArgs) -> Result<()> {
+pub(crate) fn run(ctx: &Context, args: InfoArgs) -> Result<()> {
     let (loaded, notes) = input::load_with_notes(&args.file, &args.input)?;
-    let fps = args.input.fps;
+    let fps = args.input.fps();
     let mut summary = match &loaded {
         Loaded::Scene(scene) => scene_summary(scene, fps)?,
         Loaded::Cache(c) => json!({

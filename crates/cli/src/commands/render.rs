@@ -15,7 +15,7 @@ use crate::input::{self, InputArgs};
 
 /// What the surface colour shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
-pub enum ColorArg {
+pub(crate) enum ColorArg {
     /// The meshes' own vertex colours, or grey.
     #[default]
     None,
@@ -27,43 +27,43 @@ pub enum ColorArg {
 
 /// Arguments of `toonkit render`.
 #[derive(Debug, Args)]
-pub struct RenderArgs {
+pub(crate) struct RenderArgs {
     /// The animation or mesh to preview (glTF, GLB, OBJ, PC2, MDD, STL).
-    pub input: std::path::PathBuf,
+    pub(crate) input: std::path::PathBuf,
     /// Output image: `.png` (one frame) or `.gif` (every frame, looping).
     #[arg(short, long)]
-    pub output: std::path::PathBuf,
-    /// Frame of a PNG (0-based).
-    #[arg(long, default_value_t = 0)]
-    pub frame: usize,
+    pub(crate) output: std::path::PathBuf,
+    /// Frame of a PNG (0-based; default: the first).
+    #[arg(long, value_name = "N")]
+    pub(crate) frame: Option<usize>,
     /// Onion skin: ghosts of this many neighbouring frames on each side.
     #[arg(long, default_value_t = 0)]
-    pub onion: usize,
+    pub(crate) onion: usize,
     /// Surface colouring.
     #[arg(long, value_enum, default_value_t = ColorArg::None)]
-    pub color: ColorArg,
+    pub(crate) color: ColorArg,
     /// View: front, back, side, top, three-quarter (orthographic, fitted to the whole
     /// motion), follow[:DIRECTION] (same scale, tracking a travelling subject) or camera:NAME
     /// (a scene camera).
     #[arg(long, default_value = "three-quarter")]
-    pub view: String,
+    pub(crate) view: String,
     /// Image size, WxH.
     #[arg(long, default_value = "400x400")]
-    pub size: String,
+    pub(crate) size: String,
     /// Supersampling per axis (1 = none, up to 4).
     #[arg(long, default_value_t = 2)]
-    pub supersample: u32,
+    pub(crate) supersample: u32,
     /// Write a contact sheet (`.png`): frames 0, N, 2N, … on a grid, numbered.
     #[arg(long)]
-    pub sheet: bool,
+    pub(crate) sheet: bool,
     /// Frame stride N of the contact sheet (default: about 16 cells).
     #[arg(long, requires = "sheet")]
-    pub every: Option<usize>,
+    pub(crate) every: Option<usize>,
     /// Columns of the contact sheet (default: square-ish).
     #[arg(long, requires = "sheet", default_value_t = 0)]
-    pub columns: usize,
+    pub(crate) columns: usize,
     #[command(flatten)]
-    pub input_args: InputArgs,
+    pub(crate) input_args: InputArgs,
 }
 
 fn parse_view(s: &str) -> Result<ViewSpec> {
@@ -114,7 +114,7 @@ fn output_format(path: &Path) -> Result<OutputFormat> {
 }
 
 /// Runs `toonkit render`.
-pub fn run(ctx: &Context, args: RenderArgs) -> Result<()> {
+pub(crate) fn run(ctx: &Context, args: RenderArgs) -> Result<()> {
     let start = Instant::now();
     // Check every option before reading or computing anything.
     let format = output_format(&args.output)?;
@@ -168,7 +168,7 @@ pub fn run(ctx: &Context, args: RenderArgs) -> Result<()> {
         width,
         height,
         view,
-        frame: args.frame,
+        frame: args.frame.unwrap_or(0),
         onion: args.onion,
         scalar: field.as_ref().map(|(v, m)| (v.as_slice(), *m)),
         format,

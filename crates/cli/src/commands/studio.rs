@@ -9,23 +9,23 @@ use clap::Args;
 use super::Context;
 
 #[derive(Debug, Args)]
-pub struct StudioArgs {
+pub(crate) struct StudioArgs {
     /// Files to open (the first is shown first; a second one, e.g. the face, feeds stopmo).
     /// The studio reads these files and no other.
     #[arg(required = true)]
-    pub files: Vec<PathBuf>,
+    pub(crate) files: Vec<PathBuf>,
     /// Port on 127.0.0.1 (0 = any free port).
     #[arg(long, default_value_t = studio::DEFAULT_PORT)]
-    pub port: u16,
+    pub(crate) port: u16,
     /// Do not open a browser.
     #[arg(long)]
-    pub no_open: bool,
+    pub(crate) no_open: bool,
     /// The only folder the studio writes into.
-    #[arg(long, default_value = "studio-out")]
-    pub out: PathBuf,
+    #[arg(short, long, default_value = "studio-out")]
+    pub(crate) out: PathBuf,
 }
 
-pub fn run(_ctx: &Context, args: StudioArgs) -> Result<()> {
+pub(crate) fn run(_ctx: &Context, args: StudioArgs) -> Result<()> {
     let options = studio::ServeOptions {
         files: args.files,
         port: args.port,

@@ -4,13 +4,13 @@
 use std::path::PathBuf;
 
 /// Path of a shared test asset; panics (fails loudly) if it is missing.
-pub fn data(rel: &str) -> PathBuf {
+pub(crate) fn data(rel: &str) -> PathBuf {
     testdata::asset(rel)
 }
 
 /// Keeps `bytes` as `<name>.glb` for CI's Khronos validator run, like
 /// `crates/cli/tests/common.rs`.
-pub fn keep_for_validation(bytes: &[u8], name: &str) {
+pub(crate) fn keep_for_validation(bytes: &[u8], name: &str) {
     let Ok(dest) = std::env::var("TOONKIT_VALIDATE_DIR") else {
         return;
     };

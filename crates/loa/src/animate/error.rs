@@ -62,7 +62,7 @@ pub enum AnimateError {
         expected: String,
     },
     /// The action-plane normal is zero or not finite. Give a non-zero `x,y,z`.
-    #[error("action plane normal {0:?} is zero or not finite; give a non-zero x,y,z")]
+    #[error("action plane normal {},{},{} is zero or not finite; give a non-zero x,y,z", .0[0], .0[1], .0[2])]
     PlaneNormal([f64; 3]),
     /// The line of action has no frame. Provide keystrokes.
     #[error("the line of action has no frames")]
@@ -91,7 +91,7 @@ pub enum AnimateError {
         source: anim::AnimError,
     },
     /// A numeric option is out of range.
-    #[error("invalid {name} = {value}: {expected}")]
+    #[error("invalid {name} = {}: {expected}", anim::human_number(*.value))]
     InvalidParameter {
         /// Option name.
         name: &'static str,

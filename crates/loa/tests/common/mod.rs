@@ -6,21 +6,25 @@ use std::path::PathBuf;
 use loa::Keystrokes;
 
 /// Path of a shared test asset; panics (fails loudly) if it is missing.
-pub fn data(rel: &str) -> PathBuf {
+pub(crate) fn data(rel: &str) -> PathBuf {
     let p = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/")).join(rel);
     assert!(p.exists(), "missing test asset {}", p.display());
     p
 }
 
 /// An example keystroke file of `examples/loa/`.
-pub fn example(name: &str) -> Keystrokes {
+pub(crate) fn example(name: &str) -> Keystrokes {
     let p = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/loa/")).join(name);
     let text = std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
     Keystrokes::parse(&text).unwrap()
 }
 
 /// `keys` with every keystroke's stiffness and/or damping replaced.
-pub fn with_params(keys: &Keystrokes, stiffness: Option<f64>, damping: Option<f64>) -> Keystrokes {
+pub(crate) fn with_params(
+    keys: &Keystrokes,
+    stiffness: Option<f64>,
+    damping: Option<f64>,
+) -> Keystrokes {
     let ks = keys
         .keys()
         .iter()
@@ -35,7 +39,7 @@ pub fn with_params(keys: &Keystrokes, stiffness: Option<f64>, damping: Option<f6
 }
 
 /// The character of a test asset (skinned glTF or BVH) in `pose` at 24 fps.
-pub fn character(rel: &str, pose: &str) -> (anim::Scene, loa::animate::Character) {
+pub(crate) fn character(rel: &str, pose: &str) -> (anim::Scene, loa::animate::Character) {
     let path = data(rel);
     let scene = match tkio::load(
         &path,

@@ -6,13 +6,13 @@ use glam::Vec3;
 use render::{decode_png, encode_png, Image};
 
 /// Per-channel tolerance of reference comparisons.
-pub const REF_TOLERANCE: u8 = 3;
+pub(crate) const REF_TOLERANCE: u8 = 3;
 /// Largest fraction of pixels allowed to differ beyond the tolerance.
-pub const REF_MAX_FRACTION: f64 = 0.01;
+pub(crate) const REF_MAX_FRACTION: f64 = 0.01;
 
 /// Compares `image` with `tests/refs/<name>.png`; with `TOONKIT_BLESS=1` writes it instead.
 /// A missing reference is a failure.
-pub fn check_ref(name: &str, image: &Image) {
+pub(crate) fn check_ref(name: &str, image: &Image) {
     let path = format!("{}/tests/refs/{name}.png", env!("CARGO_MANIFEST_DIR"));
     if std::env::var("TOONKIT_BLESS").as_deref() == Ok("1") {
         std::fs::write(&path, encode_png(image).unwrap()).unwrap();
@@ -31,7 +31,7 @@ pub fn check_ref(name: &str, image: &Image) {
 }
 
 /// An axis-aligned cube of half-size `h` centred at `c` (12 triangles, CCW outside).
-pub fn cube(c: Vec3, h: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+pub(crate) fn cube(c: Vec3, h: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
     let p: Vec<Vec3> = (0..8)
         .map(|i| {
             c + Vec3::new(
@@ -57,7 +57,7 @@ pub fn cube(c: Vec3, h: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
 }
 
 /// A square of half-size `h` in the plane z = `z`, facing +Z.
-pub fn quad(cx: f32, cy: f32, z: f32, h: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+pub(crate) fn quad(cx: f32, cy: f32, z: f32, h: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
     (
         vec![
             Vec3::new(cx - h, cy - h, z),
@@ -70,7 +70,7 @@ pub fn quad(cx: f32, cy: f32, z: f32, h: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
 }
 
 /// A tiny OBJ reader (positions and faces, fan-triangulated) for test assets.
-pub fn read_obj(path: &str) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+pub(crate) fn read_obj(path: &str) -> (Vec<Vec3>, Vec<[u32; 3]>) {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("cannot read {path}: {e}"));
     let mut v = Vec::new();
     let mut t = Vec::new();

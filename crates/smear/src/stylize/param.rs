@@ -78,14 +78,17 @@ impl Param {
             }
         };
         for v in values {
+            if !v.is_finite() {
+                return Err(err(format!("{v} is not a finite number")));
+            }
             let below = if lo_open { v <= lo } else { v < lo };
             let above = if hi_open { v >= hi } else { v > hi };
-            if !v.is_finite() || below || above {
-                let (l, h) = (
-                    if lo_open { '(' } else { '[' },
-                    if hi_open { ')' } else { ']' },
-                );
-                return Err(err(format!("value {v} is not in {l}{lo}, {hi}{h}")));
+            if below || above {
+                return Err(err(format!(
+                    "{} is {}",
+                    anim::human_number(v),
+                    describe_range((lo, lo_open), (hi, hi_open))
+                )));
             }
         }
         Ok(())
@@ -116,10 +119,10 @@ impl std::str::FromStr for Param {
     type Err = String;
 
     fn from_str(s: &str) -> Result<Param, String> {
-        let number = |t: &str| {
-            t.trim()
-                .parse::<f32>()
-                .map_err(|_| format!("'{}' is not a number", t.trim()))
+        let number = |t: &str| match t.trim().parse::<f32>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            Ok(_) => Err(format!("'{}' is not a finite number", t.trim())),
+            Err(_) => Err(format!("'{}' is not a number", t.trim())),
         };
         if !s.contains(':') {
             return number(s).map(Param::Constant);
@@ -153,6 +156,34 @@ impl std::fmt::Display for Param {
                 Ok(())
             }
         }
+    }
+}
+
+/// "not in [0, 1]", "not > 0", "not ≤ 1e9": a range without bounds that mean "any finite
+/// number" (`f32::MIN`, `f32::MAX`).
+fn describe_range((lo, lo_open): (f32, bool), (hi, hi_open): (f32, bool)) -> String {
+    let (has_lo, has_hi) = (lo > f32::MIN, hi < f32::MAX);
+    let lower = format!(
+        "{} {}",
+        if lo_open { ">" } else { "≥" },
+        anim::human_number(lo)
+    );
+    let upper = format!(
+        "{} {}",
+        if hi_open { "<" } else { "≤" },
+        anim::human_number(hi)
+    );
+    match (has_lo, has_hi) {
+        (true, true) => format!(
+            "not in {}{}, {}{}",
+            if lo_open { '(' } else { '[' },
+            anim::human_number(lo),
+            anim::human_number(hi),
+            if hi_open { ')' } else { ']' }
+        ),
+        (true, false) => format!("not {lower}"),
+        (false, true) => format!("not {upper}"),
+        (false, false) => "not a finite number".into(),
     }
 }
 

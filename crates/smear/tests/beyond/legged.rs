@@ -68,7 +68,7 @@ fn pose(f: f32, speed: f32, lift: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
 }
 
 /// A walk (`speed` ≈ 0.1) or run (`speed` ≈ 0.35) of `frames` frames at 24 fps.
-pub fn gait(frames: usize, speed: f32, lift: f32) -> MeshAnimation {
+pub(crate) fn gait(frames: usize, speed: f32, lift: f32) -> MeshAnimation {
     let (rest, tris) = pose(0.0, speed, lift);
     let positions = (0..frames)
         .flat_map(|f| pose(f as f32, speed, lift).0)

@@ -11,14 +11,14 @@ use anim::{FlipbookPart, MeshAnimation, SampledScene};
 use smear::{prepare, ElongateStyle, FunctionSpec, PrepareOptions, Prepared, Style};
 
 /// Prepares a point cache with the given offset options (default offsets otherwise).
-pub fn prepared(anim: &MeshAnimation, edit: impl FnOnce(&mut PrepareOptions)) -> Prepared {
+pub(crate) fn prepared(anim: &MeshAnimation, edit: impl FnOnce(&mut PrepareOptions)) -> Prepared {
     let mut options = PrepareOptions::default();
     edit(&mut options);
     prepare(SampledScene::from_animation(anim.clone()), &options).unwrap()
 }
 
 /// A style elongating by S_E(δ; β_max) = β_max·δ with the prepared offsets.
-pub fn elongation(p: &Prepared, beta_max: f32) -> Style {
+pub(crate) fn elongation(p: &Prepared, beta_max: f32) -> Style {
     Style {
         offsets: p.options().offsets.clone(),
         elongate: Some(ElongateStyle {
@@ -30,7 +30,7 @@ pub fn elongation(p: &Prepared, beta_max: f32) -> Style {
 }
 
 /// The positions of every frame of a flipbook part (point cache or per-frame meshes).
-pub fn part_frames(part: &FlipbookPart) -> Vec<Vec<glam::Vec3>> {
+pub(crate) fn part_frames(part: &FlipbookPart) -> Vec<Vec<glam::Vec3>> {
     match part {
         FlipbookPart::Animation { animation, .. } => (0..animation.frame_count())
             .map(|f| animation.frame(f).to_vec())

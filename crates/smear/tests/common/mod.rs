@@ -9,7 +9,7 @@ use glam::{Mat4, Quat, Vec3};
 
 /// A surface of revolution around +X: `profile(t) = (x, radius)` for t ∈ [0, π], poles at
 /// t = 0 and π.
-pub fn revolution(
+pub(crate) fn revolution(
     name: &str,
     rings: usize,
     segments: usize,
@@ -49,19 +49,23 @@ pub fn revolution(
 }
 
 /// A UV sphere of radius `r` centred at the origin.
-pub fn sphere(r: f32) -> Mesh {
+pub(crate) fn sphere(r: f32) -> Mesh {
     revolution("ball", 24, 32, |t| (-r * t.cos(), r * t.sin()))
 }
 
 /// The peanut of paper Fig. 4: two lobes along X joined by a narrow waist.
-pub fn peanut() -> Mesh {
+pub(crate) fn peanut() -> Mesh {
     revolution("peanut", 48, 32, |t| {
         (-2.0 * t.cos(), t.sin() * (0.75 + 0.45 * (2.0 * t).cos()))
     })
 }
 
 /// A mesh translated by `step * f` at frame f.
-pub fn translating(mesh: Mesh, frames: usize, step: impl Fn(usize) -> Vec3) -> MeshAnimation {
+pub(crate) fn translating(
+    mesh: Mesh,
+    frames: usize,
+    step: impl Fn(usize) -> Vec3,
+) -> MeshAnimation {
     let mut pos = Vec::with_capacity(frames * mesh.vertex_count());
     for f in 0..frames {
         let s = step(f);
@@ -71,7 +75,7 @@ pub fn translating(mesh: Mesh, frames: usize, step: impl Fn(usize) -> Vec3) -> M
 }
 
 /// A closed tube along +Y through rings at heights `ys`, radius `radius(y)`.
-pub fn tube(ys: &[f32], segments: usize, radius: impl Fn(f32) -> f32) -> Mesh {
+pub(crate) fn tube(ys: &[f32], segments: usize, radius: impl Fn(f32) -> f32) -> Mesh {
     let mut p = vec![Vec3::new(0.0, ys[0], 0.0)];
     for &y in ys {
         for s in 0..segments {
@@ -102,7 +106,7 @@ pub fn tube(ys: &[f32], segments: usize, radius: impl Fn(f32) -> f32) -> Mesh {
 }
 
 /// A chain of `n` joints along local +Y, `len` apart; the root carries `root_rotation`.
-pub fn chain(n: usize, len: f32, root_rotation: Quat) -> Skeleton {
+pub(crate) fn chain(n: usize, len: f32, root_rotation: Quat) -> Skeleton {
     Skeleton {
         joints: (0..n)
             .map(|k| Joint {
@@ -123,7 +127,7 @@ pub fn chain(n: usize, len: f32, root_rotation: Quat) -> Skeleton {
 
 /// A skinned object posed by `locals(f)` (joint local matrices of frame f), sampled like
 /// `anim::sample` does: linear blend skinning from the bind pose, bones per frame.
-pub fn skinned_scene(
+pub(crate) fn skinned_scene(
     mesh: Mesh,
     skeleton: Skeleton,
     weights: VertexWeights,
@@ -177,13 +181,13 @@ pub fn skinned_scene(
 }
 
 /// Bind-pose local matrices of a skeleton.
-pub fn bind_locals(s: &Skeleton) -> Vec<Mat4> {
+pub(crate) fn bind_locals(s: &Skeleton) -> Vec<Mat4> {
     s.joints.iter().map(|j| j.bind_local.matrix()).collect()
 }
 
 /// Skin weights of a tube along a chain of bones `len` apart: linear blend across each joint
 /// over ±`blend` (0 gives hard weights: vertex on bone ⌊y / len⌋).
-pub fn chain_weights(mesh: &Mesh, bones: usize, len: f32, blend: f32) -> VertexWeights {
+pub(crate) fn chain_weights(mesh: &Mesh, bones: usize, len: f32, blend: f32) -> VertexWeights {
     VertexWeights::from_influences(mesh.positions.iter().map(|p| {
         let y = p.y / len;
         let k = (y.floor().max(0.0) as usize).min(bones - 1);
@@ -204,7 +208,8 @@ pub fn chain_weights(mesh: &Mesh, bones: usize, len: f32, blend: f32) -> VertexW
 
 /// The benchmark tube's parts: a 15,002-vertex wavy tube, a 10-bone chain, skin weights and
 /// the chain's local joint matrices at frame f (it translates, bends and twists).
-pub fn benchmark_tube_parts() -> (Mesh, Skeleton, VertexWeights, impl Fn(usize) -> Vec<Mat4>) {
+pub(crate) fn benchmark_tube_parts() -> (Mesh, Skeleton, VertexWeights, impl Fn(usize) -> Vec<Mat4>)
+{
     let ys: Vec<f32> = (0..300).map(|i| i as f32 * 10.0 / 299.0).collect();
     let mesh = tube(&ys, 50, |y| 0.3 + 0.1 * (2.0 * y).sin());
     let w = chain_weights(&mesh, 10, 1.0, 0.25);
@@ -227,14 +232,14 @@ pub fn benchmark_tube_parts() -> (Mesh, Skeleton, VertexWeights, impl Fn(usize) 
 
 /// The benchmark scene (SPEC target): a 15,002-vertex wavy tube skinned to a 10-bone chain
 /// that translates, bends and twists over `frames` frames.
-pub fn benchmark_tube(frames: usize) -> SampledScene {
+pub(crate) fn benchmark_tube(frames: usize) -> SampledScene {
     let (mesh, skel, w, locals) = benchmark_tube_parts();
     skinned_scene(mesh, skel, w, frames, locals)
 }
 
 /// Path of a bundled asset (`assets/…` at the workspace root, same relative names as the
 /// shared data folder); panics if it is missing.
-pub fn asset(rel: &str) -> std::path::PathBuf {
+pub(crate) fn asset(rel: &str) -> std::path::PathBuf {
     let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../assets")
         .join(rel);

@@ -1,7 +1,8 @@
-//! The output layout of a library (SPEC "Output layouts"), as relative paths and data, so
-//! every front end writes the same files with its own writer (`tkio::save` in the CLI).
+//! The output layout of a library (SPEC "Output layouts"), as relative paths and data, and
+//! [`save_files`], the one mapping of that data to [`tkio::save`] every front end uses.
 
 use std::borrow::Cow;
+use std::path::{Path, PathBuf};
 
 use anim::{Mesh, MeshAnimation};
 
@@ -110,6 +111,49 @@ impl LibraryResult {
             all => Cow::Owned(MeshAnimation::concat("reconstruction", all)?),
         })
     }
+}
+
+impl FileData<'_> {
+    /// Writes the data to `path` with [`tkio::save`] (the format follows the extension;
+    /// parts as one morph-target glTF) and returns every file written.
+    ///
+    /// # Errors
+    /// [`tkio::IoError`] naming the file.
+    pub fn save(&self, path: &Path) -> tkio::Result<Vec<PathBuf>> {
+        let layers: Vec<(&MeshAnimation, Option<&[[f32; 4]]>)>;
+        let output = match self {
+            FileData::Text(t) => tkio::Output::Text(t),
+            FileData::Bytes(b) => tkio::Output::Bytes(b),
+            FileData::Mesh(m) => tkio::Output::Mesh(m),
+            FileData::OwnedMesh(m) => tkio::Output::Mesh(m),
+            FileData::PointCache(a) => tkio::Output::Animation {
+                animation: a,
+                layout: tkio::Layout::default(),
+                colors: None,
+            },
+            FileData::Parts(parts) => {
+                layers = parts.iter().map(|a| (*a, None)).collect();
+                tkio::Output::Parts {
+                    parts: &layers,
+                    layout: tkio::Layout::Morph,
+                }
+            }
+        };
+        tkio::save(path, &output)
+    }
+}
+
+/// Writes every file of a layout under `dir` (in parallel) and returns the files written.
+///
+/// # Errors
+/// The first [`tkio::IoError`], naming its file.
+pub fn save_files(dir: &Path, files: &[OutputFile<'_>]) -> tkio::Result<Vec<PathBuf>> {
+    use rayon::prelude::*;
+    let written: Vec<Vec<PathBuf>> = files
+        .par_iter()
+        .map(|f| f.data.save(&dir.join(&f.path)))
+        .collect::<tkio::Result<_>>()?;
+    Ok(written.into_iter().flatten().collect())
 }
 
 fn file(path: impl Into<String>, data: FileData<'_>) -> OutputFile<'_> {

@@ -14,7 +14,7 @@ mod sheets;
 mod text;
 
 pub use error::{Error, Result};
-pub use files::{FileData, OutputFile};
+pub use files::{save_files, FileData, OutputFile};
 pub use library_job::{file_safe_name, library, run};
 pub use options::{LibraryJobOptions, PieceCount, RunOptions, SegmentJobOptions, DEFAULT_PIECES};
 pub use print::{

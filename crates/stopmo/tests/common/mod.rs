@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 /// Path of a bundled asset (same relative names as under `assets/`); fails loudly if missing.
-pub fn asset(rel: &str) -> PathBuf {
+pub(crate) fn asset(rel: &str) -> PathBuf {
     let p = PathBuf::from(format!("{}/../../assets/{rel}", env!("CARGO_MANIFEST_DIR")));
     assert!(p.exists(), "missing test asset {}", p.display());
     p

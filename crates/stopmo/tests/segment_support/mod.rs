@@ -7,11 +7,11 @@ use anim::{Mesh, MeshAnimation};
 use glam::Vec3;
 
 /// Height of the still ring of [`talking_tube`].
-pub const STILL_Y: f32 = 0.2;
+pub(crate) const STILL_Y: f32 = 0.2;
 
 /// An open cylinder of radius 1, y ∈ [-1, 1], `around` columns (plus a duplicated seam
 /// column with its own UVs) and `rows` rows.
-pub fn tube(around: usize, rows: usize) -> Mesh {
+pub(crate) fn tube(around: usize, rows: usize) -> Mesh {
     let mut pos = Vec::new();
     let mut uvs = Vec::new();
     for r in 0..=rows {
@@ -39,7 +39,7 @@ pub fn tube(around: usize, rows: usize) -> Mesh {
 /// Displacement of a rest point at frame `f` of `frames`: below [`STILL_Y`] the "jaw"
 /// opens forward/down, above it the "brow" rises, both growing with the distance to the
 /// still ring (like the square root of the distance); a little asymmetric wobble in x.
-pub fn talk(p: Vec3, f: usize, frames: usize) -> Vec3 {
+pub(crate) fn talk(p: Vec3, f: usize, frames: usize) -> Vec3 {
     let t = f as f32 / frames.max(1) as f32;
     let jaw = (t * 9.0).sin().powi(2);
     let brow = (t * 5.0 + 0.7).sin().powi(2);
@@ -58,7 +58,7 @@ pub fn talk(p: Vec3, f: usize, frames: usize) -> Vec3 {
 }
 
 /// [`tube`] animated by [`talk`] over `frames` frames.
-pub fn talking_tube(around: usize, rows: usize, frames: usize) -> MeshAnimation {
+pub(crate) fn talking_tube(around: usize, rows: usize, frames: usize) -> MeshAnimation {
     let mesh = tube(around, rows);
     let pos: Vec<Vec3> = (0..frames)
         .flat_map(|f| {
@@ -72,12 +72,12 @@ pub fn talking_tube(around: usize, rows: usize, frames: usize) -> MeshAnimation 
 }
 
 /// Bounding-box diagonal over all frames.
-pub fn diagonal(a: &MeshAnimation) -> f32 {
+pub(crate) fn diagonal(a: &MeshAnimation) -> f32 {
     a.bbox().diagonal()
 }
 
 /// Total area of a mesh with the given positions.
-pub fn area(tris: &[[u32; 3]], x: &[Vec3]) -> f64 {
+pub(crate) fn area(tris: &[[u32; 3]], x: &[Vec3]) -> f64 {
     tris.iter()
         .map(|t| {
             let [a, b, c] = t.map(|i| x[i as usize].as_dvec3());

@@ -20,48 +20,48 @@ use super::{extension, read_keystrokes, warn, Context, LineFlags};
 
 /// Arguments of `toonkit loa animate`.
 #[derive(Debug, Args)]
-pub struct AnimateArgs {
+pub(crate) struct AnimateArgs {
     /// The character: a skinned glTF/GLB or a BVH skeleton.
-    pub character: PathBuf,
+    pub(crate) character: PathBuf,
     /// Keystrokes (JSON or SVG, as for `loa line`), drawn in the front view from the bone
     /// set's first bone (feet for leg presets) to its last.
-    pub keys: PathBuf,
+    pub(crate) keys: PathBuf,
     /// Output: `.glb` (character + clip `loa`) or `.bvh`.
     #[arg(short, long)]
-    pub output: PathBuf,
+    pub(crate) output: PathBuf,
     /// Also write a BVH of the motion.
     #[arg(long)]
-    pub bvh: Option<PathBuf>,
+    pub(crate) bvh: Option<PathBuf>,
     /// Bone set at a keystroke frame: a preset (right-leg-spine-head, left-leg-spine-head,
     /// arm-spine, left-arm-spine, arms, legs, full-body) or comma-separated joint names, then
     /// `@FRAME`. Repeat for changing sets.
     #[arg(long = "bones")]
-    pub bones: Vec<String>,
+    pub(crate) bones: Vec<String>,
     /// Action-plane normal `x,y,z` (default: the view direction).
     #[arg(long, allow_hyphen_values = true)]
-    pub plane_normal: Option<String>,
+    pub(crate) plane_normal: Option<String>,
     /// Contact: `JOINT@FRAME` (hold where it is), `JOINT@FRAME:x,y,z`, or `JOINT@A..B`.
     #[arg(long = "contact")]
-    pub contacts: Vec<String>,
+    pub(crate) contacts: Vec<String>,
     /// Twist: `JOINT@FRAME:DEGREES` about the bone's own axis.
     #[arg(long = "twist", allow_hyphen_values = true)]
-    pub twists: Vec<String>,
+    pub(crate) twists: Vec<String>,
     /// Initial pose: `rest`, or `CLIP@FRAME` (a frame of one of the file's clips).
     #[arg(long, default_value = "rest")]
-    pub pose: String,
+    pub(crate) pose: String,
     /// Cap on solver iterations per stage.
     #[arg(long, default_value_t = loa::animate::DEFAULT_MAX_ITERATIONS)]
-    pub iterations: usize,
+    pub(crate) iterations: usize,
     /// The camera the keystrokes are drawn through: a camera node of the character's file
     /// (perspective allowed; default an orthographic front view fitted to the character).
     #[arg(long)]
-    pub camera: Option<String>,
+    pub(crate) camera: Option<String>,
     /// Preview: `.gif` (every frame) or `.png` (first frame), the character with the line, in
     /// a view that follows the character (or through `--camera`).
     #[arg(long)]
-    pub render: Option<PathBuf>,
+    pub(crate) render: Option<PathBuf>,
     #[command(flatten)]
-    pub line: LineFlags,
+    pub(crate) line: LineFlags,
 }
 
 fn parse_vec3(s: &str) -> Result<DVec3> {
@@ -125,7 +125,7 @@ fn options(args: &AnimateArgs) -> Result<AnimateOptions> {
 }
 
 /// Runs `toonkit loa animate`.
-pub fn run(ctx: &Context, args: AnimateArgs) -> Result<()> {
+pub(crate) fn run(ctx: &Context, args: AnimateArgs) -> Result<()> {
     let start = Instant::now();
     check_outputs(&args)?;
     let mut options = options(&args)?;

@@ -11,20 +11,20 @@ use super::{extension, read_keystrokes, warn, Context, LineFlags};
 
 /// Arguments of `toonkit loa line`.
 #[derive(Debug, Args)]
-pub struct LineArgs {
+pub(crate) struct LineArgs {
     /// Keystrokes: JSON (`{"keystrokes": [{"frame", "points", "stiffness"?, "damping"?}]}`) or
     /// SVG (one `<path>`/`<polyline>` per keystroke with a `data-frame` attribute).
-    pub input: PathBuf,
+    pub(crate) input: PathBuf,
     /// Output: `.json` (frames of joint points, angles, lengths), `.svg` (onion skin), `.png`
     /// (onion skin) or `.gif` (animation).
     #[arg(short, long)]
-    pub output: PathBuf,
+    pub(crate) output: PathBuf,
     #[command(flatten)]
-    pub line: LineFlags,
+    pub(crate) line: LineFlags,
 }
 
 /// Runs `toonkit loa line`.
-pub fn run(ctx: &Context, args: LineArgs) -> Result<()> {
+pub(crate) fn run(ctx: &Context, args: LineArgs) -> Result<()> {
     let start = Instant::now();
     // Check the output first so a typo does not cost a computation.
     let ext = extension(&args.output);

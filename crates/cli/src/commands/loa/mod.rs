@@ -13,14 +13,14 @@ use super::Context;
 
 /// Arguments of `toonkit loa`.
 #[derive(Debug, Args)]
-pub struct LoaArgs {
+pub(crate) struct LoaArgs {
     #[command(subcommand)]
-    pub command: LoaCommand,
+    pub(crate) command: LoaCommand,
 }
 
 /// Subcommands of `toonkit loa`.
 #[derive(Debug, Subcommand)]
-pub enum LoaCommand {
+pub(crate) enum LoaCommand {
     /// Interpolate sketched keystrokes into a dynamic line of action (Guay et al. 2015, §3).
     Line(line::LineArgs),
     /// Synthesize 3D character motion that follows the dynamic line (Guay et al. 2015, §4).
@@ -28,7 +28,7 @@ pub enum LoaCommand {
 }
 
 /// Runs `toonkit loa …`.
-pub fn run(ctx: &Context, args: LoaArgs) -> Result<()> {
+pub(crate) fn run(ctx: &Context, args: LoaArgs) -> Result<()> {
     match args.command {
         LoaCommand::Line(a) => line::run(ctx, a),
         LoaCommand::Animate(a) => animate::run(ctx, *a),
@@ -37,7 +37,7 @@ pub fn run(ctx: &Context, args: LoaArgs) -> Result<()> {
 
 /// Interpolation mode.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
-pub enum ModeArg {
+pub(crate) enum ModeArg {
     /// Elastic chain simulation re-targeted onto every keystroke (anticipation, follow-through).
     #[default]
     Physics,
@@ -47,34 +47,34 @@ pub enum ModeArg {
 
 /// Line options shared by `loa line` and `loa animate`.
 #[derive(Debug, Args)]
-pub struct LineFlags {
+pub(crate) struct LineFlags {
     /// Interpolation mode.
     #[arg(long, value_enum, default_value_t = ModeArg::Physics)]
-    pub mode: ModeArg,
+    pub(crate) mode: ModeArg,
     /// Frames per second (default: the keystrokes', else 24).
-    #[arg(long)]
-    pub fps: Option<f64>,
+    #[arg(long, value_name = "FPS")]
+    pub(crate) fps: Option<f32>,
     /// Integration sub-steps per frame.
     #[arg(long, default_value_t = loa::DEFAULT_SUBSTEPS)]
-    pub substeps: u32,
+    pub(crate) substeps: u32,
     /// Frames simulated from each keystroke (`M`), or `gap` for the frame gap between keys.
     #[arg(long, default_value = "40")]
-    pub simulated_frames: String,
+    pub(crate) simulated_frames: String,
     /// Rigid elements per chain (even).
     #[arg(long, default_value_t = loa::DEFAULT_ELEMENTS)]
-    pub elements: usize,
+    pub(crate) elements: usize,
     /// Follow-through after the last keystroke, ending on it at rest: a frame count (0 = end
     /// on the last keystroke), or `key` for one key interval (the last one).
     #[arg(long, default_value = "key")]
-    pub settle: String,
+    pub(crate) settle: String,
     /// Drag-to-wobble `FRAME:S:DX,DY`: hit the line at frame FRAME, at arc-length position
     /// S (0..1), with impulse DX,DY (screen units per second). Repeatable.
     #[arg(long = "wobble", allow_hyphen_values = true)]
-    pub wobbles: Vec<String>,
+    pub(crate) wobbles: Vec<String>,
     /// Stroke smoothing before the fit: Gaussian σ as a fraction of the stroke's length
     /// (0 = fit the raw samples).
     #[arg(long, default_value_t = loa::DEFAULT_STROKE_SMOOTHING)]
-    pub smoothing: f64,
+    pub(crate) smoothing: f64,
 }
 
 impl LineFlags {
@@ -105,7 +105,11 @@ impl LineFlags {
             },
             elements: self.elements,
             physics: loa::PhysicsOptions {
-                fps: self.fps.or(keys.fps()).unwrap_or(loa::DEFAULT_FPS),
+                fps: self
+                    .fps
+                    .map(f64::from)
+                    .or(keys.fps())
+                    .unwrap_or(loa::DEFAULT_FPS),
                 substeps: self.substeps,
                 simulated_frames,
                 settle,

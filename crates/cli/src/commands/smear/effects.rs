@@ -32,11 +32,12 @@ use smear::{
 use tkio::{Format, Output};
 
 use super::{at_input, prepare, Context, EffectArgs, EffectIo};
-use crate::output::{self, Layout};
+use crate::output;
+use crate::shared::{self, LayoutArgs};
 
 /// Presets of S_E (SMEAR Section 5.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ElongatePreset {
+pub(crate) enum ElongatePreset {
     /// S_E(δ; β_max) = β_max·δ (SMEAR Eq. 10 example, Fig. 9b, 11b).
     Linear,
     /// S_E(δ; v, β_max) = β_max‖v‖δ (Fig. 11c).
@@ -47,104 +48,102 @@ pub enum ElongatePreset {
 
 /// Arguments of `toonkit smear elongate`.
 #[derive(Debug, Args)]
-pub struct ElongateArgs {
+pub(crate) struct ElongateArgs {
     #[command(flatten)]
-    pub io: EffectIo,
+    pub(crate) io: EffectIo,
     #[command(flatten)]
-    pub offsets: EffectArgs,
+    pub(crate) offsets: EffectArgs,
     /// Stylization preset S_E.
     #[arg(long, value_enum, default_value_t = ElongatePreset::Linear)]
-    pub preset: ElongatePreset,
+    pub(crate) preset: ElongatePreset,
     /// Maximum elongation β_max in frames; keyframes as FRAME:VALUE,... (e.g. 0:0,12:3).
     #[arg(long, default_value = "1")]
-    pub beta_max: Param,
+    pub(crate) beta_max: Param,
     /// Noise scale κ of the `noise` preset (keyframeable).
     #[arg(long, default_value = "1")]
-    pub kappa: Param,
+    pub(crate) kappa: Param,
     /// User expression for β (replaces the preset), e.g. "beta_max * speed * past(delta)".
     #[arg(long)]
-    pub expr: Option<String>,
-    /// Output layout.
-    #[arg(long, value_enum, default_value_t = Layout::Flipbook)]
-    pub layout: Layout,
+    pub(crate) expr: Option<String>,
+    #[command(flatten)]
+    pub(crate) layout: LayoutArgs,
 }
 
 /// Arguments of `toonkit smear multiples`.
 #[derive(Debug, Args)]
-pub struct MultiplesArgs {
+pub(crate) struct MultiplesArgs {
     #[command(flatten)]
-    pub io: EffectIo,
+    pub(crate) io: EffectIo,
     #[command(flatten)]
-    pub offsets: EffectArgs,
+    pub(crate) offsets: EffectArgs,
     /// Copies in the past, m_p; keyframes (FRAME:VALUE,...) fade copies in and out.
     #[arg(long, default_value = "1")]
-    pub past: Param,
+    pub(crate) past: Param,
     /// Copies in the future, m_n; keyframeable.
     #[arg(long, default_value = "1")]
-    pub future: Param,
+    pub(crate) future: Param,
     /// Temporal spacing Δf between copies, in frames; keyframes as FRAME:VALUE,...
     #[arg(long, conflicts_with = "overlap")]
-    pub spacing: Option<Param>,
+    pub(crate) spacing: Option<Param>,
     /// Copies overlapping between consecutive frames, N∩: Δf = 1/(m_p + m_n + 1 − N∩);
     /// keyframeable.
     #[arg(long)]
-    pub overlap: Option<Param>,
+    pub(crate) overlap: Option<Param>,
     /// m_max of SMEAR Eq. 12 (default: max(m_p, m_n); keyframeable).
     #[arg(long)]
-    pub m_max: Option<Param>,
+    pub(crate) m_max: Option<Param>,
     /// User expression for the opacity (replaces SMEAR Eq. 12), e.g. "step(delta * m)".
     #[arg(long)]
-    pub opacity_expr: Option<String>,
+    pub(crate) opacity_expr: Option<String>,
 }
 
 /// Arguments of `toonkit smear lines`.
 #[derive(Debug, Args)]
-pub struct LinesArgs {
+pub(crate) struct LinesArgs {
     #[command(flatten)]
-    pub io: EffectIo,
+    pub(crate) io: EffectIo,
     #[command(flatten)]
-    pub offsets: EffectArgs,
+    pub(crate) offsets: EffectArgs,
     /// Number of lines K (random surface points, area-weighted). Keyframes (FRAME:VALUE,...)
     /// sample as many seeds as the largest key and draw a fixed random subset per frame.
     #[arg(long, default_value_t = Param::Constant(smear::DEFAULT_LINE_COUNT as f32))]
-    pub count: Param,
+    pub(crate) count: Param,
     /// Maximum length τ_max in frames: S_L(δ; τ_max) = τ_max·δ (SMEAR Eq. 13); keyframeable.
     #[arg(long, default_value = "1")]
-    pub length_max: Param,
-    /// Seed of the random seed placement.
-    #[arg(long, default_value_t = smear::DEFAULT_SEED)]
-    pub seed: u64,
+    pub(crate) length_max: Param,
+    #[command(flatten)]
+    pub(crate) seed: crate::shared::SeedArg,
     /// User expression for τ (replaces the linear one), e.g. "tau_max * speed * past(delta)".
     #[arg(long)]
-    pub length_expr: Option<String>,
+    pub(crate) length_expr: Option<String>,
     /// Tube radius in scene units (default: 0.002 × bounding-box diagonal); keyframeable.
     #[arg(long, conflicts_with = "thickness_expr")]
-    pub thickness: Option<Param>,
+    pub(crate) thickness: Option<Param>,
     /// User expression for the tube radius along the line (`t` = 0 at the surface), e.g.
     /// "0.01 * (1 - t)" for tapering lines.
     #[arg(long)]
-    pub thickness_expr: Option<String>,
+    pub(crate) thickness_expr: Option<String>,
     /// User expression for the opacity along the line (`t` = 0 at the surface), e.g. "1 - t".
     #[arg(long)]
-    pub opacity_expr: Option<String>,
+    pub(crate) opacity_expr: Option<String>,
     /// Gap between surface and line, in frames along the trajectory; keyframeable.
     #[arg(long, default_value = "0")]
-    pub gap: Param,
+    pub(crate) gap: Param,
     /// Seeds slower than this (units per frame) draw no line; keyframeable.
     #[arg(long, default_value = "0")]
-    pub min_speed: Param,
+    pub(crate) min_speed: Param,
     /// Line colour, linear R,G,B in [0, 1] (default near-black).
     #[arg(long, value_delimiter = ',')]
-    pub color: Vec<f32>,
+    pub(crate) color: Vec<f32>,
     /// Only trace the past (τ clamped to ≤ 0).
     #[arg(long)]
-    pub past_only: bool,
+    pub(crate) past_only: bool,
     /// Sides of each tube.
     #[arg(long, default_value_t = smear::DEFAULT_LINE_SIDES)]
-    pub sides: usize,
+    pub(crate) sides: usize,
     /// Rings along each line.
     #[arg(long, default_value_t = smear::DEFAULT_LINE_SAMPLES)]
-    pub samples: usize,
+    pub(crate) samples: usize,
 }
 
 /// Checks that a user function compiles, naming the flag that gave it.
@@ -200,7 +199,7 @@ fn part(out: &Stylized, i: usize) -> Result<&MeshAnimation> {
 }
 
 /// Runs `toonkit smear elongate`.
-pub fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
+pub(crate) fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
     let start = Instant::now();
     if Format::from_extension(&args.io.output).is_none() {
         bail!(
@@ -216,7 +215,14 @@ pub fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
             ElongatePreset::Noise => FunctionSpec::noise(args.kappa.clone(), args.beta_max.clone()),
         }),
     };
-    check(&spec, "--expr")?;
+    check(
+        &spec,
+        if args.expr.is_some() {
+            "--expr"
+        } else {
+            "--beta-max/--kappa"
+        },
+    )?;
     args.offsets.shaping()?;
     if args.offsets.subdivide.is_some() {
         require_per_frame_topology(&args.io.output)?;
@@ -233,8 +239,9 @@ pub fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
     };
     let out = run_style(&args.io, &p, &style)?;
     let t = Instant::now();
+    let layout = args.layout.layout();
     let written = match out.animation(0) {
-        Some(body) => output::write_animation(&args.io.output, body, args.layout, None, ctx.save)?,
+        Some(body) => output::write_animation(&args.io.output, body, layout, None, ctx.save)?,
         None => {
             tkio::save_with(&args.io.output, &Output::Flipbook(&out.flipbook), ctx.save)?;
             vec![args.io.output.clone()]
@@ -257,9 +264,9 @@ pub fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
     });
     ctx.report(&summary, || {
         format!(
-            "wrote {} ({} frames × {} vertices, elongated in-betweens)",
-            args.io.output.display(),
-            body.frame_count(),
+            "wrote {} ({} × {} vertices, elongated in-betweens)",
+            shared::files(&written),
+            shared::frames_written(layout, body.frame_count()),
             body.vertex_count()
         )
     });
@@ -267,7 +274,7 @@ pub fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
 }
 
 /// Runs `toonkit smear multiples`.
-pub fn multiples(ctx: &Context, args: MultiplesArgs) -> Result<()> {
+pub(crate) fn multiples(ctx: &Context, args: MultiplesArgs) -> Result<()> {
     let start = Instant::now();
     require_scene_output(&args.io.output, "multiples")?;
     let spacing = match (args.spacing.clone(), args.overlap.clone()) {
@@ -362,14 +369,14 @@ pub fn multiples(ctx: &Context, args: MultiplesArgs) -> Result<()> {
 }
 
 /// Runs `toonkit smear lines`.
-pub fn lines(ctx: &Context, args: LinesArgs) -> Result<()> {
+pub(crate) fn lines(ctx: &Context, args: LinesArgs) -> Result<()> {
     let start = Instant::now();
     require_scene_output(&args.io.output, "lines")?;
     if let Some(t) = &args.thickness {
         if t.validate("--thickness", (0.0, true), (f32::MAX, false))
             .is_err()
         {
-            bail!("--thickness must be positive numbers, got {t:?}");
+            bail!("--thickness {t}: the tube radius must be a positive number (scene units)");
         }
     }
     let length = match &args.length_expr {
@@ -391,7 +398,7 @@ pub fn lines(ctx: &Context, args: LinesArgs) -> Result<()> {
         .is_err()
     {
         bail!(
-            "--count must be a number of lines ≥ 0, got {:?}",
+            "--count {}: give a number of lines from 0 to 10000000",
             args.count
         );
     }
@@ -423,7 +430,7 @@ pub fn lines(ctx: &Context, args: LinesArgs) -> Result<()> {
         lines: Some(LinesStyle {
             enabled: true,
             count: args.count.clone(),
-            seed: args.seed,
+            seed: args.seed.or(smear::DEFAULT_SEED),
             gap: args.gap.clone(),
             min_speed: args.min_speed.clone(),
             past_only: args.past_only,

@@ -29,16 +29,16 @@ use crate::input::{self, InputArgs};
 /// Arguments of `toonkit smear`: a subcommand, or `IN --style STYLE.toml -o OUT.glb`.
 #[derive(Debug, Args)]
 #[command(args_conflicts_with_subcommands = true)]
-pub struct SmearArgs {
+pub(crate) struct SmearArgs {
     #[command(subcommand)]
-    pub command: Option<SmearCommand>,
+    pub(crate) command: Option<SmearCommand>,
     #[command(flatten)]
-    pub style: style::StyleArgs,
+    pub(crate) style: style::StyleArgs,
 }
 
 /// Subcommands of `toonkit smear`.
 #[derive(Debug, Subcommand)]
-pub enum SmearCommand {
+pub(crate) enum SmearCommand {
     /// Motion offsets per frame and vertex: leading parts > 0, trailing parts < 0 (§3).
     Offsets(offsets::OffsetsArgs),
     /// Elongated in-betweens: vertices slid along their trajectories by β = S_E(δ) (§4.1).
@@ -50,7 +50,7 @@ pub enum SmearCommand {
 }
 
 /// Runs `toonkit smear`.
-pub fn run(ctx: &Context, args: SmearArgs) -> Result<()> {
+pub(crate) fn run(ctx: &Context, args: SmearArgs) -> Result<()> {
     match args.command {
         None => style::run(ctx, args.style),
         Some(SmearCommand::Offsets(a)) => offsets::run(ctx, a),
@@ -62,37 +62,37 @@ pub fn run(ctx: &Context, args: SmearArgs) -> Result<()> {
 
 /// Motion-offset options (SMEAR Section 3), shared by `smear offsets` and every effect.
 #[derive(Debug, Clone, Args)]
-pub struct OffsetArgs {
+pub(crate) struct OffsetArgs {
     /// Temporal smoothing half-window N of SMEAR Eq. 2 (0 = off).
     #[arg(long, default_value_t = smear::DEFAULT_SMOOTH)]
-    pub smooth: usize,
+    pub(crate) smooth: usize,
     /// Treat each skinned character as one object with one separation plane (Fig. 14).
     #[arg(long)]
-    pub whole_body: bool,
+    pub(crate) whole_body: bool,
     /// Bones to toggle off (comma-separated): their vertices follow the nearest kept ancestor.
     #[arg(long, value_delimiter = ',')]
-    pub prune: Vec<String>,
+    pub(crate) prune: Vec<String>,
     /// Compute offsets relative to this camera (node name, or index).
     #[arg(long)]
-    pub camera: Option<String>,
+    pub(crate) camera: Option<String>,
     /// Disable the collinear weight of the ribbons (paper Fig. 7, shows the shearing it
     /// prevents).
     #[arg(long)]
-    pub no_collinear: bool,
+    pub(crate) no_collinear: bool,
     /// Past-only mode: velocities, smoothing and trajectories of frame f read frames ≤ f only
     /// (as a game or live preview would); the smear lags slightly behind the offline one.
     #[arg(long)]
-    pub causal: bool,
+    pub(crate) causal: bool,
     /// Objects that revolve about an axis (wheels, propellers; comma-separated mesh names, or
     /// `auto` to detect them): offsets and trajectories follow arcs about the fitted axis.
     #[arg(long, value_delimiter = ',')]
-    pub revolve: Vec<String>,
+    pub(crate) revolve: Vec<String>,
 }
 
 impl OffsetArgs {
     /// The library options; `--camera` is a camera name, or an index when no camera has that
     /// name.
-    pub fn options(&self, sampled: &anim::SampledScene) -> OffsetOptions {
+    pub(crate) fn options(&self, sampled: &anim::SampledScene) -> OffsetOptions {
         let camera = self.camera.as_ref().map(|c| match c.parse::<usize>() {
             Ok(i) if !sampled.cameras.iter().any(|cam| cam.name == *c) => CameraSelect::Index(i),
             _ => CameraSelect::Name(c.clone()),
@@ -111,56 +111,56 @@ impl OffsetArgs {
 
 /// Input and output of an effect command.
 #[derive(Debug, Args)]
-pub struct EffectIo {
+pub(crate) struct EffectIo {
     /// Input animation (glTF/GLB with skins, OBJ sequence, PC2/MDD + rest OBJ).
-    pub input: PathBuf,
+    pub(crate) input: PathBuf,
     /// Output file (see the command's description for the formats).
     #[arg(short, long)]
-    pub output: PathBuf,
+    pub(crate) output: PathBuf,
     #[command(flatten)]
-    pub input_args: InputArgs,
+    pub(crate) input_args: InputArgs,
 }
 
 /// Options of every effect: the motion-offset options of `toonkit smear offsets`, the frame
 /// step and painted weights.
 #[derive(Debug, Clone, Args)]
-pub struct EffectArgs {
+pub(crate) struct EffectArgs {
     #[command(flatten)]
-    pub offsets: OffsetArgs,
+    pub(crate) offsets: OffsetArgs,
     /// Frame step: 2 = "on twos" (displacements scaled by 2, drawings held two frames).
     #[arg(long, default_value_t = smear::DEFAULT_FRAME_STEP)]
-    pub step: usize,
+    pub(crate) step: usize,
     /// Painted weights ω from a weight group (Fig. 15b): the skin weights of these joints and
     /// of every joint below them (comma-separated, case-sensitive). Presets are multiplied by
     /// ω; expressions read it as `weight`.
     #[arg(long, value_delimiter = ',', conflicts_with_all = ["weight_attribute", "weight_expr"])]
-    pub weight_group: Vec<String>,
+    pub(crate) weight_group: Vec<String>,
     /// With --weight-group: only the named joints, not their descendants.
     #[arg(long, requires = "weight_group")]
-    pub weight_group_only: bool,
+    pub(crate) weight_group_only: bool,
     /// Painted weights ω from a scalar vertex attribute painted in the animation package
     /// (glTF `_NAME`, e.g. `_SMEAR_WEIGHT`) or a vertex-colour channel (`COLOR_0.r`, `.g`,
     /// `.b`, `.a`), clamped to [0, 1].
     #[arg(long, conflicts_with = "weight_expr")]
-    pub weight_attribute: Option<String>,
+    pub(crate) weight_attribute: Option<String>,
     /// Painted weights ω as an expression of the rest position `x, y, z`, clamped to [0, 1],
     /// e.g. "clamp01(y / 2)".
     #[arg(long)]
-    pub weight_expr: Option<String>,
+    pub(crate) weight_expr: Option<String>,
     /// Adaptive subdivision: split output edges longer than TOL × their rest length (TOL ≥ 1,
     /// e.g. 2). The mesh then changes per frame: write .glb, .usda, .usdc, .usdz or .abc.
     #[arg(long, value_name = "TOL")]
-    pub subdivide: Option<f32>,
+    pub(crate) subdivide: Option<f32>,
     /// A ground plane y = Y that the in-betweens never cross.
     #[arg(long, value_name = "Y", allow_negative_numbers = true)]
-    pub ground: Option<f32>,
+    pub(crate) ground: Option<f32>,
     /// With --ground: squash on impact, the height scaled by 1 − AMOUNT (volume kept),
     /// easing back over --squash-frames.
     #[arg(long, value_name = "AMOUNT", requires = "ground")]
-    pub squash: Option<f32>,
+    pub(crate) squash: Option<f32>,
     /// Frames a squash lasts.
     #[arg(long, default_value_t = smear::DEFAULT_SQUASH_FRAMES, requires = "squash")]
-    pub squash_frames: usize,
+    pub(crate) squash_frames: usize,
 }
 
 impl EffectArgs {
@@ -168,7 +168,7 @@ impl EffectArgs {
     ///
     /// # Errors
     /// A tolerance below 1, a non-finite ground or a squash outside [0, 0.9].
-    pub fn shaping(&self) -> Result<(Option<f32>, Option<ContactStyle>)> {
+    pub(crate) fn shaping(&self) -> Result<(Option<f32>, Option<ContactStyle>)> {
         let contact = self.ground.map(|g| ContactStyle {
             ground: g,
             squash: self.squash.unwrap_or(0.0),
@@ -191,7 +191,7 @@ impl EffectArgs {
     }
 
     /// The painted-weight source the flags ask for, if any.
-    pub fn weight_source(&self) -> Option<WeightSource> {
+    pub(crate) fn weight_source(&self) -> Option<WeightSource> {
         if !self.weight_group.is_empty() {
             return Some(WeightSource::Group(WeightGroup {
                 group: self.weight_group.clone(),
@@ -209,7 +209,7 @@ impl EffectArgs {
     }
 
     /// A preset stylization function, multiplied by ω when painted weights are given.
-    pub fn weighted(&self, mut preset: FunctionSpec) -> FunctionSpec {
+    pub(crate) fn weighted(&self, mut preset: FunctionSpec) -> FunctionSpec {
         if self.weight_source().is_some() && preset.expr.is_none() {
             preset.stages.push(Stage::Weight);
         }

@@ -16,24 +16,24 @@ use tkio::Format;
 
 use super::{at_input, Context, OffsetArgs};
 use crate::input::{self, InputArgs};
-use crate::output::{self, Layout};
+use crate::output;
 
 /// Arguments of `toonkit smear offsets`.
 #[derive(Debug, Args)]
-pub struct OffsetsArgs {
+pub(crate) struct OffsetsArgs {
     /// Input animation (glTF/GLB with skins, OBJ sequence, PC2/MDD + rest OBJ).
-    pub input: PathBuf,
+    pub(crate) input: PathBuf,
     /// Output: `.npy` (float32, frames × vertices) or `.glb` (flipbook coloured by offset).
     #[arg(short, long)]
-    pub output: PathBuf,
+    pub(crate) output: PathBuf,
     #[command(flatten)]
-    pub input_args: InputArgs,
+    pub(crate) input_args: InputArgs,
     #[command(flatten)]
-    pub offsets: OffsetArgs,
+    pub(crate) offsets: OffsetArgs,
 }
 
 /// Runs `toonkit smear offsets`.
-pub fn run(ctx: &Context, args: OffsetsArgs) -> Result<()> {
+pub(crate) fn run(ctx: &Context, args: OffsetsArgs) -> Result<()> {
     let start = Instant::now();
     let format = Format::from_extension(&args.output);
     if !matches!(format, Some(Format::Npy) | Some(Format::Glb)) {
@@ -59,7 +59,7 @@ pub fn run(ctx: &Context, args: OffsetsArgs) -> Result<()> {
         output::write_animation(
             &args.output,
             &anim,
-            Layout::Flipbook,
+            tkio::Layout::Flipbook,
             Some(&colors),
             ctx.save,
         )?;

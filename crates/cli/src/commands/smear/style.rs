@@ -21,20 +21,20 @@ use crate::input::{self, InputArgs};
 
 /// The top-level form of `toonkit smear` (no subcommand).
 #[derive(Debug, Args)]
-pub struct StyleArgs {
+pub(crate) struct StyleArgs {
     /// Input animation (glTF/GLB with skins, OBJ sequence, PC2/MDD + rest OBJ).
-    pub input: Option<PathBuf>,
+    pub(crate) input: Option<PathBuf>,
     /// Style file (TOML, see examples/smear/).
     #[arg(long)]
-    pub style: Option<PathBuf>,
+    pub(crate) style: Option<PathBuf>,
     /// Output `.glb` (every effect of the style as flipbooks) or `.usda` (one Mesh per part).
     #[arg(short, long)]
-    pub output: Option<PathBuf>,
+    pub(crate) output: Option<PathBuf>,
     /// Also render a GIF preview of the result.
     #[arg(long)]
-    pub gif: Option<PathBuf>,
+    pub(crate) gif: Option<PathBuf>,
     #[command(flatten)]
-    pub input_args: InputArgs,
+    pub(crate) input_args: InputArgs,
 }
 
 /// Reads a style file.
@@ -49,7 +49,7 @@ fn read_style(path: &Path) -> Result<Style> {
 }
 
 /// Runs `toonkit smear IN --style S -o OUT`.
-pub fn run(ctx: &Context, args: StyleArgs) -> Result<()> {
+pub(crate) fn run(ctx: &Context, args: StyleArgs) -> Result<()> {
     let start = Instant::now();
     let (Some(input_path), Some(style_path), Some(output)) =
         (&args.input, &args.style, &args.output)

@@ -8,23 +8,23 @@ use anim::MeshAnimation;
 use anyhow::{bail, Result};
 use clap::Args;
 
-use super::{save_files, warn, LibraryOptionsArgs};
+use super::{warn, LibraryOptionsArgs};
 use crate::commands::Context;
 use crate::input::{self, InputArgs};
 
 /// Arguments of `toonkit stopmo library`.
 #[derive(Debug, Args)]
-pub struct LibraryArgs {
+pub(crate) struct LibraryArgs {
     /// Input animation; every mesh object is one part named after it (e.g. the .glb of
     /// `toonkit stopmo segment`), a single object is one part.
-    pub input: PathBuf,
+    pub(crate) input: PathBuf,
     /// Output directory.
     #[arg(short, long)]
-    pub output: PathBuf,
+    pub(crate) output: PathBuf,
     #[command(flatten)]
-    pub library: LibraryOptionsArgs,
+    pub(crate) library: LibraryOptionsArgs,
     #[command(flatten)]
-    pub input_args: InputArgs,
+    pub(crate) input_args: InputArgs,
 }
 
 /// The parts of the input: one per mesh object, named after it (file-safe; the file stem
@@ -57,7 +57,7 @@ pub(super) fn library(ctx: &Context, args: LibraryArgs) -> Result<()> {
     spinner.finish_and_clear();
     drop(anims);
     result.report.input = Some(args.input.display().to_string());
-    save_files(&args.output, &result.files()?)?;
+    stopmo::save_files(&args.output, &result.files()?)?;
     warn(ctx, &result);
     let report = serde_json::to_value(&result.report)?;
     if let Some(p) = &args.library.report {

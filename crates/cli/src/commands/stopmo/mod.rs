@@ -22,20 +22,20 @@ use stopmo::library::{
     DEFAULT_SEED, DEFAULT_THICKNESS_MM,
 };
 use stopmo::segment::{PartSpec, Seed, SegmentOptions, DEFAULT_GAMMA};
-use stopmo::{FileData, LibraryJobOptions, OutputFile, PieceCount, SegmentJobOptions};
+use stopmo::{LibraryJobOptions, PieceCount, SegmentJobOptions};
 
 use super::Context;
 
 /// Arguments of `toonkit stopmo`.
 #[derive(Debug, Args)]
-pub struct StopmoArgs {
+pub(crate) struct StopmoArgs {
     #[command(subcommand)]
-    pub command: StopmoCommand,
+    pub(crate) command: StopmoCommand,
 }
 
 /// Subcommands of `toonkit stopmo`.
 #[derive(Debug, Subcommand)]
-pub enum StopmoCommand {
+pub(crate) enum StopmoCommand {
     /// Cut the animation into parts along low-motion seams and make the seams identical in
     /// every frame (StopShop Sections 3.1–3.2).
     Segment(segment::SegmentArgs),
@@ -48,7 +48,7 @@ pub enum StopmoCommand {
 }
 
 /// Runs `toonkit stopmo …`.
-pub fn run(ctx: &Context, args: StopmoArgs) -> Result<()> {
+pub(crate) fn run(ctx: &Context, args: StopmoArgs) -> Result<()> {
     match args.command {
         StopmoCommand::Segment(a) => segment::segment(ctx, a),
         StopmoCommand::Library(a) => library::library(ctx, a),
@@ -58,29 +58,29 @@ pub fn run(ctx: &Context, args: StopmoArgs) -> Result<()> {
 
 /// Segmentation options shared by `stopmo segment` and `stopmo run`.
 #[derive(Debug, Args)]
-pub struct SegmentOptionsArgs {
+pub(crate) struct SegmentOptionsArgs {
     /// A part and its seed: `NAME=tri:ID` (triangle id) or `NAME=point:X,Y,Z` (snapped to the
     /// nearest triangle). Repeat for each part; repeat a name for several seeds.
     #[arg(long = "part", value_name = "NAME=SEED")]
-    pub parts: Vec<String>,
+    pub(crate) parts: Vec<String>,
     /// Choose N parts automatically (farthest seeds on per-triangle motion statistics).
     #[arg(long, conflicts_with = "parts")]
-    pub auto_parts: Option<usize>,
+    pub(crate) auto_parts: Option<usize>,
     /// Weight γ of the seam term (StopShop Eq. 1), after scaling the model to a unit box;
     /// ~1000 makes the cut independent of the exact seed placement (Fig. 4), much more
     /// collapses it.
     #[arg(long, default_value_t = DEFAULT_GAMMA)]
-    pub gamma: f64,
+    pub(crate) gamma: f64,
     /// Laplacian smoothing iterations of the part boundaries (0: cut along mesh edges).
     #[arg(long = "smooth-iters")]
-    pub smooth_iters: Option<usize>,
+    pub(crate) smooth_iters: Option<usize>,
     /// Keep the seams as they move (skip Section 3.2).
     #[arg(long)]
-    pub no_homogenize: bool,
+    pub(crate) no_homogenize: bool,
     /// Reuse the cut and seam targets of an earlier segmentation of the same mesh (its
     /// `segmentation.json`, or the `.glb` next to it): parts of both clips assemble together.
     #[arg(long, value_name = "SEG.json|SEG.glb", conflicts_with_all = ["parts", "auto_parts"])]
-    pub segmentation: Option<PathBuf>,
+    pub(crate) segmentation: Option<PathBuf>,
 }
 
 impl SegmentOptionsArgs {
@@ -161,7 +161,7 @@ fn parse_parts(specs: &[String]) -> Result<Vec<PartSpec>> {
 
 /// Which algorithm picks the pieces.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
-pub enum MethodArg {
+pub(crate) enum MethodArg {
     /// Positions and velocities (StopShop Eq. 10, λ from --lambda).
     #[default]
     Stopshop,
@@ -183,77 +183,76 @@ impl From<MethodArg> for Method {
 
 /// Library options shared by `stopmo library` and `stopmo run`.
 #[derive(Debug, Args)]
-pub struct LibraryOptionsArgs {
+pub(crate) struct LibraryOptionsArgs {
     /// Pieces per part: `20` for every part, or `upper=20,lower=30`.
     #[arg(long, value_name = "N|PART=N,...", conflicts_with_all = ["max_error", "budget"])]
-    pub pieces: Option<String>,
+    pub(crate) pieces: Option<String>,
     /// Smallest library per part whose worst frame's mean position error is at most this many
     /// millimetres (at --print-height).
     #[arg(long, value_name = "MM", conflicts_with = "budget")]
-    pub max_error: Option<f64>,
+    pub(crate) max_error: Option<f64>,
     /// Total number of pieces over all parts, allocated greedily.
     #[arg(long, value_name = "PIECES")]
-    pub budget: Option<usize>,
+    pub(crate) budget: Option<usize>,
     /// Velocity weight λ of StopShop Eq. 10.
     #[arg(long, default_value_t = DEFAULT_LAMBDA)]
-    pub lambda: f64,
+    pub(crate) lambda: f64,
     /// Random restarts (run in parallel, the best is kept).
     #[arg(long, default_value_t = DEFAULT_RESTARTS)]
-    pub restarts: usize,
-    /// Seed of every random choice.
-    #[arg(long, default_value_t = DEFAULT_SEED)]
-    pub seed: u64,
+    pub(crate) restarts: usize,
+    #[command(flatten)]
+    pub(crate) seed: crate::shared::SeedArg,
     /// Per-vertex saliency weights: float32 `.npy` of shape (vertices,) or (1, vertices), in
     /// the merged vertex order of the input (parts one after the other; for `stopmo run`, the
     /// input mesh's own vertex order, checked before anything is written).
     #[arg(long, value_name = "FILE.npy")]
-    pub saliency: Option<PathBuf>,
+    pub(crate) saliency: Option<PathBuf>,
     /// Frames that start a new, unrelated shot (no velocity term across them).
     #[arg(long, value_delimiter = ',')]
-    pub cuts: Vec<usize>,
+    pub(crate) cuts: Vec<usize>,
     /// Directory of pre-made pieces `<part>_<NN>.obj` (e.g. `OLD/pieces` of an earlier run);
     /// they are kept and new pieces are added up to the library size.
     #[arg(long, value_name = "DIR")]
-    pub fixed: Option<PathBuf>,
+    pub(crate) fixed: Option<PathBuf>,
     /// Algorithm.
     #[arg(long, value_enum, default_value_t = MethodArg::Stopshop)]
-    pub method: MethodArg,
+    pub(crate) method: MethodArg,
     /// Printed height of the whole model in millimetres (scales the STL files and the errors).
     #[arg(long, value_name = "MM", default_value_t = DEFAULT_PRINT_HEIGHT_MM)]
-    pub print_height: f64,
+    pub(crate) print_height: f64,
     /// Wall thickness of the printed pieces in millimetres.
     #[arg(long, value_name = "MM", default_value_t = DEFAULT_THICKNESS_MM)]
-    pub thickness: f64,
+    pub(crate) thickness: f64,
     /// Add male/female plugs (paper Fig. 13) across every seam shared by two parts: a pin
     /// under the first part, a socket tube under the second, fused into the pieces' STL files
     /// as extra shells (slicers union them). Placed on the rest geometry; listed in
     /// report.json under "plugs".
     #[arg(long)]
-    pub plugs: bool,
+    pub(crate) plugs: bool,
     /// Pin radius of the plugs in millimetres.
     #[arg(long, value_name = "MM", requires = "plugs", default_value_t = DEFAULT_PLUG_RADIUS_MM)]
-    pub plug_radius: f64,
+    pub(crate) plug_radius: f64,
     /// Plug length (boss + pin) in millimetres.
     #[arg(long, value_name = "MM", requires = "plugs", default_value_t = DEFAULT_PLUG_LENGTH_MM)]
-    pub plug_length: f64,
+    pub(crate) plug_length: f64,
     /// Radial clearance between pin and socket in millimetres (tune to the printer).
     #[arg(long, value_name = "MM", requires = "plugs",
           default_value_t = DEFAULT_PLUG_CLEARANCE_MM)]
-    pub plug_clearance: f64,
+    pub(crate) plug_clearance: f64,
     /// Printer resolution in millimetres: pieces that differ from a sibling by less are
     /// reported (a warning and report.json "printing.parts[].below_resolution").
     #[arg(long, value_name = "MM", default_value_t = stopmo::DEFAULT_RESOLUTION_MM)]
-    pub resolution: f64,
+    pub(crate) resolution: f64,
     /// No registration keys (domes on the shared back surface that fix all six degrees of
     /// freedom on the armature/head).
     #[arg(long)]
-    pub no_keys: bool,
+    pub(crate) no_keys: bool,
     /// No piece ID (`P-NN`) embossed on the back of every piece.
     #[arg(long)]
-    pub no_ids: bool,
+    pub(crate) no_ids: bool,
     /// Also write the JSON report here (it is always written to DIR/report.json).
     #[arg(long)]
-    pub report: Option<PathBuf>,
+    pub(crate) report: Option<PathBuf>,
 }
 
 impl LibraryOptionsArgs {
@@ -287,7 +286,7 @@ impl LibraryOptionsArgs {
             solve: SolveOptions {
                 lambda: self.lambda,
                 restarts: self.restarts,
-                seed: self.seed,
+                seed: self.seed.or(DEFAULT_SEED),
                 ..SolveOptions::default()
             },
             print_height_mm: self.print_height,
@@ -393,37 +392,4 @@ fn warn(ctx: &Context, result: &stopmo::LibraryResult) {
             eprintln!("toonkit: warning: {w}");
         }
     }
-}
-
-/// Writes every file of a result under `dir` with `tkio::save`.
-fn save_files(dir: &Path, files: &[OutputFile<'_>]) -> Result<()> {
-    use rayon::prelude::*;
-    files.par_iter().try_for_each(|f| -> Result<()> {
-        let path = dir.join(&f.path);
-        let output = match &f.data {
-            FileData::Text(t) => tkio::Output::Text(t),
-            FileData::Bytes(b) => tkio::Output::Bytes(b),
-            FileData::Mesh(m) => tkio::Output::Mesh(m),
-            FileData::OwnedMesh(m) => tkio::Output::Mesh(m),
-            FileData::PointCache(a) => tkio::Output::Animation {
-                animation: a,
-                layout: tkio::Layout::default(),
-                colors: None,
-            },
-            FileData::Parts(parts) => {
-                let layers: Vec<(&anim::MeshAnimation, Option<&[[f32; 4]]>)> =
-                    parts.iter().map(|a| (*a, None)).collect();
-                tkio::save(
-                    &path,
-                    &tkio::Output::Parts {
-                        parts: &layers,
-                        layout: tkio::Layout::Morph,
-                    },
-                )?;
-                return Ok(());
-            }
-        };
-        tkio::save(&path, &output)?;
-        Ok(())
-    })
 }

@@ -12,27 +12,27 @@ use anyhow::{Context as _, Result};
 use clap::Args;
 use serde_json::json;
 
-use super::{save_files, warn, LibraryOptionsArgs, SegmentOptionsArgs};
+use super::{warn, LibraryOptionsArgs, SegmentOptionsArgs};
 use crate::commands::Context;
 use crate::input::{self, InputArgs};
 
 /// Arguments of `toonkit stopmo run`.
 #[derive(Debug, Args)]
-pub struct RunArgs {
+pub(crate) struct RunArgs {
     /// Input mesh animation (fixed topology), any readable format.
-    pub input: PathBuf,
+    pub(crate) input: PathBuf,
     /// Output directory.
     #[arg(short, long)]
-    pub output: PathBuf,
+    pub(crate) output: PathBuf,
     #[command(flatten)]
-    pub segment: SegmentOptionsArgs,
+    pub(crate) segment: SegmentOptionsArgs,
     /// Also write the segmentation figure (paper Fig. 5) to DIR/segmentation.png.
     #[arg(long)]
-    pub render: bool,
+    pub(crate) render: bool,
     #[command(flatten)]
-    pub library: LibraryOptionsArgs,
+    pub(crate) library: LibraryOptionsArgs,
     #[command(flatten)]
-    pub input_args: InputArgs,
+    pub(crate) input_args: InputArgs,
 }
 
 /// Runs `toonkit stopmo run`.
@@ -71,7 +71,7 @@ pub(super) fn run(ctx: &Context, args: RunArgs) -> Result<()> {
     drop(anim);
     result.report.input = Some(args.input.display().to_string());
     let dir = &args.output;
-    save_files(dir, &result.files()?)?;
+    stopmo::save_files(dir, &result.files()?)?;
     warn(ctx, &result);
     let seg = result
         .segmented

@@ -4,44 +4,37 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context as _, Result};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use serde_json::json;
 
 use super::SegmentOptionsArgs;
 use crate::commands::Context;
 use crate::input::{self, InputArgs};
-
-/// glTF layout of the segmented parts.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
-pub enum PartsLayout {
-    /// One mesh node per part with a morph target per frame.
-    #[default]
-    Morph,
-    /// One flipbook per part.
-    Flipbook,
-}
+use crate::shared::LayoutArgs;
 
 /// Arguments of `toonkit stopmo segment`.
 #[derive(Debug, Args)]
-pub struct SegmentArgs {
+#[command(mut_arg("layout", |a| a.default_value("morph")))]
+pub(crate) struct SegmentArgs {
     /// Input mesh animation (fixed topology), any readable format.
-    pub input: PathBuf,
+    pub(crate) input: PathBuf,
     /// Output `.glb`: one mesh node per part, named after the part, all with the same frames.
     #[arg(short, long)]
-    pub output: PathBuf,
+    pub(crate) output: PathBuf,
     #[command(flatten)]
-    pub segment: SegmentOptionsArgs,
+    pub(crate) segment: SegmentOptionsArgs,
     /// Write the JSON report (parts, triangle_part, seam_vertices, gamma, cut_length).
     #[arg(long)]
-    pub report: Option<PathBuf>,
+    pub(crate) report: Option<PathBuf>,
     /// Write a PNG: parts on the average mesh and the average displacement (paper Fig. 5).
     #[arg(long)]
-    pub render: Option<PathBuf>,
-    /// glTF layout of the parts.
-    #[arg(long = "as", value_enum, default_value_t = PartsLayout::Morph)]
-    pub layout: PartsLayout,
+    pub(crate) render: Option<PathBuf>,
+    /// glTF layout of the parts: morph (default: one mesh per part, what `stopmo library`
+    /// reads) or flipbook.
     #[command(flatten)]
-    pub input_args: InputArgs,
+    pub(crate) layout: LayoutArgs,
+    #[command(flatten)]
+    pub(crate) input_args: InputArgs,
 }
 
 /// Runs `toonkit stopmo segment`.
@@ -62,10 +55,7 @@ pub(super) fn segment(ctx: &Context, args: SegmentArgs) -> Result<()> {
         .into_iter()
         .map(|a| (a, None))
         .collect();
-    let layout = match args.layout {
-        PartsLayout::Morph => tkio::Layout::Morph,
-        PartsLayout::Flipbook => tkio::Layout::Flipbook,
-    };
+    let layout = args.layout.layout();
     tkio::save(
         &args.output,
         &tkio::Output::Parts {

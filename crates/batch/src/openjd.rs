@@ -6,22 +6,24 @@
 
 use std::path::Path;
 
-use anyhow::Result;
 use serde_json::{json, Value};
 
-use super::Manifest;
+use crate::{BatchError, Manifest};
 
 /// The job template of `manifest`, as YAML text, to be written into the folder `dir`. `out` and
 /// `exe` become the defaults of the `OutputDir` and `Toonkit` job parameters (override them
 /// per job, e.g. `openjd run job.yaml --job-param OutputDir=/farm/out`). OpenJD joins PATH
 /// defaults to the template's folder and refuses absolute ones, so defaults are relative to `dir`.
-pub fn template(
+///
+/// # Errors
+/// [`BatchError::Write`] when a path cannot be made absolute (no current folder).
+pub fn openjd_template(
     manifest_path: &Path,
     out: &Path,
     exe: &Path,
     manifest: &Manifest,
     dir: &Path,
-) -> Result<String> {
+) -> Result<String, BatchError> {
     let absolute = |p: &Path| relative_to(dir, p);
     // Steps in the order tools first appear; shots in manifest order.
     let mut steps: Vec<(String, Vec<String>)> = Vec::new();
@@ -146,8 +148,9 @@ fn is_block(v: &Value) -> bool {
 }
 
 /// `p` relative to the folder `base` (both made absolute lexically, as OpenJD joins them).
-fn relative_to(base: &Path, p: &Path) -> Result<String> {
-    let (base, p) = (std::path::absolute(base)?, std::path::absolute(p)?);
+fn relative_to(base: &Path, p: &Path) -> Result<String, BatchError> {
+    let absolute = |q: &Path| std::path::absolute(q).map_err(|e| tkio::IoError::io(q, e));
+    let (base, p) = (absolute(base)?, absolute(p)?);
     let b: Vec<_> = base.components().collect();
     let q: Vec<_> = p.components().collect();
     let common = b.iter().zip(&q).take_while(|(x, y)| x == y).count();
