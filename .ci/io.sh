@@ -5,12 +5,12 @@
 #    (KHR_lights_punctual) and binary FBX with baked animation and shape keys (.ci/io_export.py);
 # 2. glTF-Transform (npm @gltf-transform/cli) compresses each plain glTF with Draco (the bpy
 #    wheel has no Draco library), gltfpack (npm) with meshopt + quantization;
-# 3. the Rust test crates/io/tests/exporters.rs reads every glTF with tkio::load and compares
+# 3. the Rust test crates/io/tests/exporters.rs reads every file with tkio::load and compares
 #    clips (frame counts) and positions with the plain glTF (Draco ≤ 1e-3 of the diagonal,
-#    gltfpack ≤ 1e-2 (6.1e-3 measured), lights ≤ 1e-5); the FBX files are written but not
-#    compared yet (open bug of the FBX mapping);
-# 4. the Khronos validator checks the quantized flipbook `toonkit smear style` writes of the
-#    robot's Dance clip (Fig. 16 style), and its size is printed next to the float one.
+#    gltfpack ≤ 1e-2, lights and FBX ≤ 1e-5);
+# 4. the Khronos validator checks the (default, quantized) flipbook `toonkit smear --style`
+#    writes of the robot's Dance clip (Fig. 16 style); its size is printed next to the float
+#    one (`--no-quantize`).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT="$PWD"
@@ -43,12 +43,12 @@ done
 echo "== toonkit reads them like the plain glTF"
 TOONKIT_IO_EXPORTS="$OUT" cargo test --quiet --workspace --test exporters -- --nocapture
 
-echo "== the Fig. 16 style on the robot's Dance clip: quantized and float"
+echo "== the Fig. 16 style on the robot's Dance clip: quantized (default) and float"
 cargo build --quiet --workspace --bins
 TK="$ROOT/target/debug/toonkit"
-"$TK" --quantize smear assets/characters/RobotExpressive.glb --clip Dance \
-    --style examples/smear/fig16_combined.toml -o "$OUT/dance_fig16.glb"
 "$TK" smear assets/characters/RobotExpressive.glb --clip Dance \
+    --style examples/smear/fig16_combined.toml -o "$OUT/dance_fig16.glb"
+"$TK" --no-quantize smear assets/characters/RobotExpressive.glb --clip Dance \
     --style examples/smear/fig16_combined.toml -o "$OUT/dance_fig16_float.glb"
 ls -l "$OUT/dance_fig16.glb" "$OUT/dance_fig16_float.glb" | awk '{print $5, $9}'
 "$TK" info "$OUT/dance_fig16.glb" | tail -3

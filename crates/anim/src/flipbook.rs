@@ -5,6 +5,8 @@
 use crate::{Mesh, MeshAnimation};
 
 /// One part of a [`Flipbook`].
+// A flipbook has a handful of parts: the size of the inline point cache does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone)]
 pub enum FlipbookPart {
     /// A fixed-topology animation with optional per-frame RGBA vertex colours (frame-major,

@@ -86,6 +86,9 @@ pub struct Mesh {
     /// Per-vertex texture coordinates in glTF's convention: `u` right and `v` down from the
     /// image's top-left corner (readers of other conventions convert, e.g. OBJ's `v ← 1 − v`).
     pub uvs: Option<Vec<[f32; 2]>>,
+    /// Further texture-coordinate sets after [`Mesh::uvs`], in the same convention:
+    /// `extra_uvs[k]` is glTF's `TEXCOORD_{k+1}` (a lightmap or detail layout), one per vertex.
+    pub extra_uvs: Vec<Vec<[f32; 2]>>,
     /// Per-vertex RGBA colours in linear space.
     pub colors: Option<Vec<[f32; 4]>>,
     /// Scalar per-vertex attributes by name (glTF application-specific attributes such as
@@ -138,6 +141,9 @@ impl Mesh {
         };
         check("normals", self.normals.as_ref().map(Vec::len))?;
         check("uvs", self.uvs.as_ref().map(Vec::len))?;
+        for (k, set) in self.extra_uvs.iter().enumerate() {
+            check(&format!("uv set {}", k + 1), Some(set.len()))?;
+        }
         check("colors", self.colors.as_ref().map(Vec::len))?;
         for (name, values) in &self.attributes {
             check(&format!("attribute {name}"), Some(values.len()))?;
@@ -181,6 +187,15 @@ impl Mesh {
         }
         merge(&mut self.normals, &other.normals, n_self, n_other, Vec3::Y);
         merge(&mut self.uvs, &other.uvs, n_self, n_other, [0.0, 0.0]);
+        // A set missing on one side reads (0, 0) there, as a missing `uvs` does.
+        let sets = self.extra_uvs.len().max(other.extra_uvs.len());
+        self.extra_uvs.resize(sets, vec![[0.0, 0.0]; n_self]);
+        for (k, set) in self.extra_uvs.iter_mut().enumerate() {
+            match other.extra_uvs.get(k) {
+                Some(b) => set.extend_from_slice(b),
+                None => set.extend(std::iter::repeat_n([0.0, 0.0], n_other)),
+            }
+        }
         merge(&mut self.colors, &other.colors, n_self, n_other, [1.0; 4]);
         // An attribute missing on one side reads 0 there (nothing painted).
         let names: Vec<String> = other
@@ -259,6 +274,24 @@ mod tests {
         assert_eq!(a.triangles[1], [3, 4, 5]);
         assert_eq!(a.colors.as_ref().unwrap().len(), 6);
         a.validate().unwrap();
+    }
+
+    #[test]
+    fn append_keeps_every_uv_set_per_vertex() {
+        let mut a = Mesh::new("a", vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 2]]);
+        let mut b = a.clone();
+        b.extra_uvs = vec![vec![[0.5, 0.25]; 3], vec![[1.0, 1.0]; 3]];
+        a.append(&b);
+        assert_eq!(a.extra_uvs.len(), 2);
+        assert_eq!(a.extra_uvs[0][..3], [[0.0, 0.0]; 3]);
+        assert_eq!(a.extra_uvs[0][3..], [[0.5, 0.25]; 3]);
+        assert_eq!(a.extra_uvs[1][5], [1.0, 1.0]);
+        a.validate().unwrap();
+        a.extra_uvs[1].pop();
+        assert!(matches!(
+            a.validate(),
+            Err(AnimError::LengthMismatch { .. })
+        ));
     }
 
     #[test]

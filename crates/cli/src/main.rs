@@ -21,10 +21,13 @@ pub(crate) struct Cli {
     /// Print a machine-readable JSON summary (timings included) on stdout instead of text.
     #[arg(long, global = true)]
     json: bool,
-    /// Write glTF flipbooks and morph outputs with KHR_mesh_quantization (about half the
-    /// size; positions within 1.5e-5 of the bounding box, so seams shared by parts may no
-    /// longer coincide exactly).
+    /// Write glTF flipbooks and morph outputs with float geometry instead of
+    /// KHR_mesh_quantization (the default: about half the size, positions within 1e-5 of the
+    /// bounding-box diagonal, seams shared by parts exact), for tools that cannot read it.
     #[arg(long, global = true)]
+    no_quantize: bool,
+    /// Quantized glTF output (the default; kept for scripts that pass it).
+    #[arg(long, global = true, hide = true, conflicts_with = "no_quantize")]
     quantize: bool,
     #[command(subcommand)]
     command: Command,
@@ -66,7 +69,7 @@ pub(crate) fn run_args(args: &[String]) -> anyhow::Result<()> {
         json: true,
         quiet: true,
         save: tkio::SaveOptions {
-            quantize: cli.quantize,
+            quantize: !cli.no_quantize,
         },
     };
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(&ctx, cli.command)))
@@ -94,7 +97,7 @@ fn main() -> ExitCode {
         json: cli.json,
         quiet: false,
         save: tkio::SaveOptions {
-            quantize: cli.quantize,
+            quantize: !cli.no_quantize,
         },
     };
     match run(&ctx, cli.command) {

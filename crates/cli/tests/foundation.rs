@@ -109,12 +109,30 @@ fn round_trip_glb_pc2_glb_keeps_positions() {
         "rest mesh written beside the cache"
     );
     ok(&[
+        "--no-quantize",
         "convert",
         pc2.to_str().unwrap(),
         back.to_str().unwrap(),
         "--as",
         "morph",
     ]);
+    // The default output is quantized: within 1e-5 of the diagonal, at about half the size.
+    let quantized = dir.path().join("dance_quantized.glb");
+    ok(&[
+        "convert",
+        pc2.to_str().unwrap(),
+        quantized.to_str().unwrap(),
+        "--as",
+        "morph",
+    ]);
+    let (float_len, quant_len) = (
+        std::fs::metadata(&back).unwrap().len(),
+        std::fs::metadata(&quantized).unwrap().len(),
+    );
+    assert!(
+        quant_len * 10 < float_len * 7,
+        "{quant_len} vs {float_len} bytes"
+    );
     let scene = tkio::gltf::read(&robot).unwrap();
     let clip = scene.find_clip("Dance").unwrap();
     let opts = anim::SampleOptions {
@@ -129,6 +147,14 @@ fn round_trip_glb_pc2_glb_keeps_positions() {
         max_diff(&original, &glb) <= 1e-5,
         "morph glb differs by {}",
         max_diff(&original, &glb)
+    );
+    let all = original.positions();
+    let lo = all.iter().fold(anim::glam::Vec3::MAX, |a, p| a.min(*p));
+    let hi = all.iter().fold(anim::glam::Vec3::MIN, |a, p| a.max(*p));
+    let q = max_diff(&original, &read_cache(&quantized));
+    assert!(
+        q > 0.0 && q <= tkio::gltf::MAX_ERROR * (hi - lo).length(),
+        "quantized morph glb differs by {q}"
     );
     keep_for_validation(dir.path(), "roundtrip_pc2");
 }
@@ -150,13 +176,19 @@ fn round_trip_glb_obj_sequence_glb_keeps_positions() {
     let back = dir.path().join("walk_morph.glb");
     let flip = dir.path().join("walk_flipbook.glb");
     ok(&[
+        "--no-quantize",
         "convert",
         first.to_str().unwrap(),
         back.to_str().unwrap(),
         "--as",
         "morph",
     ]);
-    ok(&["convert", first.to_str().unwrap(), flip.to_str().unwrap()]);
+    ok(&[
+        "convert",
+        "--no-quantize",
+        first.to_str().unwrap(),
+        flip.to_str().unwrap(),
+    ]);
     let original = read_cache(&cesium);
     let from_seq = read_cache(&first);
     assert_eq!(from_seq.frame_count(), 48);

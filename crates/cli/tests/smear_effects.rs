@@ -355,7 +355,13 @@ fn fig3e_lines_bouncing_ball_trail_and_fade() {
         .find(|n| n.name == "motion_lines")
         .expect("lines root");
     assert_eq!(lines.children.len(), 20);
-    let line_mesh = &scene.meshes[scene.nodes[lines.children[10]].mesh.unwrap()].mesh;
+    // The frame's mesh, on the frame node or (quantized output) on its dequantizing child.
+    let frame = &scene.nodes[lines.children[10]];
+    let mesh = frame
+        .mesh
+        .or_else(|| frame.children.iter().find_map(|&c| scene.nodes[c].mesh))
+        .expect("frame 10 has a line mesh");
+    let line_mesh = &scene.meshes[mesh].mesh;
     let alpha: Vec<f32> = line_mesh
         .colors
         .as_ref()

@@ -6,7 +6,8 @@
 //! baked into the geometry, cameras looking down −Z. toonkit then maps:
 //! - nodes → [`anim::Node`]s (local translation / rotation / scale at rest);
 //! - meshes → one [`SceneMesh`] per mesh (its control points are the vertices, faces are
-//!   triangulated; texture coordinates of the first corner of each vertex), with skin
+//!   triangulated; every UV set, of the first corner of each vertex, `v` flipped to glTF's
+//!   top-left origin), with skin
 //!   clusters as joints (`geometry_to_bone` is the inverse bind matrix) and blend channels as
 //!   morph targets (deltas of the channel's full-weight shape);
 //! - animation stacks → clips, sampled at the file's frame rate from `time_begin` to
@@ -190,20 +191,14 @@ fn read_mesh(mesh: &ufbx::Mesh) -> Result<(SceneMesh, Option<SkinDef>)> {
         }
     }
     let mut part = Mesh::new(name.clone(), positions, triangles);
-    if mesh.vertex_uv.exists {
-        let mut uvs = vec![[0.0f32; 2]; n];
-        for (v, &first) in mesh.vertex_first_index.iter().enumerate().take(n) {
-            let uv = mesh
-                .vertex_uv
-                .indices
-                .get(first as usize)
-                .and_then(|&i| mesh.vertex_uv.values.get(i as usize));
-            if let Some(uv) = uv {
-                uvs[v] = [uv.x as f32, uv.y as f32];
-            }
-        }
-        part.uvs = Some(uvs);
-    }
+    // Every UV set: the first is `uvs`, the others `extra_uvs` (glTF TEXCOORD_1, …).
+    let mut sets = mesh
+        .uv_sets
+        .iter()
+        .filter(|set| set.vertex_uv.exists)
+        .map(|set| vertex_uvs(mesh, &set.vertex_uv, n));
+    part.uvs = sets.next();
+    part.extra_uvs = sets.collect();
     let mut out = SceneMesh {
         mesh: part,
         ..SceneMesh::default()
@@ -266,6 +261,22 @@ fn read_mesh(mesh: &ufbx::Mesh) -> Result<(SceneMesh, Option<SkinDef>)> {
         None => None,
     };
     Ok((out, skin))
+}
+
+/// The texture coordinates of the first corner of every vertex, with `v` flipped from FBX's
+/// bottom-left origin to glTF's top-left one (as OBJ's reader does).
+fn vertex_uvs(mesh: &ufbx::Mesh, uv: &ufbx::VertexVec2, n: usize) -> Vec<[f32; 2]> {
+    let mut uvs = vec![[0.0f32; 2]; n];
+    for (v, &first) in mesh.vertex_first_index.iter().enumerate().take(n) {
+        let value = uv
+            .indices
+            .get(first as usize)
+            .and_then(|&i| uv.values.get(i as usize));
+        if let Some(value) = value {
+            uvs[v] = [value.x as f32, 1.0 - value.y as f32];
+        }
+    }
+    uvs
 }
 
 /// One animation stack sampled at the file's frame rate: TRS of every node, weights of

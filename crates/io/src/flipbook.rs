@@ -25,6 +25,7 @@ fn part_mesh(part: &FlipbookPart, f: usize) -> Option<Mesh> {
                 a.mesh.triangles.clone(),
             );
             m.uvs = a.mesh.uvs.clone();
+            m.extra_uvs = a.mesh.extra_uvs.clone();
             m.colors = colors.as_ref().map(|c| c[f * n..(f + 1) * n].to_vec());
             Some(m)
         }

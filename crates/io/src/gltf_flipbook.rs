@@ -5,7 +5,7 @@
 //! same in several frames or parts (triangles, UVs, attributes, still frames) is stored once.
 
 use anim::glam::{Quat, Vec3};
-use anim::{Channel, Clip, Interpolation, MeshAnimation, Property};
+use anim::{Channel, Clip, Interpolation, MeshAnimation, Property, SceneMesh};
 use gltf_json as json;
 
 use crate::gltf_accessors::Builder;
@@ -19,7 +19,9 @@ pub enum AnimationLayout {
     /// One node (and mesh) per frame; only the current frame's node has scale 1.
     #[default]
     Flipbook,
-    /// One mesh whose morph target `f` moves frame 0 onto frame `f`; weights are one-hot.
+    /// One mesh whose morph target `f` moves the base onto frame `f`; weights are one-hot
+    /// (frame 0's by default). The base is frame 0, or, when quantized, every vertex's mid
+    /// position over the frames (so that the deltas stay within the quantization range).
     Morph,
 }
 
@@ -86,6 +88,12 @@ pub fn write_animations_with(
         }
     }
     let times: Vec<f32> = (0..frames).map(|f| f as f32 / first.fps).collect();
+    // One dequantization for every part and frame: seams that parts share stay identical.
+    let q = if options.quantize {
+        shared_dequant(parts, layout)
+    } else {
+        None
+    };
     let mut b = Builder::new();
     let mut roots = Vec::new();
     let mut channels = Vec::new();
@@ -94,11 +102,9 @@ pub fn write_animations_with(
         let colors_of = |f: usize| colors.map(|c| &c[f * n..(f + 1) * n]);
         let root = match layout {
             AnimationLayout::Flipbook => {
-                flipbook(&mut b, anim, &times, colors_of, options, &mut channels)?
+                flipbook(&mut b, anim, &times, colors_of, q, &mut channels)?
             }
-            AnimationLayout::Morph => {
-                morph(&mut b, anim, &times, colors_of(0), options, &mut channels)?
-            }
+            AnimationLayout::Morph => morph(&mut b, anim, &times, colors_of(0), q, &mut channels)?,
         };
         roots.push(root);
     }
@@ -143,7 +149,7 @@ fn flipbook<'a>(
     anim: &MeshAnimation,
     times: &[f32],
     colors_of: impl Fn(usize) -> Option<&'a [[f32; 4]]>,
-    options: GlbOptions,
+    q: Option<Dequant>,
     channels: &mut Vec<Channel>,
 ) -> Result<json::Index<json::Node>> {
     let frames = anim.frame_count();
@@ -151,7 +157,6 @@ fn flipbook<'a>(
     let mut children = Vec::with_capacity(frames);
     for f in 0..frames {
         let sm = frame_mesh(&anim.mesh, anim.frame(f), colors_of(f));
-        let q = options.quantize.then(|| Dequant::of(&sm));
         let mesh = b.mesh_with(&sm, q)?;
         // The frame node's scale switches visibility; a quantized mesh's dequantization
         // goes on a child below it.
@@ -160,7 +165,7 @@ fn flipbook<'a>(
                 let child = b.root.push(json::Node {
                     mesh: Some(mesh),
                     name: Some(format!("{name}_f{:04}_quantized", f + 1)),
-                    ..trs_node(q.center, Quat::IDENTITY, Vec3::splat(q.scale))
+                    ..trs_node(q.center, Quat::IDENTITY, q.scale)
                 });
                 (None, Some(vec![child]))
             }
@@ -188,31 +193,15 @@ fn morph(
     anim: &MeshAnimation,
     times: &[f32],
     colors: Option<&[[f32; 4]]>,
-    options: GlbOptions,
+    q: Option<Dequant>,
     channels: &mut Vec<Channel>,
 ) -> Result<json::Index<json::Node>> {
     let frames = anim.frame_count();
-    let base = anim.frame(0);
-    let mut sm = frame_mesh(&anim.mesh, base, colors);
-    if frames > 1 {
-        sm.morph_targets = (0..frames)
-            .map(|f| anim::MorphTarget {
-                name: format!("frame_{:04}", f + 1),
-                positions: anim
-                    .frame(f)
-                    .iter()
-                    .zip(base)
-                    .map(|(p, q)| *p - *q)
-                    .collect::<Vec<Vec3>>(),
-            })
-            .collect();
-        sm.default_weights = vec![0.0; frames];
-    }
-    let q = options.quantize.then(|| Dequant::of(&sm));
+    let sm = morph_mesh(anim, colors, q.is_some());
     let mesh = b.mesh_with(&sm, q)?;
     // Only the weights of this node are animated: the dequantization is its own transform.
     let trs = match q {
-        Some(q) => trs_node(q.center, Quat::IDENTITY, Vec3::splat(q.scale)),
+        Some(q) => trs_node(q.center, Quat::IDENTITY, q.scale),
         None => empty_node(),
     };
     let node = b.root.push(json::Node {
@@ -234,6 +223,68 @@ fn morph(
         });
     }
     Ok(node)
+}
+
+/// The morph layout's mesh: the base with one target per frame (the base onto frame `f`)
+/// and frame 0's weights by default. The base is frame 0, or with `midrange` every vertex's
+/// mid position over all frames, which halves the largest delta (quantized output).
+fn morph_mesh(anim: &MeshAnimation, colors: Option<&[[f32; 4]]>, midrange: bool) -> SceneMesh {
+    let frames = anim.frame_count();
+    let base: Vec<Vec3> = if midrange && frames > 1 {
+        let n = anim.vertex_count();
+        let (mut lo, mut hi) = (anim.frame(0).to_vec(), anim.frame(0).to_vec());
+        for f in 1..frames {
+            for (v, p) in anim.frame(f).iter().enumerate().take(n) {
+                lo[v] = lo[v].min(*p);
+                hi[v] = hi[v].max(*p);
+            }
+        }
+        lo.iter().zip(&hi).map(|(a, b)| (*a + *b) * 0.5).collect()
+    } else {
+        anim.frame(0).to_vec()
+    };
+    let mut sm = frame_mesh(&anim.mesh, &base, colors);
+    if frames > 1 {
+        sm.morph_targets = (0..frames)
+            .map(|f| anim::MorphTarget {
+                name: format!("frame_{:04}", f + 1),
+                positions: anim
+                    .frame(f)
+                    .iter()
+                    .zip(&base)
+                    .map(|(p, q)| *p - *q)
+                    .collect::<Vec<Vec3>>(),
+            })
+            .collect();
+        sm.default_weights = vec![0.0; frames];
+        if midrange {
+            sm.default_weights[0] = 1.0;
+        }
+    }
+    sm
+}
+
+/// The dequantization every part and frame of one output shares, when the position error
+/// stays within [`MAX_ERROR`](crate::gltf_quantize::MAX_ERROR) of their common bounding-box diagonal.
+fn shared_dequant(
+    parts: &[(&MeshAnimation, Option<&[[f32; 4]]>)],
+    layout: AnimationLayout,
+) -> Option<Dequant> {
+    let meshes: Vec<SceneMesh> = match layout {
+        // Positions only: one mesh per part holding all its frames.
+        AnimationLayout::Flipbook => parts
+            .iter()
+            .map(|(a, _)| SceneMesh {
+                mesh: anim::Mesh::new("", a.positions().to_vec(), Vec::new()),
+                ..SceneMesh::default()
+            })
+            .collect(),
+        AnimationLayout::Morph => parts
+            .iter()
+            .map(|(a, _)| morph_mesh(a, None, true))
+            .collect(),
+    };
+    Dequant::shared(meshes.iter())
 }
 
 /// A node with no transform (the flipbook roots and frames that need no dequantization).

@@ -260,6 +260,13 @@ fn read_mesh(mesh: &gltf::Mesh, buffers: &[&[u8]]) -> Result<SceneMesh> {
         if let Some(acc) = prim.get(&gltf::Semantic::TexCoords(0)) {
             part.uvs = Some(vec2s(&acc, buffers, "TEXCOORD_0")?);
         }
+        // Further sets (TEXCOORD_1, …) are numbered without gaps (glTF 2.0 §3.7.2.1).
+        let mut set = 1;
+        while let Some(acc) = prim.get(&gltf::Semantic::TexCoords(set)) {
+            let name = format!("TEXCOORD_{set}");
+            part.extra_uvs.push(vec2s(&acc, buffers, &name)?);
+            set += 1;
+        }
         if let Some(acc) = prim.get(&gltf::Semantic::Colors(0)) {
             let dims = acc.dimensions();
             if dims != Dimensions::Vec3 && dims != Dimensions::Vec4 {
@@ -378,7 +385,8 @@ fn check_len(m: &Mesh, n: usize) -> Result<()> {
         m.uvs.as_ref().map(Vec::len),
         m.colors.as_ref().map(Vec::len),
     ];
-    if lens.iter().flatten().any(|&l| l != n) {
+    let sets = m.extra_uvs.iter().map(Vec::len);
+    if lens.iter().flatten().copied().chain(sets).any(|l| l != n) {
         return Err(bad(
             "a vertex attribute count differs from the POSITION count",
         ));

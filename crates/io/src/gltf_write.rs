@@ -90,7 +90,7 @@ impl Builder {
             None => m.vertex_normals(&m.positions),
         };
         let nrm = match q {
-            Some(_) => self.snorm_vec3s(&normals, false, false),
+            Some(q) => self.snorm_vec3s(&q.encode_normals(&normals), false, false),
             None => self.vec3s(&normals, false),
         };
         attributes.insert(Valid(json::mesh::Semantic::Normals), nrm);
@@ -98,6 +98,13 @@ impl Builder {
             let flat: Vec<f32> = uv.iter().flatten().copied().collect();
             let acc = self.floats(&flat, 2, Usage::Vertex, false);
             attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), acc);
+        }
+        for (k, uv) in m.extra_uvs.iter().enumerate() {
+            let flat: Vec<f32> = uv.iter().flatten().copied().collect();
+            let acc = self.floats(&flat, 2, Usage::Vertex, false);
+            // Set k + 1 follows set k: without `uvs`, the first extra set is TEXCOORD_0.
+            let set = k as u32 + u32::from(m.uvs.is_some());
+            attributes.insert(Valid(json::mesh::Semantic::TexCoords(set)), acc);
         }
         let mut blend = false;
         if let Some(c) = &m.colors {
@@ -128,7 +135,11 @@ impl Builder {
                 .iter()
                 .map(|t| json::mesh::MorphTarget {
                     positions: Some(match q {
-                        Some(q) => self.snorm_vec3s(&q.encode_delta(&t.positions), true, true),
+                        Some(q) => self.snorm_vec3s(
+                            &q.encode_delta(&m.positions, &t.positions),
+                            true,
+                            true,
+                        ),
                         None => self.vec3s(&t.positions, true),
                     }),
                     normals: None,
@@ -201,7 +212,9 @@ pub fn write_glb(scene: &Scene) -> Result<Vec<u8>> {
 }
 
 /// Writes a whole scene as `.glb` bytes; with `options.quantize`, unskinned meshes are
-/// written with `KHR_mesh_quantization` (see [`GlbOptions`]).
+/// written with `KHR_mesh_quantization`, all with one dequantization, unless the position
+/// error would exceed [`MAX_ERROR`](crate::gltf_quantize::MAX_ERROR) of their bounding-box diagonal (see
+/// [`GlbOptions`]).
 ///
 /// # Errors
 /// When a mesh is empty or the result would exceed the GLB size limit.
@@ -322,7 +335,7 @@ pub fn write_glb_with(scene: &Scene, options: GlbOptions) -> Result<Vec<u8>> {
         b.root.push(json::Node {
             mesh,
             name: (!name.is_empty()).then(|| format!("{name}_quantized")),
-            ..trs_node(q.center, Quat::IDENTITY, Vec3::splat(q.scale))
+            ..trs_node(q.center, Quat::IDENTITY, q.scale)
         });
     }
     let roots = (0..scene.nodes.len()).filter(|&i| scene.nodes[i].parent.is_none());
@@ -424,6 +437,7 @@ pub(crate) fn frame_mesh(
         polygons: None,
         normals: None,
         uvs: base.uvs.clone(),
+        extra_uvs: base.extra_uvs.clone(),
         colors: colors
             .map(<[[f32; 4]]>::to_vec)
             .or_else(|| base.colors.clone()),

@@ -55,7 +55,7 @@ pub mod gltf {
     pub use crate::gltf_flipbook::{
         write_animation, write_animations, write_animations_with, AnimationLayout,
     };
-    pub use crate::gltf_quantize::GlbOptions;
+    pub use crate::gltf_quantize::{GlbOptions, MAX_ERROR};
     pub use crate::gltf_read::{read, read_bytes};
     pub use crate::gltf_write::{write_glb, write_glb_with};
 }

@@ -175,6 +175,7 @@ pub fn read(bytes: &[u8]) -> Result<Mesh> {
         normals: per_position_normals,
         uvs: per_position_uvs,
         colors: (colors.len() == n && n > 0).then_some(colors),
+        extra_uvs: Vec::new(),
         attributes: Default::default(),
     };
     mesh.validate()?;

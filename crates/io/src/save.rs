@@ -114,18 +114,26 @@ pub enum Output<'a> {
 }
 
 /// How [`save_with`] writes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SaveOptions {
     /// glTF flipbooks, parts, motion lines and morph outputs with `KHR_mesh_quantization`
     /// (positions and morph deltas as normalized SHORT, normals as BYTE: about half the
-    /// bytes; position error ≤ 1.5e-5 of the bounding box). Default `false`: exact positions keep
-    /// the seams that parts share identical and vertex colours at full precision.
+    /// bytes). One dequantization covers every part and frame of an output, so seams that
+    /// parts share stay identical; the position error is at most
+    /// [`crate::gltf::MAX_ERROR`] of the bounding-box diagonal, else the output stays float.
+    /// Default `true`.
     pub quantize: bool,
+}
+
+impl Default for SaveOptions {
+    fn default() -> Self {
+        SaveOptions { quantize: true }
+    }
 }
 
 /// Writes `output` to `path` in the format its extension names and returns every file written
 /// (PC2 and MDD caches get their rest mesh as a same-name `.obj` beside them; OBJ sequences
-/// one file per frame). glTF geometry is written as float ([`SaveOptions::default`]).
+/// one file per frame). glTF geometry is quantized ([`SaveOptions::default`]).
 ///
 /// # Errors
 /// [`IoError::Unsupported`] naming `path` when the extension is unknown or cannot hold the
@@ -134,7 +142,7 @@ pub fn save(path: &Path, output: &Output<'_>) -> Result<Vec<PathBuf>> {
     save_with(path, output, SaveOptions::default())
 }
 
-/// [`save`] with options (e.g. quantized glTF geometry: `SaveOptions { quantize: true }`).
+/// [`save`] with options (e.g. float glTF geometry: `SaveOptions { quantize: false }`).
 ///
 /// # Errors
 /// As [`save`].

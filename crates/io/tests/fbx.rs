@@ -1,6 +1,7 @@
 //! FBX through ufbx: a small file Blender wrote (`tests/data/bend_box.fbx`, see the README
 //! there) reads with its skeleton, skin, shape key, camera and clip, converted to Y-up metres,
-//! and its sampled positions equal those of Blender's glTF export of the same scene.
+//! and its sampled positions equal those of Blender's glTF export of the same scene (at rest
+//! and in every frame of its animation; whole characters in `tests/exporters.rs`).
 
 use std::path::PathBuf;
 
@@ -86,40 +87,83 @@ fn blender_fbx_reads_skeleton_skin_shape_key_camera_and_clip() {
     assert!((lo.y).abs() < 1e-4, "{lo}");
 }
 
-#[test]
-#[ignore = "open bug: FBX rest positions differ from Blender's glTF export by 0.25 m"]
-fn blender_fbx_rest_positions_equal_its_gltf_export() {
-    // Blender's glTF export splits the armature and shape-key actions into separate clips
-    // while its FBX export bakes both into one stack, so the rest pose is compared here and
-    // the animated frames in `.ci/io.sh` (crates/io/tests/exporters.rs) on whole characters.
-    let (mut fbx, _) = load("bend_box.fbx");
-    let (mut glb, _) = load("bend_box.glb");
-    // The exporters disagree on the rest weight of the shape key (FBX: its value when
-    // exported; glTF: 0): compare the geometry and skin with the key off.
-    for m in fbx.meshes.iter_mut().chain(glb.meshes.iter_mut()) {
+/// The scene without clips (its rest pose) and with its shape keys off (the exporters
+/// disagree on the rest weight of a shape key: FBX writes its value when exported, glTF 0).
+fn at_rest(scene: &Scene) -> Scene {
+    let mut s = scene.clone();
+    s.clips.clear();
+    for m in &mut s.meshes {
         m.default_weights.iter_mut().for_each(|w| *w = 0.0);
     }
-    let a = frames(&fbx, None);
-    let b = frames(&glb, None);
+    s
+}
+
+/// Largest distance from a point of either set to the nearest point of the other.
+fn set_distance(a: &[Vec3], b: &[Vec3]) -> f32 {
+    let directed = |a: &[Vec3], b: &[Vec3]| {
+        a.iter()
+            .map(|p| b.iter().map(|q| p.distance(*q)).fold(f32::MAX, f32::min))
+            .fold(0.0f32, f32::max)
+    };
+    directed(a, b).max(directed(b, a))
+}
+
+#[test]
+fn blender_fbx_positions_equal_its_gltf_export_at_rest_and_every_frame() {
+    let (fbx, _) = load("bend_box.fbx");
+    let (glb, _) = load("bend_box.glb");
+    // 1e-5 of the box's 4.24 m diagonal.
+    let tolerance = 1e-5 * Vec3::new(1.0, 4.0, 1.0).length();
+
+    let (a, b) = (frames(&at_rest(&fbx), None), frames(&at_rest(&glb), None));
+    assert_eq!((a.len(), b.len()), (1, 1));
+    // The glTF splits each corner of the box into its own vertex: compare as point sets.
+    let d = set_distance(&a[0], &b[0]);
+    assert!(d < tolerance, "rest pose: largest distance {d}");
+
+    // Blender's glTF export splits the armature action and the shape-key action into two
+    // clips; its FBX export bakes both into one stack. Merged, they are the same animation.
+    assert_eq!(fbx.clips.len(), 1);
+    assert_eq!(glb.clips.len(), 2);
+    let mut merged = glb.clone();
+    let key_action = merged.clips.pop().unwrap();
+    merged.clips[0].channels.extend(key_action.channels);
+    let (a, b) = (frames(&fbx, Some(0)), frames(&merged, Some(0)));
+    assert_eq!(a.len(), 13, "frame count");
     assert_eq!(a.len(), b.len(), "frame counts");
-    let mut worst = 0.0f32;
-    for (fa, fb) in a.iter().zip(&b) {
-        // The glTF splits each corner of the box into its own vertex: compare as point sets.
-        for p in fa {
-            let d = fb.iter().map(|q| p.distance(*q)).fold(f32::MAX, f32::min);
-            worst = worst.max(d);
-        }
-        for q in fb {
-            let d = fa.iter().map(|p| p.distance(*q)).fold(f32::MAX, f32::min);
-            worst = worst.max(d);
-        }
+    for (f, (fa, fb)) in a.iter().zip(&b).enumerate() {
+        let d = set_distance(fa, fb);
+        assert!(d < tolerance, "frame {f}: largest distance {d}");
     }
-    // 1e-5 of the box's 4.2 m diagonal.
-    assert!(worst < 4.3e-5, "largest distance {worst}");
-    // The tip bends: the clip's last frame differs from its first.
-    let clip = frames(&fbx, Some(0));
-    assert_eq!(clip.len(), 13);
-    assert!(clip[0] != clip[12]);
+    // The tip bends and the box bulges: the clip's last frame differs from its first.
+    assert!(set_distance(&a[0], &a[12]) > 0.5);
+}
+
+#[test]
+fn blender_fbx_uvs_are_those_of_its_gltf_export() {
+    let (fbx, _) = load("bend_box.fbx");
+    let (glb, _) = load("bend_box.glb");
+    let (f, g) = (&fbx.meshes[0].mesh, &glb.meshes[0].mesh);
+    let (fu, gu) = (f.uvs.as_ref().unwrap(), g.uvs.as_ref().unwrap());
+    assert!(f.extra_uvs.is_empty(), "one UV set");
+    // FBX keeps one vertex per control point (the UVs of its first corner), the glTF one per
+    // corner: every FBX vertex has a glTF copy at its rest position with its UV (v flipped
+    // from FBX's bottom-left origin to glTF's top-left one).
+    let f_world = anim::sample(&at_rest(&fbx), &SampleOptions::default()).unwrap();
+    let g_world = anim::sample(&at_rest(&glb), &SampleOptions::default()).unwrap();
+    let (fw, gw) = (
+        f_world.objects[0].animation.frame(0),
+        g_world.objects[0].animation.frame(0),
+    );
+    for (v, (p, uv)) in fw.iter().zip(fu).enumerate() {
+        let found = gw.iter().zip(gu).any(|(q, w)| {
+            p.distance(*q) < 1e-4 && (uv[0] - w[0]).abs() + (uv[1] - w[1]).abs() < 1e-5
+        });
+        assert!(
+            found,
+            "FBX vertex {v} at {p} with UV {uv:?} has no glTF copy"
+        );
+    }
 }
 
 #[test]

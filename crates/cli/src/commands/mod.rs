@@ -18,7 +18,7 @@ pub(crate) struct Context {
     /// Print no summary at all (the caller reports: steps of `toonkit demo`, shots of
     /// `toonkit batch`).
     pub(crate) quiet: bool,
-    /// How results are written (`--quantize`: KHR_mesh_quantization glTF geometry).
+    /// How results are written (`--no-quantize`: float glTF geometry).
     pub(crate) save: tkio::SaveOptions,
 }
 
