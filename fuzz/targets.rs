@@ -109,16 +109,23 @@ pub(crate) fn keystrokes(data: &[u8]) {
 
 /// MDD: any bytes give Ok or Err; a valid file re-encodes to the same positions.
 pub(crate) fn mdd(data: &[u8]) {
-    use anim::glam::Vec3;
-    use anim::Mesh;
     use tkio::mdd;
-    let points = mdd::read_header(data)
-        .map(|h| h.points)
-        .unwrap_or(3)
-        .min(1 << 16);
-    let rest = Mesh::new("r", vec![Vec3::ZERO; points], Vec::new());
-    if let Ok(a) = mdd::read(data, rest.clone(), 24.0) {
-        let b = mdd::read(&mdd::write(&a), rest, a.fps).expect("re-read of written MDD");
+    let points = mdd::read_header(data).map(|h| h.points).ok();
+    point_cache(data, points, mdd::read, mdd::write);
+}
+
+/// A point cache (PC2, MDD) with `points` vertices per frame by its header: any bytes give
+/// Ok or Err; a file that reads re-encodes to the same positions.
+fn point_cache(
+    data: &[u8],
+    points: Option<usize>,
+    read: fn(&[u8], anim::Mesh, f32) -> tkio::Result<anim::MeshAnimation>,
+    write: fn(&anim::MeshAnimation) -> Vec<u8>,
+) {
+    let points = points.unwrap_or(3).min(1 << 16);
+    let rest = anim::Mesh::new("r", vec![anim::glam::Vec3::ZERO; points], Vec::new());
+    if let Ok(a) = read(data, rest.clone(), 24.0) {
+        let b = read(&write(&a), rest, a.fps).expect("re-read of written point cache");
         assert_eq!(a.positions(), b.positions());
     }
 }
@@ -146,18 +153,9 @@ pub(crate) fn obj(data: &[u8]) {
 
 /// PC2: any bytes give Ok or Err; a valid file re-encodes to the same positions.
 pub(crate) fn pc2(data: &[u8]) {
-    use anim::glam::Vec3;
-    use anim::Mesh;
     use tkio::pc2;
-    let points = pc2::read_header(data)
-        .map(|h| h.points)
-        .unwrap_or(3)
-        .min(1 << 16);
-    let rest = Mesh::new("r", vec![Vec3::ZERO; points], Vec::new());
-    if let Ok(a) = pc2::read(data, rest.clone(), 24.0) {
-        let b = pc2::read(&pc2::write(&a), rest, a.fps).expect("re-read of written PC2");
-        assert_eq!(a.positions(), b.positions());
-    }
+    let points = pc2::read_header(data).map(|h| h.points).ok();
+    point_cache(data, points, pc2::read, pc2::write);
 }
 
 /// STL: any bytes give Ok or Err; a mesh that reads writes back to the same welded mesh.

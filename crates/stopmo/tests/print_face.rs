@@ -134,13 +134,7 @@ fn shells(
         .into_iter()
         .enumerate()
         .map(|(p, (mut shell, avg, _))| {
-            let seams: Vec<Vec<u32>> = boundaries
-                .iter()
-                .enumerate()
-                .filter(|(q, _)| *q != p)
-                .map(|(_, other)| shell.seam_vertices(&avg, other))
-                .filter(|v| !v.is_empty())
-                .collect();
+            let seams = shell.shared_seams(&avg, &boundaries, p);
             let keys = shell
                 .add_seam_keys(&KeyOptions::for_print_height(HEIGHT_MM), &seams)
                 .expect("keys");

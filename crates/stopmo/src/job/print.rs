@@ -211,14 +211,7 @@ pub(crate) fn print_pieces(
         } = built;
         let part = &lib.parts[p];
         let a = anims[p];
-        // The seams this part shares with every other part (in part order).
-        let seams: Vec<Vec<u32>> = boundaries
-            .iter()
-            .enumerate()
-            .filter(|(q, _)| *q != p)
-            .map(|(_, other)| shell.seam_vertices(&avg, other))
-            .filter(|v| !v.is_empty())
-            .collect();
+        let seams = shell.shared_seams(&avg, &boundaries, p);
         let keys = if s.keys {
             shell.add_seam_keys(&KeyOptions::for_print_height(s.print_height_mm), &seams)?
         } else {

@@ -44,6 +44,24 @@ impl PartShell {
             .collect()
     }
 
+    /// The seams this part (`part`, in part order) shares with every other part:
+    /// [`PartShell::seam_vertices`] against each other part's boundary pairs in
+    /// `boundaries` (indexed by part), empty seams left out.
+    pub fn shared_seams(
+        &self,
+        average: &[Vec3],
+        boundaries: &[Vec<(Vec3, Vec3)>],
+        part: usize,
+    ) -> Vec<Vec<u32>> {
+        boundaries
+            .iter()
+            .enumerate()
+            .filter(|(q, _)| *q != part)
+            .map(|(_, other)| self.seam_vertices(average, other))
+            .filter(|v| !v.is_empty())
+            .collect()
+    }
+
     /// Replaces the back surface by a printed one (shell vertex order, millimetres, before
     /// keys and IDs: [`PartShell::back`] of an earlier run, `pieces/<part>_back.obj`), so
     /// new pieces seat on the same head as the printed ones; `pieces` are the part's pieces
