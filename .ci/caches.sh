@@ -20,7 +20,7 @@ test -x "$VENV/bin/python" || "$PY" -m venv "$VENV"
 "$VENV/bin/pip" install --quiet --disable-pip-version-check \
     "bpy==4.2.0" "numpy<2" "openjd-cli" "usd-core==26.11"
 
-# --workspace: the same features as `cargo test --workspace`, so its dependencies are reused.
+# --workspace: the same features and profile as `cargo test --workspace`: nothing is rebuilt.
 cargo build --quiet --workspace --bins
 TK="$ROOT/target/debug/toonkit"
 WORK="$ROOT/target/caches"

@@ -10,8 +10,8 @@ command -v node >/dev/null || { apt-get update -qq && apt-get install -y -qq nod
 npm ci --prefix crates/studio/web --no-audit --no-fund --loglevel=error
 npm ci --prefix .ci/studio --no-audit --no-fund --loglevel=error
 
-# The test-profile binary `cargo test --workspace` built (no new profile, no rebuild).
-cargo test --workspace --no-run -q 2>/dev/null || cargo test --workspace --no-run
+# The binary `cargo test --workspace` built (dev and test share one profile: no rebuild).
+cargo build --quiet --workspace --bins
 BIN=target/debug/toonkit
 PORT=${STUDIO_PORT:-18765}
 OUT=target/studio-out
