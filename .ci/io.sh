@@ -3,6 +3,7 @@
 # 1. Blender 4.2 (bpy, headless; the venv .ci/caches.sh makes) exports the bundled characters
 #    (RobotExpressive, CesiumMan, AnimatedMorphSphere) as plain glTF, glTF with a light
 #    (KHR_lights_punctual) and binary FBX with baked animation and shape keys (.ci/io_export.py);
+#    Assimp (Debian's assimp-utils) writes ASCII FBX 7.5 of two of them and reads it back as OBJ;
 # 2. glTF-Transform (npm @gltf-transform/cli) compresses each plain glTF with Draco (the bpy
 #    wheel has no Draco library), gltfpack (npm) with meshopt + quantization;
 # 3. the Rust test crates/io/tests/exporters.rs reads every file with tkio::load and compares
@@ -38,6 +39,15 @@ BIN="$NPM/node_modules/.bin"
 for name in RobotExpressive CesiumMan AnimatedMorphSphere; do
     "$BIN/gltf-transform" draco "$OUT/$name.glb" "$OUT/${name}_draco.glb" | tail -1
     "$BIN/gltfpack" -i "$OUT/$name.glb" -o "$OUT/${name}_gltfpack.glb" -c -kn -km | tail -1
+done
+
+echo "== Assimp (Debian's assimp-utils): ASCII FBX 7.5, and Assimp's own reading of it as OBJ"
+command -v assimp >/dev/null || { apt-get update -qq && apt-get install -y -qq assimp-utils; }
+for src in assets/characters/CesiumMan.glb assets/morph/AnimatedMorphSphere/AnimatedMorphSphere.gltf; do
+    name=$(basename "${src%.*}")
+    assimp export "$src" "$OUT/${name}_ascii.fbx" -ffbxa >/dev/null
+    assimp export "$OUT/${name}_ascii.fbx" "$OUT/${name}_ascii.obj" >/dev/null
+    echo "exported ${name}_ascii.fbx ($(head -c 24 "$OUT/${name}_ascii.fbx" | head -1))"
 done
 
 echo "== toonkit reads them like the plain glTF"

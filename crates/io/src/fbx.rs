@@ -68,6 +68,15 @@ fn mat4(m: &ufbx::Matrix) -> Mat4 {
     ])
 }
 
+/// ufbx's error in one line: its description and, when it gives one, its detail (`info`).
+fn load_error(e: &ufbx::Error) -> String {
+    let mut text = e.description.to_string();
+    if !e.info().is_empty() {
+        text.push_str(&format!(": {}", e.info()));
+    }
+    text.replace(['\n', '\r'], " ")
+}
+
 /// Reads FBX bytes; returns the scene and notes (version, creator, units and axes converted).
 ///
 /// # Errors
@@ -82,7 +91,7 @@ pub fn read(bytes: &[u8]) -> Result<(Scene, Vec<String>)> {
         inherit_mode_handling: ufbx::InheritModeHandling::Compensate,
         ..Default::default()
     };
-    let root = ufbx::load_memory(bytes, opts).map_err(|e| bad(e.description.to_string()))?;
+    let root = ufbx::load_memory(bytes, opts).map_err(|e| bad(load_error(&e)))?;
     let fbx: &ufbx::Scene = &root;
     let notes = notes(fbx);
     let mut scene = Scene::default();

@@ -186,8 +186,23 @@ fn load_buffer(
     base: Option<&Path>,
 ) -> Result<Vec<u8>> {
     if let Some(uri) = buffer.get("uri").and_then(Value::as_str) {
-        let data = gltf::buffer::Data::from_source(gltf::buffer::Source::Uri(uri), base)
-            .map_err(|e| bad(format!("buffer {i}: {e}")))?;
+        let data =
+            gltf::buffer::Data::from_source(gltf::buffer::Source::Uri(uri), base).map_err(|e| {
+                match e {
+                    // The common case of a .gltf copied without its .bin: name the file it needs.
+                    gltf::Error::Io(io) if io.kind() == std::io::ErrorKind::NotFound => {
+                        bad(format!(
+                    "buffer {i}: {uri} is missing beside the file: copy it next to the .gltf, \
+                     or export a .glb"
+                ))
+                    }
+                    gltf::Error::Io(io) if !uri.starts_with("data:") => bad(format!(
+                        "buffer {i}: cannot read {uri}: {}",
+                        crate::error::describe_io(&io)
+                    )),
+                    e => bad(format!("buffer {i}: {e}")),
+                }
+            })?;
         return Ok(data.0);
     }
     let fallback = buffer

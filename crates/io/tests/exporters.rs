@@ -254,3 +254,67 @@ fn files_of_real_exporters_read_like_the_plain_gltf() {
     }
     assert!(checked >= 4, "no exported file found in {}", dir.display());
 }
+
+/// Every vertex of an OBJ file (Assimp's own reading of the ASCII FBX).
+fn obj_points(path: &Path) -> Vec<Vec3> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    text.lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let v: Vec<f32> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            Vec3::new(v[0], v[1], v[2])
+        })
+        .collect()
+}
+
+/// ASCII FBX 7.5 written by a second real exporter (Assimp, Debian's `assimp-utils`; Blender
+/// writes binary FBX only): the geometry toonkit reads equals Assimp's own reading of the same
+/// file (`{name}_ascii.obj`, which ignores the file's units) once the declared centimetres are
+/// converted to metres (rest pose); the file's animation stack is read as a clip.
+#[test]
+fn ascii_fbx_reads_like_its_exporter_reads_it() {
+    let Some(dir) = exports() else {
+        println!("TOONKIT_IO_EXPORTS is not set (.ci/io.sh sets it): nothing to compare");
+        return;
+    };
+    let mut checked = 0;
+    for name in ["CesiumMan", "AnimatedMorphSphere"] {
+        let fbx = dir.join(format!("{name}_ascii.fbx"));
+        if !fbx.exists() {
+            continue;
+        }
+        let head = std::fs::read(&fbx).unwrap();
+        assert!(
+            head.starts_with(b"; FBX"),
+            "{}: not ASCII FBX",
+            fbx.display()
+        );
+        let (scene, notes) = load(&fbx);
+        assert!(
+            notes.iter().any(|n| n.contains("ASCII")) && notes.iter().any(|n| n.contains("0.01 m")),
+            "{}: {notes:?}",
+            fbx.display()
+        );
+        assert_eq!(
+            scene.clips.len(),
+            1,
+            "{}: one animation stack",
+            fbx.display()
+        );
+        // The rest pose as every tool samples it (node transforms applied), in Assimp's units.
+        let mut rest = scene.clone();
+        rest.clips.clear();
+        let ours: Vec<Vec3> = frames(&rest, None)[0].iter().map(|p| *p * 100.0).collect();
+        let theirs = obj_points(&dir.join(format!("{name}_ascii.obj")));
+        let d = directed(&ours, &theirs).max(directed(&theirs, &ours)) / diagonal(&theirs);
+        println!(
+            "{}: {} vertices, {} clip(s), largest distance to Assimp's reading {d:.2e} of the diagonal",
+            fbx.display(),
+            ours.len(),
+            scene.clips.len()
+        );
+        assert!(d <= 1e-5, "{}: {d}", fbx.display());
+        checked += 1;
+    }
+    assert!(checked >= 1, "no ASCII FBX found in {}", dir.display());
+}

@@ -387,3 +387,26 @@ fn one_of_several_scenes_is_read_and_scene_picks_it() {
         "{err}"
     );
 }
+
+/// A .gltf copied without its .bin (as in an engine's asset folder fetched partially): one line
+/// naming the missing file and how to fix it, not the OS error.
+#[test]
+fn gltf_without_its_bin_names_the_missing_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mut json, _) = split(&robot_glb());
+    json["buffers"][0]["uri"] = json!("Robot_data.bin");
+    let p = write_tmp(
+        dir.path(),
+        "robot.gltf",
+        &serde_json::to_vec(&json).unwrap(),
+    );
+    let err = tkio::load(&p, &Default::default()).unwrap_err().to_string();
+    assert!(!err.contains('\n'), "{err}");
+    assert!(
+        err.contains("robot.gltf")
+            && err.contains("Robot_data.bin is missing")
+            && err.contains(".glb"),
+        "{err}"
+    );
+    assert!(!err.contains("os error"), "{err}");
+}
