@@ -121,7 +121,8 @@ pub struct Bone {
 impl Bone {
     /// Bone length.
     pub fn length(&self) -> f32 {
-        (self.tip - self.root).length()
+        // In f64: the squared length of a valid f32 vector beyond ~1e19 overflows f32.
+        (self.tip.as_dvec3() - self.root.as_dvec3()).length() as f32
     }
 }
 

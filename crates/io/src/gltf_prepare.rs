@@ -186,6 +186,13 @@ fn load_buffer(
     base: Option<&Path>,
 ) -> Result<Vec<u8>> {
     if let Some(uri) = buffer.get("uri").and_then(Value::as_str) {
+        // gltf 1.4 unwraps this decoding of a relative URI (a panic on "%FF").
+        if !uri.contains(':') && urlencoding::decode(uri).is_err() {
+            return Err(bad(format!(
+                "buffer {i}: its uri is not percent-encoded UTF-8: {:.80}",
+                uri.escape_default().to_string()
+            )));
+        }
         let data =
             gltf::buffer::Data::from_source(gltf::buffer::Source::Uri(uri), base).map_err(|e| {
                 match e {

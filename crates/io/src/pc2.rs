@@ -29,6 +29,9 @@ pub const MAGIC: &[u8; 12] = b"POINTCACHE2\0";
 /// Size of the fixed header in bytes.
 pub const HEADER_LEN: usize = 32;
 const FORMAT: &str = "PC2";
+/// Frames per sample a cache may have: wide for real caches (Blender writes 1), narrow enough
+/// that the frame rate derived from it stays an ordinary number.
+pub const SAMPLE_RATES: std::ops::RangeInclusive<f32> = 1e-4..=1e4;
 
 /// The fixed header of a PC2 file.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -79,16 +82,22 @@ pub fn read_header(bytes: &[u8]) -> Result<Pc2Header> {
     let start_frame = f32_at(20);
     let sample_rate = f32_at(24);
     let samples = count(i32_at(28), "sample")?;
-    if !start_frame.is_finite() {
+    if !(SAMPLE_RATES.contains(&sample_rate)) {
         return Err(IoError::malformed(
             FORMAT,
-            "start frame is not a finite number",
+            format!(
+                "sample rate {sample_rate} (frames per sample) is outside {}..{}",
+                SAMPLE_RATES.start(),
+                SAMPLE_RATES.end()
+            ),
         ));
     }
-    if !(sample_rate.is_finite() && sample_rate > 0.0) {
+    // The start in samples is what a re-write stores (at one sample per frame): it must stay
+    // finite too.
+    if !(start_frame.is_finite() && (start_frame / sample_rate).is_finite()) {
         return Err(IoError::malformed(
             FORMAT,
-            format!("sample rate must be positive, got {sample_rate}"),
+            format!("start frame {start_frame} at sample rate {sample_rate} is not finite"),
         ));
     }
     let need = points
@@ -181,7 +190,9 @@ pub fn write(anim: &MeshAnimation) -> Vec<u8> {
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&1i32.to_le_bytes());
     out.extend_from_slice(&clamp_i32(anim.vertex_count()).to_le_bytes());
-    out.extend_from_slice(&(anim.start_time * anim.fps).to_le_bytes());
+    // In f64 and clamped: the product of two valid f32 can overflow f32.
+    let start = (anim.start_time as f64 * anim.fps as f64).clamp(f32::MIN as f64, f32::MAX as f64);
+    out.extend_from_slice(&(start as f32).to_le_bytes());
     out.extend_from_slice(&1.0f32.to_le_bytes());
     out.extend_from_slice(&clamp_i32(positions.len() / anim.vertex_count().max(1)).to_le_bytes());
     for p in positions {

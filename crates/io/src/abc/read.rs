@@ -43,11 +43,18 @@ pub struct AbcFrame {
     pub visible: bool,
 }
 
+/// Most bytes [`read`] decodes (points, faces, colours of every sample of every mesh).
+/// Alembic stores a repeated sample once, so a file of a few hundred bytes can declare
+/// millions of samples of the same data: past this budget the archive is refused rather than
+/// expanded into gigabytes.
+pub const MAX_DECODED_BYTES: usize = 512 << 20;
+
 /// Reads an archive from its bytes.
 ///
 /// # Errors
 /// [`crate::IoError::Malformed`] for anything that is not a well-formed Ogawa archive of
-/// polygon meshes (truncated, bad offsets, unexpected types). Never panics.
+/// polygon meshes (truncated, bad offsets, unexpected types), or one that decodes to more
+/// than [`MAX_DECODED_BYTES`]. Never panics.
 pub fn read(bytes: &[u8]) -> Result<AbcArchive> {
     let (r, root) = Reader::open(bytes)?;
     let top = r.children(root)?;
@@ -64,8 +71,9 @@ pub fn read(bytes: &[u8]) -> Result<AbcArchive> {
     let names = object_names(r.data(headers)?)?;
     let mut meshes = Vec::new();
     let mut sampling = None;
+    let mut budget = MAX_DECODED_BYTES;
     for (name, object) in names.into_iter().zip(children.iter().skip(1)) {
-        let (mesh, ts) = polymesh(&r, *object, name)?;
+        let (mesh, ts) = polymesh(&r, *object, name, &mut budget)?;
         sampling = sampling.or(Some(ts));
         meshes.push(mesh);
     }
@@ -178,8 +186,9 @@ fn property_headers(bytes: &[u8]) -> Result<Vec<PropertyHeader>> {
     Ok(out)
 }
 
-/// One `PolyMesh` object; also returns the time sampling index of its points.
-fn polymesh(r: &Reader, object: Node, name: String) -> Result<(AbcMesh, u32)> {
+/// One `PolyMesh` object; also returns the time sampling index of its points. Every decoded
+/// sample is charged to `budget` (bytes left of [`MAX_DECODED_BYTES`]).
+fn polymesh(r: &Reader, object: Node, name: String, budget: &mut usize) -> Result<(AbcMesh, u32)> {
     let kids = r.children(object)?;
     let props = compound(r, *kids.first().ok_or_else(|| malformed("empty object"))?)?;
     let find = |props: &[(PropertyHeader, Node)], n: &str| {
@@ -198,6 +207,17 @@ fn polymesh(r: &Reader, object: Node, name: String) -> Result<(AbcMesh, u32)> {
         None => None,
     };
     let visible = find(&props, "visible");
+    let too_big = || {
+        malformed(format!(
+            "the samples decode to more than {} MiB (PolyMesh '{name}' declares {} samples)",
+            MAX_DECODED_BYTES >> 20,
+            p.0.samples
+        ))
+    };
+    // Every sample costs at least its frame record: refuse absurd counts before decoding.
+    if (p.0.samples as usize).saturating_mul(std::mem::size_of::<AbcFrame>()) > *budget {
+        return Err(too_big());
+    }
     let frames = (0..p.0.samples)
         .map(|f| {
             let points = floats(&sample(r, &p, f, Pod::Float32)?);
@@ -225,6 +245,10 @@ fn polymesh(r: &Reader, object: Node, name: String) -> Result<(AbcMesh, u32)> {
                 Some(v) => sample(r, v, f, Pod::Int8)?.first().is_none_or(|&b| b != 0),
                 None => true,
             };
+            let size = std::mem::size_of::<AbcFrame>()
+                + 4 * (points.len() + counts.len() + indices.len())
+                + colors.as_ref().map_or(0, |c: &Vec<[f32; 4]>| 16 * c.len());
+            *budget = budget.checked_sub(size).ok_or_else(too_big)?;
             Ok(AbcFrame {
                 points: points
                     .chunks_exact(3)
