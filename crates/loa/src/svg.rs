@@ -136,10 +136,9 @@ fn numbers(s: &str) -> Result<Vec<f64>, String> {
         match token.parse::<f64>() {
             Ok(v) if v.is_finite() => out.push(v),
             _ => {
-                return Err(format!(
-                    "cannot read a number at \"{}\"",
-                    &s[start..(start + 12).min(s.len())]
-                ))
+                // Twelve characters, not bytes: the text may hold any UTF-8.
+                let near: String = s[start..].chars().take(12).collect();
+                return Err(format!("cannot read a number at \"{near}\""));
             }
         }
     }
