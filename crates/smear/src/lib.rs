@@ -106,6 +106,7 @@
 
 #![warn(missing_docs, unreachable_pub)]
 
+mod collider;
 mod effects;
 mod error;
 mod field;
@@ -123,6 +124,7 @@ mod stylize;
 mod surface;
 mod velocity;
 
+pub use collider::Collider;
 pub use effects::{
     attribute_weights, elongate, elongate_frame, eq12_opacity, group_weights, held_frame,
     motion_lines, motion_lines_frame, multiple_opacity, multiples, multiples_frame,
