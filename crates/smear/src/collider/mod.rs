@@ -4,7 +4,8 @@
 //! nearest surface point q: `(p − q) · n < 0`, where n is the angle-weighted pseudo-normal
 //! of the feature q lies on (face normal; sum of the two face normals on an edge;
 //! angle-weighted vertex normal at a corner — Bærentzen & Aanæs 2005, exact for closed,
-//! consistently oriented meshes). For a closed mesh this is its solid; for an open mesh (a
+//! consistently oriented meshes; a closed mesh wound inside out is turned outward). For a
+//! closed mesh this is its solid; for an open mesh (a
 //! ground quad, a ramp) it is the region under its front side, so a horizontal quad at
 //! `y = g` acts as the ground plane `y = g` wherever the quad is the nearest geometry.
 //! Vertices are welded by exact position first, so meshes split at UV or normal seams (a
@@ -88,6 +89,26 @@ impl Shape {
             }
             tris.push(t);
             face_normals.push(n);
+        }
+        // A closed mesh wound inside out (negative volume) gets its normals turned outward.
+        let mut uses: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut volume = 0.0f64;
+        for t in &tris {
+            let c = corners(&positions, t);
+            volume += c[0].dot(c[1].cross(c[2])) as f64;
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        if volume < 0.0 && uses.values().all(|&n| n == 2) {
+            for n in face_normals
+                .iter_mut()
+                .chain(vertex_normals.iter_mut())
+                .chain(edge_normals.values_mut())
+            {
+                *n = -*n;
+            }
         }
         let boxes: Vec<Aabb> = tris
             .iter()
@@ -273,6 +294,17 @@ mod tests {
                 assert_eq!(q, p);
             }
         }
+    }
+
+    #[test]
+    fn an_inside_out_box_is_turned_outward() {
+        let mut b = split_box(Vec3::ZERO, Vec3::ONE);
+        for t in &mut b.triangles {
+            t.swap(1, 2);
+        }
+        let c = Collider::from_mesh(&b);
+        assert!(c.inside(0, Vec3::splat(0.5)) && !c.inside(0, Vec3::splat(1.5)));
+        assert!(c.push_out(0, Vec3::new(0.5, 0.9, 0.5)).y > 1.0);
     }
 
     #[test]
