@@ -326,6 +326,29 @@ mod tests {
     }
 
     #[test]
+    fn a_ramp_blocks_what_is_under_it() {
+        // A ramp rising 1 in 2 along +X, facing up; the plane y = x / 2.
+        let ramp = Mesh::new(
+            "ramp",
+            vec![
+                Vec3::new(0.0, 0.0, -1.0),
+                Vec3::new(0.0, 0.0, 1.0),
+                Vec3::new(4.0, 2.0, 1.0),
+                Vec3::new(4.0, 2.0, -1.0),
+            ],
+            vec![[0, 1, 2], [0, 2, 3]],
+        );
+        let c = Collider::from_mesh(&ramp);
+        for x in [0.5f32, 1.0, 2.0, 3.5] {
+            let on = Vec3::new(x, x / 2.0, 0.3);
+            assert!(!c.inside(0, on + Vec3::Y * 0.01) && c.inside(0, on - Vec3::Y * 0.01));
+            let q = c.push_out(0, on - Vec3::Y * 0.2);
+            // Out along the ramp's normal (−1, 2, 0)/√5, onto the plane.
+            assert!((q.y - q.x / 2.0).abs() < 1e-3 && q.x < on.x, "{x}: {q}");
+        }
+    }
+
+    #[test]
     fn an_open_quad_acts_as_a_plane_under_it() {
         let quad = Mesh::new(
             "floor",
