@@ -143,3 +143,96 @@ fn elongate_subdivides_grounds_and_refuses_point_caches() {
     let msg = String::from_utf8_lossy(&bad.stderr);
     assert!(msg.contains("wheel") && msg.contains("drop"), "{msg}");
 }
+
+/// Lowest y over every frame of a `.pc2` written by toonkit.
+fn lowest(path: &Path) -> f32 {
+    read_pc2(path)
+        .positions()
+        .iter()
+        .fold(f32::INFINITY, |m, p| m.min(p.y))
+}
+
+#[test]
+fn elongate_stays_out_of_a_collider_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = write_drop(dir.path());
+    // A platform under the landing (top y = 0) as an OBJ: 8 corners, 12 outward triangles.
+    let (lo, hi) = (Vec3::new(-3.0, -1.0, -2.0), Vec3::new(12.0, 0.0, 2.0));
+    let corner = |k: u32| {
+        Vec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        )
+    };
+    let faces = [
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+    ];
+    let tris = faces
+        .iter()
+        .flat_map(|f| [[f[0], f[1], f[2]], [f[0], f[2], f[3]]])
+        .collect();
+    let platform = Mesh::new("platform", (0..8).map(corner).collect(), tris);
+    let obj = dir.path().join("platform.obj");
+    std::fs::write(&obj, tkio::obj::write(&platform)).unwrap();
+
+    let run = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec!["smear", "elongate", s(&input), "--beta-max", "4"];
+        args.extend_from_slice(extra);
+        args.extend(["-o", s(&out)]);
+        ok(&args);
+        out
+    };
+    let free = run("free.pc2", &[]);
+    assert!(lowest(&free) < -1e-2, "nothing crossed: {}", lowest(&free));
+    let collided = run("collided.pc2", &["--collider", s(&obj)]);
+    let grounded = run("grounded.pc2", &["--ground", "0"]);
+    assert!(lowest(&collided) >= 0.0, "{}", lowest(&collided));
+    let (a, b) = (read_pc2(&collided), read_pc2(&grounded));
+    let worst = a
+        .positions()
+        .iter()
+        .zip(b.positions())
+        .fold(0.0f32, |m, (p, q)| m.max(p.distance(*q)));
+    assert!(
+        worst < 1e-3,
+        "the platform's top acts as the ground: {worst}"
+    );
+
+    // A missing collider file is one line naming it, exit code 2.
+    let missing = dir.path().join("nope.obj");
+    let bad = toonkit(&[
+        "smear",
+        "elongate",
+        s(&input),
+        "--collider",
+        s(&missing),
+        "-o",
+        s(&dir.path().join("x.pc2")),
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+    let msg = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        msg.contains("nope.obj") && msg.trim().lines().count() == 1,
+        "{msg}"
+    );
+    // An unknown collider object names the input's objects.
+    let bad = toonkit(&[
+        "smear",
+        "elongate",
+        s(&input),
+        "--collider-object",
+        "Ramp",
+        "-o",
+        s(&dir.path().join("x.pc2")),
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+    let msg = String::from_utf8_lossy(&bad.stderr);
+    assert!(msg.contains("'Ramp'") && msg.contains("drop"), "{msg}");
+}

@@ -72,9 +72,10 @@ impl Prepared {
 }
 
 /// The native half of `toonkit.smear.prepare`; `options_json` holds the other
-/// `PrepareOptions` fields (`weights`, `merge`) as JSON.
+/// `PrepareOptions` fields (`weights`, `merge`, `colliders`) as JSON; every object of the
+/// `collider_scenes` becomes a collider mesh (issue #22).
 #[pyfunction(name = "smear_prepare")]
-#[pyo3(signature = (scene, smooth=smear::DEFAULT_SMOOTH, whole_body=false, prune=Vec::new(), camera=None, options_json=None, progress=None, causal=false, revolve=Vec::new()))]
+#[pyo3(signature = (scene, smooth=smear::DEFAULT_SMOOTH, whole_body=false, prune=Vec::new(), camera=None, options_json=None, progress=None, causal=false, revolve=Vec::new(), collider_scenes=Vec::new()))]
 pub(crate) fn prepare(
     py: Python<'_>,
     scene: &Bound<'_, Scene>,
@@ -86,6 +87,7 @@ pub(crate) fn prepare(
     progress: Option<Py<PyAny>>,
     causal: bool,
     revolve: Vec<String>,
+    collider_scenes: Vec<Bound<'_, Scene>>,
 ) -> PyResult<Prepared> {
     let scene = scene.get();
     scene.merged_check()?;
@@ -97,9 +99,26 @@ pub(crate) fn prepare(
     };
     options.offsets = offset_options(smooth, whole_body, prune, camera, (causal, revolve));
     report(py, progress.as_ref(), "prepare", 0.0)?;
+    let mut colliders = Vec::with_capacity(collider_scenes.len());
+    for c in &collider_scenes {
+        let c = c.get();
+        if c.sampled.objects.is_empty() {
+            return Err(value_error(format!(
+                "{}: the collider has no mesh",
+                c.source
+            )));
+        }
+        colliders.push(c.sampled.clone());
+    }
     let sampled = scene.sampled.clone();
     let prepared = py
-        .detach(move || smear::prepare((*sampled).clone(), &options))
+        .detach(move || {
+            let mut p = smear::prepare((*sampled).clone(), &options)?;
+            for o in colliders.iter().flat_map(|c| &c.objects) {
+                p.add_collider(smear::Collider::from_animation(&o.animation));
+            }
+            Ok(p)
+        })
         .map_err(|e| smear_error(&scene.source, e))?;
     report(py, progress.as_ref(), "prepare", 1.0)?;
     Ok(Prepared {

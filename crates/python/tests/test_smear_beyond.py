@@ -76,3 +76,31 @@ def test_revolve_names_unknown_objects():
     scene = toonkit.Scene.from_arrays(pos, tris)
     with pytest.raises(ValueError, match="wheel"):
         toonkit.smear.prepare(scene, revolve=["wheel"])
+
+
+def test_colliders_keep_the_smear_out_of_a_slab():
+    pos, tris = hopping_box()
+    # Drop the box onto y = 0 and stop it there: Catmull-Rom overshoots the stop.
+    t = np.arange(pos.shape[0], dtype=np.float32)
+    pos = pos - pos[:, :1] + pos[:1, :1]  # the box's own shape, at the origin
+    pos = pos + np.stack([0.3 * t, np.maximum(4.0 - 0.5 * t, 0.0), 0 * t], 1)[:, None]
+    pos = pos.astype(np.float32)
+    # A slab under the hops (top y = 0): the box corners of hopping_box, scaled.
+    lo, hi = np.float32([-2.0, -1.0, -1.0]), np.float32([8.0, 0.0, 1.0])
+    corners = np.array(
+        [[x, y, z] for y in (lo[1], hi[1]) for z in (lo[2], hi[2]) for x in (lo[0], hi[0])],
+        dtype=np.float32,
+    )
+    slab = toonkit.Scene.from_arrays(corners[None], tris)
+    scene = toonkit.Scene.from_arrays(pos, tris)
+
+    def inside(points):
+        return int(np.all((points > lo + 1e-6) & (points < hi - 1e-6), axis=-1).sum())
+
+    free = toonkit.smear.stylize(toonkit.smear.prepare(scene), LINEAR).elongated
+    assert inside(free) > 0  # trajectories overshoot the landings into the slab
+    kept = toonkit.smear.stylize(toonkit.smear.prepare(scene, colliders=[slab]), LINEAR)
+    assert inside(kept.elongated) == 0
+    assert np.abs(kept.elongated - pos).max() > 0.1  # still smeared
+    with pytest.raises(toonkit.ToonkitError, match="Ramp"):
+        toonkit.smear.prepare(scene, colliders="Ramp")

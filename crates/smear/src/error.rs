@@ -46,6 +46,15 @@ pub enum SmearError {
         /// Comma-separated camera names (empty when the input has none).
         available: String,
     },
+    /// An object named as a collider is not in the scene. Use one of the listed object names
+    /// (case-sensitive).
+    #[error("no object named '{name}' to use as a collider; objects are: {available}")]
+    UnknownCollider {
+        /// The name that was asked for.
+        name: String,
+        /// Comma-separated object names.
+        available: String,
+    },
     /// An object index is out of range. Use an index below the number of objects.
     #[error("object {index} does not exist; there are {count} objects")]
     UnknownObject {

@@ -65,7 +65,9 @@
 //!   elongated blades stay on their circles. The construction is documented in `revolve`.
 //! * **Contact** ([`Style::contact`], [`ContactStyle`]): a displacement that would end below
 //!   the ground plane stops where its trajectory reaches it ([`Trajectories::displaced`]);
-//!   optional volume-preserving squash on impact ([`squash_frames`]).
+//!   optional volume-preserving squash on impact ([`squash_frames`]). Collider meshes
+//!   ([`Collider`], [`PrepareOptions::colliders`], [`Prepared::add_collider`]) stop
+//!   displacements the same way and push out what is inside.
 //! * **Causal mode** ([`OffsetOptions::causal`]) and **streaming** ([`Stream`]): backward
 //!   velocity differences, the past half of SMEAR Eq. 2's window
 //!   ([`causal_smoothing_weights`]) and trajectories that extrapolate past the current frame
@@ -106,6 +108,7 @@
 
 #![warn(missing_docs, unreachable_pub)]
 
+mod collider;
 mod effects;
 mod error;
 mod field;
@@ -123,6 +126,7 @@ mod stylize;
 mod surface;
 mod velocity;
 
+pub use collider::Collider;
 pub use effects::{
     attribute_weights, elongate, elongate_frame, eq12_opacity, group_weights, held_frame,
     motion_lines, motion_lines_frame, multiple_opacity, multiples, multiples_frame,

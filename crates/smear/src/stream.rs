@@ -43,7 +43,9 @@ pub struct StreamOptions {
     pub elongate: FunctionSpec,
     /// Past frames kept: β below −(history − 1) clamps to the oldest kept frame.
     pub history: usize,
-    /// A ground plane `y = ground` the result never goes below.
+    /// A ground plane `y = ground` the result never goes below. (Collider meshes are not
+    /// streamed yet: use [`prepare`](crate::prepare) with
+    /// [`PrepareOptions::colliders`](crate::PrepareOptions::colliders).)
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ground: Option<f32>,
 }

@@ -121,6 +121,9 @@ def smear_prepare(
     camera: Optional[Union[str, int]] = None,
     options_json: Optional[str] = None,
     progress: Optional[Callable[[str, float], Any]] = None,
+    causal: bool = False,
+    revolve: Sequence[str] = ...,
+    collider_scenes: Sequence[Scene] = ...,
 ) -> Prepared: ...
 def smear_stylize(
     prepared: Prepared,

@@ -83,6 +83,7 @@ def prepare(
     progress: Optional[Callable[[str, float], None]] = None,
     causal: bool = False,
     revolve: Iterable[str] = (),
+    colliders: Iterable[Union[str, "_native.Scene"]] = (),
 ) -> Prepared:
     """Everything a style does not change, computed once: offsets, camera, weights, velocities.
 
@@ -90,6 +91,11 @@ def prepare(
     table of a style file, e.g. ``{"group": ["Head"]}``) and ``merge`` (merge all objects
     into one of this name, as ``toonkit smear elongate`` does). Pass the result to
     :func:`stylize` as often as you like: the offsets are never solved again.
+
+    ``colliders`` are meshes the elongated and multiple in-betweens never enter (the CLI's
+    ``--collider-object NAME`` / ``--collider FILE``): a name takes that object out of
+    ``scene`` (not smeared, not in the results); a :class:`toonkit.Scene` (e.g.
+    ``toonkit.load("ramp.obj")``) adds each of its meshes, static or animated.
 
     >>> prepared = toonkit.smear.prepare(scene, smooth=2)
     >>> prepared.offsets.shape == scene.positions.shape[:2]
@@ -100,6 +106,11 @@ def prepare(
         extra["weights"] = dict(weights)
     if merge is not None:
         extra["merge"] = str(merge)
+    colliders = [colliders] if isinstance(colliders, (str, _native.Scene)) else list(colliders)
+    names = [c for c in colliders if isinstance(c, str)]
+    scenes = [c for c in colliders if not isinstance(c, str)]
+    if names:
+        extra["colliders"] = names
     return _native.smear_prepare(
         scene,
         int(smooth),
@@ -110,6 +121,7 @@ def prepare(
         progress,
         bool(causal),
         _prune_list(revolve),
+        scenes,
     )
 
 

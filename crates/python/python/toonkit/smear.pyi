@@ -29,6 +29,7 @@ def prepare(
     progress: Optional[Callable[[str, float], Any]] = None,
     causal: bool = False,
     revolve: Iterable[str] = (),
+    colliders: Iterable[Union[str, Scene]] = (),
 ) -> Prepared: ...
 def stream(
     triangles: Any,

@@ -10,6 +10,7 @@ use rayon::prelude::*;
 
 use super::{StyleInput, Trajectories};
 use crate::revolve::Arcs;
+use crate::Collider;
 use crate::{MotionOffsets, Result, SmearError, SurfacePoint};
 
 /// Default frame step: every frame is its own drawing ("on ones").
@@ -36,6 +37,8 @@ pub struct EffectInputs<'a> {
     ground: Option<f32>,
     /// Revolving parts: their points move along arcs.
     arcs: Option<Cow<'a, Arcs>>,
+    /// Collider meshes the displaced points never enter.
+    colliders: &'a [Collider],
 }
 
 fn mismatch(name: &'static str, expected: usize, found: usize) -> SmearError {
@@ -78,6 +81,7 @@ impl<'a> EffectInputs<'a> {
             causal: false,
             ground: None,
             arcs: None,
+            colliders: &[],
         }
     }
 
@@ -160,6 +164,7 @@ impl<'a> EffectInputs<'a> {
             causal: false,
             ground: None,
             arcs: None,
+            colliders: &[],
         })
     }
 
@@ -183,6 +188,17 @@ impl<'a> EffectInputs<'a> {
     pub fn with_ground(mut self, ground: Option<f32>) -> Self {
         self.ground = ground;
         self
+    }
+
+    /// Collider meshes that displaced points never enter (issue #22; see [`Collider`]).
+    pub fn with_colliders(mut self, colliders: &'a [Collider]) -> Self {
+        self.colliders = colliders;
+        self
+    }
+
+    /// The collider meshes.
+    pub fn colliders(&self) -> &'a [Collider] {
+        self.colliders
     }
 
     /// Arcs of revolving parts, one entry per point (issue #22; see `crate::revolve`).
@@ -296,6 +312,7 @@ impl<'a> EffectInputs<'a> {
         Trajectories::new(&self.positions, self.frames, self.points)
             .expect("length checked on construction")
             .shaped(self.causal, self.ground, self.arcs.as_deref())
+            .with_colliders(self.colliders)
     }
 
     /// The stylization inputs of point `i` at frame `f` (`m` and `t` left 0). `f` and `i`

@@ -104,7 +104,8 @@ pub struct SubdivisionStats {
 /// One smeared frame, adaptively subdivided.
 ///
 /// # Arguments
-/// * `tr` — the trajectories the frame was displaced along (causal mode, arcs, ground apply).
+/// * `tr` — the trajectories the frame was displaced along (causal mode, arcs, ground and
+///   colliders apply).
 /// * `mesh` — the input mesh (triangles and attributes; its positions are not used).
 /// * `h` — the drawing's frame: rest lengths are measured on `tr.frame(h)`.
 /// * `beta` — β of every input vertex at this frame, in frames.
@@ -123,21 +124,17 @@ pub fn subdivide_frame(
     tolerance: f32,
 ) -> (Mesh, SubdivisionStats) {
     let rest = tr.frame(h);
-    let ground = tr.ground();
     let place = |b: &Blend| -> Vec3 {
         if b.count() == 1 {
             return tr.displaced(h, b.v[0] as usize, beta[b.v[0] as usize]);
         }
         let bb: f32 = b.support().map(|(v, w)| w * beta[v as usize]).sum();
         let bb = if bb.is_finite() { bb } else { 0.0 };
-        let mut p: Vec3 = b
+        let p: Vec3 = b
             .support()
             .map(|(v, w)| tr.seen_from(h, v as usize, h as f32 + bb) * w)
             .sum();
-        if let Some(g) = ground {
-            p.y = p.y.max(g);
-        }
-        p
+        tr.lifted(h, p)
     };
     let mut blends: Vec<Blend> = (0..mesh.vertex_count() as u32).map(Blend::one).collect();
     let mut pos: Vec<Vec3> = blends.iter().map(place).collect();

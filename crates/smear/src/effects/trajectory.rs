@@ -5,9 +5,10 @@
 use glam::Vec3;
 
 use crate::revolve::Arcs;
+use crate::Collider;
 use crate::{Result, SmearError};
 
-/// Bisection steps when a displacement is shortened to stop at the ground.
+/// Bisection steps when a displacement is shortened to stop at the ground or a collider.
 const GROUND_STEPS: usize = 16;
 
 /// The trajectories of a frame-major `frames × points` position buffer (mesh vertices, or
@@ -27,7 +28,10 @@ const GROUND_STEPS: usize = 16;
 /// * **arcs** — points of revolving parts move along screw arcs (see `crate::revolve`);
 /// * **ground** — [`Trajectories::displaced`] shortens a displacement that would end below
 ///   the plane `y = ground` to where the trajectory reaches it (and lifts what is below
-///   already), so elongated and multiple in-betweens never cross it.
+///   already), so elongated and multiple in-betweens never cross it;
+/// * **colliders** — the same for collider meshes ([`Trajectories::with_colliders`]): a
+///   displacement stops where its trajectory enters one and what is still inside is pushed
+///   out (see [`Collider`]).
 #[derive(Debug, Clone, Copy)]
 pub struct Trajectories<'a> {
     positions: &'a [Vec3],
@@ -36,6 +40,7 @@ pub struct Trajectories<'a> {
     causal: bool,
     ground: Option<f32>,
     arcs: Option<&'a Arcs>,
+    colliders: &'a [Collider],
 }
 
 impl<'a> Trajectories<'a> {
@@ -57,6 +62,7 @@ impl<'a> Trajectories<'a> {
             causal: false,
             ground: None,
             arcs: None,
+            colliders: &[],
         })
     }
 
@@ -80,7 +86,33 @@ impl<'a> Trajectories<'a> {
             causal: false,
             ground: None,
             arcs: None,
+            colliders: &[],
         }
+    }
+
+    /// The same trajectories stopped at `colliders` too (frame f of a displacement uses each
+    /// collider's frame f).
+    pub fn with_colliders(self, colliders: &'a [Collider]) -> Self {
+        Trajectories { colliders, ..self }
+    }
+
+    /// Whether `p` is below the ground or inside a collider at frame `f`.
+    #[inline]
+    pub fn is_blocked(&self, f: usize, p: Vec3) -> bool {
+        self.ground.is_some_and(|g| p.y < g) || self.colliders.iter().any(|c| c.inside(f, p))
+    }
+
+    /// `p` lifted onto the ground if below it, then pushed out of every collider it is
+    /// inside at frame `f` ([`Collider::push_out`]).
+    #[inline]
+    pub fn lifted(&self, f: usize, mut p: Vec3) -> Vec3 {
+        if let Some(g) = self.ground {
+            p.y = p.y.max(g);
+        }
+        for c in self.colliders {
+            p = c.push_out(f, p);
+        }
+        p
     }
 
     /// The ground plane height displacements stop at, if any.
@@ -195,39 +227,40 @@ impl<'a> Trajectories<'a> {
 
     /// Point `i` of frame `f` displaced by `beta` frames along its trajectory:
     /// `p′_i(f) = Q_{i, f+⌊β⌋}(β − ⌊β⌋)` (Section 4.1). A non-finite `beta` counts as 0.
-    /// With a ground plane, a displacement that would end below it stops where the trajectory
-    /// reaches it (bisection on β), and a point already below is lifted onto it.
+    /// With a ground plane or colliders, a displacement that would end below the ground or
+    /// inside a collider stops where the trajectory reaches it (bisection on β), and a point
+    /// already there is lifted out ([`Trajectories::lifted`]).
     #[inline]
     pub fn displaced(&self, f: usize, i: usize, beta: f32) -> Vec3 {
         let beta = if beta.is_finite() { beta } else { 0.0 };
         let q = self.seen_from(f, i, f as f32 + beta);
-        match self.ground {
-            Some(g) if q.y < g => self.grounded(f, i, beta, g),
-            _ => q,
+        if self.is_blocked(f, q) {
+            self.stopped(f, i, beta)
+        } else {
+            q
         }
     }
 
-    /// [`Trajectories::displaced`] when the full displacement ends below the ground `g`: the
-    /// largest fraction of β whose point stays above (the trajectory may dip and return, so
-    /// this finds one crossing, not necessarily the first), lifted onto the plane if needed.
+    /// [`Trajectories::displaced`] when the full displacement ends blocked: the largest
+    /// fraction of β whose point is free (the trajectory may dip and return, so this finds
+    /// one crossing, not necessarily the first), lifted out if needed.
     #[cold]
-    fn grounded(&self, f: usize, i: usize, beta: f32, g: f32) -> Vec3 {
+    fn stopped(&self, f: usize, i: usize, beta: f32) -> Vec3 {
         let at = |s: f32| self.seen_from(f, i, f as f32 + beta * s);
         let mut q = at(0.0);
-        if q.y >= g {
+        if !self.is_blocked(f, q) {
             let (mut lo, mut hi) = (0.0f32, 1.0f32);
             for _ in 0..GROUND_STEPS {
                 let mid = 0.5 * (lo + hi);
-                if at(mid).y >= g {
-                    lo = mid;
-                } else {
+                if self.is_blocked(f, at(mid)) {
                     hi = mid;
+                } else {
+                    lo = mid;
                 }
             }
             q = at(lo);
         }
-        q.y = q.y.max(g);
-        q
+        self.lifted(f, q)
     }
 }
 

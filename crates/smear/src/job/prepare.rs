@@ -12,8 +12,8 @@ use crate::revolve::{replace_offsets, revolving_objects, target_arcs, Arcs};
 use crate::solver::SolvedField;
 use crate::velocity::{buffer_velocities, camera_buffer_velocities, CameraSpace};
 use crate::{
-    EffectInputs, MotionOffsets, OffsetMode, OffsetOptions, Result, SmearError, SurfacePoint,
-    WeightSource,
+    Collider, EffectInputs, MotionOffsets, OffsetMode, OffsetOptions, Result, SmearError,
+    SurfacePoint, WeightSource,
 };
 
 /// What [`prepare`] computes once for any number of [`stylize`](crate::stylize) calls.
@@ -34,6 +34,12 @@ pub struct PrepareOptions {
     /// objects apart, so a style can override its effects per object.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub merge: Option<String>,
+    /// Objects of the scene that are collider meshes (issue #22): taken out of the scene
+    /// (neither smeared nor in the results) and kept as [`Collider`]s that the elongated and
+    /// multiple in-betweens of every other object never enter. More colliders (e.g. loaded
+    /// from a file) join with [`Prepared::add_collider`].
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub colliders: Vec<String>,
 }
 
 /// How one object's offsets came out.
@@ -91,7 +97,27 @@ pub struct Prepared {
     camera: Option<Camera>,
     merged: Option<MeshAnimation>,
     targets: Vec<Target>,
+    colliders: Vec<Collider>,
     report: PrepareReport,
+}
+
+/// Takes the objects named in `names` out of `scene` as colliders.
+///
+/// # Errors
+/// [`SmearError::UnknownCollider`] for a name no object has.
+fn take_colliders(scene: &mut SampledScene, names: &[String]) -> Result<Vec<Collider>> {
+    let mut colliders = Vec::with_capacity(names.len());
+    for name in names {
+        let Some(k) = scene.objects.iter().position(|o| &o.name == name) else {
+            let available: Vec<&str> = scene.objects.iter().map(|o| o.name.as_str()).collect();
+            return Err(SmearError::UnknownCollider {
+                name: name.clone(),
+                available: available.join(", "),
+            });
+        };
+        colliders.push(Collider::from_animation(&scene.objects.remove(k).animation));
+    }
+    Ok(colliders)
 }
 
 /// Per-object offset reports.
@@ -179,14 +205,15 @@ pub fn offsets(scene: &SampledScene, options: &OffsetOptions) -> Result<SceneOff
 /// painted weights, and measures the velocities (camera-relative when a camera is selected).
 ///
 /// # Errors
-/// Unknown pruned joint, camera, weight joint or attribute; an inconsistent scene; merging a
+/// Unknown pruned joint, camera, weight joint, attribute or collider object; an inconsistent scene; merging a
 /// scene without objects.
 ///
 /// # Performance
 /// The offset solve dominates (parallel over frames); velocities are one pass over the
 /// positions.
-pub fn prepare(scene: SampledScene, options: &PrepareOptions) -> Result<Prepared> {
+pub fn prepare(mut scene: SampledScene, options: &PrepareOptions) -> Result<Prepared> {
     let start = Instant::now();
+    let colliders = take_colliders(&mut scene, &options.colliders)?;
     let camera = options.offsets.selected_camera(&scene.cameras)?.cloned();
     let field = SolvedField::new(&scene, &options.offsets)?;
     let revolving = revolving_objects(&scene, &options.offsets.revolve)?;
@@ -267,6 +294,7 @@ pub fn prepare(scene: SampledScene, options: &PrepareOptions) -> Result<Prepared
         camera,
         merged,
         targets,
+        colliders,
         report,
     })
 }
@@ -275,6 +303,17 @@ impl Prepared {
     /// The scene as sampled.
     pub fn scene(&self) -> &SampledScene {
         &self.scene
+    }
+
+    /// The collider meshes every object's in-betweens stay out of (issue #22).
+    pub fn colliders(&self) -> &[Collider] {
+        &self.colliders
+    }
+
+    /// Adds a collider mesh (e.g. [`Collider::from_animation`] of a file loaded with
+    /// `tkio::load`): later [`stylize`](crate::stylize) calls keep every in-between out of it.
+    pub fn add_collider(&mut self, collider: Collider) {
+        self.colliders.push(collider);
     }
 
     /// The options it was prepared with.
@@ -368,7 +407,8 @@ impl Prepared {
         let inputs =
             EffectInputs::from_prepared(self.animation(i), &t.offsets, &t.velocities, None)
                 .with_causal(self.options.offsets.causal)
-                .with_arcs(t.arcs.as_ref().map(std::borrow::Cow::Borrowed))?;
+                .with_arcs(t.arcs.as_ref().map(std::borrow::Cow::Borrowed))?
+                .with_colliders(&self.colliders);
         match weights {
             Some(w) => inputs.with_weights(w),
             None => Ok(inputs),

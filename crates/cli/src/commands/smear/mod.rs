@@ -161,6 +161,14 @@ pub(crate) struct EffectArgs {
     /// Frames a squash lasts.
     #[arg(long, default_value_t = smear::DEFAULT_SQUASH_FRAMES, requires = "squash")]
     pub(crate) squash_frames: usize,
+    /// Collider meshes the in-betweens never enter (repeatable): every mesh of FILE (.obj,
+    /// .glb, .stl, …), static or animated frame by frame. An open mesh blocks the side
+    /// behind its normals, as the ground plane does.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) collider: Vec<PathBuf>,
+    /// An object of the input used as a collider (repeatable): not smeared, not written.
+    #[arg(long, value_name = "NAME")]
+    pub(crate) collider_object: Vec<String>,
 }
 
 impl EffectArgs {
@@ -235,8 +243,19 @@ fn prepare(io: &EffectIo, a: &EffectArgs) -> Result<Prepared> {
         offsets: a.offsets.options(&sampled),
         weights: a.weight_source(),
         merge: Some(input::merged_name(path)),
+        colliders: a.collider_object.clone(),
     };
-    smear::prepare(sampled, &options).map_err(at_input(path))
+    let mut prepared = smear::prepare(sampled, &options).map_err(at_input(path))?;
+    for file in &a.collider {
+        let scene = input::open(file, &InputArgs::default())?;
+        if scene.objects.is_empty() {
+            bail!("{}: the collider file has no mesh", file.display());
+        }
+        for o in &scene.objects {
+            prepared.add_collider(smear::Collider::from_animation(&o.animation));
+        }
+    }
+    Ok(prepared)
 }
 
 /// Maps a smear error to one line naming the input.
