@@ -6,6 +6,8 @@ The bundled talking face (2 fps), two `part_<NAME>` vertex groups painted around
 points the CLI tests use; `toonkit.stopmo_run` must write the same `assembly.csv` and energy as
 `toonkit.stopmo.run` on the same evaluated data (the module equals the CLI: crates/python/tests),
 and the reconstruction object must show at frame k the pieces of `assembly.csv` row k.
+Without vertex groups, the same seed points picked at the 3D cursor must give the module's
+result for those seed points.
 """
 
 import csv
@@ -104,6 +106,56 @@ def test_stopmo_run_matches_the_module():
           "no size-vs-error image")
 
 
+def test_stopmo_cursor_seeds():
+    """No part_ groups: seeds picked at the 3D cursor give the module's (= the CLI's) result
+    for the same seed points."""
+    scene, obj = face()
+    for g in list(obj.vertex_groups):
+        obj.vertex_groups.remove(g)
+    s = scene.toonkit_stopmo
+    s.count, s.pieces, s.restarts, s.seed = "EACH", PIECES, 2, 1
+    for name, seed in SEEDS.items():
+        scene.cursor.location = seed
+        r = bpy.ops.toonkit.stopmo_add_seed(part=name)
+        check(r == {"FINISHED"}, f"stopmo_add_seed returned {r}")
+    scene.cursor.location = (5.0, 5.0, 5.0)
+    s.seed_part = "stray"
+    bpy.ops.toonkit.stopmo_add_seed()
+    check([x.part for x in s.seeds] == ["upper", "lower", "stray"], "seeds not stored")
+    bpy.ops.toonkit.stopmo_remove_seed(index=2)
+    check([x.part for x in s.seeds] == ["upper", "lower"], "the seed was not removed")
+    folder = os.path.join(OUT, "stopmo-seeds")
+    r = bpy.ops.toonkit.stopmo_run(directory=folder)
+    check(r == {"FINISHED"}, f"stopmo_run returned {r}")
+    from bl_ext.user_default.toonkit import sample, stopmo
+
+    taken = sample.sample(bpy.context, [obj])
+    parts = {name: [seed] for name, seed in SEEDS.items()}
+    ref = toonkit.stopmo.run(toonkit.Scene.from_arrays(taken.positions, taken.triangles,
+                                                       fps=taken.fps),
+                             parts=parts, **stopmo.options(s))
+    ref_dir = os.path.join(OUT, "module-seeds")
+    ref.save(ref_dir)
+    for name in ("assembly.csv", "shooting_order.csv"):
+        with open(os.path.join(folder, name)) as a, open(os.path.join(ref_dir, name)) as b:
+            check(a.read() == b.read(), f"{name} differs from the module's")
+    ours = json.load(open(os.path.join(folder, "report.json")))
+    theirs = json.load(open(os.path.join(ref_dir, "report.json")))
+    check(abs(ours["energy"] - theirs["energy"]) <= 1e-6 * abs(theirs["energy"]),
+          f"energy {ours['energy']} vs {theirs['energy']}")
+    print(f"  cursor seeds: energy {ours['energy']:.6g} (module {theirs['energy']:.6g})")
+    # One seed part only: one line, nothing made.
+    bpy.ops.toonkit.stopmo_remove_seed()
+    before = sorted(o.name for o in bpy.data.objects)
+    try:
+        bpy.ops.toonkit.stopmo_run(directory=os.path.join(OUT, "bad-seeds"))
+    except RuntimeError as e:
+        check("at least two parts" in str(e), f"message {e}")
+    else:
+        raise AssertionError("one seed part was accepted")
+    check(sorted(o.name for o in bpy.data.objects) == before, "the scene changed")
+
+
 def test_stopmo_errors():
     scene, obj = face()
     obj.vertex_groups.remove(obj.vertex_groups["part_lower"])
@@ -118,5 +170,5 @@ def test_stopmo_errors():
 
 
 if __name__ == "__main__":
-    code = run([test_stopmo_errors, test_stopmo_run_matches_the_module])
+    code = run([test_stopmo_errors, test_stopmo_cursor_seeds, test_stopmo_run_matches_the_module])
     os._exit(code)  # bpy's interpreter teardown can crash after a headless run

@@ -1,0 +1,159 @@
+"""The armature as a loa character, and the synthesized motion back as a new Action.
+
+The loa crate poses characters read from a skinned glTF or a BVH file. The armature is handed
+over as a BVH of its rest pose in armature space (one `ROOT`/`JOINT` per bone at its head, an
+`End Site` at each leaf bone's tip, one frame of zeros): BVH joints have no rest rotation, so
+the crate's world rotation `D_b(t)` of a joint is the bone's rotation away from its rest in
+armature space. Blender keeps a pose bone's rotation relative to its rest and its parent, so
+`basis_b = R_b⁻¹ · D_parent⁻¹ · D_b · R_b` with `R_b` the bone's rest rotation; root bones
+also move their head to the crate's joint position.
+"""
+
+import os
+
+from mathutils import Matrix, Quaternion, Vector
+
+from . import job
+
+VIRTUAL_ROOT = "toonkit_loa_root"  # joins several root bones under one BVH ROOT
+
+
+def _name(bone):
+    name = "_".join(bone.name.split())
+    if not name or "{" in name or "}" in name:
+        raise job.JobError(f"bone '{bone.name}' cannot be named in a BVH file")
+    return name
+
+
+def leaf_tip(armature, bone):
+    """Rest tip of a leaf bone (armature space): the glTF importer's `<bone>_end` empty parented
+    to it (the file's tip node, as the CLI reads it), else the bone's tail."""
+    for child in armature.children:
+        if (child.type == "EMPTY" and child.parent_type == "BONE"
+                and child.parent_bone == bone.name and child.name.startswith(f"{bone.name}_end")):
+            at_tail = bone.matrix_local @ Matrix.Translation((0.0, bone.length, 0.0))
+            return (at_tail @ child.matrix_parent_inverse @ child.matrix_basis).translation
+    return bone.tail_local
+
+
+def write_bvh(armature, path):
+    """Writes the rest skeleton of `armature` (armature space); returns {joint: bone name}."""
+    bones = armature.data.bones
+    if len(bones) == 0:
+        raise job.JobError(f"{armature.name}: the armature has no bones")
+    names = {}
+    lines = ["HIERARCHY"]
+
+    def joint(bone, parent_head, depth, keyword):
+        pad = "  " * depth
+        n = _name(bone)
+        if n in names:
+            raise job.JobError(f"{armature.name}: two bones are named '{n}' in a BVH file")
+        names[n] = bone.name
+        off = bone.head_local - parent_head
+        lines.append(f"{pad}{keyword} {n}")
+        lines.append(f"{pad}{{")
+        lines.append(f"{pad}  OFFSET {off.x:.9g} {off.y:.9g} {off.z:.9g}")
+        if keyword == "ROOT":
+            lines.append(f"{pad}  CHANNELS 6 Xposition Yposition Zposition "
+                         "Zrotation Xrotation Yrotation")
+        else:
+            lines.append(f"{pad}  CHANNELS 3 Zrotation Xrotation Yrotation")
+        if bone.children:
+            for c in bone.children:
+                joint(c, bone.head_local, depth + 1, "JOINT")
+        else:
+            tip = leaf_tip(armature, bone) - bone.head_local
+            lines += [f"{pad}  End Site", f"{pad}  {{",
+                      f"{pad}    OFFSET {tip.x:.9g} {tip.y:.9g} {tip.z:.9g}", f"{pad}  }}"]
+        lines.append(f"{pad}}}")
+
+    roots = [b for b in bones if b.parent is None]
+    if len(roots) == 1:
+        joint(roots[0], Vector((0.0, 0.0, 0.0)), 0, "ROOT")
+    else:
+        names[VIRTUAL_ROOT] = None
+        lines += [f"ROOT {VIRTUAL_ROOT}", "{", "  OFFSET 0 0 0",
+                  "  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation"]
+        for r in roots:
+            joint(r, Vector((0.0, 0.0, 0.0)), 1, "JOINT")
+        lines.append("}")
+    channels = 3 * (len(names) + 1)
+    lines += ["MOTION", "Frames: 1", "Frame Time: 0.0416667", " ".join(["0"] * channels)]
+    with open(path, "w", encoding="utf-8") as fh:
+        fh.write("\n".join(lines) + "\n")
+    return names
+
+
+def pose_keys(armature, motion, names):
+    """[(frame, {bone: (rotation, location or None)})] of the crate's motion."""
+    rotations = motion.rotations  # (frames, joints, 4) x, y, z, w
+    positions = motion.positions
+    index = {n: k for k, n in enumerate(motion.joint_names)}
+    missing = [n for n in names if n not in index]
+    if missing:
+        raise job.JobError(f"the motion has no joint {missing[0]!r}")
+    bones = armature.data.bones
+    rest = {b.name: b.matrix_local.to_quaternion() for b in bones}
+    keys = []
+    for f in range(rotations.shape[0]):
+        world = {}
+        for n, bone in names.items():
+            if bone is not None:
+                x, y, z, w = rotations[f, index[n]]
+                world[bone] = Quaternion((w, x, y, z))
+        by_bone = {bone: n for n, bone in names.items() if bone is not None}
+        pose = {}
+        for b in bones:
+            d = world[b.name]
+            dp = world[b.parent.name] if b.parent else Quaternion()
+            basis = rest[b.name].inverted() @ dp.inverted() @ d @ rest[b.name]
+            loc = None
+            if b.parent is None:
+                head = Vector(positions[f, index[by_bone[b.name]]])
+                loc = rest[b.name].inverted() @ (head - b.head_local)
+            pose[b.name] = (basis, loc)
+        keys.append((motion.first_frame + f, pose))
+    return keys
+
+
+def key_action(armature, keys):
+    """Keys `keys` into a NEW action of `armature` (the previous one kept with a fake user)."""
+    ad = armature.animation_data or armature.animation_data_create()
+    previous = ad.action
+    if previous is not None:
+        previous.use_fake_user = True
+    ad.action = None
+    for frame, pose in keys:
+        for name, (rot, loc) in pose.items():
+            pb = armature.pose.bones[name]
+            if pb.rotation_mode == "QUATERNION":
+                pb.rotation_quaternion = rot
+                pb.keyframe_insert("rotation_quaternion", frame=frame, group=name)
+            elif pb.rotation_mode == "AXIS_ANGLE":
+                axis, angle = rot.to_axis_angle()
+                pb.rotation_axis_angle = (angle, *axis)
+                pb.keyframe_insert("rotation_axis_angle", frame=frame, group=name)
+            else:
+                pb.rotation_euler = rot.to_euler(pb.rotation_mode, pb.rotation_euler)
+                pb.keyframe_insert("rotation_euler", frame=frame, group=name)
+            if loc is not None:
+                pb.location = loc
+                pb.keyframe_insert("location", frame=frame, group=name)
+    action = ad.action
+    action.name = f"{armature.name} loa"
+    return action, previous
+
+
+def bvh_path(folder):
+    return os.path.join(folder, "character.bvh")
+
+
+def rest_center(armature):
+    """Centre of the bones' rest heads and tails (armature space)."""
+    pts = [b.head_local for b in armature.data.bones] + [b.tail_local
+                                                        for b in armature.data.bones]
+    lo = Vector(tuple(min(p[i] for p in pts) for i in range(3)))
+    hi = Vector(tuple(max(p[i] for p in pts) for i in range(3)))
+    return 0.5 * (lo + hi), (hi - lo).length
+
