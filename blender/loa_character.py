@@ -64,8 +64,8 @@ def write_bvh(armature, path):
                 joint(c, bone.head_local, depth + 1, "JOINT")
         else:
             tip = leaf_tip(armature, bone) - bone.head_local
-            lines += [f"{pad}  End Site", f"{pad}  {{",
-                      f"{pad}    OFFSET {tip.x:.9g} {tip.y:.9g} {tip.z:.9g}", f"{pad}  }}"]
+            lines.extend([f"{pad}  End Site", f"{pad}  {{",
+                          f"{pad}    OFFSET {tip.x:.9g} {tip.y:.9g} {tip.z:.9g}", f"{pad}  }}"])
         lines.append(f"{pad}}}")
 
     roots = [b for b in bones if b.parent is None]

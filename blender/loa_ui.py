@@ -3,7 +3,7 @@
 import bpy
 from bpy.props import IntProperty
 
-from . import job, loa, loa_job, sample
+from . import job, listed, loa, loa_job, sample
 
 
 def _armature(context):
@@ -61,13 +61,8 @@ class TOONKIT_OT_loa_bone_key_remove(bpy.types.Operator):
     index: IntProperty(default=-1)
 
     def execute(self, context):
-        keys = context.scene.toonkit_loa.bone_keys
-        i = self.index if self.index >= 0 else len(keys) - 1
-        if not 0 <= i < len(keys):
-            self.report({"ERROR"}, f"loa: no bone set {self.index}")
-            return {"CANCELLED"}
-        keys.remove(i)
-        return {"FINISHED"}
+        items = context.scene.toonkit_loa.bone_keys
+        return listed.remove_item(self, items, self.index, "loa bone set")
 
 
 class TOONKIT_PT_loa(bpy.types.Panel):

@@ -3,7 +3,7 @@
 import bpy
 from bpy.props import IntProperty, StringProperty
 
-from . import job, stopmo
+from . import job, listed, stopmo
 
 
 class TOONKIT_OT_stopmo_run(bpy.types.Operator):
@@ -65,13 +65,8 @@ class TOONKIT_OT_stopmo_remove_seed(bpy.types.Operator):
     index: IntProperty(name="Index", default=-1, description="Seed index (-1: the last)")
 
     def execute(self, context):
-        seeds = context.scene.toonkit_stopmo.seeds
-        i = self.index if self.index >= 0 else len(seeds) - 1
-        if not 0 <= i < len(seeds):
-            self.report({"ERROR"}, f"stopmo seed: no seed {self.index} ({len(seeds)} seeds)")
-            return {"CANCELLED"}
-        seeds.remove(i)
-        return {"FINISHED"}
+        items = context.scene.toonkit_stopmo.seeds
+        return listed.remove_item(self, items, self.index, "stopmo seed")
 
 
 class TOONKIT_PT_stopmo(bpy.types.Panel):

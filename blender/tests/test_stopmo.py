@@ -36,6 +36,19 @@ SEEDS = {"upper": (0.0, -13.0, 10.0), "lower": (0.0, -10.0, -14.0)}
 PIECES = 4
 
 
+def same_as_module(folder, ref, ref_dir):
+    """`folder`'s assembly, shooting order and energy equal those of the module's `ref`."""
+    ref.save(ref_dir)
+    for name in ("assembly.csv", "shooting_order.csv"):
+        with open(os.path.join(folder, name)) as a, open(os.path.join(ref_dir, name)) as b:
+            check(a.read() == b.read(), f"{name} differs from the module's")
+    ours = json.load(open(os.path.join(folder, "report.json")))
+    theirs = json.load(open(os.path.join(ref_dir, "report.json")))
+    check(abs(ours["energy"] - theirs["energy"]) <= 1e-6 * abs(theirs["energy"]),
+          f"energy {ours['energy']} vs {theirs['energy']}")
+    return ours, theirs
+
+
 def face():
     scene = empty_scene()
     scene.render.fps = 2
@@ -71,15 +84,7 @@ def test_stopmo_run_matches_the_module():
     ref = toonkit.stopmo.run(toonkit.Scene.from_arrays(taken.positions, taken.triangles,
                                                        fps=taken.fps),
                              parts=parts, **stopmo.options(s))
-    ref_dir = os.path.join(OUT, "module")
-    ref.save(ref_dir)
-    for name in ("assembly.csv", "shooting_order.csv"):
-        with open(os.path.join(folder, name)) as a, open(os.path.join(ref_dir, name)) as b:
-            check(a.read() == b.read(), f"{name} differs from the module's")
-    ours = json.load(open(os.path.join(folder, "report.json")))
-    theirs = json.load(open(os.path.join(ref_dir, "report.json")))
-    check(abs(ours["energy"] - theirs["energy"]) <= 1e-6 * abs(theirs["energy"]),
-          f"energy {ours['energy']} vs {theirs['energy']}")
+    same_as_module(folder, ref, os.path.join(OUT, "module"))
     pieces = sorted(os.listdir(os.path.join(folder, "pieces")))
     check(len(pieces) > 0, "no pieces written")
 
@@ -134,39 +139,29 @@ def test_stopmo_cursor_seeds():
     ref = toonkit.stopmo.run(toonkit.Scene.from_arrays(taken.positions, taken.triangles,
                                                        fps=taken.fps),
                              parts=parts, **stopmo.options(s))
-    ref_dir = os.path.join(OUT, "module-seeds")
-    ref.save(ref_dir)
-    for name in ("assembly.csv", "shooting_order.csv"):
-        with open(os.path.join(folder, name)) as a, open(os.path.join(ref_dir, name)) as b:
-            check(a.read() == b.read(), f"{name} differs from the module's")
-    ours = json.load(open(os.path.join(folder, "report.json")))
-    theirs = json.load(open(os.path.join(ref_dir, "report.json")))
-    check(abs(ours["energy"] - theirs["energy"]) <= 1e-6 * abs(theirs["energy"]),
-          f"energy {ours['energy']} vs {theirs['energy']}")
+    ours, theirs = same_as_module(folder, ref, os.path.join(OUT, "module-seeds"))
     print(f"  cursor seeds: energy {ours['energy']:.6g} (module {theirs['energy']:.6g})")
     # One seed part only: one line, nothing made.
     bpy.ops.toonkit.stopmo_remove_seed()
+    refused("bad-seeds", "at least two parts")
+
+
+def refused(directory, expect):
+    """`stopmo_run` fails with `expect` in its one-line message and adds no object."""
     before = sorted(o.name for o in bpy.data.objects)
     try:
-        bpy.ops.toonkit.stopmo_run(directory=os.path.join(OUT, "bad-seeds"))
+        bpy.ops.toonkit.stopmo_run(directory=os.path.join(OUT, directory))
     except RuntimeError as e:
-        check("at least two parts" in str(e), f"message {e}")
+        check(expect in str(e), f"message {e}")
     else:
-        raise AssertionError("one seed part was accepted")
+        raise AssertionError(f"no error ({expect})")
     check(sorted(o.name for o in bpy.data.objects) == before, "the scene changed")
 
 
 def test_stopmo_errors():
     scene, obj = face()
     obj.vertex_groups.remove(obj.vertex_groups["part_lower"])
-    before = sorted(o.name for o in bpy.data.objects)
-    try:
-        bpy.ops.toonkit.stopmo_run(directory=os.path.join(OUT, "bad"))
-    except RuntimeError as e:
-        check("at least two vertex groups" in str(e), f"message {e}")
-    else:
-        raise AssertionError("one part was accepted")
-    check(sorted(o.name for o in bpy.data.objects) == before, "the scene changed")
+    refused("bad", "at least two vertex groups")
 
 
 if __name__ == "__main__":
