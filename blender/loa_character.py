@@ -1,10 +1,12 @@
 """The armature as a loa character, and the synthesized motion back as a new Action.
 
 The loa crate poses characters read from a skinned glTF or a BVH file. The armature is handed
-over as a BVH of its rest pose in armature space (one `ROOT`/`JOINT` per bone at its head, an
-`End Site` at each leaf bone's tip, one frame of zeros): BVH joints have no rest rotation, so
-the crate's world rotation `D_b(t)` of a joint is the bone's rotation away from its rest in
-armature space. Blender keeps a pose bone's rotation relative to its rest and its parent, so
+over as a BVH of its rest pose in world space (one `ROOT`/`JOINT` per bone at its head, an
+`End Site` at each leaf bone's tip, one frame of zeros; world units, so the solver sees the
+character at the size the camera sees it): BVH joints have no rest rotation, so the crate's
+world rotation of a joint is the bone's rotation away from its rest, `D_b(t)` in armature
+space once the armature's own rotation `W` is taken out (`W⁻¹ · D · W`). Blender keeps a pose
+bone's rotation relative to its rest and its parent, so
 `basis_b = R_b⁻¹ · D_parent⁻¹ · D_b · R_b` with `R_b` the bone's rest rotation; root bones
 also move their head to the crate's joint position.
 """
@@ -37,10 +39,11 @@ def leaf_tip(armature, bone):
 
 
 def write_bvh(armature, path):
-    """Writes the rest skeleton of `armature` (armature space); returns {joint: bone name}."""
+    """Writes the rest skeleton of `armature` (world space); returns {joint: bone name}."""
     bones = armature.data.bones
     if len(bones) == 0:
         raise job.JobError(f"{armature.name}: the armature has no bones")
+    w = armature.matrix_world
     names = {}
     lines = ["HIERARCHY"]
 
@@ -50,7 +53,7 @@ def write_bvh(armature, path):
         if n in names:
             raise job.JobError(f"{armature.name}: two bones are named '{n}' in a BVH file")
         names[n] = bone.name
-        off = bone.head_local - parent_head
+        off = w @ bone.head_local - parent_head
         lines.append(f"{pad}{keyword} {n}")
         lines.append(f"{pad}{{")
         lines.append(f"{pad}  OFFSET {off.x:.9g} {off.y:.9g} {off.z:.9g}")
@@ -61,9 +64,9 @@ def write_bvh(armature, path):
             lines.append(f"{pad}  CHANNELS 3 Zrotation Xrotation Yrotation")
         if bone.children:
             for c in bone.children:
-                joint(c, bone.head_local, depth + 1, "JOINT")
+                joint(c, w @ bone.head_local, depth + 1, "JOINT")
         else:
-            tip = leaf_tip(armature, bone) - bone.head_local
+            tip = w @ leaf_tip(armature, bone) - w @ bone.head_local
             lines.extend([f"{pad}  End Site", f"{pad}  {{",
                           f"{pad}    OFFSET {tip.x:.9g} {tip.y:.9g} {tip.z:.9g}", f"{pad}  }}"])
         lines.append(f"{pad}}}")
@@ -95,13 +98,15 @@ def pose_keys(armature, motion, names):
         raise job.JobError(f"the motion has no joint {missing[0]!r}")
     bones = armature.data.bones
     rest = {b.name: b.matrix_local.to_quaternion() for b in bones}
+    turn = armature.matrix_world.to_quaternion()
+    to_arm = armature.matrix_world.inverted()
     keys = []
     for f in range(rotations.shape[0]):
         world = {}
         for n, bone in names.items():
             if bone is not None:
                 x, y, z, w = rotations[f, index[n]]
-                world[bone] = Quaternion((w, x, y, z))
+                world[bone] = turn.inverted() @ Quaternion((w, x, y, z)) @ turn
         by_bone = {bone: n for n, bone in names.items() if bone is not None}
         pose = {}
         for b in bones:
@@ -110,7 +115,7 @@ def pose_keys(armature, motion, names):
             basis = rest[b.name].inverted() @ dp.inverted() @ d @ rest[b.name]
             loc = None
             if b.parent is None:
-                head = Vector(positions[f, index[by_bone[b.name]]])
+                head = to_arm @ Vector(positions[f, index[by_bone[b.name]]])
                 loc = rest[b.name].inverted() @ (head - b.head_local)
             pose[b.name] = (basis, loc)
         keys.append((motion.first_frame + f, pose))
@@ -150,9 +155,10 @@ def bvh_path(folder):
 
 
 def rest_center(armature):
-    """Centre of the bones' rest heads and tails (armature space)."""
-    pts = [b.head_local for b in armature.data.bones] + [b.tail_local
-                                                        for b in armature.data.bones]
+    """Centre of the bones' rest heads and tails and the diagonal of their box (world)."""
+    w = armature.matrix_world
+    pts = [w @ b.head_local for b in armature.data.bones] + [w @ b.tail_local
+                                                            for b in armature.data.bones]
     lo = Vector(tuple(min(p[i] for p in pts) for i in range(3)))
     hi = Vector(tuple(max(p[i] for p in pts) for i in range(3)))
     return 0.5 * (lo + hi), (hi - lo).length

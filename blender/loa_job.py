@@ -36,7 +36,7 @@ def solve(context, armature):
     if len(strokes) < 1:
         raise job.JobError(f"'{gp.name}' has no keystroke")
     center, size = loa_character.rest_center(armature)
-    view = loa_strokes.View(camera, armature, armature.matrix_world @ center)
+    view = loa_strokes.View(camera, center)
     keys = []
     for frame, pts in strokes:
         k = {"frame": frame, "points": [view.screen(p) for p in pts]}

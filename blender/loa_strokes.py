@@ -6,8 +6,8 @@ strokes → points `.co`) and 4.3+'s (object type `GREASEPENCIL`: layers → fra
 `drawing.strokes` → points `.position`). Every Grease Pencil keyframe is one keystroke: its
 longest stroke (over all visible layers), in world space (4.3+ layer transforms applied).
 
-The camera is the loa crate's `ActionCamera` in the armature's space (the space of the
-character handed to the loa crate): focal plane through the character's centre, image
+The camera is the loa crate's `ActionCamera` in world space (the space of the character
+handed to the loa crate): focal plane through the character's centre, image
 coordinates `P x = D/z · ((x − c)·r, (x − c)·u)` (perspective) or `((x − c)·r, (x − c)·u)`
 (orthographic). Keystroke points are given to the crate as screen points `(P x)_x, −(P x)_y`
 with the identity screen map, so the line is exactly where the strokes are in the view.
@@ -77,13 +77,13 @@ def keystrokes(obj):
 
 
 class View:
-    """The active camera as the loa crate's `ActionCamera`, in armature space."""
+    """The active camera as the loa crate's `ActionCamera`, in world space."""
 
-    def __init__(self, camera, armature, target):
-        to_arm = armature.matrix_world.inverted() @ camera.matrix_world
-        eye = to_arm.translation.copy()
-        self.forward = -Vector(to_arm.col[2][:3]).normalized()
-        self.right = self.forward.cross(Vector(to_arm.col[1][:3])).normalized()
+    def __init__(self, camera, target):
+        m = camera.matrix_world
+        eye = m.translation.copy()
+        self.forward = -Vector(m.col[2][:3]).normalized()
+        self.right = self.forward.cross(Vector(m.col[1][:3])).normalized()
         self.up = self.right.cross(self.forward).normalized()
         depth = max((target - eye).dot(self.forward), 1e-6)
         self.center = eye + self.forward * depth
@@ -93,8 +93,6 @@ class View:
         else:
             self.eye_distance = depth
             self.half_height = depth * math.tan(0.5 * camera.data.angle_y)
-        self.to_world = armature.matrix_world.copy()
-        self.to_arm = armature.matrix_world.inverted()
 
     def as_options(self):
         """`camera` and `screen` of the crate's `AnimateOptions`."""
@@ -106,7 +104,7 @@ class View:
 
     def screen(self, world):
         """Screen point (x right, y down) of a world point."""
-        d = self.to_arm @ world - self.center
+        d = world - self.center
         s = 1.0
         if self.eye_distance is not None:
             z = self.eye_distance + d.dot(self.forward)
@@ -115,7 +113,7 @@ class View:
 
     def unproject(self, x, y):
         """The world point of screen point (x, y) on the focal plane."""
-        return self.to_world @ (self.center + self.right * x - self.up * y)
+        return self.center + self.right * x - self.up * y
 
 
 def camera_of(context):

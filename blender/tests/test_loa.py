@@ -159,7 +159,7 @@ def test_loa_animate_follows_the_strokes():
         print(f"  frame {f}: line → skeleton {100 * ours[-1]:.2f} % (rest {100 * rest[-1]:.2f} %)")
     print(f"  mean distance line → skeleton: {100 * np.mean(ours):.2f} % of the stroke length "
           f"(rest pose {100 * np.mean(rest):.2f} %)")
-    check(np.mean(ours) < np.mean(rest),
+    check(np.mean(ours) < 0.6 * np.mean(rest),
           f"the character does not move toward the line: {np.mean(ours)} vs {np.mean(rest)}")
     if OUT:
         for f in (12, 24):
