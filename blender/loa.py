@@ -14,7 +14,8 @@ from bpy.props import (CollectionProperty, EnumProperty, FloatProperty, IntPrope
 
 # The CLI's preset names (`toonkit loa animate --bones NAME`), and a custom joint list.
 PRESETS = [
-    ("right-leg-spine-head", "Right leg, spine, head", "Right foot → right leg → spine → head"),
+    ("right-leg-spine-head", "Right leg, spine, head",
+     "Right foot → right leg → spine → head"),
     ("left-leg-spine-head", "Left leg, spine, head", "Left foot → left leg → spine → head"),
     ("arm-spine", "Right arm, spine", "Right hand → right arm → spine → hips"),
     ("left-arm-spine", "Left arm, spine", "Left hand → left arm → spine → hips"),

@@ -7,7 +7,8 @@ from . import job, listed, stopmo
 
 
 class TOONKIT_OT_stopmo_run(bpy.types.Operator):
-    """Build a replacement library from the active mesh's part_<NAME> vertex groups or 3D-cursor seeds"""
+    """Build a replacement library from the active mesh's part_<NAME> vertex groups (or the
+    3D-cursor seeds)"""
 
     bl_idname = "toonkit.stopmo_run"
     bl_label = "Build library"

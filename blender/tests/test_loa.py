@@ -156,7 +156,8 @@ def test_loa_animate_follows_the_strokes():
         a, b = skeleton(arm)
         rest.append(to_segments(shown, image(cam, a), image(cam, b)).mean() / length)
         arm.data.pose_position = "POSE"
-        print(f"  frame {f}: line → skeleton {100 * ours[-1]:.2f} % (rest {100 * rest[-1]:.2f} %)")
+        print(f"  frame {f}: line → skeleton {100 * ours[-1]:.2f} % "
+              f"(rest {100 * rest[-1]:.2f} %)")
     print(f"  mean distance line → skeleton: {100 * np.mean(ours):.2f} % of the stroke length "
           f"(rest pose {100 * np.mean(rest):.2f} %)")
     check(np.mean(ours) < 0.6 * np.mean(rest),
