@@ -55,7 +55,9 @@ def solve(context, armature):
                                      **view.as_options())
         pose = loa_character.pose_keys(armature, motion, names)
     except (toonkit.ToonkitError, ValueError, OSError) as e:
-        raise job.JobError(job._one_line(e)) from e
+        # The character file is ours and temporary: name the armature instead.
+        text = job._one_line(e).replace(loa_character.bvh_path(folder), armature.name)
+        raise job.JobError(text) from e
     finally:
         shutil.rmtree(folder, ignore_errors=True)
     return line, motion, pose, view, strokes, size
