@@ -6,8 +6,8 @@ The bundled talking face (2 fps), two `part_<NAME>` vertex groups painted around
 points the CLI tests use; `toonkit.stopmo_run` must write the same `assembly.csv` and energy as
 `toonkit.stopmo.run` on the same evaluated data (the module equals the CLI: crates/python/tests),
 and the reconstruction object must show at frame k the pieces of `assembly.csv` row k.
-Without vertex groups, the same seed points picked at the 3D cursor must give the module's
-result for those seed points.
+Without vertex groups, the same seed points picked at the 3D cursor must give the CLI's
+result for those seed points (the .glb loaded as the CLI loads it).
 """
 
 import csv
@@ -33,11 +33,12 @@ os.makedirs(OUT, exist_ok=True)
 toonkit = install(ZIP)
 # The CLI tests' seeds (glTF, Y up) in Blender's Z-up frame: (x, y, z) -> (x, -z, y).
 SEEDS = {"upper": (0.0, -13.0, 10.0), "lower": (0.0, -10.0, -14.0)}
+GLTF_SEEDS = {"upper": [(0.0, 10.0, 13.0)], "lower": [(0.0, -14.0, 10.0)]}
 PIECES = 4
 
 
-def same_as_module(folder, ref, ref_dir):
-    """`folder`'s assembly, shooting order and energy equal those of the module's `ref`."""
+def same_as(folder, ref, ref_dir):
+    """`folder`'s assembly, shooting order and energy equal those of the library `ref`."""
     ref.save(ref_dir)
     for name in ("assembly.csv", "shooting_order.csv"):
         with open(os.path.join(folder, name)) as a, open(os.path.join(ref_dir, name)) as b:
@@ -84,7 +85,7 @@ def test_stopmo_run_matches_the_module():
     ref = toonkit.stopmo.run(toonkit.Scene.from_arrays(taken.positions, taken.triangles,
                                                        fps=taken.fps),
                              parts=parts, **stopmo.options(s))
-    same_as_module(folder, ref, os.path.join(OUT, "module"))
+    same_as(folder, ref, os.path.join(OUT, "module"))
     pieces = sorted(os.listdir(os.path.join(folder, "pieces")))
     check(len(pieces) > 0, "no pieces written")
 
@@ -112,8 +113,9 @@ def test_stopmo_run_matches_the_module():
 
 
 def test_stopmo_cursor_seeds():
-    """No part_ groups: seeds picked at the 3D cursor give the module's (= the CLI's) result
-    for the same seed points."""
+    """No part_ groups: seeds picked at the 3D cursor give the CLI's result for its seed
+    points (the .glb read as the CLI reads it, seeds in glTF axes): same assembly, shooting
+    order and energy."""
     scene, obj = face()
     for g in list(obj.vertex_groups):
         obj.vertex_groups.remove(g)
@@ -133,15 +135,13 @@ def test_stopmo_cursor_seeds():
     folder = os.path.join(OUT, "stopmo-seeds")
     r = bpy.ops.toonkit.stopmo_run(directory=folder)
     check(r == {"FINISHED"}, f"stopmo_run returned {r}")
-    from bl_ext.user_default.toonkit import sample, stopmo
+    from bl_ext.user_default.toonkit import stopmo
 
-    taken = sample.sample(bpy.context, [obj])
-    parts = {name: [seed] for name, seed in SEEDS.items()}
-    ref = toonkit.stopmo.run(toonkit.Scene.from_arrays(taken.positions, taken.triangles,
-                                                       fps=taken.fps),
-                             parts=parts, **stopmo.options(s))
-    ours, theirs = same_as_module(folder, ref, os.path.join(OUT, "module-seeds"))
-    print(f"  cursor seeds: energy {ours['energy']:.6g} (module {theirs['energy']:.6g})")
+    # The CLI's way: the .glb as `toonkit stopmo run` reads it, the seeds in glTF axes.
+    glb = toonkit.load(os.path.join(REPO, "assets", "face", "ict-face-talk.glb"), fps=2)
+    ref = toonkit.stopmo.run(glb, parts=GLTF_SEEDS, **stopmo.options(s))
+    ours, theirs = same_as(folder, ref, os.path.join(OUT, "cli-seeds"))
+    print(f"  cursor seeds: energy {ours['energy']!r} (CLI seeds {theirs['energy']!r})")
     # One seed part only: one line, nothing made.
     bpy.ops.toonkit.stopmo_remove_seed()
     refused("bad-seeds", "at least two parts")
