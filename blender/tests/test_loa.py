@@ -182,7 +182,6 @@ def test_loa_errors():
               arm.animation_data.action.name)
 
     def fails(expect):
-        nonlocal before
         try:
             bpy.ops.toonkit.loa_animate()
         except RuntimeError as e:
