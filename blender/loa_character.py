@@ -1,18 +1,29 @@
 """The armature as a loa character, and the synthesized motion back as a new Action.
 
 The loa crate poses characters read from a skinned glTF or a BVH file. The armature is handed
-over as a BVH of its rest pose in world space (one `ROOT`/`JOINT` per bone at its head, an
-`End Site` at each leaf bone's tip, one frame of zeros; world units, so the solver sees the
-character at the size the camera sees it): BVH joints have no rest rotation, so the crate's
-world rotation of a joint is the bone's rotation away from its rest, `D_b(t)` in armature
-space once the armature's own rotation `W` is taken out (`W⁻¹ · D · W`). Blender keeps a pose
-bone's rotation relative to its rest and its parent, so
-`basis_b = R_b⁻¹ · D_parent⁻¹ · D_b · R_b` with `R_b` the bone's rest rotation; root bones
-also move their head to the crate's joint position.
+over as a BVH of its pose at the scene's start frame as it is evaluated (its current action,
+constraints and drivers; for a glTF import the pose the importer gives), not its rest (bind)
+pose, which for imported characters often looks broken: one `ROOT`/`JOINT` per bone at its
+posed head, an `End Site` at each leaf bone's posed tip, one frame of zeros, in world space
+(world units, so the solver sees the character at the size the camera sees it). BVH joints
+have no rest rotation, so the crate's world rotation of a joint is the bone's rotation away
+from that posed reference, `D_b(t)` in armature space once the armature's own rotation `W` is
+taken out (`W⁻¹ · D · W`).
+
+With `P_b` the reference's armature-space rotation of bone b (`pose_bone.matrix`) and `R_b` its
+rest rotation (`bone.matrix_local`), the new armature-space rotation is `Q_b = D_b · P_b`.
+Blender composes a pose bone as `M_b = M_parent · R_parent⁻¹ · R_b · basis_b` (rotations;
+translations follow the same chain), so `basis_b = R_b⁻¹ · R_parent · Q_parent⁻¹ · Q_b`, and
+`basis_b = R_b⁻¹ · Q_b` for a root. A root's location moves its head to the crate's joint
+position `h`: `M_root = matrix_local · basis` puts the head at `head_local + R_b · loc`, so
+`loc = R_b⁻¹ · (h − head_local)`. Other bones keep the reference's location (and scale, when
+it is not 1) channel, so a child's head stays where its parent carries it, as the BVH offset
+does. With every `D_b` the identity the new action reproduces the reference pose.
 """
 
 import os
 
+import bpy
 from mathutils import Matrix, Quaternion, Vector
 
 from . import job
@@ -38,8 +49,32 @@ def leaf_tip(armature, bone):
     return bone.tail_local
 
 
-def write_bvh(armature, path):
-    """Writes the rest skeleton of `armature` (world space); returns {joint: bone name}."""
+class Reference:
+    """The evaluated pose of `armature` at `frame` (armature space): per bone its matrix,
+    location and scale channels. The scene's current frame is restored."""
+
+    def __init__(self, scene, armature, frame):
+        back, sub = scene.frame_current, scene.frame_subframe
+        scene.frame_set(frame)
+        try:
+            ev = armature.evaluated_get(bpy.context.evaluated_depsgraph_get())
+            self.matrix = {pb.name: pb.matrix.copy() for pb in ev.pose.bones}
+            self.location = {pb.name: pb.location.copy() for pb in ev.pose.bones}
+            self.scale = {pb.name: pb.scale.copy() for pb in ev.pose.bones}
+        finally:
+            scene.frame_set(back, subframe=sub)
+
+    def head(self, bone):
+        return self.matrix[bone.name].translation
+
+    def tip(self, armature, bone):
+        """The posed tip of a leaf bone: its rest tip carried by the bone's pose."""
+        return self.matrix[bone.name] @ bone.matrix_local.inverted() @ leaf_tip(armature, bone)
+
+
+def write_bvh(armature, ref, path):
+    """Writes the skeleton of `armature` posed as `ref` (a `Reference`; world space);
+    returns {joint: bone name}."""
     bones = armature.data.bones
     if len(bones) == 0:
         raise job.JobError(f"{armature.name}: the armature has no bones")
@@ -53,7 +88,7 @@ def write_bvh(armature, path):
         if n in names:
             raise job.JobError(f"{armature.name}: two bones are named '{n}' in a BVH file")
         names[n] = bone.name
-        off = w @ bone.head_local - parent_head
+        off = w @ ref.head(bone) - parent_head
         lines.append(f"{pad}{keyword} {n}")
         lines.append(f"{pad}{{")
         lines.append(f"{pad}  OFFSET {off.x:.9g} {off.y:.9g} {off.z:.9g}")
@@ -64,9 +99,9 @@ def write_bvh(armature, path):
             lines.append(f"{pad}  CHANNELS 3 Zrotation Xrotation Yrotation")
         if bone.children:
             for c in bone.children:
-                joint(c, w @ bone.head_local, depth + 1, "JOINT")
+                joint(c, w @ ref.head(bone), depth + 1, "JOINT")
         else:
-            tip = w @ leaf_tip(armature, bone) - w @ bone.head_local
+            tip = w @ ref.tip(armature, bone) - w @ ref.head(bone)
             lines.extend([f"{pad}  End Site", f"{pad}  {{",
                           f"{pad}    OFFSET {tip.x:.9g} {tip.y:.9g} {tip.z:.9g}", f"{pad}  }}"])
         lines.append(f"{pad}}}")
@@ -88,8 +123,9 @@ def write_bvh(armature, path):
     return names
 
 
-def pose_keys(armature, motion, names):
-    """[(frame, {bone: (rotation, location or None)})] of the crate's motion."""
+def pose_keys(armature, motion, names, ref):
+    """[(frame, {bone: (rotation, location, scale or None)})] of the crate's motion, as deltas
+    from the reference pose `ref`."""
     rotations = motion.rotations  # (frames, joints, 4) x, y, z, w
     positions = motion.positions
     index = {n: k for k, n in enumerate(motion.joint_names)}
@@ -100,7 +136,10 @@ def pose_keys(armature, motion, names):
     rest = {b.name: b.matrix_local.to_quaternion() for b in bones}
     turn = armature.matrix_world.to_quaternion()
     to_arm = armature.matrix_world.inverted()
-    keys = []
+    posed = {b.name: ref.matrix[b.name].to_quaternion() for b in bones}
+    scale = {b.name: ref.scale[b.name] for b in bones
+             if (ref.scale[b.name] - Vector((1.0, 1.0, 1.0))).length > 1e-6}
+    keys, before = [], {}
     for f in range(rotations.shape[0]):
         world = {}
         for n, bone in names.items():
@@ -108,16 +147,22 @@ def pose_keys(armature, motion, names):
                 x, y, z, w = rotations[f, index[n]]
                 world[bone] = turn.inverted() @ Quaternion((w, x, y, z)) @ turn
         by_bone = {bone: n for n, bone in names.items() if bone is not None}
+        q = {b.name: world[b.name] @ posed[b.name] for b in bones}  # Q_b = D_b · P_b
         pose = {}
         for b in bones:
-            d = world[b.name]
-            dp = world[b.parent.name] if b.parent else Quaternion()
-            basis = rest[b.name].inverted() @ dp.inverted() @ d @ rest[b.name]
-            loc = None
             if b.parent is None:
+                basis = rest[b.name].inverted() @ q[b.name]
                 head = to_arm @ Vector(positions[f, index[by_bone[b.name]]])
                 loc = rest[b.name].inverted() @ (head - b.head_local)
-            pose[b.name] = (basis, loc)
+            else:
+                p = b.parent.name
+                basis = (rest[b.name].inverted() @ rest[p] @ q[p].inverted() @ q[b.name])
+                loc = ref.location[b.name]
+            basis.normalize()
+            if b.name in before and basis.dot(before[b.name]) < 0.0:
+                basis.negate()  # the same rotation, keyed without a flip between frames
+            before[b.name] = basis
+            pose[b.name] = (basis, loc, scale.get(b.name))
         keys.append((motion.first_frame + f, pose))
     return keys
 
@@ -130,7 +175,7 @@ def key_action(armature, keys):
         previous.use_fake_user = True
     ad.action = None
     for frame, pose in keys:
-        for name, (rot, loc) in pose.items():
+        for name, (rot, loc, scale) in pose.items():
             pb = armature.pose.bones[name]
             if pb.rotation_mode == "QUATERNION":
                 pb.rotation_quaternion = rot
@@ -142,9 +187,11 @@ def key_action(armature, keys):
             else:
                 pb.rotation_euler = rot.to_euler(pb.rotation_mode, pb.rotation_euler)
                 pb.keyframe_insert("rotation_euler", frame=frame, group=name)
-            if loc is not None:
-                pb.location = loc
-                pb.keyframe_insert("location", frame=frame, group=name)
+            pb.location = loc
+            pb.keyframe_insert("location", frame=frame, group=name)
+            if scale is not None:
+                pb.scale = scale
+                pb.keyframe_insert("scale", frame=frame, group=name)
     action = ad.action
     action.name = f"{armature.name} loa"
     return action, previous
@@ -154,11 +201,14 @@ def bvh_path(folder):
     return os.path.join(folder, "character.bvh")
 
 
-def rest_center(armature):
-    """Centre of the bones' rest heads and tails and the diagonal of their box (world)."""
+def center(armature, ref):
+    """Centre of the bones' heads and tails posed as `ref` and the diagonal of their box
+    (world)."""
     w = armature.matrix_world
-    pts = [w @ b.head_local for b in armature.data.bones] + [w @ b.tail_local
-                                                            for b in armature.data.bones]
+    pts = []
+    for b in armature.data.bones:
+        m = ref.matrix[b.name]
+        pts += [w @ m.translation, w @ (m @ Vector((0.0, b.length, 0.0)))]
     lo = Vector(tuple(min(p[i] for p in pts) for i in range(3)))
     hi = Vector(tuple(max(p[i] for p in pts) for i in range(3)))
     return 0.5 * (lo + hi), (hi - lo).length

@@ -35,7 +35,8 @@ def solve(context, armature):
     strokes = loa_strokes.keystrokes(gp)
     if len(strokes) < 1:
         raise job.JobError(f"'{gp.name}' has no keystroke")
-    center, size = loa_character.rest_center(armature)
+    ref = loa_character.Reference(context.scene, armature, context.scene.frame_start)
+    center, size = loa_character.center(armature, ref)
     view = loa_strokes.View(camera, center)
     keys = []
     for frame, pts in strokes:
@@ -48,12 +49,12 @@ def solve(context, armature):
     fps = context.scene.render.fps / context.scene.render.fps_base
     folder = tempfile.mkdtemp(prefix="toonkit-loa-")
     try:
-        names = loa_character.write_bvh(armature, loa_character.bvh_path(folder))
+        names = loa_character.write_bvh(armature, ref, loa_character.bvh_path(folder))
         line = toonkit.loa.line(keys, mode=s.mode, fps=fps)
         motion = toonkit.loa.animate(loa_character.bvh_path(folder), line,
                                      bones=loa.bone_sets(s, strokes[0][0]),
                                      **view.as_options())
-        pose = loa_character.pose_keys(armature, motion, names)
+        pose = loa_character.pose_keys(armature, motion, names, ref)
     except (toonkit.ToonkitError, ValueError, OSError) as e:
         # The character file is ours and temporary: name the armature instead.
         text = job._one_line(e).replace(loa_character.bvh_path(folder), armature.name)

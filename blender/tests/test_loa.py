@@ -7,7 +7,9 @@ The bundled robot in front of a perspective camera; a Grease Pencil object made 
 3 frames, drawn on a plane facing the camera. `toonkit.loa_animate` must give a line (a curve
 object keyed per frame) that passes through each stroke at its frame in the camera view
 (within 2 % of the stroke's length) and a NEW action (the previous one kept) that brings the
-robot's skeleton closer to the line than its rest pose. With OUT_DIR, renders frame 24.
+robot's skeleton closer to the line than its starting pose (the importer's pose at the
+scene's start frame, the character loa starts from). Keying the crate's identity motion must
+reproduce that starting pose. With OUT_DIR, renders the start and frame 24.
 """
 
 import math
@@ -30,7 +32,7 @@ ZIP = os.path.abspath(ARGS[0])
 OUT = os.path.abspath(ARGS[1]) if len(ARGS) > 1 else None
 toonkit = install(ZIP)
 
-FOOT, TOP = -2.35, 1.2  # the robot's rest feet and head top (Blender world z)
+FOOT, TOP = 0.0, 3.55  # the robot's feet and head top at the start frame (Blender world z)
 
 
 def stroke(frame, n=24):
@@ -49,7 +51,7 @@ def robot():
     arm = next(o for o in bpy.data.objects if o.type == "ARMATURE")
     cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
     scene.collection.objects.link(cam)
-    cam.location = (0.0, -16.0, -0.4)
+    cam.location = (0.0, -10.5, 1.6)
     cam.rotation_euler = (math.pi / 2, 0.0, 0.0)
     scene.camera = cam
     for o in bpy.data.objects:
@@ -126,11 +128,60 @@ def skeleton(arm):
     return a, b
 
 
+class IdentityMotion:
+    """The crate's motion shape with every joint unrotated at its reference position."""
+
+    def __init__(self, arm, ref, names, first_frame, frames=2):
+        self.joint_names = list(names)
+        self.first_frame = first_frame
+        j = len(names)
+        self.rotations = np.tile(np.array([0.0, 0.0, 0.0, 1.0]), (frames, j, 1))
+        heads = [arm.matrix_world @ ref.head(arm.data.bones[b]) if b else Vector()
+                 for b in names.values()]
+        self.positions = np.tile(np.array([tuple(h) for h in heads]), (frames, 1, 1))
+
+
+def angle(a, b):
+    """The angle between two rotations (quaternions), in [0, π]."""
+    t = a.rotation_difference(b).angle
+    return min(t, 2.0 * math.pi - t)
+
+
+def test_loa_identity_reproduces_the_start_pose():
+    from bl_ext.user_default.toonkit import loa_character
+
+    scene, arm, cam = robot()
+    ref = loa_character.Reference(scene, arm, scene.frame_start)
+    rest = max(angle(arm.data.bones[n].matrix_local.to_quaternion(), m.to_quaternion())
+               for n, m in ref.matrix.items())
+    check(rest > 0.1, f"the starting pose is the rest pose ({rest} rad)")
+    folder = os.path.join(os.environ.get("TMPDIR", "/tmp"), f"toonkit-loa-id-{os.getpid()}")
+    os.makedirs(folder, exist_ok=True)
+    names = loa_character.write_bvh(arm, ref, loa_character.bvh_path(folder))
+    keys = loa_character.pose_keys(arm, IdentityMotion(arm, ref, names, 7), names, ref)
+    loa_character.key_action(arm, keys)
+    size = loa_character.center(arm, ref)[1]
+    for f in (7, 8):
+        scene.frame_set(f)
+        ev = arm.evaluated_get(bpy.context.evaluated_depsgraph_get())
+        turn = max(angle(pb.matrix.to_quaternion(), ref.matrix[pb.name].to_quaternion())
+                   for pb in ev.pose.bones)
+        move = max((arm.matrix_world @ pb.head - arm.matrix_world @ ref.head(pb.bone)).length
+                   for pb in ev.pose.bones) / size
+        print(f"  frame {f}: identity motion vs starting pose: {turn:.2e} rad, "
+              f"{move:.2e} of the skeleton's size (starting pose vs rest {rest:.2f} rad)")
+        check(turn < 1e-4 and move < 1e-5, f"the identity motion moves the robot: {turn}, {move}")
+
+
 def test_loa_animate_follows_the_strokes():
     scene, arm, cam = robot()
     previous = arm.animation_data.action
     keys = [(f, stroke(f)) for f in (1, 12, 24)]
     gp = grease_pencil(scene, keys)
+    scene.frame_set(scene.frame_start)
+    start = skeleton(arm)
+    if OUT:
+        render(scene, os.path.join(OUT, "loa_start.png"), scene.frame_start)
     r = bpy.ops.toonkit.loa_animate()
     check(r == {"FINISHED"}, f"loa_animate returned {r}")
     action = arm.animation_data.action
@@ -140,7 +191,7 @@ def test_loa_animate_follows_the_strokes():
     line = next(o for o in bpy.data.objects if o.get("toonkit_role") == "loa line")
     check(line.type == "CURVE", f"the line is a {line.type}")
     print(f"  {gp.type}: action '{action.name}', line '{line.name}'")
-    ours, rest = [], []
+    ours, rest, begin = [], [], []
     for f, pts in keys:
         scene.frame_set(f)
         drawn = image(cam, [gp.matrix_world @ Vector(p) for p in pts])
@@ -156,12 +207,14 @@ def test_loa_animate_follows_the_strokes():
         a, b = skeleton(arm)
         rest.append(to_segments(shown, image(cam, a), image(cam, b)).mean() / length)
         arm.data.pose_position = "POSE"
+        begin.append(to_segments(shown, image(cam, start[0]), image(cam, start[1])).mean()
+                     / length)
         print(f"  frame {f}: line → skeleton {100 * ours[-1]:.2f} % "
-              f"(rest {100 * rest[-1]:.2f} %)")
+              f"(starting pose {100 * begin[-1]:.2f} %, rest pose {100 * rest[-1]:.2f} %)")
     print(f"  mean distance line → skeleton: {100 * np.mean(ours):.2f} % of the stroke length "
-          f"(rest pose {100 * np.mean(rest):.2f} %)")
-    check(np.mean(ours) < 0.6 * np.mean(rest),
-          f"the character does not move toward the line: {np.mean(ours)} vs {np.mean(rest)}")
+          f"(starting pose {100 * np.mean(begin):.2f} %, rest pose {100 * np.mean(rest):.2f} %)")
+    check(np.mean(ours) < 0.6 * np.mean(begin),
+          f"the character does not move toward the line: {np.mean(ours)} vs {np.mean(begin)}")
     if OUT:
         render(scene, os.path.join(OUT, "loa_frame24.png"), 24)
 
@@ -210,5 +263,6 @@ def test_loa_errors():
 
 
 if __name__ == "__main__":
-    code = run([test_loa_errors, test_loa_animate_follows_the_strokes])
+    code = run([test_loa_errors, test_loa_identity_reproduces_the_start_pose,
+                test_loa_animate_follows_the_strokes])
     os._exit(code)  # bpy's interpreter teardown can crash after a headless run
