@@ -51,7 +51,7 @@ def robot():
     arm = next(o for o in bpy.data.objects if o.type == "ARMATURE")
     cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
     scene.collection.objects.link(cam)
-    cam.location = (0.0, -10.5, 1.6)
+    cam.location = (0.4, -11.0, 2.0)
     cam.rotation_euler = (math.pi / 2, 0.0, 0.0)
     scene.camera = cam
     for o in bpy.data.objects:
