@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# Blender extension CI (issue 16), called by .ci/run after python.sh and caches.sh:
+# Blender extension CI (issues 16 and 17), called by .ci/run after python.sh and caches.sh:
 # builds the extension zip (python blender/build.py, reusing python.sh's release wheel in
 # target/pywheels/ when it is there), then on real Blender through `bpy` from PyPI -- 4.2.0
 # LTS (reusing caches.sh's target/caches-venv) and 5.0.1 (own venv), each with numpy<2 --
 # installs the zip with bpy.ops.extensions.package_install_files and runs
-# blender/tests/test_smear.py and test_stopmo.py (one PASS/FAIL line per test, non-zero exit
-# on a failure).
+# blender/tests/test_smear.py, test_stopmo.py and test_loa.py (one PASS/FAIL line per test,
+# non-zero exit on a failure).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT="$PWD"
@@ -33,7 +33,7 @@ for spec in "4.2.0:target/caches-venv" "5.0.1:target/blender-venv-5.0"; do
     out="target/blender-out-$version"
     rm -rf "$out" "target/blender-user-$version"
     echo "== Blender $version"
-    for t in smear stopmo; do
+    for t in smear stopmo loa; do
         rm -rf "target/blender-user-$version"
         BLENDER_USER_RESOURCES="$ROOT/target/blender-user-$version" \
             "$dir/bin/python" "blender/tests/test_$t.py" "$zip" "$out/$t" || status=1

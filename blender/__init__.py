@@ -2,13 +2,14 @@
 whatever Blender evaluates, on the bundled `toonkit` Python module.
 
 Operators: `bpy.ops.toonkit.smear_bake()`, `bpy.ops.toonkit.smear_update()`,
-`bpy.ops.toonkit.smear_unbake()`; settings in `context.scene.toonkit_smear`; panel in
-View3D ▸ Sidebar ▸ toonkit.
+`bpy.ops.toonkit.smear_unbake()`, `bpy.ops.toonkit.stopmo_run()`,
+`bpy.ops.toonkit.loa_animate()`; settings in `context.scene.toonkit_smear`, `toonkit_stopmo`,
+`toonkit_loa`; panels in View3D ▸ Sidebar ▸ toonkit.
 """
 
-from . import operators, panel, settings, stopmo_ui
+from . import loa_ui, operators, panel, settings, stopmo_ui
 
-_MODULES = (settings, operators, panel, stopmo_ui)
+_MODULES = (settings, operators, panel, stopmo_ui, loa_ui)
 
 
 def register():

@@ -1,7 +1,9 @@
 """Stop-motion replacement libraries (StopShop) from the active mesh's painted parts.
 
 Parts are the vertex groups named `part_<NAME>` (two or more): the triangles whose three
-vertices weigh >= 0.5 in a group seed that part. `toonkit.stopmo.run` segments the animation
+vertices weigh >= 0.5 in a group seed that part. A mesh without such groups uses the seed
+points picked with the 3D cursor (`scene.toonkit_stopmo.seeds`, world space, two or more part
+names), exactly as the CLI's `--part NAME=x,y,z` seeds. `toonkit.stopmo.run` segments the animation
 over the scene range and builds the library; the CLI's folder layout is written to the chosen
 directory, and a reconstruction object (toonkit-owned, beside the original) plays the
 replacement animation with an integer point attribute `piece` (the piece index of the
@@ -12,11 +14,19 @@ import os
 
 import bpy
 import numpy as np
-from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
+from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty,
+                       FloatVectorProperty, IntProperty, StringProperty)
 
 from . import job, results, sample
 
 PREFIX = "part_"
+
+
+class StopmoSeed(bpy.types.PropertyGroup):
+    """A seed point of a part, picked from the 3D cursor (world space)."""
+
+    part: StringProperty(name="Part", default="")
+    location: FloatVectorProperty(name="Location", size=3, subtype="XYZ")
 
 
 class StopmoSettings(bpy.types.PropertyGroup):
@@ -37,6 +47,28 @@ class StopmoSettings(bpy.types.PropertyGroup):
     plugs: BoolProperty(name="Plugs", default=False,
                         description="Registration plugs between parts")
     directory: StringProperty(name="Directory", default="//stopmo", subtype="DIR_PATH")
+    seeds: CollectionProperty(type=StopmoSeed, name="Seeds")
+    seed_part: StringProperty(name="Part", default="upper",
+                              description="The part the next 3D-cursor seed belongs to")
+
+
+def seed_parts(s):
+    """{name: [(x, y, z), ...]} of the 3D-cursor seeds, in the order the parts were named."""
+    parts = {}
+    for seed in s.seeds:
+        parts.setdefault(seed.part, []).append(tuple(float(c) for c in seed.location))
+    return parts
+
+
+def parts_for(obj, triangles, s):
+    """The parts of `obj`: its `part_<NAME>` vertex groups, else the 3D-cursor seeds."""
+    if any(g.name.startswith(PREFIX) for g in obj.vertex_groups) or len(s.seeds) == 0:
+        return parts_of(obj, triangles)
+    parts = seed_parts(s)
+    if len(parts) < 2:
+        raise job.JobError(f"3D-cursor seeds name {len(parts)} part(s); add seeds for at "
+                           f"least two parts (or paint vertex groups '{PREFIX}<NAME>')")
+    return parts
 
 
 def parts_of(obj, triangles):
@@ -44,7 +76,8 @@ def parts_of(obj, triangles):
     groups = [g for g in obj.vertex_groups if g.name.startswith(PREFIX)]
     if len(groups) < 2:
         raise job.JobError(f"{obj.name}: paint at least two vertex groups named "
-                           f"'{PREFIX}<NAME>' (found {len(groups)})")
+                           f"'{PREFIX}<NAME>' (found {len(groups)}) or add 3D-cursor seeds "
+                           f"for two parts")
     n = len(obj.data.vertices)
     weights = np.zeros((len(groups), n), np.float32)
     index = {g.index: k for k, g in enumerate(groups)}
@@ -105,7 +138,7 @@ def run(context, obj):
         taken = sample.sample(context, [obj])
     except sample.SampleError as e:
         raise job.JobError(str(e)) from e
-    parts = parts_of(obj, taken.triangles)
+    parts = parts_for(obj, taken.triangles, s)
     folder = bpy.path.abspath(s.directory)
     if s.directory.startswith("//") and not bpy.data.filepath:
         raise job.JobError("save the .blend first, or choose an absolute directory")

@@ -6,6 +6,8 @@ The bundled talking face (2 fps), two `part_<NAME>` vertex groups painted around
 points the CLI tests use; `toonkit.stopmo_run` must write the same `assembly.csv` and energy as
 `toonkit.stopmo.run` on the same evaluated data (the module equals the CLI: crates/python/tests),
 and the reconstruction object must show at frame k the pieces of `assembly.csv` row k.
+Without vertex groups, the same seed points picked at the 3D cursor must give the CLI's
+result for those seed points (the .glb loaded as the CLI loads it).
 """
 
 import csv
@@ -31,7 +33,21 @@ os.makedirs(OUT, exist_ok=True)
 toonkit = install(ZIP)
 # The CLI tests' seeds (glTF, Y up) in Blender's Z-up frame: (x, y, z) -> (x, -z, y).
 SEEDS = {"upper": (0.0, -13.0, 10.0), "lower": (0.0, -10.0, -14.0)}
+GLTF_SEEDS = {"upper": [(0.0, 10.0, 13.0)], "lower": [(0.0, -14.0, 10.0)]}
 PIECES = 4
+
+
+def same_as(folder, ref, ref_dir):
+    """`folder`'s assembly, shooting order and energy equal those of the library `ref`."""
+    ref.save(ref_dir)
+    for name in ("assembly.csv", "shooting_order.csv"):
+        with open(os.path.join(folder, name)) as a, open(os.path.join(ref_dir, name)) as b:
+            check(a.read() == b.read(), f"{name} differs from the module's")
+    ours = json.load(open(os.path.join(folder, "report.json")))
+    theirs = json.load(open(os.path.join(ref_dir, "report.json")))
+    check(abs(ours["energy"] - theirs["energy"]) <= 1e-6 * abs(theirs["energy"]),
+          f"energy {ours['energy']} vs {theirs['energy']}")
+    return ours, theirs
 
 
 def face():
@@ -69,15 +85,7 @@ def test_stopmo_run_matches_the_module():
     ref = toonkit.stopmo.run(toonkit.Scene.from_arrays(taken.positions, taken.triangles,
                                                        fps=taken.fps),
                              parts=parts, **stopmo.options(s))
-    ref_dir = os.path.join(OUT, "module")
-    ref.save(ref_dir)
-    for name in ("assembly.csv", "shooting_order.csv"):
-        with open(os.path.join(folder, name)) as a, open(os.path.join(ref_dir, name)) as b:
-            check(a.read() == b.read(), f"{name} differs from the module's")
-    ours = json.load(open(os.path.join(folder, "report.json")))
-    theirs = json.load(open(os.path.join(ref_dir, "report.json")))
-    check(abs(ours["energy"] - theirs["energy"]) <= 1e-6 * abs(theirs["energy"]),
-          f"energy {ours['energy']} vs {theirs['energy']}")
+    same_as(folder, ref, os.path.join(OUT, "module"))
     pieces = sorted(os.listdir(os.path.join(folder, "pieces")))
     check(len(pieces) > 0, "no pieces written")
 
@@ -104,19 +112,59 @@ def test_stopmo_run_matches_the_module():
           "no size-vs-error image")
 
 
-def test_stopmo_errors():
+def test_stopmo_cursor_seeds():
+    """No part_ groups: seeds picked at the 3D cursor give the CLI's result for its seed
+    points (the .glb read as the CLI reads it, seeds in glTF axes): same assembly, shooting
+    order and energy."""
     scene, obj = face()
-    obj.vertex_groups.remove(obj.vertex_groups["part_lower"])
+    for g in list(obj.vertex_groups):
+        obj.vertex_groups.remove(g)
+    s = scene.toonkit_stopmo
+    # One restart: what is tested here is where the parts come from.
+    s.count, s.pieces, s.restarts, s.seed = "EACH", PIECES, 1, 1
+    for name, seed in SEEDS.items():
+        scene.cursor.location = seed
+        r = bpy.ops.toonkit.stopmo_add_seed(part=name)
+        check(r == {"FINISHED"}, f"stopmo_add_seed returned {r}")
+    scene.cursor.location = (5.0, 5.0, 5.0)
+    s.seed_part = "stray"
+    bpy.ops.toonkit.stopmo_add_seed()
+    check([x.part for x in s.seeds] == ["upper", "lower", "stray"], "seeds not stored")
+    bpy.ops.toonkit.stopmo_remove_seed(index=2)
+    check([x.part for x in s.seeds] == ["upper", "lower"], "the seed was not removed")
+    folder = os.path.join(OUT, "stopmo-seeds")
+    r = bpy.ops.toonkit.stopmo_run(directory=folder)
+    check(r == {"FINISHED"}, f"stopmo_run returned {r}")
+    from bl_ext.user_default.toonkit import stopmo
+
+    # The CLI's way: the .glb as `toonkit stopmo run` reads it, the seeds in glTF axes.
+    glb = toonkit.load(os.path.join(REPO, "assets", "face", "ict-face-talk.glb"), fps=2)
+    ref = toonkit.stopmo.run(glb, parts=GLTF_SEEDS, **stopmo.options(s))
+    ours, theirs = same_as(folder, ref, os.path.join(OUT, "cli-seeds"))
+    print(f"  cursor seeds: energy {ours['energy']!r} (CLI seeds {theirs['energy']!r})")
+    # One seed part only: one line, nothing made.
+    bpy.ops.toonkit.stopmo_remove_seed()
+    refused("bad-seeds", "at least two parts")
+
+
+def refused(directory, expect):
+    """`stopmo_run` fails with `expect` in its one-line message and adds no object."""
     before = sorted(o.name for o in bpy.data.objects)
     try:
-        bpy.ops.toonkit.stopmo_run(directory=os.path.join(OUT, "bad"))
+        bpy.ops.toonkit.stopmo_run(directory=os.path.join(OUT, directory))
     except RuntimeError as e:
-        check("at least two vertex groups" in str(e), f"message {e}")
+        check(expect in str(e), f"message {e}")
     else:
-        raise AssertionError("one part was accepted")
+        raise AssertionError(f"no error ({expect})")
     check(sorted(o.name for o in bpy.data.objects) == before, "the scene changed")
 
 
+def test_stopmo_errors():
+    scene, obj = face()
+    obj.vertex_groups.remove(obj.vertex_groups["part_lower"])
+    refused("bad", "at least two vertex groups")
+
+
 if __name__ == "__main__":
-    code = run([test_stopmo_errors, test_stopmo_run_matches_the_module])
+    code = run([test_stopmo_errors, test_stopmo_cursor_seeds, test_stopmo_run_matches_the_module])
     os._exit(code)  # bpy's interpreter teardown can crash after a headless run
