@@ -69,6 +69,15 @@ fn how_to_convert(ext: &str) -> String {
 /// Splits `.glb` bytes into JSON and binary chunk; `.gltf` is all JSON.
 fn split(bytes: &[u8]) -> Result<(Vec<u8>, Option<Vec<u8>>)> {
     if bytes.starts_with(b"glTF") {
+        // gltf 1.4 subtracts the 12-byte header from the declared length unchecked.
+        let declared = bytes
+            .get(8..12)
+            .map_or(0, |l| u32::from_le_bytes([l[0], l[1], l[2], l[3]]));
+        if declared < 12 {
+            return Err(bad(format!(
+                "the GLB header declares {declared} bytes, less than the header itself"
+            )));
+        }
         let glb = gltf::binary::Glb::from_slice(bytes).map_err(|e| bad(e.to_string()))?;
         Ok((glb.json.into_owned(), glb.bin.map(|b| b.into_owned())))
     } else {
