@@ -106,6 +106,8 @@
 
 #![warn(missing_docs, unreachable_pub)]
 
+#[cfg(feature = "clap")]
+pub mod args;
 mod effects;
 mod error;
 mod field;
