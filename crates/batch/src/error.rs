@@ -32,6 +32,9 @@ pub enum BatchError {
         /// The OS error.
         source: std::io::Error,
     },
+    /// The worker threads of a batch cannot start.
+    #[error("cannot start the worker threads: {0}")]
+    Threads(String),
     /// A stamp or template cannot be written, or a path cannot be made absolute.
     #[error(transparent)]
     Write(#[from] tkio::IoError),

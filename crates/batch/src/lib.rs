@@ -29,12 +29,17 @@
 //! ```
 #![warn(missing_docs, unreachable_pub)]
 
+pub mod demo;
 mod error;
 mod manifest;
 mod openjd;
+mod run;
 mod stamp;
 
 pub use error::BatchError;
 pub use manifest::{manifest_dir, read_manifest, Manifest, Shot, ToolOutput};
 pub use openjd::openjd_template;
+pub use run::{
+    run_shots, select_shots, BatchReport, RunOptions, Runner, ShotFailure, ShotReport, ShotsFailed,
+};
 pub use stamp::{Stamp, STAMP_DIR};

@@ -53,6 +53,27 @@ pub enum ToolOutput {
     Option,
 }
 
+#[cfg(feature = "clap")]
+impl ToolOutput {
+    /// How the command `words` (subcommand names under `root`) takes its output file, read
+    /// from the parser itself: an argument with id `output`, positional or not.
+    pub fn of(root: &clap::Command, words: &[&str]) -> ToolOutput {
+        let mut command = root;
+        for w in words {
+            match command.find_subcommand(w) {
+                Some(c) => command = c,
+                None => return ToolOutput::Unknown,
+            }
+        }
+        let output = command.get_arguments().find(|a| a.get_id() == "output");
+        match output.map(|a| a.is_positional()) {
+            Some(true) => ToolOutput::Positional,
+            Some(false) => ToolOutput::Option,
+            None => ToolOutput::NoOutput,
+        }
+    }
+}
+
 /// Reads and checks a manifest (unique, file-safe names; outputs listed).
 ///
 /// # Errors

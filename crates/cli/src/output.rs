@@ -34,21 +34,3 @@ pub(crate) fn extension(path: &Path) -> String {
         .map(str::to_ascii_lowercase)
         .unwrap_or_default()
 }
-
-/// Writes a scalar field per frame and vertex as `.npy` (float32, frames × vertices).
-pub(crate) fn write_npy_field(
-    path: &Path,
-    frames: usize,
-    vertices: usize,
-    values: &[f32],
-) -> Result<()> {
-    tkio::save(
-        path,
-        &Output::Field {
-            frames,
-            vertices,
-            values,
-        },
-    )?;
-    Ok(())
-}

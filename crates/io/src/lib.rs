@@ -17,7 +17,10 @@ mod error;
 mod save;
 
 pub mod abc;
+#[cfg(feature = "clap")]
+pub mod args;
 pub mod bvh;
+pub mod info;
 pub mod mdd;
 pub mod npy;
 #[cfg(feature = "obj")]

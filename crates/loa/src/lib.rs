@@ -49,10 +49,10 @@
 //!
 //! # SPEC decisions (where toonkit departs from or adds to the paper)
 //!
-//! * **Timing** (LoA §3.2, Eq. 2): the paper re-times the simulated frames `0..=t*` onto the
+//! * **Timing** (LoA §3.2, LoA Eq. 2): the paper re-times the simulated frames `0..=t*` onto the
 //!   whole keyframe interval, which makes the interval's speed independent of the stiffness.
-//!   toonkit reports Eq. 2's `t*` but lays the *first pass* (the first local minimum of
-//!   Eq. 2's distance, [`Retarget::first_pass`]) at the simulation's own speed (arriving there
+//!   toonkit reports LoA Eq. 2's `t*` but lays the *first pass* (the first local minimum of
+//!   LoA Eq. 2's distance, [`Retarget::first_pass`]) at the simulation's own speed (arriving there
 //!   after the keystroke, later only when the per-frame motion cap needs it, sped up only when
 //!   it is past the next keystroke); root and lengths replay their Hermite curves over the
 //!   approach. Then it lets the line
@@ -138,6 +138,8 @@
 
 pub mod animate;
 mod animation;
+#[cfg(feature = "clap")]
+pub mod args;
 mod chain;
 mod dynamics;
 mod error;
@@ -149,6 +151,7 @@ mod linalg;
 mod line;
 mod onion;
 mod physics;
+pub mod preview;
 mod retarget;
 mod stroke;
 pub mod svg;

@@ -68,7 +68,7 @@ pub fn interpolate_physics(
                 .collect()
         };
         let correction = delta(t_star);
-        // The first pass: the first local minimum of Eq. 2's distance (a later, closer swing
+        // The first pass: the first local minimum of LoA Eq. 2's distance (a later, closer swing
         // would force a sped-up replay of several swings, which strobes).
         let first = first_pass(&whole, to.chain.angles()).min(t_star);
         let applied = delta(first);
@@ -128,7 +128,7 @@ impl Interval<'_> {
         (self.to.frame - self.from.frame) as f64
     }
 
-    /// Lays the approach simulation `sim` (from the first keystroke, Eq. 2's `t_star` and
+    /// Lays the approach simulation `sim` (from the first keystroke, LoA Eq. 2's `t_star` and
     /// correction) onto the interval.
     pub(crate) fn lay(
         &self,

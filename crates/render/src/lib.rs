@@ -40,6 +40,8 @@
 #![warn(missing_docs, unreachable_pub)]
 
 mod animation;
+#[cfg(feature = "clap")]
+pub mod args;
 pub mod chart;
 mod color;
 mod colormap;
@@ -58,6 +60,7 @@ mod raster;
 mod renderer;
 mod rig_preview;
 mod sheet;
+mod spec;
 mod view;
 
 pub use animation::{
@@ -89,4 +92,5 @@ pub use renderer::{
 };
 pub use rig_preview::{rig_preview, RigPreview, RigView, ViewAxes, DEFAULT_RIG_PREVIEW_SIZE};
 pub use sheet::{contact_sheet, SheetOptions, DEFAULT_SHEET_GAP};
+pub use spec::parse_size;
 pub use view::{animation_bbox, View, ViewDirection, DEFAULT_FIT_MARGIN};

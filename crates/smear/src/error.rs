@@ -55,6 +55,9 @@ pub enum SmearError {
         /// Comma-separated object names.
         available: String,
     },
+    /// A scene given as colliders has no mesh. Give a file with at least one mesh.
+    #[error("the collider scene has no mesh")]
+    NoColliderMesh,
     /// An object index is out of range. Use an index below the number of objects.
     #[error("object {index} does not exist; there are {count} objects")]
     UnknownObject {

@@ -108,6 +108,8 @@
 
 #![warn(missing_docs, unreachable_pub)]
 
+#[cfg(feature = "clap")]
+pub mod args;
 mod collider;
 mod effects;
 mod error;

@@ -93,6 +93,9 @@
 
 #![warn(missing_docs, unreachable_pub)]
 
+#[cfg(feature = "clap")]
+pub mod args;
+
 mod job;
 pub mod library;
 pub mod segment;

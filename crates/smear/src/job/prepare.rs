@@ -316,6 +316,21 @@ impl Prepared {
         self.colliders.push(collider);
     }
 
+    /// Adds every mesh of `scene` (a collider file, loaded and sampled) as a collider,
+    /// moving frame by frame when the scene is animated.
+    ///
+    /// # Errors
+    /// [`SmearError::NoColliderMesh`] when the scene has no mesh.
+    pub fn add_colliders(&mut self, scene: &SampledScene) -> Result<()> {
+        if scene.objects.is_empty() {
+            return Err(SmearError::NoColliderMesh);
+        }
+        for o in &scene.objects {
+            self.add_collider(Collider::from_animation(&o.animation));
+        }
+        Ok(())
+    }
+
     /// The options it was prepared with.
     pub fn options(&self) -> &PrepareOptions {
         &self.options

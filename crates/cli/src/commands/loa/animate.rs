@@ -10,10 +10,10 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anim::glam::{DVec3, Vec3};
 use anyhow::{bail, Context as _, Result};
 use clap::Args;
-use loa::animate::{ActionCamera, AnimateOptions, Character, ContactKey, InitialPose, Motion};
+use loa::animate::{ActionCamera, Character};
+use loa::args::MotionFlags;
 use serde_json::json;
 
 use super::{extension, read_keystrokes, warn, Context, LineFlags};
@@ -32,26 +32,8 @@ pub(crate) struct AnimateArgs {
     /// Also write a BVH of the motion.
     #[arg(long)]
     pub(crate) bvh: Option<PathBuf>,
-    /// Bone set at a keystroke frame: a preset (right-leg-spine-head, left-leg-spine-head,
-    /// arm-spine, left-arm-spine, arms, legs, full-body) or comma-separated joint names, then
-    /// `@FRAME`. Repeat for changing sets.
-    #[arg(long = "bones")]
-    pub(crate) bones: Vec<String>,
-    /// Action-plane normal `x,y,z` (default: the view direction).
-    #[arg(long, allow_hyphen_values = true)]
-    pub(crate) plane_normal: Option<String>,
-    /// Contact: `JOINT@FRAME` (hold where it is), `JOINT@FRAME:x,y,z`, or `JOINT@A..B`.
-    #[arg(long = "contact")]
-    pub(crate) contacts: Vec<String>,
-    /// Twist: `JOINT@FRAME:DEGREES` about the bone's own axis.
-    #[arg(long = "twist", allow_hyphen_values = true)]
-    pub(crate) twists: Vec<String>,
-    /// Initial pose: `rest`, or `CLIP@FRAME` (a frame of one of the file's clips).
-    #[arg(long, default_value = "rest")]
-    pub(crate) pose: String,
-    /// Cap on solver iterations per stage.
-    #[arg(long, default_value_t = loa::animate::DEFAULT_MAX_ITERATIONS)]
-    pub(crate) iterations: usize,
+    #[command(flatten)]
+    pub(crate) motion: MotionFlags,
     /// The camera the keystrokes are drawn through: a camera node of the character's file
     /// (perspective allowed; default an orthographic front view fitted to the character).
     #[arg(long)]
@@ -62,18 +44,6 @@ pub(crate) struct AnimateArgs {
     pub(crate) render: Option<PathBuf>,
     #[command(flatten)]
     pub(crate) line: LineFlags,
-}
-
-fn parse_vec3(s: &str) -> Result<DVec3> {
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|x| x.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .with_context(|| format!("--plane-normal {s}: expected x,y,z"))?;
-    if v.len() != 3 {
-        bail!("--plane-normal {s}: expected three numbers x,y,z");
-    }
-    Ok(DVec3::new(v[0], v[1], v[2]))
 }
 
 /// Checks the output paths' extensions before any work.
@@ -98,41 +68,12 @@ fn check_outputs(args: &AnimateArgs) -> Result<()> {
     Ok(())
 }
 
-/// The library options from the flags.
-fn options(args: &AnimateArgs) -> Result<AnimateOptions> {
-    let bone_sets = args
-        .bones
-        .iter()
-        .map(|b| b.parse().with_context(|| format!("--bones {b}")))
-        .collect::<Result<_>>()?;
-    let mut contacts = Vec::new();
-    for c in &args.contacts {
-        contacts.extend(ContactKey::parse_all(c).with_context(|| format!("--contact {c}"))?);
-    }
-    let twists = args
-        .twists
-        .iter()
-        .map(|t| t.parse().with_context(|| format!("--twist {t}")))
-        .collect::<Result<_>>()?;
-    Ok(AnimateOptions {
-        bone_sets,
-        contacts,
-        twists,
-        plane_normal: args.plane_normal.as_deref().map(parse_vec3).transpose()?,
-        max_iterations: args.iterations,
-        ..Default::default()
-    })
-}
-
 /// Runs `toonkit loa animate`.
 pub(crate) fn run(ctx: &Context, args: AnimateArgs) -> Result<()> {
     let start = Instant::now();
     check_outputs(&args)?;
-    let mut options = options(&args)?;
-    let pose: InitialPose = args
-        .pose
-        .parse()
-        .with_context(|| format!("--pose {}", args.pose))?;
+    let mut options = args.motion.options()?;
+    let pose = args.motion.pose()?;
     let keys = read_keystrokes(&args.keys)?;
     let line_options = args.line.options(&keys)?;
     let fps = line_options.physics.fps;
@@ -185,8 +126,14 @@ pub(crate) fn run(ctx: &Context, args: AnimateArgs) -> Result<()> {
     }
     if let Some(r) = &args.render {
         let gif = extension(r) == "gif";
-        let bytes = render_motion(&out_scene, &motion, &skeleton, scene_camera.as_ref(), gif)
-            .with_context(|| r.display().to_string())?;
+        let bytes = loa::preview::motion_preview(
+            &out_scene,
+            &motion,
+            &skeleton,
+            scene_camera.as_ref(),
+            gif,
+        )
+        .with_context(|| r.display().to_string())?;
         tkio::save(r, &tkio::Output::Bytes(&bytes))?;
     }
     spinner.finish_and_clear();
@@ -232,51 +179,4 @@ pub(crate) fn run(ctx: &Context, args: AnimateArgs) -> Result<()> {
         )
     });
     Ok(())
-}
-
-/// The preview: the character's meshes sampled from the written clip, its bones, the line
-/// and the constrained joints, through a view that follows the character.
-fn render_motion(
-    scene: &anim::Scene,
-    motion: &Motion,
-    skeleton: &anim::Skeleton,
-    camera: Option<&anim::Camera>,
-    gif: bool,
-) -> Result<Vec<u8>> {
-    let sampled = anim::sample(
-        scene,
-        &anim::SampleOptions {
-            fps: motion.fps as f32,
-            clip: Some(0),
-            meshes: Vec::new(),
-        },
-    )?;
-    let meshes: Vec<&anim::MeshAnimation> = sampled.objects.iter().map(|o| &o.animation).collect();
-    let positions: Vec<Vec3> = motion.positions.iter().map(|p| p.as_vec3()).collect();
-    let bones: Vec<(usize, usize)> = skeleton
-        .joints
-        .iter()
-        .enumerate()
-        .filter_map(|(k, j)| j.parent.map(|p| (p, k)))
-        .collect();
-    let lines: Vec<Vec<Vec3>> = (0..motion.frames())
-        .map(|f| motion.line_world(f).iter().map(|p| p.as_vec3()).collect())
-        .collect();
-    let cam = &motion.camera;
-    let preview = render::RigPreview {
-        meshes: &meshes,
-        joints: motion.joints,
-        positions: &positions,
-        bones: &bones,
-        lines: &lines,
-        marked: &motion.constrained,
-        fps: motion.fps as f32,
-    };
-    let axes = render::ViewAxes {
-        right: cam.right.as_vec3(),
-        up: cam.up.as_vec3(),
-        forward: cam.forward.as_vec3(),
-    };
-    let view = camera.map_or(render::RigView::Follow(axes), render::RigView::Camera);
-    Ok(render::rig_preview(&preview, view, gif)?)
 }

@@ -51,7 +51,7 @@ pub(crate) fn run(ctx: &Context, args: LineArgs) -> Result<()> {
             tkio::Output::Text(&text)
         }
         _ => {
-            bytes = super::render_line(a, &keys, ext == "gif")
+            bytes = loa::preview::line_preview(a, &keys, ext == "gif")
                 .with_context(|| args.output.display().to_string())?;
             tkio::Output::Bytes(&bytes)
         }

@@ -12,7 +12,7 @@ use std::time::Instant;
 use anyhow::{bail, Result};
 use clap::Args;
 use serde_json::json;
-use tkio::Format;
+use tkio::{Format, Output};
 
 use super::{at_input, Context, OffsetArgs};
 use crate::input::{self, InputArgs};
@@ -52,7 +52,15 @@ pub(crate) fn run(ctx: &Context, args: OffsetsArgs) -> Result<()> {
     let merged = &result.offsets;
     let (frames, vertices) = (merged.frame_count(), merged.vertex_count());
     if format == Some(Format::Npy) {
-        output::write_npy_field(&args.output, frames, vertices, merged.values())?;
+        let values = merged.values();
+        tkio::save(
+            &args.output,
+            &Output::Field {
+                frames,
+                vertices,
+                values,
+            },
+        )?;
     } else {
         let anim = input::merged(&args.input, &sampled)?;
         let colors = render::offset_colors(merged.values());

@@ -65,7 +65,7 @@ pub(super) fn run(ctx: &Context, args: RunArgs) -> Result<()> {
         stopmo::Error::Segment(_) => {
             anyhow::Error::new(e).context(args.input.display().to_string())
         }
-        e => args.library.context(e, &args.input),
+        e => args.library.context(e, &args.input).into(),
     })?;
     spinner.finish_and_clear();
     drop(anim);

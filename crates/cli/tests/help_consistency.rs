@@ -5,9 +5,8 @@
 
 use std::collections::BTreeMap;
 
-use clap::{Arg, Command, CommandFactory, Parser};
-
-use crate::Cli;
+use clap::{Arg, Command, CommandFactory};
+use toonkit_cli::Cli;
 
 /// Names that mean different things in different commands (homonyms, not one concept):
 /// `--render PATH` writes a picture (segment, animate) while `stopmo run --render` turns the
@@ -137,22 +136,22 @@ fn shared_concepts_use_one_name_and_old_spellings_are_hidden() {
 
 #[test]
 fn as_is_an_alias_of_layout() {
-    let cli = Cli::try_parse_from(["toonkit", "convert", "a.glb", "b.obj", "--as", "sequence"]);
-    let Ok(Cli {
-        command: crate::Command::Convert(c),
-        ..
-    }) = cli
-    else {
-        panic!("--as does not parse");
+    let convert = |extra: [&str; 2]| {
+        let argv = ["toonkit", "convert", "a.glb", "b.obj"]
+            .into_iter()
+            .chain(extra);
+        let matches = Cli::command().try_get_matches_from(argv);
+        let matches = matches.expect("convert parses");
+        matches
+            .subcommand_matches("convert")
+            .expect("convert")
+            .clone()
     };
-    assert_eq!(c.layout.layout(), tkio::Layout::Sequence);
-    let cli = Cli::try_parse_from(["toonkit", "convert", "a.glb", "b.obj", "--frame", "3"]);
-    let Ok(Cli {
-        command: crate::Command::Convert(c),
-        ..
-    }) = cli
-    else {
-        panic!("--frame does not parse");
-    };
-    assert_eq!(c.layout.layout(), tkio::Layout::Frame(3));
+    let m = convert(["--as", "sequence"]);
+    assert_eq!(
+        m.get_one::<tkio::Layout>("layout"),
+        Some(&tkio::Layout::Sequence)
+    );
+    let m = convert(["--frame", "3"]);
+    assert_eq!(m.get_one::<usize>("frame"), Some(&3));
 }

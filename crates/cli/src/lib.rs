@@ -1,0 +1,154 @@
+//! `toonkit`: smear frames, stop-motion replacement libraries and dynamic lines of action for
+//! 3D animation. The CLI is thin: it parses options, calls the library crates, and reports.
+//! The binary (`src/main.rs`) calls [`main`]; the parser [`Cli`] is public so that tests can
+//! walk every subcommand's options.
+
+mod commands;
+mod output;
+mod progress;
+
+/// The shared input flags and the load → sample steps they drive.
+use tkio::args as input;
+/// The shared layout and seed flags.
+use tkio::args as shared;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Stylization tools for 3D animation: smear frames, 3D-printed stop-motion, lines of action.
+#[derive(Debug, Parser)]
+#[command(name = "toonkit", version, about, propagate_version = true)]
+pub struct Cli {
+    /// Print a machine-readable JSON summary (timings included) on stdout instead of text.
+    #[arg(long, global = true)]
+    json: bool,
+    /// Write glTF flipbooks and morph outputs with float geometry instead of
+    /// KHR_mesh_quantization (the default: about half the size, positions within 1e-5 of the
+    /// bounding-box diagonal, seams shared by parts exact), for tools that cannot read it.
+    #[arg(long, global = true)]
+    no_quantize: bool,
+    /// Quantized glTF output (the default; kept for scripts that pass it).
+    #[arg(long, global = true, hide = true, conflicts_with = "no_quantize")]
+    quantize: bool,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Describe a file: meshes, vertices, triangles, joints, morph targets, clips, bounds.
+    Info(commands::info::InfoArgs),
+    /// Convert any readable animation into any writable one.
+    Convert(commands::convert::ConvertArgs),
+    /// Run the tools on the bundled sample and write the results.
+    Demo(commands::demo::DemoArgs),
+    /// Dynamic lines of action: sketched keystrokes → animated line (Guay et al. 2015).
+    Loa(commands::loa::LoaArgs),
+    /// Preview an animation as PNG (one frame, onion skins) or GIF, coloured by motion offsets.
+    Render(commands::render::RenderArgs),
+    /// Smear frames: motion offsets (Basset et al. 2024).
+    Smear(Box<commands::smear::SmearArgs>),
+    /// Replacement libraries for 3D-printed stop-motion (StopShop).
+    Stopmo(Box<commands::stopmo::StopmoArgs>),
+    /// A local web page to tune smears, sketch lines of action and segment faces (127.0.0.1).
+    Studio(commands::studio::StudioArgs),
+    /// Many shots from a manifest: in parallel here, or as an Open Job Description farm job.
+    Batch(commands::batch::BatchArgs),
+}
+
+/// Runs `toonkit ARGS…` in this process, quietly (no summary, no spinner): the demo's steps
+/// and batch shots are exactly the command lines a user would type. A panic in a command is
+/// an error of that command, not a crash of the caller.
+pub(crate) fn run_args(args: &[String]) -> anyhow::Result<()> {
+    let argv = std::iter::once("toonkit").chain(args.iter().map(String::as_str));
+    let cli = Cli::try_parse_from(argv).map_err(|e| {
+        let text = e.to_string();
+        let first = text.lines().next().unwrap_or("invalid arguments");
+        anyhow::anyhow!("{}", first.trim_start_matches("error: "))
+    })?;
+    let ctx = commands::Context {
+        json: true,
+        quiet: true,
+        save: tkio::SaveOptions {
+            quantize: !cli.no_quantize,
+        },
+    };
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(&ctx, cli.command)))
+        .unwrap_or_else(|_| {
+            Err(anyhow::anyhow!(
+                "the command panicked (a bug: please report it)"
+            ))
+        })
+}
+
+/// Runs `toonkit` on the process's arguments: exit 0, 2 on any error (one line on stderr), or
+/// the number of failed shots of `toonkit batch`.
+pub fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if e.use_stderr() => {
+            // Usage errors in one line too (clap adds usage and a --help hint below).
+            let text = e.to_string();
+            let first = text.lines().next().unwrap_or("invalid arguments");
+            let first = first.strip_prefix("error: ").unwrap_or(first);
+            eprintln!("toonkit: error: {first} (see --help)");
+            return ExitCode::from(2);
+        }
+        Err(e) => e.exit(), // --help, --version
+    };
+    let ctx = commands::Context {
+        json: cli.json,
+        quiet: false,
+        save: tkio::SaveOptions {
+            quantize: !cli.no_quantize,
+        },
+    };
+    match run(&ctx, cli.command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.is::<commands::batch::ShotsFailed>() => {
+            let failed = e.downcast_ref::<commands::batch::ShotsFailed>();
+            eprintln!("toonkit: error: {e}");
+            ExitCode::from(failed.map_or(2, |f| f.exit_code()))
+        }
+        Err(e) => {
+            eprintln!("toonkit: error: {}", one_line(&e));
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// An error and its causes as one line, each text once: a cause already said by the message
+/// before it (an OS error its wrapper described in the user's terms, a path the context
+/// repeats) is left out.
+pub(crate) fn one_line(e: &anyhow::Error) -> String {
+    let mut msg = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if msg.is_empty() || text.contains(msg.as_str()) {
+            msg = text;
+        } else if msg.contains(text.as_str()) || cause.is::<std::io::Error>() {
+            continue;
+        } else {
+            msg.push_str(": ");
+            msg.push_str(&text);
+        }
+    }
+    msg.replace('\n', " ")
+}
+
+/// Runs one parsed command (the binary's dispatcher; `toonkit batch` runs its shots through
+/// it too).
+fn run(ctx: &commands::Context, command: Command) -> anyhow::Result<()> {
+    match command {
+        Command::Info(a) => commands::info::run(ctx, a),
+        Command::Convert(a) => commands::convert::run(ctx, a),
+        Command::Demo(a) => commands::demo::run(ctx, a),
+        Command::Loa(a) => commands::loa::run(ctx, a),
+        Command::Render(a) => commands::render::run(ctx, a),
+        Command::Smear(a) => commands::smear::run(ctx, *a),
+        Command::Stopmo(a) => commands::stopmo::run(ctx, *a),
+        Command::Batch(a) => commands::batch::run(ctx, a),
+        Command::Studio(a) => commands::studio::run(ctx, a),
+    }
+}

@@ -1,0 +1,206 @@
+//! The command-line flags of the loa jobs (cargo feature `clap`), declared next to the
+//! options they fill: [`LineFlags`] → [`LineOptions`] (`loa line` and `loa animate`) and
+//! [`MotionFlags`] → [`AnimateOptions`] (`loa animate`).
+
+use clap::{Args, ValueEnum};
+use glam::DVec3;
+
+use crate::animate::{AnimateOptions, ContactKey, InitialPose};
+use crate::{Keystrokes, LineOptions};
+
+/// A flag whose value cannot be used, in the user's terms (`--settle x: …`).
+#[derive(Debug, thiserror::Error)]
+pub enum FlagError {
+    /// A flag's value is wrong; the text names the flag.
+    #[error("{0}")]
+    Flag(String),
+    /// A flag and value (`at`) and what is wrong with it.
+    #[error("{at}")]
+    At {
+        /// The flag and its value.
+        at: String,
+        /// What is wrong.
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
+}
+
+/// `result`, its error named by the flag and value `at`.
+fn at<T, E: std::error::Error + Send + Sync + 'static>(
+    result: Result<T, E>,
+    at: impl FnOnce() -> String,
+) -> Result<T, FlagError> {
+    result.map_err(|e| FlagError::At {
+        at: at(),
+        source: Box::new(e),
+    })
+}
+
+/// Interpolation mode.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum ModeArg {
+    /// Elastic chain simulation re-targeted onto every keystroke (anticipation, follow-through).
+    #[default]
+    Physics,
+    /// Hermite splines of angles, lengths and root (geometric in-betweens).
+    Hermite,
+}
+
+/// Line options shared by `loa line` and `loa animate`.
+#[derive(Debug, Clone, Args)]
+pub struct LineFlags {
+    /// Interpolation mode.
+    #[arg(long, value_enum, default_value_t = ModeArg::Physics)]
+    pub mode: ModeArg,
+    /// Frames per second (default: the keystrokes', else 24).
+    #[arg(long, value_name = "FPS")]
+    pub fps: Option<f32>,
+    /// Integration sub-steps per frame.
+    #[arg(long, default_value_t = crate::DEFAULT_SUBSTEPS)]
+    pub substeps: u32,
+    /// Frames simulated from each keystroke (`M`), or `gap` for the frame gap between keys.
+    #[arg(long, default_value = "40")]
+    pub simulated_frames: String,
+    /// Rigid elements per chain (even).
+    #[arg(long, default_value_t = crate::DEFAULT_ELEMENTS)]
+    pub elements: usize,
+    /// Follow-through after the last keystroke, ending on it at rest: a frame count (0 = end
+    /// on the last keystroke), or `key` for one key interval (the last one).
+    #[arg(long, default_value = "key")]
+    pub settle: String,
+    /// Drag-to-wobble `FRAME:S:DX,DY`: hit the line at frame FRAME, at arc-length position
+    /// S (0..1), with impulse DX,DY (screen units per second). Repeatable.
+    #[arg(long = "wobble", allow_hyphen_values = true)]
+    pub wobbles: Vec<String>,
+    /// Stroke smoothing before the fit: Gaussian σ as a fraction of the stroke's length
+    /// (0 = fit the raw samples).
+    #[arg(long, default_value_t = crate::DEFAULT_STROKE_SMOOTHING)]
+    pub smoothing: f64,
+}
+
+impl LineFlags {
+    /// The library options for keystrokes `keys`.
+    ///
+    /// # Errors
+    /// A bad `--simulated-frames`, `--settle` or `--wobble`.
+    pub fn options(&self, keys: &Keystrokes) -> Result<LineOptions, FlagError> {
+        let simulated_frames = match self.simulated_frames.trim() {
+            "gap" => crate::SimulatedFrames::FrameGap,
+            m => crate::SimulatedFrames::Fixed(at(m.parse(), || {
+                format!("--simulated-frames {m}: expected a frame count or \"gap\"")
+            })?),
+        };
+        let settle = match self.settle.trim() {
+            "key" => crate::Settle::KeyInterval,
+            s => crate::Settle::Frames(at(s.parse(), || {
+                format!("--settle {s}: expected a frame count or \"key\"")
+            })?),
+        };
+        let wobbles = self
+            .wobbles
+            .iter()
+            .map(|w| at(w.parse(), || format!("--wobble {w}")))
+            .collect::<Result<_, _>>()?;
+        Ok(LineOptions {
+            mode: match self.mode {
+                ModeArg::Physics => crate::Mode::Physics,
+                ModeArg::Hermite => crate::Mode::Hermite,
+            },
+            elements: self.elements,
+            physics: crate::PhysicsOptions {
+                fps: self
+                    .fps
+                    .map(f64::from)
+                    .or(keys.fps())
+                    .unwrap_or(crate::DEFAULT_FPS),
+                substeps: self.substeps,
+                simulated_frames,
+                settle,
+                ..Default::default()
+            },
+            smoothing: self.smoothing,
+            wobbles,
+            ..Default::default()
+        })
+    }
+}
+
+/// The motion options of `loa animate`: bone sets, action plane, contacts, twists, the
+/// initial pose and the solver's iteration cap.
+#[derive(Debug, Clone, Args)]
+pub struct MotionFlags {
+    /// Bone set at a keystroke frame: a preset (right-leg-spine-head, left-leg-spine-head,
+    /// arm-spine, left-arm-spine, arms, legs, full-body) or comma-separated joint names, then
+    /// `@FRAME`. Repeat for changing sets.
+    #[arg(long = "bones")]
+    pub bones: Vec<String>,
+    /// Action-plane normal `x,y,z` (default: the view direction).
+    #[arg(long, allow_hyphen_values = true)]
+    pub plane_normal: Option<String>,
+    /// Contact: `JOINT@FRAME` (hold where it is), `JOINT@FRAME:x,y,z`, or `JOINT@A..B`.
+    #[arg(long = "contact")]
+    pub contacts: Vec<String>,
+    /// Twist: `JOINT@FRAME:DEGREES` about the bone's own axis.
+    #[arg(long = "twist", allow_hyphen_values = true)]
+    pub twists: Vec<String>,
+    /// Initial pose: `rest`, or `CLIP@FRAME` (a frame of one of the file's clips).
+    #[arg(long, default_value = "rest")]
+    pub pose: String,
+    /// Cap on solver iterations per stage.
+    #[arg(long, default_value_t = crate::animate::DEFAULT_MAX_ITERATIONS)]
+    pub iterations: usize,
+}
+
+impl MotionFlags {
+    /// The library options (no camera: that needs the character's scene).
+    ///
+    /// # Errors
+    /// A bad `--bones`, `--contact`, `--twist` or `--plane-normal`.
+    pub fn options(&self) -> Result<AnimateOptions, FlagError> {
+        let bone_sets = self
+            .bones
+            .iter()
+            .map(|b| at(b.parse(), || format!("--bones {b}")))
+            .collect::<Result<_, _>>()?;
+        let mut contacts = Vec::new();
+        for c in &self.contacts {
+            contacts.extend(at(ContactKey::parse_all(c), || format!("--contact {c}"))?);
+        }
+        let twists = self
+            .twists
+            .iter()
+            .map(|t| at(t.parse(), || format!("--twist {t}")))
+            .collect::<Result<_, _>>()?;
+        Ok(AnimateOptions {
+            bone_sets,
+            contacts,
+            twists,
+            plane_normal: self.plane_normal.as_deref().map(parse_vec3).transpose()?,
+            max_iterations: self.iterations,
+            ..Default::default()
+        })
+    }
+
+    /// `--pose`.
+    ///
+    /// # Errors
+    /// Neither `rest` nor `CLIP@FRAME`.
+    pub fn pose(&self) -> Result<InitialPose, FlagError> {
+        at(self.pose.parse(), || format!("--pose {}", self.pose))
+    }
+}
+
+fn parse_vec3(s: &str) -> Result<DVec3, FlagError> {
+    let v: Vec<f64> = at(
+        s.split(',')
+            .map(|x| x.trim().parse::<f64>())
+            .collect::<Result<_, _>>(),
+        || format!("--plane-normal {s}: expected x,y,z"),
+    )?;
+    if v.len() != 3 {
+        return Err(FlagError::Flag(format!(
+            "--plane-normal {s}: expected three numbers x,y,z"
+        )));
+    }
+    Ok(DVec3::new(v[0], v[1], v[2]))
+}

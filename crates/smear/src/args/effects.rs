@@ -1,0 +1,340 @@
+//! The flags of `toonkit smear elongate | multiples | lines` (SMEAR Section 4) and the part of
+//! the [`Style`] each describes. Expressions are those of `smear::Expression` with the
+//! effect's maximum bound as a parameter (`beta_max`, `m_max`, `tau_max`).
+
+use clap::{Args, ValueEnum};
+
+use super::{check, EffectArgs, FlagError};
+use crate::{
+    ElongateStyle, FunctionSpec, LineOptions, LinesStyle, MultiplesOptions, MultiplesStyle, Param,
+    Prepared, Spacing, Stage, Style,
+};
+
+/// Presets of S_E (SMEAR Section 5.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ElongatePreset {
+    /// S_E(δ; β_max) = β_max·δ (SMEAR Eq. 10 example, Fig. 9b, 11b).
+    Linear,
+    /// S_E(δ; v, β_max) = β_max‖v‖δ (Fig. 11c).
+    Speed,
+    /// S_E(δ⁻; v, κ, β_max) = β_max‖v‖F1(p(0), κ)δ⁻ (Fig. 11d).
+    Noise,
+}
+
+/// Flags of the elongated in-betweens (SMEAR Eq. 10).
+#[derive(Debug, Clone, Args)]
+pub struct Elongate {
+    /// Stylization preset S_E.
+    #[arg(long, value_enum, default_value_t = ElongatePreset::Linear)]
+    pub preset: ElongatePreset,
+    /// Maximum elongation β_max in frames; keyframes as FRAME:VALUE,... (e.g. 0:0,12:3).
+    #[arg(long, default_value = "1")]
+    pub beta_max: Param,
+    /// Noise scale κ of the `noise` preset (keyframeable).
+    #[arg(long, default_value = "1")]
+    pub kappa: Param,
+    /// User expression for β (replaces the preset), e.g. "beta_max * speed * past(delta)".
+    #[arg(long)]
+    pub expr: Option<String>,
+}
+
+impl Elongate {
+    /// S_E: the expression, or the preset (times ω with painted weights), checked.
+    ///
+    /// # Errors
+    /// A function that does not compile, naming its flag.
+    pub fn function(&self, effect: &EffectArgs) -> Result<FunctionSpec, FlagError> {
+        let spec = match &self.expr {
+            Some(e) => FunctionSpec::expr(e, &[("beta_max", self.beta_max.clone())]),
+            None => effect.weighted(match self.preset {
+                ElongatePreset::Linear => FunctionSpec::linear(self.beta_max.clone()),
+                ElongatePreset::Speed => FunctionSpec::speed(self.beta_max.clone()),
+                ElongatePreset::Noise => {
+                    FunctionSpec::noise(self.kappa.clone(), self.beta_max.clone())
+                }
+            }),
+        };
+        let flag = match self.expr {
+            Some(_) => "--expr",
+            None => "--beta-max/--kappa",
+        };
+        check(&spec, flag)?;
+        Ok(spec)
+    }
+
+    /// The style: the offsets `prepared` was made with and the elongation.
+    ///
+    /// # Errors
+    /// As [`Elongate::function`] and [`EffectArgs::shaping`].
+    pub fn style(&self, effect: &EffectArgs, prepared: &Prepared) -> Result<Style, FlagError> {
+        Ok(Style {
+            elongate: Some(ElongateStyle {
+                enabled: true,
+                step: effect.step,
+                function: self.function(effect)?,
+            }),
+            ..effect.base_style(prepared)?
+        })
+    }
+}
+
+/// Flags of the multiple in-betweens (SMEAR Eqs. 11–12).
+#[derive(Debug, Clone, Args)]
+pub struct Multiples {
+    /// Copies in the past, m_p; keyframes (FRAME:VALUE,...) fade copies in and out.
+    #[arg(long, default_value = "1")]
+    pub past: Param,
+    /// Copies in the future, m_n; keyframeable.
+    #[arg(long, default_value = "1")]
+    pub future: Param,
+    /// Temporal spacing Δf between copies, in frames; keyframes as FRAME:VALUE,...
+    #[arg(long, conflicts_with = "overlap")]
+    pub spacing: Option<Param>,
+    /// Copies overlapping between consecutive frames, N∩: Δf = 1/(m_p + m_n + 1 − N∩);
+    /// keyframeable.
+    #[arg(long)]
+    pub overlap: Option<Param>,
+    /// m_max of SMEAR Eq. 12 (default: max(m_p, m_n); keyframeable).
+    #[arg(long)]
+    pub m_max: Option<Param>,
+    /// User expression for the opacity (replaces SMEAR Eq. 12), e.g. "step(delta * m)".
+    #[arg(long)]
+    pub opacity_expr: Option<String>,
+}
+
+/// What the multiples flags resolve to before the input is read.
+#[derive(Debug, Clone)]
+pub struct MultiplesPlan {
+    /// Copies, spacing and step.
+    pub options: MultiplesOptions,
+    /// Spacing Δf at frame 0.
+    pub spacing: f32,
+    /// m_max of SMEAR Eq. 12.
+    pub m_max: Param,
+    /// The opacity function (SMEAR Eq. 12 or the user's).
+    pub opacity: FunctionSpec,
+}
+
+impl Multiples {
+    /// Copies, spacing and opacity, checked.
+    ///
+    /// # Errors
+    /// No copy at all, a bad spacing, or an opacity expression that does not compile.
+    pub fn plan(&self, effect: &EffectArgs) -> Result<MultiplesPlan, FlagError> {
+        let spacing = match (self.spacing.clone(), self.overlap.clone()) {
+            (_, Some(n)) => Spacing::Overlap(n),
+            (Some(df), None) => Spacing::Frames(df),
+            (None, None) => Spacing::Frames(crate::DEFAULT_SPACING.into()),
+        };
+        let options = MultiplesOptions {
+            past: self.past.clone(),
+            future: self.future.clone(),
+            spacing,
+            step: effect.step,
+        };
+        if options.indices().is_empty() {
+            return Err(FlagError::Flag(
+                "--past and --future are both 0: there is no copy to draw".into(),
+            ));
+        }
+        let spacing = options.spacing_at(0.0)?;
+        let largest = self.past.max_value().max(self.future.max_value()).round();
+        let m_max = self.m_max.clone().unwrap_or(Param::Constant(largest));
+        let opacity = match &self.opacity_expr {
+            Some(e) => FunctionSpec::expr(e, &[("m_max", m_max.clone())]),
+            None => effect.weighted(FunctionSpec::multiples(m_max.clone())),
+        };
+        check(&opacity, "--opacity-expr")?;
+        Ok(MultiplesPlan {
+            options,
+            spacing,
+            m_max,
+            opacity,
+        })
+    }
+
+    /// The style: the offsets `prepared` was made with and the copies of `plan`.
+    ///
+    /// # Errors
+    /// As [`EffectArgs::shaping`].
+    pub fn style(
+        &self,
+        effect: &EffectArgs,
+        plan: &MultiplesPlan,
+        prepared: &Prepared,
+    ) -> Result<Style, FlagError> {
+        Ok(Style {
+            multiples: Some(MultiplesStyle {
+                enabled: true,
+                past: self.past.clone(),
+                future: self.future.clone(),
+                spacing: self.spacing.clone(),
+                overlap: self.overlap.clone(),
+                step: effect.step,
+                opacity: Some(plan.opacity.clone()),
+                color: [1.0; 3],
+            }),
+            ..effect.base_style(prepared)?
+        })
+    }
+}
+
+/// Flags of the motion lines (SMEAR Eq. 13).
+#[derive(Debug, Clone, Args)]
+pub struct Lines {
+    /// Number of lines K (random surface points, area-weighted). Keyframes (FRAME:VALUE,...)
+    /// sample as many seeds as the largest key and draw a fixed random subset per frame.
+    #[arg(long, default_value_t = Param::Constant(crate::DEFAULT_LINE_COUNT as f32))]
+    pub count: Param,
+    /// Maximum length τ_max in frames: S_L(δ; τ_max) = τ_max·δ (SMEAR Eq. 13); keyframeable.
+    #[arg(long, default_value = "1")]
+    pub length_max: Param,
+    /// Seed of every random choice (default: the tool's fixed seed; runs are reproducible).
+    #[arg(long, value_name = "SEED")]
+    pub seed: Option<u64>,
+    /// User expression for τ (replaces the linear one), e.g. "tau_max * speed * past(delta)".
+    #[arg(long)]
+    pub length_expr: Option<String>,
+    /// Tube radius in scene units (default: 0.002 × bounding-box diagonal); keyframeable.
+    #[arg(long, conflicts_with = "thickness_expr")]
+    pub thickness: Option<Param>,
+    /// User expression for the tube radius along the line (`t` = 0 at the surface), e.g.
+    /// "0.01 * (1 - t)" for tapering lines.
+    #[arg(long)]
+    pub thickness_expr: Option<String>,
+    /// User expression for the opacity along the line (`t` = 0 at the surface), e.g. "1 - t".
+    #[arg(long)]
+    pub opacity_expr: Option<String>,
+    /// Gap between surface and line, in frames along the trajectory; keyframeable.
+    #[arg(long, default_value = "0")]
+    pub gap: Param,
+    /// Seeds slower than this (units per frame) draw no line; keyframeable.
+    #[arg(long, default_value = "0")]
+    pub min_speed: Param,
+    /// Line colour, linear R,G,B in [0, 1] (default near-black).
+    #[arg(long, value_delimiter = ',')]
+    pub color: Vec<f32>,
+    /// Only trace the past (τ clamped to ≤ 0).
+    #[arg(long)]
+    pub past_only: bool,
+    /// Sides of each tube.
+    #[arg(long, default_value_t = crate::DEFAULT_LINE_SIDES)]
+    pub sides: usize,
+    /// Rings along each line.
+    #[arg(long, default_value_t = crate::DEFAULT_LINE_SAMPLES)]
+    pub samples: usize,
+}
+
+/// What the lines flags resolve to before the input is read.
+#[derive(Debug, Clone)]
+pub struct LinesPlan {
+    /// S_L, the length function.
+    pub length: FunctionSpec,
+    /// The opacity along a line.
+    pub opacity: FunctionSpec,
+    /// The line colour.
+    pub color: [Param; 3],
+}
+
+impl Lines {
+    /// Length, opacity, count and colour, checked.
+    ///
+    /// # Errors
+    /// A non-positive thickness, a function that does not compile, a count out of range or
+    /// a colour that is not three numbers.
+    pub fn plan(&self, effect: &EffectArgs) -> Result<LinesPlan, FlagError> {
+        let flag = |s: String| Err(FlagError::Flag(s));
+        if let Some(t) = &self.thickness {
+            if t.validate("--thickness", (0.0, true), (f32::MAX, false))
+                .is_err()
+            {
+                return flag(format!(
+                    "--thickness {t}: the tube radius must be a positive number (scene units)"
+                ));
+            }
+        }
+        let length = match &self.length_expr {
+            Some(e) => FunctionSpec::expr(e, &[("tau_max", self.length_max.clone())]),
+            None => effect.weighted(FunctionSpec::linear(self.length_max.clone())),
+        };
+        check(&length, "--length-expr")?;
+        let opacity = match &self.opacity_expr {
+            Some(e) => FunctionSpec::expr(e, &[]),
+            None => FunctionSpec::stages(vec![Stage::Set { value: 1.0.into() }]),
+        };
+        check(&opacity, "--opacity-expr")?;
+        if self
+            .count
+            .validate("--count", (0.0, false), (1e7, false))
+            .is_err()
+        {
+            return flag(format!(
+                "--count {}: give a number of lines from 0 to 10000000",
+                self.count
+            ));
+        }
+        let color = match self.color.as_slice() {
+            [] => LineOptions::default().color,
+            &[r, g, b] => [r, g, b].map(Param::Constant),
+            c => {
+                return flag(format!(
+                    "--color takes R,G,B (3 numbers in [0, 1]), got {} numbers",
+                    c.len()
+                ))
+            }
+        };
+        Ok(LinesPlan {
+            length,
+            opacity,
+            color,
+        })
+    }
+
+    /// The tube radius: `--thickness`, or 0.002 × the bounding-box diagonal of the body.
+    pub fn radius(&self, prepared: &Prepared) -> Param {
+        self.thickness.clone().unwrap_or(Param::Constant(
+            crate::DEFAULT_LINE_THICKNESS * prepared.animation(0).bbox().diagonal(),
+        ))
+    }
+
+    /// The style: the offsets `prepared` was made with and the lines of `plan`.
+    ///
+    /// # Errors
+    /// A thickness function that does not compile, or as [`EffectArgs::shaping`].
+    pub fn style(
+        &self,
+        effect: &EffectArgs,
+        plan: &LinesPlan,
+        prepared: &Prepared,
+    ) -> Result<Style, FlagError> {
+        let thickness = match &self.thickness_expr {
+            Some(e) => FunctionSpec::expr(e, &[]),
+            None => FunctionSpec::stages(vec![Stage::Set {
+                value: self.radius(prepared),
+            }]),
+        };
+        let flag = match self.thickness_expr {
+            Some(_) => "--thickness-expr",
+            None => "--thickness",
+        };
+        check(&thickness, flag)?;
+        Ok(Style {
+            lines: Some(LinesStyle {
+                enabled: true,
+                count: self.count.clone(),
+                seed: self.seed.unwrap_or(crate::DEFAULT_SEED),
+                gap: self.gap.clone(),
+                min_speed: self.min_speed.clone(),
+                past_only: self.past_only,
+                sides: self.sides,
+                samples: self.samples,
+                step: effect.step,
+                color: plan.color.clone(),
+                length: plan.length.clone(),
+                thickness: Some(thickness),
+                opacity: plan.opacity.clone(),
+            }),
+            ..effect.base_style(prepared)?
+        })
+    }
+}

@@ -1,0 +1,215 @@
+//! The command-line flags of the smear jobs (cargo feature `clap`), declared next to the
+//! options they fill: [`OffsetArgs`] → [`OffsetOptions`], [`EffectArgs`] → the offset,
+//! weight, subdivision and contact parts of a [`Style`], and one struct per effect
+//! ([`Elongate`], [`Multiples`], [`Lines`]) that builds the effect's part of the style. The
+//! `toonkit smear` commands flatten them; other front ends can parse the same flags.
+
+mod effects;
+
+pub use effects::{Elongate, ElongatePreset, Lines, LinesPlan, Multiples, MultiplesPlan};
+
+use clap::Args;
+
+use crate::{
+    CameraSelect, ContactStyle, FunctionSpec, OffsetOptions, Prepared, SmearError, Stage, Style,
+    WeightAttribute, WeightGroup, WeightSource,
+};
+
+/// A flag whose value cannot be used, in the user's terms (`--step must be ≥ 1 …`).
+#[derive(Debug, thiserror::Error)]
+pub enum FlagError {
+    /// A flag's value is wrong; the text names the flag.
+    #[error("{0}")]
+    Flag(String),
+    /// The smear library refused the options the flags describe.
+    #[error(transparent)]
+    Smear(#[from] SmearError),
+}
+
+/// Motion-offset options (SMEAR Section 3), shared by `smear offsets` and every effect.
+#[derive(Debug, Clone, Args)]
+pub struct OffsetArgs {
+    /// Temporal smoothing half-window N of SMEAR Eq. 2 (0 = off).
+    #[arg(long, default_value_t = crate::DEFAULT_SMOOTH)]
+    pub smooth: usize,
+    /// Treat each skinned character as one object with one separation plane (Fig. 14).
+    #[arg(long)]
+    pub whole_body: bool,
+    /// Bones to toggle off (comma-separated): their vertices follow the nearest kept ancestor.
+    #[arg(long, value_delimiter = ',')]
+    pub prune: Vec<String>,
+    /// Compute offsets relative to this camera (node name, or index).
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// Disable the collinear weight of the ribbons (paper Fig. 7, shows the shearing it
+    /// prevents).
+    #[arg(long)]
+    pub no_collinear: bool,
+    /// Past-only mode: velocities, smoothing and trajectories of frame f read frames ≤ f only
+    /// (as a game or live preview would); the smear lags slightly behind the offline one.
+    #[arg(long)]
+    pub causal: bool,
+    /// Objects that revolve about an axis (wheels, propellers; comma-separated mesh names, or
+    /// `auto` to detect them): offsets and trajectories follow arcs about the fitted axis.
+    #[arg(long, value_delimiter = ',')]
+    pub revolve: Vec<String>,
+}
+
+impl OffsetArgs {
+    /// The library options; `--camera` is a camera name, or an index when no camera has that
+    /// name.
+    pub fn options(&self, sampled: &anim::SampledScene) -> OffsetOptions {
+        let camera = self.camera.as_ref().map(|c| match c.parse::<usize>() {
+            Ok(i) if !sampled.cameras.iter().any(|cam| cam.name == *c) => CameraSelect::Index(i),
+            _ => CameraSelect::Name(c.clone()),
+        });
+        OffsetOptions {
+            smooth: self.smooth,
+            whole_body: self.whole_body,
+            prune: self.prune.clone(),
+            camera,
+            collinear_weight: !self.no_collinear,
+            causal: self.causal,
+            revolve: self.revolve.clone(),
+        }
+    }
+}
+
+/// Options of every effect: the motion-offset options of `toonkit smear offsets`, the frame
+/// step and painted weights.
+#[derive(Debug, Clone, Args)]
+pub struct EffectArgs {
+    /// The motion-offset flags.
+    #[command(flatten)]
+    pub offsets: OffsetArgs,
+    /// Frame step: 2 = "on twos" (displacements scaled by 2, drawings held two frames).
+    #[arg(long, default_value_t = crate::DEFAULT_FRAME_STEP)]
+    pub step: usize,
+    /// Painted weights ω from a weight group (Fig. 15b): the skin weights of these joints and
+    /// of every joint below them (comma-separated, case-sensitive). Presets are multiplied by
+    /// ω; expressions read it as `weight`.
+    #[arg(long, value_delimiter = ',', conflicts_with_all = ["weight_attribute", "weight_expr"])]
+    pub weight_group: Vec<String>,
+    /// With --weight-group: only the named joints, not their descendants.
+    #[arg(long, requires = "weight_group")]
+    pub weight_group_only: bool,
+    /// Painted weights ω from a scalar vertex attribute painted in the animation package
+    /// (glTF `_NAME`, e.g. `_SMEAR_WEIGHT`) or a vertex-colour channel (`COLOR_0.r`, `.g`,
+    /// `.b`, `.a`), clamped to [0, 1].
+    #[arg(long, conflicts_with = "weight_expr")]
+    pub weight_attribute: Option<String>,
+    /// Painted weights ω as an expression of the rest position `x, y, z`, clamped to [0, 1],
+    /// e.g. "clamp01(y / 2)".
+    #[arg(long)]
+    pub weight_expr: Option<String>,
+    /// Adaptive subdivision: split output edges longer than TOL × their rest length (TOL ≥ 1,
+    /// e.g. 2). The mesh then changes per frame: write .glb, .usda, .usdc, .usdz or .abc.
+    #[arg(long, value_name = "TOL")]
+    pub subdivide: Option<f32>,
+    /// A ground plane y = Y that the in-betweens never cross.
+    #[arg(long, value_name = "Y", allow_negative_numbers = true)]
+    pub ground: Option<f32>,
+    /// With --ground: squash on impact, the height scaled by 1 − AMOUNT (volume kept),
+    /// easing back over --squash-frames.
+    #[arg(long, value_name = "AMOUNT", requires = "ground")]
+    pub squash: Option<f32>,
+    /// Frames a squash lasts.
+    #[arg(long, default_value_t = crate::DEFAULT_SQUASH_FRAMES, requires = "squash")]
+    pub squash_frames: usize,
+    /// Collider meshes the in-betweens never enter (repeatable): every mesh of FILE (.obj,
+    /// .glb, .stl, …), static or animated frame by frame. An open mesh blocks the side
+    /// behind its normals, as the ground plane does.
+    #[arg(long, value_name = "FILE")]
+    pub collider: Vec<std::path::PathBuf>,
+    /// An object of the input used as a collider (repeatable): not smeared, not written.
+    #[arg(long, value_name = "NAME")]
+    pub collider_object: Vec<String>,
+}
+
+impl EffectArgs {
+    /// The style's subdivision and contact settings (issue #22), checked.
+    ///
+    /// # Errors
+    /// A tolerance below 1, a non-finite ground or a squash outside [0, 0.9].
+    pub fn shaping(&self) -> Result<(Option<f32>, Option<ContactStyle>), FlagError> {
+        let contact = self.ground.map(|g| ContactStyle {
+            ground: g,
+            squash: self.squash.unwrap_or(0.0),
+            squash_frames: self.squash_frames,
+        });
+        let probe = Style {
+            subdivide: self.subdivide,
+            contact: contact.clone(),
+            ..Style::default()
+        };
+        if let Err(e) = probe.validate() {
+            return Err(FlagError::Flag(
+                e.to_string()
+                    .replace("subdivide", "--subdivide")
+                    .replace("contact", "--ground/--squash"),
+            ));
+        }
+        Ok((self.subdivide, contact))
+    }
+
+    /// `--step`, checked.
+    ///
+    /// # Errors
+    /// A step of 0.
+    pub fn check_step(&self) -> Result<(), FlagError> {
+        if self.step == 0 {
+            return Err(FlagError::Flag(
+                "--step must be ≥ 1 (1 = on ones, 2 = on twos)".into(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The painted-weight source the flags ask for, if any.
+    pub fn weight_source(&self) -> Option<WeightSource> {
+        if !self.weight_group.is_empty() {
+            return Some(WeightSource::Group(WeightGroup {
+                group: self.weight_group.clone(),
+                descendants: !self.weight_group_only,
+            }));
+        }
+        if let Some(a) = &self.weight_attribute {
+            return Some(WeightSource::Attribute(WeightAttribute {
+                attribute: a.clone(),
+            }));
+        }
+        self.weight_expr
+            .as_ref()
+            .map(|e| WeightSource::Function(FunctionSpec::expr(e, &[])))
+    }
+
+    /// A preset stylization function, multiplied by ω when painted weights are given.
+    pub fn weighted(&self, mut preset: FunctionSpec) -> FunctionSpec {
+        if self.weight_source().is_some() && preset.expr.is_none() {
+            preset.stages.push(Stage::Weight);
+        }
+        preset
+    }
+
+    /// A style with only the offsets `prepared` was prepared with and the subdivision and
+    /// contact settings of the flags (the effects add themselves).
+    ///
+    /// # Errors
+    /// As [`EffectArgs::shaping`].
+    pub fn base_style(&self, prepared: &Prepared) -> Result<Style, FlagError> {
+        let (subdivide, contact) = self.shaping()?;
+        Ok(Style {
+            offsets: prepared.options().offsets.clone(),
+            subdivide,
+            contact,
+            ..Style::default()
+        })
+    }
+}
+
+/// Checks that a user function compiles, naming the flag that gave it.
+fn check(spec: &FunctionSpec, flag: &str) -> Result<(), FlagError> {
+    spec.compile()
+        .map(|_| ())
+        .map_err(|e| FlagError::Flag(format!("{flag}: {e}")))
+}

@@ -1,0 +1,422 @@
+//! The command-line flags of the stopmo jobs (cargo feature `clap`), declared next to the
+//! options they fill: [`SegmentOptionsArgs`] → [`SegmentJobOptions`] (`stopmo segment` and
+//! `stopmo run`), [`LibraryOptionsArgs`] → [`LibraryJobOptions`] (`stopmo library` and
+//! `stopmo run`), with the files the flags name (`--segmentation`, `--saliency`, `--fixed`)
+//! read through `tkio`.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use clap::{Args, ValueEnum};
+use glam::Vec3;
+
+use crate::library::{
+    Method, PlugOptions, SolveOptions, DEFAULT_LAMBDA, DEFAULT_PLUG_CLEARANCE_MM,
+    DEFAULT_PLUG_LENGTH_MM, DEFAULT_PLUG_RADIUS_MM, DEFAULT_PRINT_HEIGHT_MM, DEFAULT_RESTARTS,
+    DEFAULT_SEED, DEFAULT_THICKNESS_MM,
+};
+use crate::segment::{PartSpec, Seed, SegmentOptions, DEFAULT_GAMMA};
+use crate::{LibraryJobOptions, PieceCount, SegmentJobOptions};
+
+/// A flag whose value or file cannot be used, in the user's terms (`--part X: …`).
+#[derive(Debug, thiserror::Error)]
+pub enum FlagError {
+    /// A flag's value is wrong; the text names the flag.
+    #[error("{0}")]
+    Flag(String),
+    /// A flag or file (`at`) and what is wrong with it.
+    #[error("{at}")]
+    At {
+        /// The flag and value, or the file.
+        at: String,
+        /// What is wrong.
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
+    /// A file a flag names cannot be read.
+    #[error(transparent)]
+    Io(#[from] tkio::IoError),
+}
+
+type Result<T, E = FlagError> = std::result::Result<T, E>;
+
+macro_rules! bail {
+    ($($t:tt)*) => {
+        return Err(FlagError::Flag(format!($($t)*)))
+    };
+}
+
+/// Names the flag or file an error is about.
+trait At<T> {
+    fn with_context(self, at: impl FnOnce() -> String) -> Result<T>;
+}
+
+impl<T, E: std::error::Error + Send + Sync + 'static> At<T> for std::result::Result<T, E> {
+    fn with_context(self, at: impl FnOnce() -> String) -> Result<T> {
+        self.map_err(|e| FlagError::At {
+            at: at(),
+            source: Box::new(e),
+        })
+    }
+}
+
+impl<T> At<T> for Option<T> {
+    fn with_context(self, at: impl FnOnce() -> String) -> Result<T> {
+        self.ok_or_else(|| FlagError::Flag(at()))
+    }
+}
+
+/// Segmentation options shared by `stopmo segment` and `stopmo run`.
+#[derive(Debug, Args)]
+pub struct SegmentOptionsArgs {
+    /// A part and its seed: `NAME=tri:ID` (triangle id) or `NAME=point:X,Y,Z` (snapped to the
+    /// nearest triangle). Repeat for each part; repeat a name for several seeds.
+    #[arg(long = "part", value_name = "NAME=SEED")]
+    pub parts: Vec<String>,
+    /// Choose N parts automatically (farthest seeds on per-triangle motion statistics).
+    #[arg(long, conflicts_with = "parts")]
+    pub auto_parts: Option<usize>,
+    /// Weight γ of the seam term (StopShop Eq. 1), after scaling the model to a unit box;
+    /// ~1000 makes the cut independent of the exact seed placement (Fig. 4), much more
+    /// collapses it.
+    #[arg(long, default_value_t = DEFAULT_GAMMA)]
+    pub gamma: f64,
+    /// Laplacian smoothing iterations of the part boundaries (0: cut along mesh edges).
+    #[arg(long = "smooth-iters")]
+    pub smooth_iters: Option<usize>,
+    /// Keep the seams as they move (skip Section 3.2).
+    #[arg(long)]
+    pub no_homogenize: bool,
+    /// Reuse the cut and seam targets of an earlier segmentation of the same mesh (its
+    /// `segmentation.json`, or the `.glb` next to it): parts of both clips assemble together.
+    #[arg(long, value_name = "SEG.json|SEG.glb", conflicts_with_all = ["parts", "auto_parts"])]
+    pub segmentation: Option<PathBuf>,
+}
+
+impl SegmentOptionsArgs {
+    /// The job options (`figure`: also draw StopShop Fig. 5).
+    ///
+    /// # Errors
+    /// A bad `--part` or an unreadable `--segmentation` file.
+    pub fn options(&self, figure: bool) -> Result<SegmentJobOptions> {
+        let mut segment = SegmentOptions {
+            gamma: self.gamma,
+            homogenize: !self.no_homogenize,
+            ..SegmentOptions::default()
+        };
+        if let Some(k) = self.smooth_iters {
+            segment.smooth_iterations = k;
+        }
+        let reuse = match &self.segmentation {
+            Some(path) => Some(read_saved(path)?),
+            None => None,
+        };
+        Ok(SegmentJobOptions {
+            parts: parse_parts(&self.parts)?,
+            auto_parts: self.auto_parts,
+            figure,
+            reuse,
+            segment,
+        })
+    }
+}
+
+/// Reads `--segmentation`: a `segmentation.json` (a `.glb` stands for the `.json` of the same
+/// name next to it, as `stopmo run` writes them).
+fn read_saved(path: &Path) -> Result<crate::segment::SavedSegmentation> {
+    let json = if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+    {
+        path.with_extension("json")
+    } else {
+        path.to_path_buf()
+    };
+    let bytes =
+        tkio::read_file(&json).with_context(|| format!("--segmentation {}", path.display()))?;
+    crate::saved_segmentation(&String::from_utf8_lossy(&bytes))
+        .with_context(|| format!("--segmentation {}", json.display()))
+}
+
+/// Parses `NAME=tri:ID` or `NAME=point:X,Y,Z` and groups seeds by part name (in order).
+fn parse_parts(specs: &[String]) -> Result<Vec<PartSpec>> {
+    let mut parts: Vec<PartSpec> = Vec::new();
+    for s in specs {
+        let (name, seed) = s
+            .split_once('=')
+            .with_context(|| format!("--part {s}: expected NAME=tri:ID or NAME=point:X,Y,Z"))?;
+        let seed = if let Some(id) = seed.strip_prefix("tri:") {
+            Seed::Triangle(
+                id.trim()
+                    .parse()
+                    .with_context(|| format!("--part {s}: bad triangle id"))?,
+            )
+        } else if let Some(p) = seed.strip_prefix("point:") {
+            let v: Vec<f32> = p
+                .split(',')
+                .map(|x| x.trim().parse::<f32>())
+                .collect::<Result<_, _>>()
+                .with_context(|| format!("--part {s}: bad point"))?;
+            if v.len() != 3 || !v.iter().all(|x| x.is_finite()) {
+                bail!("--part {s}: a point needs three finite coordinates");
+            }
+            Seed::Point(Vec3::new(v[0], v[1], v[2]))
+        } else {
+            bail!("--part {s}: the seed must start with tri: or point:");
+        };
+        match parts.iter_mut().find(|p| p.name == name) {
+            Some(p) => p.seeds.push(seed),
+            None => parts.push(PartSpec::new(name, vec![seed])),
+        }
+    }
+    Ok(parts)
+}
+
+/// Which algorithm picks the pieces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum MethodArg {
+    /// Positions and velocities (StopShop Eq. 10, λ from --lambda).
+    #[default]
+    Stopshop,
+    /// λ = 0: k-means on positions only.
+    Kmeans,
+    /// Uniform temporal sampling (the naive baseline).
+    Uniform,
+}
+
+impl From<MethodArg> for Method {
+    fn from(m: MethodArg) -> Method {
+        match m {
+            MethodArg::Stopshop => Method::StopShop,
+            MethodArg::Kmeans => Method::KMeans,
+            MethodArg::Uniform => Method::Uniform,
+        }
+    }
+}
+
+/// Library options shared by `stopmo library` and `stopmo run`.
+#[derive(Debug, Args)]
+pub struct LibraryOptionsArgs {
+    /// Pieces per part: `20` for every part, or `upper=20,lower=30`.
+    #[arg(long, value_name = "N|PART=N,...", conflicts_with_all = ["max_error", "budget"])]
+    pub pieces: Option<String>,
+    /// Smallest library per part whose worst frame's mean position error is at most this many
+    /// millimetres (at --print-height).
+    #[arg(long, value_name = "MM", conflicts_with = "budget")]
+    pub max_error: Option<f64>,
+    /// Total number of pieces over all parts, allocated greedily.
+    #[arg(long, value_name = "PIECES")]
+    pub budget: Option<usize>,
+    /// Velocity weight λ of StopShop Eq. 10.
+    #[arg(long, default_value_t = DEFAULT_LAMBDA)]
+    pub lambda: f64,
+    /// Random restarts (run in parallel, the best is kept).
+    #[arg(long, default_value_t = DEFAULT_RESTARTS)]
+    pub restarts: usize,
+    /// Seed of every random choice (default: the tool's fixed seed; runs are reproducible).
+    #[arg(long, value_name = "SEED")]
+    pub seed: Option<u64>,
+    /// Per-vertex saliency weights: float32 `.npy` of shape (vertices,) or (1, vertices), in
+    /// the merged vertex order of the input (parts one after the other; for `stopmo run`, the
+    /// input mesh's own vertex order, checked before anything is written).
+    #[arg(long, value_name = "FILE.npy")]
+    pub saliency: Option<PathBuf>,
+    /// Frames that start a new, unrelated shot (no velocity term across them).
+    #[arg(long, value_delimiter = ',')]
+    pub cuts: Vec<usize>,
+    /// Directory of pre-made pieces `<part>_<NN>.obj` (e.g. `OLD/pieces` of an earlier run);
+    /// they are kept and new pieces are added up to the library size. The printed back
+    /// surfaces `<part>_back.obj` there are reused, so the new pieces seat on the same head.
+    #[arg(long, value_name = "DIR")]
+    pub fixed: Option<PathBuf>,
+    /// Algorithm.
+    #[arg(long, value_enum, default_value_t = MethodArg::Stopshop)]
+    pub method: MethodArg,
+    /// Printed height of the whole model in millimetres (scales the STL files and the errors).
+    #[arg(long, value_name = "MM", default_value_t = DEFAULT_PRINT_HEIGHT_MM)]
+    pub print_height: f64,
+    /// Wall thickness of the printed pieces in millimetres.
+    #[arg(long, value_name = "MM", default_value_t = DEFAULT_THICKNESS_MM)]
+    pub thickness: f64,
+    /// Add male/female plugs (paper Fig. 13) across every seam shared by two parts: a pin
+    /// under the first part, a socket tube under the second, fused into the pieces' STL files
+    /// as extra shells (slicers union them). Placed on the rest geometry; listed in
+    /// report.json under "plugs".
+    #[arg(long)]
+    pub plugs: bool,
+    /// Pin radius of the plugs in millimetres.
+    #[arg(long, value_name = "MM", requires = "plugs", default_value_t = DEFAULT_PLUG_RADIUS_MM)]
+    pub plug_radius: f64,
+    /// Plug length (boss + pin) in millimetres.
+    #[arg(long, value_name = "MM", requires = "plugs", default_value_t = DEFAULT_PLUG_LENGTH_MM)]
+    pub plug_length: f64,
+    /// Radial clearance between pin and socket in millimetres (tune to the printer).
+    #[arg(long, value_name = "MM", requires = "plugs",
+          default_value_t = DEFAULT_PLUG_CLEARANCE_MM)]
+    pub plug_clearance: f64,
+    /// Printer resolution in millimetres: pieces that differ from a sibling by less are
+    /// reported (a warning and report.json "printing.parts[].below_resolution").
+    #[arg(long, value_name = "MM", default_value_t = crate::DEFAULT_RESOLUTION_MM)]
+    pub resolution: f64,
+    /// No registration keys (domes on the shared back surface that fix all six degrees of
+    /// freedom on the armature/head).
+    #[arg(long)]
+    pub no_keys: bool,
+    /// No piece ID (`P-NN`) embossed on the back of every piece.
+    #[arg(long)]
+    pub no_ids: bool,
+    /// Also write the JSON report here (it is always written to DIR/report.json).
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+}
+
+impl LibraryOptionsArgs {
+    /// The job options for parts named `names`, reading the saliency and fixed-piece files.
+    ///
+    /// # Errors
+    /// A bad `--pieces`, `--max-error` or `--thickness`, or an unreadable `--saliency` file
+    /// or `--fixed` folder.
+    pub fn options(&self, names: &[String]) -> Result<LibraryJobOptions> {
+        let pieces = match (&self.pieces, self.max_error, self.budget) {
+            (Some(p), _, _) => parse_pieces(p)?,
+            (None, Some(e), _) => {
+                if !(e.is_finite() && e > 0.0) {
+                    bail!("--max-error must be a positive number of millimetres, got {e}");
+                }
+                PieceCount::MaxErrorMm(e)
+            }
+            (None, None, Some(b)) => PieceCount::Budget(b),
+            (None, None, None) => PieceCount::default(),
+        };
+        if !(self.thickness.is_finite() && self.thickness > 0.0) {
+            bail!("--thickness must be a positive number of millimetres");
+        }
+        let saliency = match &self.saliency {
+            Some(p) => Some(read_saliency(p)?),
+            None => None,
+        };
+        let (fixed, backs) = match &self.fixed {
+            Some(dir) => (read_fixed(dir, names)?, read_backs(dir, names)?),
+            None => (BTreeMap::new(), BTreeMap::new()),
+        };
+        Ok(LibraryJobOptions {
+            pieces,
+            method: self.method.into(),
+            solve: SolveOptions {
+                lambda: self.lambda,
+                restarts: self.restarts,
+                seed: self.seed.unwrap_or(DEFAULT_SEED),
+                ..SolveOptions::default()
+            },
+            print_height_mm: self.print_height,
+            thickness_mm: self.thickness,
+            plugs: self.plugs.then(|| PlugOptions {
+                radius_mm: self.plug_radius,
+                length_mm: self.plug_length,
+                clearance_mm: self.plug_clearance,
+                ..PlugOptions::default()
+            }),
+            saliency,
+            cuts: self.cuts.clone(),
+            fixed,
+            backs,
+            resolution_mm: self.resolution,
+            keys: !self.no_keys,
+            ids: !self.no_ids,
+        })
+    }
+
+    /// Names the file or option a library error is about: `--saliency FILE`, `--fixed DIR`,
+    /// `--pieces …`, otherwise the input.
+    pub fn context(&self, e: crate::Error, input: &Path) -> FlagError {
+        let at = match (e.option(), &self.saliency, &self.fixed) {
+            (Some("saliency"), Some(p), _) => p.display().to_string(),
+            (Some("fixed"), _, Some(d)) => format!("--fixed {}", d.display()),
+            (Some("resolution_mm"), _, _) => format!("--resolution {}", self.resolution),
+            (Some("pieces"), _, _) => format!("--pieces {}", self.pieces.as_deref().unwrap_or("")),
+            _ => input.display().to_string(),
+        };
+        FlagError::At {
+            at,
+            source: Box::new(e),
+        }
+    }
+}
+
+/// Parses `--pieces`: `N` or `PART=N,...`.
+fn parse_pieces(spec: &str) -> Result<PieceCount> {
+    let spec = spec.trim();
+    if let Ok(n) = spec.parse::<usize>() {
+        return Ok(PieceCount::Each(n));
+    }
+    let mut sizes = BTreeMap::new();
+    for item in spec.split(',') {
+        let (name, n) = item
+            .split_once('=')
+            .with_context(|| format!("--pieces {spec}: expected N or PART=N,..."))?;
+        let n: usize = n
+            .trim()
+            .parse()
+            .with_context(|| format!("--pieces {spec}: bad count '{n}'"))?;
+        sizes.insert(name.trim().to_string(), n);
+    }
+    Ok(PieceCount::PerPart(sizes))
+}
+
+/// The saliency weights of a float32 `.npy` of shape (vertices,) or (1, vertices).
+fn read_saliency(path: &Path) -> Result<Vec<f32>> {
+    let bytes = tkio::read_file(path)?;
+    let (shape, values) = tkio::npy::read_f32(&bytes).map_err(|e| e.at(path))?;
+    if !matches!(shape.as_slice(), [_] | [1, _]) {
+        bail!(
+            "{}: saliency shape {shape:?}, expected (vertices,) or (1, vertices) (one weight per vertex)",
+            path.display()
+        );
+    }
+    Ok(values)
+}
+
+/// The fixed pieces `<part>_<NN>.obj` in `dir` of every part in `names`, in file-name order.
+fn read_fixed(dir: &Path, names: &[String]) -> Result<BTreeMap<String, Vec<Vec<Vec3>>>> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .with_context(|| format!("--fixed {}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "obj"))
+        .collect();
+    files.sort();
+    let mut out = BTreeMap::new();
+    for name in names {
+        let prefix = format!("{name}_");
+        let pieces = files
+            .iter()
+            .filter(|p| {
+                p.file_stem().and_then(|s| s.to_str()).is_some_and(|s| {
+                    s.strip_prefix(&prefix)
+                        .is_some_and(|n| !n.is_empty() && n.chars().all(|c| c.is_ascii_digit()))
+                })
+            })
+            .map(|f| {
+                Ok(tkio::obj::read(&tkio::read_file(f)?)
+                    .map_err(|e| e.at(f))?
+                    .positions)
+            })
+            .collect::<Result<Vec<_>>>()?;
+        if !pieces.is_empty() {
+            out.insert(name.clone(), pieces);
+        }
+    }
+    Ok(out)
+}
+
+/// The printed back surfaces `<part>_back.obj` in `dir` of the parts in `names` (those present).
+fn read_backs(dir: &Path, names: &[String]) -> Result<BTreeMap<String, Vec<Vec3>>> {
+    let mut out = BTreeMap::new();
+    for name in names {
+        let f = dir.join(format!("{name}_back.obj"));
+        if f.is_file() {
+            let mesh = tkio::obj::read(&tkio::read_file(&f)?).map_err(|e| e.at(&f))?;
+            out.insert(name.clone(), mesh.positions);
+        }
+    }
+    Ok(out)
+}
