@@ -123,7 +123,10 @@ impl PropertyHeader {
         if constant || f < self.first_changed {
             0
         } else if f >= self.last_changed {
-            self.last_changed - self.first_changed + 1
+            // Saturating: a malformed header may have its last change before its first.
+            self.last_changed
+                .saturating_sub(self.first_changed)
+                .saturating_add(1)
         } else {
             f - self.first_changed + 1
         }
