@@ -255,18 +255,6 @@ fn files_of_real_exporters_read_like_the_plain_gltf() {
     assert!(checked >= 4, "no exported file found in {}", dir.display());
 }
 
-/// Every vertex of an OBJ file (Assimp's own reading of the ASCII FBX).
-fn obj_points(path: &Path) -> Vec<Vec3> {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    text.lines()
-        .filter_map(|l| l.strip_prefix("v "))
-        .map(|l| {
-            let v: Vec<f32> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
-            Vec3::new(v[0], v[1], v[2])
-        })
-        .collect()
-}
-
 /// ASCII FBX 7.5 written by a second real exporter (Assimp, Debian's `assimp-utils`; Blender
 /// writes binary FBX only): the geometry toonkit reads equals Assimp's own reading of the same
 /// file (`{name}_ascii.obj`, which ignores the file's units) once the declared centimetres are
@@ -305,7 +293,9 @@ fn ascii_fbx_reads_like_its_exporter_reads_it() {
         let mut rest = scene.clone();
         rest.clips.clear();
         let ours: Vec<Vec3> = frames(&rest, None)[0].iter().map(|p| *p * 100.0).collect();
-        let theirs = obj_points(&dir.join(format!("{name}_ascii.obj")));
+        let obj = dir.join(format!("{name}_ascii.obj"));
+        let bytes = std::fs::read(&obj).unwrap_or_else(|e| panic!("{}: {e}", obj.display()));
+        let theirs = tkio::obj::read(&bytes).unwrap().positions;
         let d = directed(&ours, &theirs).max(directed(&theirs, &ours)) / diagonal(&theirs);
         println!(
             "{}: {} vertices, {} clip(s), largest distance to Assimp's reading {d:.2e} of the diagonal",
