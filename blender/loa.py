@@ -12,7 +12,11 @@ import bpy
 from bpy.props import (CollectionProperty, EnumProperty, FloatProperty, IntProperty,
                        StringProperty)
 
-# The CLI's preset names (`toonkit loa animate --bones NAME`), and a custom joint list.
+from . import loa_bones
+
+# The CLI's preset names (`toonkit loa animate --bones NAME`, found from humanoid bone names),
+# the presets read from the armature's hierarchy (`loa_bones`, for any bone names), and a
+# custom joint list.
 PRESETS = [
     ("right-leg-spine-head", "Right leg, spine, head",
      "Right foot → right leg → spine → head"),
@@ -22,6 +26,7 @@ PRESETS = [
     ("arms", "Arms", "Left hand → arms and shoulders → right hand"),
     ("legs", "Legs", "Left foot → legs → right foot"),
     ("full-body", "Full body", "Left foot → left leg → spine → right arm → right hand"),
+    *loa_bones.PRESETS,
     ("CUSTOM", "Bones…", "A comma-separated list of bones along the line (e.g. FootR,Head)"),
 ]
 
@@ -38,14 +43,6 @@ class LoaBoneKey(bpy.types.PropertyGroup):
     preset: EnumProperty(name="Bones", items=PRESETS, default="right-leg-spine-head")
     joints: StringProperty(name="Bone list", default="",
                            description="Comma-separated bones (when the set is 'Bones…')")
-
-
-def bone_set(preset, joints):
-    """The CLI's SET text of a preset or a custom bone list."""
-    if preset != "CUSTOM":
-        return preset
-    names = [j.strip() for j in joints.split(",") if j.strip()]
-    return ",".join(names)
 
 
 class LoaSettings(bpy.types.PropertyGroup):
@@ -68,11 +65,12 @@ class LoaSettings(bpy.types.PropertyGroup):
                               description="Bevel of the line curve; 0 = 0.5 % of the height")
 
 
-def bone_sets(s, first_frame):
-    """The `--bones` values: the first set at `first_frame`, then the per-frame ones."""
-    out = [f"{bone_set(s.bones, s.joints)}@{first_frame}"]
+def bone_sets(s, first_frame, armature, ref):
+    """The `--bones` values: the first set at `first_frame`, then the per-frame ones
+    (hierarchy presets resolved on `armature` posed as `ref`)."""
+    out = [f"{loa_bones.bone_set(armature, ref, s.bones, s.joints)}@{first_frame}"]
     for k in sorted(s.bone_keys, key=lambda k: k.frame):
-        out.append(f"{bone_set(k.preset, k.joints)}@{k.frame}")
+        out.append(f"{loa_bones.bone_set(armature, ref, k.preset, k.joints)}@{k.frame}")
     return out
 
 

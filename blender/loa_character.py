@@ -26,13 +26,13 @@ import os
 import bpy
 from mathutils import Matrix, Quaternion, Vector
 
-from . import job
+from . import job, loa_bones
 
 VIRTUAL_ROOT = "toonkit_loa_root"  # joins several root bones under one BVH ROOT
 
 
 def _name(bone):
-    name = "_".join(bone.name.split())
+    name = loa_bones.bvh_name(bone.name)
     if not name or "{" in name or "}" in name:
         raise job.JobError(f"bone '{bone.name}' cannot be named in a BVH file")
     return name

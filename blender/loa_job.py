@@ -11,7 +11,7 @@ import tempfile
 
 import bpy
 
-from . import job, loa, loa_character, loa_strokes, results
+from . import job, loa, loa_bones, loa_character, loa_strokes, results
 
 ROLE = "loa line"
 
@@ -38,6 +38,9 @@ def solve(context, armature):
     ref = loa_character.Reference(context.scene, armature, context.scene.frame_start)
     center, size = loa_character.center(armature, ref)
     view = loa_strokes.View(camera, center)
+    bones = loa.bone_sets(s, strokes[0][0], armature, ref)
+    first = loa_bones.first_point(armature, ref, s.bones, s.joints)
+    strokes = loa_strokes.oriented(strokes, view, first)
     keys = []
     for frame, pts in strokes:
         k = {"frame": frame, "points": [view.screen(p) for p in pts]}
@@ -51,17 +54,26 @@ def solve(context, armature):
     try:
         names = loa_character.write_bvh(armature, ref, loa_character.bvh_path(folder))
         line = toonkit.loa.line(keys, mode=s.mode, fps=fps)
-        motion = toonkit.loa.animate(loa_character.bvh_path(folder), line,
-                                     bones=loa.bone_sets(s, strokes[0][0]),
+        motion = toonkit.loa.animate(loa_character.bvh_path(folder), line, bones=bones,
                                      **view.as_options())
         pose = loa_character.pose_keys(armature, motion, names, ref)
     except (toonkit.ToonkitError, ValueError, OSError) as e:
         # The character file is ours and temporary: name the armature instead.
         text = job._one_line(e).replace(loa_character.bvh_path(folder), armature.name)
+        if "found for the preset" in text:  # a name preset on other bone names
+            text = (f"{armature.name}: the bone names do not fit a name preset "
+                    f"({text.split(': ', 1)[-1].split(' (joints:')[0]}); choose "
+                    f"'{loa_bones.PRESETS[0][1]}' or list bones ({_bone_list(armature)})")
         raise job.JobError(text) from e
     finally:
         shutil.rmtree(folder, ignore_errors=True)
     return line, motion, pose, view, strokes, size
+
+
+def _bone_list(armature, most=12):
+    names = [b.name for b in armature.data.bones]
+    more = f", … {len(names) - most} more" if len(names) > most else ""
+    return ", ".join(names[:most]) + more
 
 
 def animate(context, armature):

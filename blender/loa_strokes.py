@@ -76,6 +76,22 @@ def keystrokes(obj):
     return sorted(by_frame.items())
 
 
+def oriented(strokes, view, first):
+    """The keystrokes with their first points on the bone set's first point (LoA maps a
+    stroke's start onto the chain's start): when the first keystroke's end is nearer `first`
+    (world, the chain's first point in the start pose; None: unknown, strokes kept as drawn)
+    in the view than its start, the user drew from the other end and every keystroke is
+    reversed (one sense for all keys, so a key where the body turns over stays as drawn)."""
+    if first is None:
+        return strokes
+    at = Vector(view.screen(first))
+    pts = strokes[0][1]
+    start, end = Vector(view.screen(pts[0])), Vector(view.screen(pts[-1]))
+    if (end - at).length >= (start - at).length:
+        return strokes
+    return [(frame, list(reversed(p))) for frame, p in strokes]
+
+
 class View:
     """The active camera as the loa crate's `ActionCamera`, in world space."""
 

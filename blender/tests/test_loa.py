@@ -26,6 +26,8 @@ import numpy as np  # noqa: E402
 from mathutils import Vector  # noqa: E402
 
 from harness import ASSETS, argv_after_dashes, check, empty_scene, install, run  # noqa: E402
+from loa_check import (drawn_strokes, fitted_camera, follows, grease_pencil,  # noqa: E402
+                       skeleton)
 
 ARGS = argv_after_dashes()
 ZIP = os.path.abspath(ARGS[0])
@@ -59,73 +61,6 @@ def robot():
     arm.select_set(True)
     bpy.context.view_layer.objects.active = arm
     return scene, arm, cam
-
-
-def grease_pencil(scene, keys, depth=0.0):
-    """A Grease Pencil object with one stroke per (frame, points), in this Blender's API."""
-    data = (getattr(bpy.data, "grease_pencils_v3", None) or bpy.data.grease_pencils).new("Line")
-    obj = bpy.data.objects.new("Line", data)
-    scene.collection.objects.link(obj)
-    layer = data.layers.new("strokes")
-    for frame, pts in keys:
-        fr = layer.frames.new(frame)
-        pts = [(x, y + depth, z) for x, y, z in pts]
-        for extra in (False, True):  # a short second stroke: the longest one is the key
-            p = pts[:3] if extra else pts
-            if obj.type == "GPENCIL":
-                s = fr.strokes.new()
-                s.points.add(len(p))
-                for q, c in zip(s.points, p):
-                    q.co = c
-            else:
-                fr.drawing.add_strokes([len(p)])
-                s = fr.drawing.strokes[len(fr.drawing.strokes) - 1]
-                for q, c in zip(s.points, p):
-                    q.position = c
-    return obj
-
-
-def image(cam, points):
-    """Camera image-plane coordinates (tangents) of world points."""
-    m = cam.matrix_world.inverted()
-    out = []
-    for p in points:
-        q = m @ Vector(p)
-        out.append((q.x / -q.z, q.y / -q.z))
-    return np.array(out)
-
-
-def to_polyline(points, line):
-    """Distance of each point to the polyline `line` (2D)."""
-    a, b = line[:-1], line[1:]
-    ab = b - a
-    d = []
-    for p in points:
-        t = np.clip(((p - a) * ab).sum(1) / np.maximum((ab * ab).sum(1), 1e-30), 0.0, 1.0)
-        d.append(np.linalg.norm(a + t[:, None] * ab - p, axis=1).min())
-    return np.array(d)
-
-
-def to_segments(points, a, b):
-    ab = b - a
-    t = np.clip(((points[:, None] - a) * ab).sum(2) / np.maximum((ab * ab).sum(1), 1e-30), 0, 1)
-    return np.linalg.norm(a + t[..., None] * ab - points[:, None], axis=2).min(1)
-
-
-def line_points(obj):
-    return [obj.matrix_world @ Vector(p.co[:3]) for p in obj.data.splines[0].points]
-
-
-def skeleton(arm):
-    """World (parent head, head) segments of the evaluated pose."""
-    dg = bpy.context.evaluated_depsgraph_get()
-    ev = arm.evaluated_get(dg)
-    a, b = [], []
-    for pb in ev.pose.bones:
-        if pb.parent is not None:
-            a.append(ev.matrix_world @ pb.parent.head)
-            b.append(ev.matrix_world @ pb.head)
-    return a, b
 
 
 class IdentityMotion:
@@ -175,58 +110,62 @@ def test_loa_identity_reproduces_the_start_pose():
 
 def test_loa_animate_follows_the_strokes():
     scene, arm, cam = robot()
-    previous = arm.animation_data.action
-    keys = [(f, stroke(f)) for f in (1, 12, 24)]
-    gp = grease_pencil(scene, keys)
-    scene.frame_set(scene.frame_start)
-    start = skeleton(arm)
-    if OUT:
-        render(scene, os.path.join(OUT, "loa_start.png"), scene.frame_start)
-    r = bpy.ops.toonkit.loa_animate()
-    check(r == {"FINISHED"}, f"loa_animate returned {r}")
-    action = arm.animation_data.action
-    check(action is not None and action != previous, "no new action")
-    check(previous.name in bpy.data.actions and previous.use_fake_user,
-          "the previous action was not kept")
-    line = next(o for o in bpy.data.objects if o.get("toonkit_role") == "loa line")
-    check(line.type == "CURVE", f"the line is a {line.type}")
-    print(f"  {gp.type}: action '{action.name}', line '{line.name}'")
-    ours, rest, begin = [], [], []
-    for f, pts in keys:
-        scene.frame_set(f)
-        drawn = image(cam, [gp.matrix_world @ Vector(p) for p in pts])
-        shown = image(cam, line_points(line))
-        length = float(np.linalg.norm(np.diff(drawn, axis=0), axis=1).sum())
-        gap = max(to_polyline(drawn, shown).max(), to_polyline(shown, drawn).max()) / length
-        print(f"  frame {f}: line to stroke {100 * gap:.2f} % of the stroke length")
-        check(gap <= 0.02, f"frame {f}: the line is {100 * gap:.2f} % of the stroke away")
-        a, b = skeleton(arm)
-        ours.append(to_segments(shown, image(cam, a), image(cam, b)).mean() / length)
-        arm.data.pose_position = "REST"
-        scene.frame_set(f)
-        a, b = skeleton(arm)
-        rest.append(to_segments(shown, image(cam, a), image(cam, b)).mean() / length)
-        arm.data.pose_position = "POSE"
-        begin.append(to_segments(shown, image(cam, start[0]), image(cam, start[1])).mean()
-                     / length)
-        print(f"  frame {f}: line → skeleton {100 * ours[-1]:.2f} % "
-              f"(starting pose {100 * begin[-1]:.2f} %, rest pose {100 * rest[-1]:.2f} %)")
-    print(f"  mean distance line → skeleton: {100 * np.mean(ours):.2f} % of the stroke length "
-          f"(starting pose {100 * np.mean(begin):.2f} %, rest pose {100 * np.mean(rest):.2f} %)")
-    check(np.mean(ours) < 0.6 * np.mean(begin),
-          f"the character does not move toward the line: {np.mean(ours)} vs {np.mean(begin)}")
-    if OUT:
-        render(scene, os.path.join(OUT, "loa_frame24.png"), 24)
+    follows(scene, arm, cam, [(f, stroke(f)) for f in (1, 12, 24)], OUT)
 
 
-def render(scene, path, frame):
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    scene.frame_set(frame)
-    scene.render.engine = "BLENDER_WORKBENCH"
-    scene.render.resolution_x, scene.render.resolution_y = 640, 480
-    scene.render.filepath = path
-    bpy.ops.render.render(write_still=True)
-    print(f"  rendered {path}")
+def cesium(yaw_deg=0.0):
+    """CesiumMan (its walk's first frame is the start pose), a camera fitted to its skeleton,
+    and the hierarchy's foot-to-head bone set (its bone names fit no name preset)."""
+    scene = empty_scene()
+    scene.render.fps = 24
+    scene.frame_start, scene.frame_end = 1, 30
+    bpy.ops.import_scene.gltf(filepath=os.path.join(ASSETS, "CesiumMan.glb"))
+    arm = next(o for o in bpy.data.objects if o.type == "ARMATURE")
+    for o in bpy.data.objects:
+        o.select_set(False)
+    arm.select_set(True)
+    bpy.context.view_layer.objects.active = arm
+    cam = fitted_camera(scene, arm, yaw_deg)
+    scene.toonkit_loa.bones = "foot-head"
+    return scene, arm, cam
+
+
+def test_loa_cesium_follows_the_strokes():
+    """A second armature: strokes drawn to CesiumMan's size in a fitted camera."""
+    scene, arm, cam = cesium()
+    keys = drawn_strokes(scene, arm, cam, (1, 12, 24))
+    gaps, ours, begin = follows(scene, arm, cam, keys, OUT, "cesium")
+    # Drawn from the head down: the same keystrokes once oriented, so the same motion.
+    scene, arm, cam = cesium()
+    back = follows(scene, arm, cam, drawn_strokes(scene, arm, cam, (1, 12, 24), reverse=True))
+    print(f"  drawn head first: line → skeleton {100 * back[1]:.2f} % (foot first "
+          f"{100 * ours:.2f} %)")
+    check(abs(back[1] - ours) <= 1e-6 * ours, f"drawn head first: {back[1]} vs {ours}")
+
+
+def test_loa_cesium_turned_camera():
+    """The camera turned 30° about Z (not axis-aligned) with strokes drawn in its view."""
+    scene, arm, cam = cesium(30.0)
+    follows(scene, arm, cam, drawn_strokes(scene, arm, cam, (1, 12, 24)))
+
+
+def test_loa_cesium_name_preset():
+    """A name preset on CesiumMan's bone names: one line naming the hierarchy preset, the
+    scene unchanged."""
+    scene, arm, cam = cesium()
+    grease_pencil(scene, drawn_strokes(scene, arm, cam, (1, 12)))
+    scene.toonkit_loa.bones = "right-leg-spine-head"
+    before = (sorted(o.name for o in bpy.data.objects), sorted(a.name for a in bpy.data.actions))
+    try:
+        bpy.ops.toonkit.loa_animate()
+    except RuntimeError as e:
+        text = str(e).strip()
+        print(f"  {text}")
+        check("Foot to head" in text and "\n" not in text, f"message {e!r}")
+    else:
+        raise AssertionError("a name preset on CesiumMan's bones gave no error")
+    check(before == (sorted(o.name for o in bpy.data.objects),
+                     sorted(a.name for a in bpy.data.actions)), "the scene changed")
 
 
 def test_loa_errors():
@@ -264,5 +203,6 @@ def test_loa_errors():
 
 if __name__ == "__main__":
     code = run([test_loa_errors, test_loa_identity_reproduces_the_start_pose,
-                test_loa_animate_follows_the_strokes])
+                test_loa_animate_follows_the_strokes, test_loa_cesium_follows_the_strokes,
+                test_loa_cesium_turned_camera, test_loa_cesium_name_preset])
     os._exit(code)  # bpy's interpreter teardown can crash after a headless run
