@@ -7,11 +7,14 @@ points the CLI tests use; `toonkit.stopmo_run` must write the same `assembly.csv
 `toonkit.stopmo.run` on the same evaluated data (the module equals the CLI: crates/python/tests),
 and the reconstruction object must show at frame k the pieces of `assembly.csv` row k.
 Without vertex groups, the same seed points picked at the 3D cursor must give the CLI's
-result for those seed points (the .glb loaded as the CLI loads it).
+result for those seed points (the .glb loaded as the CLI loads it). A second mesh, Suzanne
+subdivided once and animated by two shape keys, split into upper and lower parts by two
+3D-cursor seeds, must give the module's library and show it the same way.
 """
 
 import csv
 import json
+import math
 import os
 import sys
 
@@ -22,6 +25,7 @@ os.environ.setdefault("BLENDER_USER_RESOURCES", os.path.join(
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
+from mathutils import Vector  # noqa: E402
 
 from harness import (REPO, argv_after_dashes, check, empty_scene, install, run,  # noqa: E402
                      tmpdir, world_positions)
@@ -86,10 +90,16 @@ def test_stopmo_run_matches_the_module():
                                                        fps=taken.fps),
                              parts=parts, **stopmo.options(s))
     same_as(folder, ref, os.path.join(OUT, "module"))
+    shows_assembly(scene, folder, ref)
+    check(bpy.data.images.get("toonkit error curve") is not None or s.count == "EACH",
+          "no size-vs-error image")
+
+
+def shows_assembly(scene, folder, ref):
+    """Pieces were written, and the reconstruction object shows at frame k the pieces of
+    `assembly.csv` row k (those of the library `ref`, equal to the operator's)."""
     pieces = sorted(os.listdir(os.path.join(folder, "pieces")))
     check(len(pieces) > 0, "no pieces written")
-
-    # The reconstruction shows at frame k the pieces of assembly.csv row k.
     rec = next(o for o in bpy.data.objects if o.get("toonkit_role") == "stopmo")
     rows = list(csv.reader(open(os.path.join(folder, "assembly.csv"))))
     header, rows = rows[0], rows[1:]
@@ -108,8 +118,7 @@ def test_stopmo_run_matches_the_module():
         check(set(shown) <= set(rows[k]), f"frame {f}: {shown} not in {rows[k]}")
         check(set(np.unique(piece)) == set(int(i) for i in labels[k]),
               f"frame {f}: piece attribute {np.unique(piece)} vs labels {labels[k]}")
-    check(bpy.data.images.get("toonkit error curve") is not None or s.count == "EACH",
-          "no size-vs-error image")
+    return pieces, rows
 
 
 def test_stopmo_cursor_seeds():
@@ -147,6 +156,60 @@ def test_stopmo_cursor_seeds():
     refused("bad-seeds", "at least two parts")
 
 
+def suzanne():
+    """Blender's Suzanne subdivided once, animated over 12 frames by two shape keys: the jaw
+    (below the nose) opens and closes, the brow (above the eyes) rises and falls, at other
+    rates."""
+    scene = empty_scene()
+    scene.render.fps = 12
+    scene.frame_start, scene.frame_end = 1, 12
+    bpy.ops.mesh.primitive_monkey_add(size=2.0)
+    obj = bpy.context.active_object
+    mod = obj.modifiers.new("subdivide", "SUBSURF")
+    mod.levels = 1
+    bpy.ops.object.modifier_apply(modifier=mod.name)
+    obj.shape_key_add(name="Basis")
+    for name, moved in (("jaw", lambda c: (0.0, -0.1, -0.35) if c.z < -0.15 else None),
+                        ("brow", lambda c: (0.0, 0.05, 0.25) if c.z > 0.35 else None)):
+        key = obj.shape_key_add(name=name, from_mix=False)
+        for v, k in zip(obj.data.vertices, key.data):
+            d = moved(v.co)
+            if d is not None:
+                w = min(1.0, abs(v.co.z - (-0.15 if name == "jaw" else 0.35)) / 0.3)
+                k.co = v.co + w * Vector(d)
+        for f in range(scene.frame_start, scene.frame_end + 1):
+            rate = 6.0 if name == "jaw" else 4.0
+            key.value = 0.5 - 0.5 * math.cos(2.0 * math.pi * (f - 1) / rate)
+            key.keyframe_insert("value", frame=f)
+    return scene, obj
+
+
+def test_stopmo_cursor_seeds_suzanne():
+    """A second mesh: Suzanne's upper and lower halves from two 3D-cursor seeds; the pieces
+    and assembly.csv written, the reconstruction showing row k at frame k."""
+    scene, obj = suzanne()
+    s = scene.toonkit_stopmo
+    s.count, s.pieces, s.restarts, s.seed = "EACH", 3, 1, 1
+    seeds = {"upper": (0.0, -0.6, 0.75), "lower": (0.0, -0.8, -0.45)}
+    for name, seed in seeds.items():
+        scene.cursor.location = seed
+        check(bpy.ops.toonkit.stopmo_add_seed(part=name) == {"FINISHED"}, "no seed added")
+    folder = os.path.join(OUT, "stopmo-suzanne")
+    r = bpy.ops.toonkit.stopmo_run(directory=folder)
+    check(r == {"FINISHED"}, f"stopmo_run returned {r}")
+    from bl_ext.user_default.toonkit import sample, stopmo
+
+    taken = sample.sample(bpy.context, [obj])
+    ref = toonkit.stopmo.run(toonkit.Scene.from_arrays(taken.positions, taken.triangles,
+                                                       fps=taken.fps),
+                             parts={n: [p] for n, p in seeds.items()}, **stopmo.options(s))
+    ours, _ = same_as(folder, ref, os.path.join(OUT, "suzanne-module"))
+    pieces, rows = shows_assembly(scene, folder, ref)
+    sizes = {p["name"]: p["vertices"] for p in ours["parts"]}
+    print(f"  Suzanne: {len(pieces)} piece files, {len(rows)} assembly rows, parts {sizes}, "
+          f"energy {ours['energy']!r}")
+
+
 def refused(directory, expect):
     """`stopmo_run` fails with `expect` in its one-line message and adds no object."""
     before = sorted(o.name for o in bpy.data.objects)
@@ -166,5 +229,6 @@ def test_stopmo_errors():
 
 
 if __name__ == "__main__":
-    code = run([test_stopmo_errors, test_stopmo_cursor_seeds, test_stopmo_run_matches_the_module])
+    code = run([test_stopmo_errors, test_stopmo_cursor_seeds, test_stopmo_run_matches_the_module,
+                test_stopmo_cursor_seeds_suzanne])
     os._exit(code)  # bpy's interpreter teardown can crash after a headless run
