@@ -6,6 +6,7 @@ scene is touched; then the armature gets a new Action and the line is shown as a
 (`<armature> line of action`, toonkit-owned) whose points are keyed at every frame.
 """
 
+import re
 import shutil
 import tempfile
 
@@ -60,10 +61,12 @@ def solve(context, armature):
     except (toonkit.ToonkitError, ValueError, OSError) as e:
         # The character file is ours and temporary: name the armature instead.
         text = job._one_line(e).replace(loa_character.bvh_path(folder), armature.name)
-        if "found for the preset" in text:  # a name preset on other bone names
-            text = (f"{armature.name}: the bone names do not fit a name preset "
-                    f"({text.split(': ', 1)[-1].split(' (joints:')[0]}); choose "
-                    f"'{loa_bones.PRESETS[0][1]}' or list bones ({_bone_list(armature)})")
+        role = re.search(r"no (\w+) joint found for the preset", text)
+        if role:  # a name preset on other bone names
+            used = sorted({b.split("@")[0] for b in bones} & {p[0] for p in loa.PRESETS})
+            text = (f"{armature.name}: the preset '{', '.join(used)}' finds no "
+                    f"{role.group(1)} bone by name; choose '{loa_bones.PRESETS[0][1]}' "
+                    f"or list bones ({_bone_list(armature)})")
         raise job.JobError(text) from e
     finally:
         shutil.rmtree(folder, ignore_errors=True)

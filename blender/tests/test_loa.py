@@ -161,11 +161,24 @@ def test_loa_cesium_name_preset():
     except RuntimeError as e:
         text = str(e).strip()
         print(f"  {text}")
-        check("Foot to head" in text and "\n" not in text, f"message {e!r}")
+        check("'right-leg-spine-head' finds no foot bone" in text and "Foot to head" in text
+              and "\n" not in text, f"message {e!r}")
     else:
         raise AssertionError("a name preset on CesiumMan's bones gave no error")
     check(before == (sorted(o.name for o in bpy.data.objects),
                      sorted(a.name for a in bpy.data.actions)), "the scene changed")
+    # What the hierarchy presets pick on CesiumMan: a toe (the lowest leaf) or the hips
+    # (the root) up to the head (the highest leaf).
+    from bl_ext.user_default.toonkit import loa_bones, loa_character
+
+    ref = loa_character.Reference(scene, arm, scene.frame_start)
+    foot, head = loa_bones.waypoints(arm, ref, "foot-head")
+    print(f"  foot-head: {foot} → {head}; spine-head: "
+          f"{' → '.join(loa_bones.waypoints(arm, ref, 'spine-head'))}")
+    check(foot in ("leg_joint_L_5", "leg_joint_R_5") and head == "Skeleton_neck_joint_2",
+          f"foot-head: {foot} → {head}")
+    check(loa_bones.waypoints(arm, ref, "spine-head") == [arm.data.bones[0].name, head],
+          "spine-head does not start at the root")
 
 
 def test_loa_errors():
