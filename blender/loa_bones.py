@@ -4,9 +4,11 @@
 Two presets read the hierarchy and the pose loa starts from (world Z up, Blender's
 convention), not bone names:
 
-- `foot-head` ("Foot to head"): the leaf bone whose tip is lowest → up the hierarchy → the
-  leaf bone whose tip is highest: for a standing humanoid a foot, its leg, the spine and the
-  head (what `right-leg-spine-head` finds by name);
+- `foot-head` ("Foot to head"): a foot → up the hierarchy → the leaf bone whose tip is
+  highest (the head). The foot is the lowest leaf among those branching off that head's
+  chain nearest its root (legs branch at the hips, arms higher up, so long hanging arms are
+  not taken for legs): for a standing humanoid a foot, its leg, the spine and the head (what
+  `right-leg-spine-head` finds by name);
 - `spine-head` ("Spine and head"): the root bone → the highest leaf bone.
 
 Both resolve to the crate's explicit joint lists (BVH joint names, see `loa_character`). The
@@ -19,8 +21,8 @@ from . import job
 # (identifier, label, description) of the hierarchy presets, after the CLI's name presets.
 PRESETS = [
     ("foot-head", "Foot to head (hierarchy)",
-     "Lowest leaf bone → hierarchy → highest leaf bone: found from the armature's hierarchy "
-     "and its pose, for any bone names"),
+     "Lowest leg-like leaf bone → hierarchy → highest leaf bone: found from the armature's "
+     "hierarchy and its pose, for any bone names"),
     ("spine-head", "Spine and head (hierarchy)",
      "Root bone → hierarchy → highest leaf bone, for any bone names"),
 ]
@@ -36,6 +38,31 @@ def _leaves(armature):
     return [b for b in armature.data.bones if not b.children]
 
 
+def _ancestry(bone):
+    """`bone` and its ancestors up to its root."""
+    out = [bone]
+    while out[-1].parent is not None:
+        out.append(out[-1].parent)
+    return out
+
+
+def _foot(leaves, top, height):
+    """The foot: among the leaves that branch off the spine (root → `top`) nearest the root
+    (legs branch at the hips, arms higher up; a leaf of another root counts as branching at
+    the root), the lowest. Hanging arms reaching below the feet do not count."""
+    spine = {b.name: k for k, b in enumerate(reversed(_ancestry(top)))}
+
+    def branch(leaf):
+        return next((spine[b.name] for b in _ancestry(leaf) if b.name in spine), 0)
+
+    others = [b for b in leaves if b != top]
+    if not others:
+        return top
+    first = min(branch(b) for b in others)
+    return min((b for b in others if branch(b) == first),
+               key=lambda b: (height[b.name], b.name))
+
+
 def waypoints(armature, ref, preset):
     """Bone names (Blender) along which `preset` runs on `armature` posed as `ref`."""
     w = armature.matrix_world
@@ -45,12 +72,9 @@ def waypoints(armature, ref, preset):
     height = {b.name: (w @ ref.tip(armature, b)).z for b in leaves}
     top = max(leaves, key=lambda b: (height[b.name], b.name))
     if preset == "foot-head":
-        low = min(leaves, key=lambda b: (height[b.name], b.name))
-        start = low
+        start = _foot(leaves, top, height)
     else:
-        start = top
-        while start.parent is not None:
-            start = start.parent
+        start = _ancestry(top)[-1]
     if start == top:
         raise job.JobError(f"{armature.name}: the '{preset}' bone set needs two bones on a "
                            f"chain; list the bones instead")

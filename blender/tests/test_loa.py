@@ -113,6 +113,14 @@ def test_loa_animate_follows_the_strokes():
     follows(scene, arm, cam, [(f, stroke(f)) for f in (1, 12, 24)], OUT)
 
 
+def test_loa_robot_hierarchy_bones():
+    """The hierarchy's foot-to-head bone set on the robot (whose hanging hands reach below its
+    feet in the start pose) follows the same strokes as its name preset."""
+    scene, arm, cam = robot()
+    scene.toonkit_loa.bones = "foot-head"
+    follows(scene, arm, cam, [(f, stroke(f)) for f in (1, 12, 24)])
+
+
 def cesium(yaw_deg=0.0):
     """CesiumMan (its walk's first frame is the start pose), a camera fitted to its skeleton,
     and the hierarchy's foot-to-head bone set (its bone names fit no name preset)."""
@@ -216,6 +224,7 @@ def test_loa_errors():
 
 if __name__ == "__main__":
     code = run([test_loa_errors, test_loa_identity_reproduces_the_start_pose,
-                test_loa_animate_follows_the_strokes, test_loa_cesium_follows_the_strokes,
+                test_loa_animate_follows_the_strokes, test_loa_robot_hierarchy_bones,
+                test_loa_cesium_follows_the_strokes,
                 test_loa_cesium_turned_camera, test_loa_cesium_name_preset])
     os._exit(code)  # bpy's interpreter teardown can crash after a headless run
