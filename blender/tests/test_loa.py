@@ -9,7 +9,10 @@ object keyed per frame) that passes through each stroke at its frame in the came
 (within 2 % of the stroke's length) and a NEW action (the previous one kept) that brings the
 robot's skeleton closer to the line than its starting pose (the importer's pose at the
 scene's start frame, the character loa starts from). Keying the crate's identity motion must
-reproduce that starting pose. With OUT_DIR, renders the start and frame 24.
+reproduce that starting pose. The same checks (`loa_check.follows`) run on a second armature,
+CesiumMan, whose bone names fit no name preset: a camera fitted to its skeleton, strokes drawn
+to its size, the hierarchy's foot-to-head bone set; drawn head first (the same motion), and in
+a camera turned 30° about Z. With OUT_DIR, renders the start and frame 24 (robot, CesiumMan).
 """
 
 import math

