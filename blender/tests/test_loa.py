@@ -29,8 +29,7 @@ import numpy as np  # noqa: E402
 from mathutils import Vector  # noqa: E402
 
 from harness import ASSETS, argv_after_dashes, check, empty_scene, install, run  # noqa: E402
-from loa_check import (drawn_strokes, fitted_camera, follows, grease_pencil,  # noqa: E402
-                       skeleton)
+from loa_check import drawn_strokes, fitted_camera, follows, grease_pencil  # noqa: E402
 
 ARGS = argv_after_dashes()
 ZIP = os.path.abspath(ARGS[0])
