@@ -22,7 +22,7 @@ examples() { # $1 = binary, $2 = output root
     "$t" --json stopmo segment "$face" -o "$o/parts.glb" --fps 2 "${seeds[@]}" \
         --report "$o/seg.json" --render "$o/seg.png" >"$o/segment.stdout.json"
     "$t" --json stopmo segment "$face" -o "$o/parts_flip.glb" --fps 2 --auto-parts 3 \
-        --gamma 1000 --smooth-iters 4 --as flipbook >"$o/segment_auto.stdout.json"
+        --gamma 100 --smooth-iters 4 --layout flipbook >"$o/segment_auto.stdout.json"
     "$t" --json stopmo library "$o/parts.glb" -o "$o/lib" --fps 2 --pieces upper=4,lower=6 \
         --restarts 2 --seed 1 --report "$o/lib_report.json" >"$o/library.stdout.json"
     "$t" --json stopmo library "$face" -o "$o/lib_curve" --fps 2 --max-error 0.25 \

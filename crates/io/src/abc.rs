@@ -55,7 +55,7 @@ mod read;
 mod schema;
 mod write;
 
-pub use read::{read, AbcArchive, AbcFrame, AbcMesh, MAX_DECODED_BYTES};
+pub use read::{read, read_with_limit, AbcArchive, AbcFrame, AbcMesh, MAX_DECODED_BYTES};
 pub use write::{write, write_animation, write_parts};
 
 /// Whether `bytes` start like an Ogawa (Alembic) file.

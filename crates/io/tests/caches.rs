@@ -75,6 +75,21 @@ fn abc_robot_punch_round_trips_bit_exactly() {
     );
 }
 
+/// The decoding budget is the caller's: the robot's Punch (21 frames of 7,214 points) reads
+/// with the default budget and is refused, naming the budget, with one of 1 MiB.
+#[test]
+fn abc_decoding_budget_refuses_archives_that_expand_past_it() {
+    let anim = robot("Punch");
+    let bytes = tkio::abc::write_animation(&anim, None).unwrap();
+    let decoded = anim.frame_count() * anim.vertex_count() * 12;
+    assert!(decoded > 1 << 20, "{decoded} bytes decode past 1 MiB");
+    assert!(tkio::abc::read_with_limit(&bytes, decoded * 2).is_ok());
+    let err = tkio::abc::read_with_limit(&bytes, 1 << 20)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("more than 1 MiB"), "{err}");
+}
+
 /// Motion-line-like frames: topology changes, one frame empty, per-vertex colours.
 fn line_frames() -> Vec<Mesh> {
     line_frames_from(3)

@@ -56,6 +56,16 @@ pub const MAX_DECODED_BYTES: usize = 512 << 20;
 /// polygon meshes (truncated, bad offsets, unexpected types), or one that decodes to more
 /// than [`MAX_DECODED_BYTES`]. Never panics.
 pub fn read(bytes: &[u8]) -> Result<AbcArchive> {
+    read_with_limit(bytes, MAX_DECODED_BYTES)
+}
+
+/// [`read`] with another decoding budget: `max_decoded_bytes` replaces
+/// [`MAX_DECODED_BYTES`] (a fuzzer or a server takes a few MiB so that every input stays
+/// cheap; a farm job reading a long cache may take more).
+///
+/// # Errors
+/// As [`read`], with `max_decoded_bytes` as the budget.
+pub fn read_with_limit(bytes: &[u8], max_decoded_bytes: usize) -> Result<AbcArchive> {
     let (r, root) = Reader::open(bytes)?;
     let top = r.children(root)?;
     if top.len() < 6 {
@@ -71,9 +81,9 @@ pub fn read(bytes: &[u8]) -> Result<AbcArchive> {
     let names = object_names(r.data(headers)?)?;
     let mut meshes = Vec::new();
     let mut sampling = None;
-    let mut budget = MAX_DECODED_BYTES;
+    let mut budget = max_decoded_bytes;
     for (name, object) in names.into_iter().zip(children.iter().skip(1)) {
-        let (mesh, ts) = polymesh(&r, *object, name, &mut budget)?;
+        let (mesh, ts) = polymesh(&r, *object, name, (&mut budget, max_decoded_bytes))?;
         sampling = sampling.or(Some(ts));
         meshes.push(mesh);
     }
@@ -187,8 +197,13 @@ fn property_headers(bytes: &[u8]) -> Result<Vec<PropertyHeader>> {
 }
 
 /// One `PolyMesh` object; also returns the time sampling index of its points. Every decoded
-/// sample is charged to `budget` (bytes left of [`MAX_DECODED_BYTES`]).
-fn polymesh(r: &Reader, object: Node, name: String, budget: &mut usize) -> Result<(AbcMesh, u32)> {
+/// sample is charged to `budget.0`, the bytes left of the whole budget `budget.1`.
+fn polymesh(
+    r: &Reader,
+    object: Node,
+    name: String,
+    (budget, limit): (&mut usize, usize),
+) -> Result<(AbcMesh, u32)> {
     let kids = r.children(object)?;
     let props = compound(r, *kids.first().ok_or_else(|| malformed("empty object"))?)?;
     let find = |props: &[(PropertyHeader, Node)], n: &str| {
@@ -210,7 +225,7 @@ fn polymesh(r: &Reader, object: Node, name: String, budget: &mut usize) -> Resul
     let too_big = || {
         malformed(format!(
             "the samples decode to more than {} MiB (PolyMesh '{name}' declares {} samples)",
-            MAX_DECODED_BYTES >> 20,
+            limit as f64 / f64::from(1u32 << 20),
             p.0.samples
         ))
     };
