@@ -81,7 +81,10 @@
 //!   translates), a second frees them from that solution, so the pelvis tilts and the whole
 //!   body leans with the line ([`animate::AnimateOptions::hold_pelvis`] stops after the
 //!   first). The solver iterates until an accepted step gains less than
-//!   [`animate::DEFAULT_TOLERANCE`] (cap [`animate::DEFAULT_MAX_ITERATIONS`]).
+//!   [`animate::DEFAULT_TOLERANCE`] (cap [`animate::DEFAULT_MAX_ITERATIONS`]); the first,
+//!   staging solve stops at the looser [`animate::STAGING_TOLERANCE`], since the second
+//!   refines its solution anyway (on the bench: 33 iterations in all instead of 97, for a
+//!   final energy 0.02 % lower).
 //! * **Contacts** (LoA §4.1, E_⊥): the paper adds E_⊥ to one 3D solve over the whole clip;
 //!   here the 3D stage solves twice — without contacts (the *free* motion, with any twists)
 //!   and, from it, with every contact held on its keyed frames only (a held limb gets LoA

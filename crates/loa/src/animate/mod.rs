@@ -69,7 +69,7 @@ pub use reduction::Reduction;
 pub use release::{CONTACT_RELEASE_MAX_TURN, MAX_CONTACT_RELEASE};
 pub use rig::ATTACH_TOLERANCE;
 pub use scene::{InitialPose, CLIP_NAME};
-pub use solver::{StageReport, DEFAULT_INITIAL_DAMPING, DEFAULT_TOLERANCE};
+pub use solver::{StageReport, DEFAULT_INITIAL_DAMPING, DEFAULT_TOLERANCE, STAGING_TOLERANCE};
 
 use anim::{Skeleton, Transform};
 use glam::{DQuat, DVec2, DVec3, Mat4};

@@ -12,7 +12,7 @@ use super::keys::{BoneSetKey, ContactKey, TwistKey};
 use super::reduction::Reduction;
 use super::release;
 use super::rig::{Rig, WorldPose};
-use super::solver::{Poses, Stage, StageReport};
+use super::solver::{Poses, Stage, StageReport, DEFAULT_TOLERANCE, STAGING_TOLERANCE};
 use super::targets::{
     image_lines, line_targets, twist_target, ContactTarget, FrameTargets, ImageLine, KeyChain,
     OrientTarget,
@@ -226,9 +226,15 @@ pub(crate) fn run(
         ref_length,
         height,
     };
-    let mut planar = planar_stage(&held).solve(&mut poses, max_iterations);
-    if !options.hold_pelvis && held != dof {
-        let free = planar_stage(&dof).solve(&mut poses, max_iterations);
+    let staging = !options.hold_pelvis && held != dof;
+    let tolerance = if staging {
+        STAGING_TOLERANCE
+    } else {
+        DEFAULT_TOLERANCE
+    };
+    let mut planar = planar_stage(&held).solve(&mut poses, max_iterations, tolerance);
+    if staging {
+        let free = planar_stage(&dof).solve(&mut poses, max_iterations, DEFAULT_TOLERANCE);
         planar = StageReport {
             unknowns: free.unknowns,
             iterations: planar.iterations + free.iterations,
@@ -317,7 +323,7 @@ pub(crate) fn run(
                 ref_length,
                 height,
             }
-            .solve(poses, max_iterations)
+            .solve(poses, max_iterations, DEFAULT_TOLERANCE)
         };
         if !twists.is_empty() {
             spatial = Some(solve(&free_targets, &mut poses));
