@@ -1,40 +1,25 @@
 //! Contact trajectories of the 3D stage (LoA §4.1, E_⊥): the keyed positions interpolated
-//! between keys, and the eases before the first key and after the last.
-//!
-//! **Easing.** A contact does not switch on or off in one frame: before its first key the
-//! target slides from the planar stage's pose onto the contact, and after its last key back.
-//! The slide turns about the limb's root (the contact joint's kinematic grandparent: the hip
-//! for a foot, the shoulder for a hand) rather than moving in a straight line, so the limb
-//! keeps its reach instead of folding up as the target passes near its root; and it lasts
-//! long enough that the limb turns at most [`CONTACT_RELEASE_MAX_TURN`] per frame about that
-//! root (at least [`super::DEFAULT_CONTACT_RELEASE`] frames, at most
-//! [`MAX_CONTACT_RELEASE`]).
+//! between a contact's first and last key, the frames each contact holds, and the limbs it
+//! holds. How the motion blends into and out of a contact is [`super::release`].
 
 use std::collections::BTreeMap;
 
-use glam::{DQuat, DVec3};
+use glam::DVec3;
 
 use super::error::AnimateError;
 use super::keys::ContactKey;
 use super::rig::{Rig, WorldPose};
 use super::targets::ContactTarget;
-use super::DEFAULT_CONTACT_RELEASE;
-use crate::retarget::Blend;
 
-/// Largest turn (radians, 8°) of a released limb about its root in one frame of an ease.
-pub const CONTACT_RELEASE_MAX_TURN: f64 = 8.0 * std::f64::consts::PI / 180.0;
-/// Longest ease (frames) before a contact's first key or after its last.
-pub const MAX_CONTACT_RELEASE: usize = 24;
-
-/// Keyed contact targets per frame and the eases around them (both per frame).
+/// Keyed contact targets per frame, the held windows and the held limbs.
 pub(crate) struct ContactTrajectories {
     /// Targets on and between keys.
     pub held: Vec<Vec<ContactTarget>>,
-    /// Targets of the ease-in and ease-out frames.
-    pub easing: Vec<Vec<ContactTarget>>,
-    /// Per frame, the joints of every limb held or easing (contact joint up to its root), for
-    /// LoA Eq. 3's smoothness of constrained bones.
+    /// Per frame, the joints of every held limb (contact joint up to its root), for LoA
+    /// Eq. 3's smoothness of constrained bones.
     pub limbs: Vec<Vec<usize>>,
+    /// Every contact's held frames `(first key, last key)`.
+    pub windows: Vec<(usize, usize)>,
 }
 
 /// Resolves `contacts` (frames already checked to lie in `0..worlds.len()` after
@@ -49,8 +34,8 @@ pub(crate) fn contact_trajectories(
     let frames = worlds.len();
     let mut out = ContactTrajectories {
         held: vec![Vec::new(); frames],
-        easing: vec![Vec::new(); frames],
         limbs: vec![Vec::new(); frames],
+        windows: Vec::new(),
     };
     let mut by_joint: BTreeMap<usize, Vec<(usize, Option<DVec3>)>> = BTreeMap::new();
     for c in contacts {
@@ -91,34 +76,9 @@ pub(crate) fn contact_trajectories(
             }
         }
         let limb = limb(rig, j);
-        let pivot = *limb.last().unwrap_or(&j);
-        let (first_key, last_key) = (resolved[0], resolved[resolved.len() - 1]);
-        let mut touched: Vec<usize> = (first_key.0..=last_key.0).collect();
-        for (key, before) in [(first_key, true), (last_key, false)] {
-            // Frame of the i-th ease frame away from the key (None outside the clip).
-            let frame = |i: usize| -> Option<usize> {
-                if before {
-                    key.0.checked_sub(i)
-                } else {
-                    Some(key.0 + i).filter(|&f| f < frames)
-                }
-            };
-            let n = ease_length(worlds, j, pivot, key.1, &frame);
-            for i in 1..=n {
-                let Some(f) = frame(i) else { break };
-                if out.held[f].iter().any(|c| c.joint == j) {
-                    continue;
-                }
-                let w = 1.0 - Blend::Smoothstep.weight(i as f64 / (n + 1) as f64);
-                let free = &worlds[f];
-                out.easing[f].push(ContactTarget {
-                    joint: j,
-                    position: turn_about(free.position[pivot], key.1, free.position[j], w),
-                    rotation: free.rotation[j].slerp(rotation, w),
-                });
-                touched.push(f);
-            }
-        }
+        let (first_key, last_key) = (resolved[0].0, resolved[resolved.len() - 1].0);
+        out.windows.push((first_key, last_key));
+        let touched = first_key..=last_key;
         for f in touched {
             for &k in &limb {
                 if !out.limbs[f].contains(&k) {
@@ -139,69 +99,4 @@ fn limb(rig: &Rig, j: usize) -> Vec<usize> {
         a = rig.parent[k];
     }
     v
-}
-
-/// The point `w` of the way from `free` back to `held` (`w = 1`: `held`), turning about
-/// `pivot`: the direction from the pivot turns along the great circle, the distance from it
-/// changes linearly.
-fn turn_about(pivot: DVec3, held: DVec3, free: DVec3, w: f64) -> DVec3 {
-    let (a, b) = (held - pivot, free - pivot);
-    let (la, lb) = (a.length(), b.length());
-    let (Some(da), Some(db)) = (a.try_normalize(), b.try_normalize()) else {
-        return free.lerp(held, w);
-    };
-    if da.dot(db) < -0.999 {
-        return free.lerp(held, w);
-    }
-    let turn = DQuat::IDENTITY.slerp(DQuat::from_rotation_arc(db, da), w);
-    pivot + turn * db * (lb + (la - lb) * w)
-}
-
-/// The shortest ease (frames) in which the limb turns at most [`CONTACT_RELEASE_MAX_TURN`]
-/// per frame about its pivot, within [`DEFAULT_CONTACT_RELEASE`]..=[`MAX_CONTACT_RELEASE`].
-fn ease_length(
-    worlds: &[WorldPose],
-    j: usize,
-    pivot: usize,
-    held: DVec3,
-    frame: &dyn Fn(usize) -> Option<usize>,
-) -> usize {
-    let direction = |i: usize, n: usize| -> Option<DVec3> {
-        let f = frame(i)?;
-        let w = if i == 0 {
-            1.0
-        } else {
-            1.0 - Blend::Smoothstep.weight(i as f64 / (n + 1) as f64)
-        };
-        let p = worlds[f].position[pivot];
-        (turn_about(p, held, worlds[f].position[j], w) - p).try_normalize()
-    };
-    for n in DEFAULT_CONTACT_RELEASE..=MAX_CONTACT_RELEASE {
-        let worst = (0..=n)
-            .filter_map(|i| Some(direction(i, n)?.angle_between(direction(i + 1, n)?)))
-            .fold(0.0, f64::max);
-        if worst <= CONTACT_RELEASE_MAX_TURN {
-            return n;
-        }
-    }
-    MAX_CONTACT_RELEASE
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_ease_turns_about_the_limb_root_keeping_its_reach() {
-        let pivot = DVec3::new(0.0, 1.0, 0.0);
-        let held = DVec3::new(0.0, -1.0, 0.0); // 2 below the pivot
-        let free = DVec3::new(2.0, 1.0, 0.0); // 2 beside it
-        assert!((turn_about(pivot, held, free, 1.0) - held).length() < 1e-12);
-        assert!((turn_about(pivot, held, free, 0.0) - free).length() < 1e-12);
-        let mid = turn_about(pivot, held, free, 0.5);
-        // A straight slide would pass 1.41 from the pivot; the turn keeps the reach of 2.
-        assert!(((mid - pivot).length() - 2.0).abs() < 1e-12);
-        let d = (mid - pivot).normalize();
-        assert!((d.angle_between(DVec3::NEG_Y) - std::f64::consts::FRAC_PI_4).abs() < 1e-9);
-    }
 }

@@ -53,6 +53,7 @@ mod contacts;
 mod error;
 mod keys;
 mod reduction;
+mod release;
 mod rig;
 mod scene;
 mod solver;
@@ -62,13 +63,13 @@ mod terms;
 
 pub use bones::{BoneSet, Preset};
 pub use camera::{ActionCamera, ActionPlane, ScreenMap, DEFAULT_CAMERA_MARGIN};
-pub use contacts::{CONTACT_RELEASE_MAX_TURN, MAX_CONTACT_RELEASE};
 pub use error::AnimateError;
 pub use keys::{BoneSetKey, ContactKey, TwistKey};
 pub use reduction::Reduction;
+pub use release::{CONTACT_RELEASE_MAX_TURN, MAX_CONTACT_RELEASE};
 pub use rig::ATTACH_TOLERANCE;
 pub use scene::{InitialPose, CLIP_NAME};
-pub use solver::{StageReport, DEFAULT_INITIAL_DAMPING, DEFAULT_TOLERANCE};
+pub use solver::{StageReport, DEFAULT_INITIAL_DAMPING, DEFAULT_TOLERANCE, STAGING_TOLERANCE};
 
 use anim::{Skeleton, Transform};
 use glam::{DQuat, DVec2, DVec3, Mat4};
@@ -110,8 +111,8 @@ pub const DEFAULT_SPATIAL_REGULARIZATION: f64 = 1e-2;
 /// solver stops earlier, when an accepted step lowers the energy by less than
 /// [`DEFAULT_TOLERANCE`].
 pub const DEFAULT_MAX_ITERATIONS: usize = 200;
-/// Frames over which a contact eases in before its first key and out after its last: the
-/// target slides between the planar pose and the contact along a smoothstep.
+/// Fewest frames over which the motion blends into a contact before its first key and out of
+/// it after its last (in rotation space, along a smoothstep; see [`MAX_CONTACT_RELEASE`]).
 pub const DEFAULT_CONTACT_RELEASE: usize = 6;
 
 /// Weights of the energy terms.

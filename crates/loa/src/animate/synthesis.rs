@@ -10,8 +10,9 @@ use super::contacts::contact_trajectories;
 use super::error::AnimateError;
 use super::keys::{BoneSetKey, ContactKey, TwistKey};
 use super::reduction::Reduction;
+use super::release;
 use super::rig::{Rig, WorldPose};
-use super::solver::{Poses, Stage, StageReport};
+use super::solver::{Poses, Stage, StageReport, DEFAULT_TOLERANCE, STAGING_TOLERANCE};
 use super::targets::{
     image_lines, line_targets, twist_target, ContactTarget, FrameTargets, ImageLine, KeyChain,
     OrientTarget,
@@ -225,9 +226,15 @@ pub(crate) fn run(
         ref_length,
         height,
     };
-    let mut planar = planar_stage(&held).solve(&mut poses, max_iterations);
-    if !options.hold_pelvis && held != dof {
-        let free = planar_stage(&dof).solve(&mut poses, max_iterations);
+    let staging = !options.hold_pelvis && held != dof;
+    let tolerance = if staging {
+        STAGING_TOLERANCE
+    } else {
+        DEFAULT_TOLERANCE
+    };
+    let mut planar = planar_stage(&held).solve(&mut poses, max_iterations, tolerance);
+    if staging {
+        let free = planar_stage(&dof).solve(&mut poses, max_iterations, DEFAULT_TOLERANCE);
         planar = StageReport {
             unknowns: free.unknowns,
             iterations: planar.iterations + free.iterations,
@@ -267,16 +274,10 @@ pub(crate) fn run(
                 .or_default()
                 .push((frame_index("twist", t.frame)?, t.angle));
         }
-        let mut targets3 = targets.clone();
-        for (f, t) in targets3.iter_mut().enumerate() {
-            t.contacts = contact_targets[f].clone();
-            t.contacts.extend_from_slice(&trajectories.easing[f]);
-            // A limb held by a contact is constrained: LoA Eq. 3 smooths it like Ω(t)'s bones.
-            for &k in &trajectories.limbs[f] {
-                if !t.bones.contains(&k) {
-                    t.bones.push(k);
-                }
-            }
+        // The free motion carries the twists; the held one adds the contacts on their keyed
+        // frames (LoA Eq. 3 smooths a held limb like Ω(t)'s bones); `release` blends them.
+        let mut free_targets = targets.clone();
+        for (f, t) in free_targets.iter_mut().enumerate() {
             for (&j, ks) in &twist_by_joint {
                 let angle = piecewise_linear(ks, f);
                 t.twists.push(OrientTarget {
@@ -285,7 +286,16 @@ pub(crate) fn run(
                 });
             }
         }
-        for t in &targets3 {
+        let mut held_targets = free_targets.clone();
+        for (f, t) in held_targets.iter_mut().enumerate() {
+            t.contacts = contact_targets[f].clone();
+            for &k in &trajectories.limbs[f] {
+                if !t.bones.contains(&k) {
+                    t.bones.push(k);
+                }
+            }
+        }
+        for t in &held_targets {
             for c in &t.contacts {
                 mark_ancestors(rig, ChainPoint::Tip(c.joint), &mut dof);
             }
@@ -297,22 +307,40 @@ pub(crate) fn run(
             regularization: weights.spatial_regularization,
             ..*weights
         };
-        let stage = Stage {
-            rig,
-            camera: &camera,
-            cols: Columns::new(
+        let solve = |targets: &[FrameTargets], poses: &mut Poses| {
+            Stage {
                 rig,
-                &dof,
-                &[DVec3::X, DVec3::Y, DVec3::Z],
-                &[DVec3::X, DVec3::Y, DVec3::Z],
-            ),
-            targets: &targets3,
-            reduction: &reduction,
-            weights: &weights3,
-            ref_length,
-            height,
+                camera: &camera,
+                cols: Columns::new(
+                    rig,
+                    &dof,
+                    &[DVec3::X, DVec3::Y, DVec3::Z],
+                    &[DVec3::X, DVec3::Y, DVec3::Z],
+                ),
+                targets,
+                reduction: &reduction,
+                weights: &weights3,
+                ref_length,
+                height,
+            }
+            .solve(poses, max_iterations, DEFAULT_TOLERANCE)
         };
-        spatial = Some(stage.solve(&mut poses, max_iterations));
+        if !twists.is_empty() {
+            spatial = Some(solve(&free_targets, &mut poses));
+        }
+        if !contacts.is_empty() {
+            let mut held = poses.clone();
+            let report = solve(&held_targets, &mut held);
+            spatial = Some(match spatial {
+                Some(free) => StageReport {
+                    iterations: free.iterations + report.iterations,
+                    initial_energy: free.initial_energy,
+                    ..report
+                },
+                None => report,
+            });
+            poses = release::blend(&poses, &held, &trajectories.windows);
+        }
     }
 
     // Output and measurements.
