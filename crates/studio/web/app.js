@@ -8,7 +8,7 @@ import { StopmoPanel } from './stopmo.js';
 const $ = (id) => document.getElementById(id);
 
 export const studio = {
-  stats: { smear: [], loa: [], errors: [] },
+  stats: { smear: [], smearAll: [], loa: [], loaAll: [], errors: [] },
   info: null,
   file: 0,
   clip: '',
