@@ -77,6 +77,11 @@ try {
   }
   const smearMs = median(lat.map((l) => l.ms));
   console.log(`latency smear slider → current frame's new geometry drawn (robot Dance, 7,214 vertices): median ${smearMs.toFixed(1)} ms of ${lat.length}, max ${Math.max(...lat.map((l) => l.ms)).toFixed(1)} ms, server median ${median(lat.map((l) => l.server_ms)).toFixed(1)} ms, ${(median(lat.map((l) => l.bytes)) / 1024).toFixed(0)} KiB; target 100 ms`);
+  const part = (k) => median(lat.map((l) => l[k])).toFixed(1);
+  console.log(`  of which: request until answer ${part('fetch_ms')} ms, buffers into the scene ${part('apply_ms')} ms, until the next render is done ${part('draw_ms')} ms (one render of the page ${part('render_ms')} ms: software GL)`);
+  // Margin: measured medians 22 ms (slider) and 110 ms (stroke) with the 2-core machine at
+  // load 9 (debug server); the targets are 4.5× and 2.7× those, so the medians are asserted.
+  check('slider → current frame drawn: median ≤ 100 ms', smearMs <= 100, `${smearMs.toFixed(1)} ms`);
   console.log(`latency smear slider → all 81 frames drawn (background load): median ${median(latAll.map((l) => l.ms)).toFixed(1)} ms, server median ${median(latAll.map((l) => l.server_ms)).toFixed(1)} ms, ${(median(latAll.map((l) => l.bytes)) / 1048576).toFixed(1)} MiB`);
   await page.evaluate(() => { const c = document.getElementById('show-offsets'); c.checked = true; c.dispatchEvent(new Event('change')); });
   await page.waitForTimeout(1500);
@@ -144,6 +149,8 @@ try {
     loaAll.push(await page.evaluate(() => window.studio.stats.loaAll.at(-1)));
   }
   console.log(`latency new stroke → line + character (current frame) drawn: median ${median(loaLat.map((l) => l.ms)).toFixed(1)} ms of ${loaLat.length}, max ${Math.max(...loaLat.map((l) => l.ms)).toFixed(1)} ms, server median ${median(loaLat.map((l) => l.server_ms)).toFixed(1)} ms, ${(median(loaLat.map((l) => l.bytes)) / 1024).toFixed(0)} KiB; target 300 ms`);
+  const strokeMs = median(loaLat.map((l) => l.ms));
+  check('new stroke → line + character drawn: median ≤ 300 ms', strokeMs <= 300, `${strokeMs.toFixed(1)} ms`);
   console.log(`latency new stroke → whole character motion drawn (background load): median ${median(loaAll.map((l) => l.ms)).toFixed(1)} ms, ${(median(loaAll.map((l) => l.bytes)) / 1048576).toFixed(1)} MiB`);
 
   // stopmo: two seed clicks on the face + run → two parts.

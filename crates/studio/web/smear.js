@@ -142,6 +142,7 @@ export class SmearPanel {
     const f = s.frame;
     try {
       const r = await getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...body, frames: [f, f + 1] });
+      const fetched = performance.now();
       if (!this.pending) {
         const gen = this.gen;
         $('style-error').textContent = '';
@@ -152,9 +153,10 @@ export class SmearPanel {
         this.lastBody = { style: this.style };
         this.fresh = new Set([f]);
         this.apply(r);
+        const applied = performance.now();
         await s.view.rendered();
         const ms = performance.now() - t0;
-        s.stats.smear.push({ ms, server_ms: r.header.seconds * 1000, bytes: r.bytes });
+        s.stats.smear.push({ ms, server_ms: r.header.seconds * 1000, bytes: r.bytes, fetch_ms: fetched - t0, apply_ms: applied - fetched, draw_ms: performance.now() - applied, render_ms: s.view.renderMs });
         $('smear-report').textContent = `frame ${f} restyled in ${ms.toFixed(0)} ms (server ${(r.header.seconds * 1000).toFixed(0)} ms, ${(r.bytes / 1024).toFixed(0)} KiB; offset solves so far: ${r.header.report.offset_solves})`;
         this.loadRest(gen, t0);
       }

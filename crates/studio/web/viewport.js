@@ -204,7 +204,9 @@ export class Viewport {
   }
 
   render() {
+    const t = performance.now();
     this.renderer.render(this.scene, this.camera);
+    this.renderMs = performance.now() - t;
     this.dirty = false;
     const done = this.onRendered; this.onRendered = [];
     for (const f of done) f();
