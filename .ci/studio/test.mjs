@@ -28,7 +28,7 @@ try {
   page.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
   page.on('pageerror', (e) => consoleErrors.push(e.message));
   await page.goto(url);
-  await page.waitForFunction(() => window.studio && window.studio.ready && window.studio.stats.smear.length > 0, null, { timeout: 120000 });
+  await page.waitForFunction(() => window.studio && window.studio.ready && window.studio.stats.smearAll.length > 0, null, { timeout: 120000 });
 
   // Canvas not blank: pixels differ from the background somewhere.
   const pixels = () => page.evaluate(() => {
@@ -62,16 +62,27 @@ try {
   for (let i = 0; i < atRest.length; i += 4) if (Math.abs(atRest[i] - stretched[i]) + Math.abs(atRest[i + 1] - stretched[i + 1]) + Math.abs(atRest[i + 2] - stretched[i + 2]) > 30) changed++;
   check('moving the β-max slider changes the rendered pixels', changed > 200, `${changed} pixels changed`);
   await page.screenshot({ path: join(shots, 'smear.png') });
-  // Latency: ten slider moves, each waited for.
-  const lat = [];
+  // Latency: ten slider moves, each waited for until the whole clip has arrived too (a user
+  // moving the slider and looking). Measured in the page: from the input event to the render
+  // (in requestAnimationFrame) after the current frame's new buffers are uploaded.
+  const counts = (what) => page.evaluate((w) => window.studio.stats[w].length, what);
+  const lat = [], latAll = [];
   for (let k = 0; k < 10; k++) {
-    const n = await page.evaluate(() => window.studio.stats.smear.length);
+    const n = await counts('smear'), nAll = await counts('smearAll');
     await setSlider(2 + k * 1.5);
     await page.waitForFunction((n) => window.studio.stats.smear.length > n, n, { timeout: 60000 });
+    await page.waitForFunction((n) => window.studio.stats.smearAll.length > n, nAll, { timeout: 60000 });
     lat.push(await page.evaluate(() => window.studio.stats.smear.at(-1)));
+    latAll.push(await page.evaluate(() => window.studio.stats.smearAll.at(-1)));
   }
   const smearMs = median(lat.map((l) => l.ms));
-  console.log(`latency smear slider → new geometry drawn (robot Dance): median ${smearMs.toFixed(1)} ms, max ${Math.max(...lat.map((l) => l.ms)).toFixed(1)} ms, server median ${median(lat.map((l) => l.server_ms)).toFixed(1)} ms`);
+  console.log(`latency smear slider → current frame's new geometry drawn (robot Dance, 7,214 vertices): median ${smearMs.toFixed(1)} ms of ${lat.length}, max ${Math.max(...lat.map((l) => l.ms)).toFixed(1)} ms, server median ${median(lat.map((l) => l.server_ms)).toFixed(1)} ms, ${(median(lat.map((l) => l.bytes)) / 1024).toFixed(0)} KiB; target 100 ms`);
+  const part = (k) => median(lat.map((l) => l[k])).toFixed(1);
+  console.log(`  of which: request until answer ${part('fetch_ms')} ms, buffers into the scene ${part('apply_ms')} ms, until the next render is done ${part('draw_ms')} ms (one render of the page ${part('render_ms')} ms: software GL)`);
+  // Margin: measured medians 22 ms (slider) and 110 ms (stroke) with the 2-core machine at
+  // load 9 (debug server); the targets are 4.5× and 2.7× those, so the medians are asserted.
+  check('slider → current frame drawn: median ≤ 100 ms', smearMs <= 100, `${smearMs.toFixed(1)} ms`);
+  console.log(`latency smear slider → all 81 frames drawn (background load): median ${median(latAll.map((l) => l.ms)).toFixed(1)} ms, server median ${median(latAll.map((l) => l.server_ms)).toFixed(1)} ms, ${(median(latAll.map((l) => l.bytes)) / 1048576).toFixed(1)} MiB`);
   await page.evaluate(() => { const c = document.getElementById('show-offsets'); c.checked = true; c.dispatchEvent(new Event('change')); });
   await page.waitForTimeout(1500);
   await page.screenshot({ path: join(shots, 'smear-offsets.png') });
@@ -95,7 +106,10 @@ try {
     await page.mouse.down();
     for (const p of pts.slice(1)) await page.mouse.move(box.x + p[0], box.y + p[1]);
     await page.mouse.up();
-    if (frame > 0) await page.waitForFunction((n) => window.studio.stats.loa.length > n, n, { timeout: 120000 });
+    if (frame > 0) {
+      await page.waitForFunction((n) => window.studio.stats.loa.length > n, n, { timeout: 120000 });
+      await page.waitForFunction(() => window.studio.panels.loa.result && !window.studio.panels.loa.restCtl, null, { timeout: 120000 });
+    }
   }
   const loaErr = await page.evaluate(() => document.getElementById('error').hidden ? '' : document.getElementById('error').textContent);
   check('three strokes give a line and a motion without error', loaErr === '', loaErr);
@@ -119,7 +133,7 @@ try {
   await page.waitForTimeout(300);
   await page.screenshot({ path: join(shots, 'loa.png') });
   // Latency: redraw the middle stroke five times.
-  const loaLat = [];
+  const loaLat = [], loaAll = [];
   for (let k = 0; k < 5; k++) {
     const n = await page.evaluate(() => window.studio.stats.loa.length);
     await page.evaluate(({ pts }) => window.studio.setFrame(12), drawn[1]);
@@ -128,10 +142,16 @@ try {
     await page.mouse.down();
     for (const p of pts.slice(1)) await page.mouse.move(box.x + p[0], box.y + p[1]);
     await page.mouse.up();
+    const nAll = await counts('loaAll');
     await page.waitForFunction((n) => window.studio.stats.loa.length > n, n, { timeout: 120000 });
+    await page.waitForFunction((n) => window.studio.stats.loaAll.length > n, nAll, { timeout: 120000 });
     loaLat.push(await page.evaluate(() => window.studio.stats.loa.at(-1)));
+    loaAll.push(await page.evaluate(() => window.studio.stats.loaAll.at(-1)));
   }
-  console.log(`latency new stroke → line + character drawn: median ${median(loaLat.map((l) => l.ms)).toFixed(1)} ms, max ${Math.max(...loaLat.map((l) => l.ms)).toFixed(1)} ms, server median ${median(loaLat.map((l) => l.server_ms)).toFixed(1)} ms`);
+  console.log(`latency new stroke → line + character (current frame) drawn: median ${median(loaLat.map((l) => l.ms)).toFixed(1)} ms of ${loaLat.length}, max ${Math.max(...loaLat.map((l) => l.ms)).toFixed(1)} ms, server median ${median(loaLat.map((l) => l.server_ms)).toFixed(1)} ms, ${(median(loaLat.map((l) => l.bytes)) / 1024).toFixed(0)} KiB; target 300 ms`);
+  const strokeMs = median(loaLat.map((l) => l.ms));
+  check('new stroke → line + character drawn: median ≤ 300 ms', strokeMs <= 300, `${strokeMs.toFixed(1)} ms`);
+  console.log(`latency new stroke → whole character motion drawn (background load): median ${median(loaAll.map((l) => l.ms)).toFixed(1)} ms, ${(median(loaAll.map((l) => l.bytes)) / 1048576).toFixed(1)} MiB`);
 
   // stopmo: two seed clicks on the face + run → two parts.
   await page.evaluate(() => window.studio.activate('stopmo'));

@@ -1,13 +1,14 @@
 //! The whole smear job on a real character: `prepare` once, `stylize` many times. A second
 //! `stylize` with another style reuses the prepared offsets (no solve, and much faster than
-//! preparing), and the merged job gives the offsets of the per-object solve.
+//! preparing), and the merged job gives the offsets of the per-object solve. A frame range
+//! (`stylize_frames`, the studio's current frame first) gives those frames of the whole clip.
 
 mod common;
 
 use std::time::Instant;
 
 use anim::{sample, SampleOptions, SampledScene};
-use smear::{prepare, stylize, OffsetOptions, PrepareOptions, Style};
+use smear::{prepare, stylize, stylize_frames, OffsetOptions, PrepareOptions, Style};
 
 fn robot_dance() -> SampledScene {
     let path = common::asset("characters/RobotExpressive.glb");
@@ -121,4 +122,65 @@ fn merged_prepare_matches_per_object_offsets() {
         ..Style::default()
     };
     assert!(stylize(&merged, &other).is_err());
+}
+
+/// Frame `f` of every part of a stylized flipbook: positions and colours.
+fn part_frame(part: &anim::FlipbookPart, f: usize) -> (Vec<anim::glam::Vec3>, Vec<[f32; 4]>) {
+    match part {
+        anim::FlipbookPart::Animation { animation, colors } => {
+            let n = animation.vertex_count();
+            let c = colors
+                .as_ref()
+                .map_or(Vec::new(), |c| c[f * n..(f + 1) * n].to_vec());
+            (animation.frame(f).to_vec(), c)
+        }
+        anim::FlipbookPart::Frames { meshes, .. } => (
+            meshes[f].positions.clone(),
+            meshes[f].colors.clone().unwrap_or_default(),
+        ),
+    }
+}
+
+#[test]
+fn stylize_frames_gives_those_frames_of_the_clip() {
+    // All three effects (SMEAR Fig. 16): elongation, multiples, motion lines.
+    let style = example_style("fig16_combined.toml");
+    let options = PrepareOptions {
+        offsets: style.offsets.clone(),
+        ..PrepareOptions::default()
+    };
+    let prepared = prepare(robot_dance(), &options).unwrap();
+    let whole = stylize(&prepared, &style).unwrap();
+    let frames = prepared.report().frames;
+    assert_eq!(whole.first_frame, 0);
+    let mut lines_seen = 0;
+    for range in [40..41, 0..1, frames - 3..frames] {
+        let part = stylize_frames(&prepared, &style, range.clone()).unwrap();
+        assert_eq!(part.first_frame, range.start);
+        assert_eq!(part.flipbook.frames, range.len());
+        assert_eq!(part.flipbook.parts.len(), whole.flipbook.parts.len());
+        assert_eq!(part.objects, whole.objects);
+        for (a, b) in part.flipbook.parts.iter().zip(&whole.flipbook.parts) {
+            for (k, f) in range.clone().enumerate() {
+                let (pa, ca) = part_frame(a, k);
+                let (pb, cb) = part_frame(b, f);
+                assert_eq!(pa.len(), pb.len(), "{} frame {f}", a.name());
+                for (p, q) in pa.iter().zip(&pb) {
+                    assert!(p.distance(*q) < 1e-5, "{} frame {f}: {p} vs {q}", a.name());
+                }
+                assert_eq!(ca, cb, "{} frame {f} colours", a.name());
+                if matches!(a, anim::FlipbookPart::Frames { .. }) {
+                    lines_seen += pa.len();
+                }
+            }
+        }
+    }
+    assert!(
+        lines_seen > 0,
+        "no motion line drawn in the frames compared"
+    );
+    for bad in [5..5, frames..frames + 1, 0..frames + 1] {
+        let e = stylize_frames(&prepared, &style, bad.clone()).unwrap_err();
+        assert!(e.to_string().contains("frames"), "{bad:?}: {e}");
+    }
 }

@@ -30,6 +30,11 @@ pub struct LoaSession {
     pub scene: anim::Scene,
     /// The synthesized joint motion.
     pub motion: loa::animate::Motion,
+    /// The character's merged mesh per motion frame (f32, frames × vertices × 3), for the
+    /// page's second request (`GET /api/loa/motion`).
+    pub positions: Vec<f32>,
+    /// Counts the animate requests: a page asking for the motion of an older one is refused.
+    pub version: u64,
 }
 
 /// The server's state, shared by every request.

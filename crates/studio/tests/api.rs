@@ -235,6 +235,46 @@ async fn a_slider_change_restyles_without_solving_offsets_again() {
 }
 
 #[tokio::test]
+async fn a_restyle_of_the_current_frame_is_that_frame_of_the_whole_clip() {
+    let dir = tempfile::tempdir().unwrap();
+    let app = app(dir.path());
+    let mut request = json!({"clip": "Wave", "style": {"elongate": {"function": {"stages": [{"op": "speed"}, {"op": "scale", "by": 8}]}}}});
+    let (status, whole) = send(&app, post("/api/smear/stylize", request.clone())).await;
+    assert_eq!(
+        status,
+        StatusCode::OK,
+        "{}",
+        String::from_utf8_lossy(&whole)
+    );
+    let (hw, all) = pack::read_f32(&whole, "body").unwrap();
+    let frames = hw["frames"].as_u64().unwrap() as usize;
+    assert_eq!(hw["clip_frames"], hw["frames"]);
+    let per_frame = all.len() / frames;
+    let f = frames / 2;
+    request["frames"] = json!([f, f + 1]);
+    let (status, one) = send(&app, post("/api/smear/stylize", request.clone())).await;
+    assert_eq!(status, StatusCode::OK, "{}", String::from_utf8_lossy(&one));
+    let (h1, body) = pack::read_f32(&one, "body").unwrap();
+    assert_eq!(
+        (h1["first_frame"].as_u64(), h1["frames"].as_u64()),
+        (Some(f as u64), Some(1))
+    );
+    assert_eq!(h1["clip_frames"], hw["frames"]);
+    assert_eq!(body, all[f * per_frame..(f + 1) * per_frame].to_vec());
+    assert!(
+        one.len() * 10 < whole.len(),
+        "one frame is not smaller: {} vs {} bytes",
+        one.len(),
+        whole.len()
+    );
+    // A range past the clip is a JSON error, not a crash.
+    request["frames"] = json!([frames, frames + 4]);
+    let (status, body) = send(&app, post("/api/smear/stylize", request)).await;
+    assert_eq!(status, StatusCode::BAD_REQUEST);
+    assert!(error_of(&body).contains("frames"), "{}", error_of(&body));
+}
+
+#[tokio::test]
 async fn strokes_give_a_line_through_them_and_a_moving_character() {
     let dir = tempfile::tempdir().unwrap();
     let app = app(dir.path());
@@ -308,6 +348,36 @@ async fn strokes_give_a_line_through_them_and_a_moving_character() {
             "frame {k}: the line passes {far} px from the stroke"
         );
     }
+    // The current frame first: the same keystrokes with `frame` give that motion frame only,
+    // and `GET /api/loa/motion` the rest of that answer (a stale version is refused).
+    let (status, fast) = send(
+        &app,
+        post(
+            "/api/loa/animate",
+            json!({"keystrokes": keys, "width": w, "height": h, "frame": 12}),
+        ),
+    )
+    .await;
+    assert_eq!(status, StatusCode::OK, "{}", String::from_utf8_lossy(&fast));
+    let (hf, one) = pack::read_f32(&fast, "positions").unwrap();
+    let k = (12 - header["motion"]["first_frame"].as_i64().unwrap()) as usize;
+    assert_eq!(hf["motion"]["positions_first"].as_u64(), Some(k as u64));
+    assert_eq!(
+        one,
+        positions[k * vertices * 3..(k + 1) * vertices * 3].to_vec()
+    );
+    let version = hf["version"].as_u64().unwrap();
+    assert_eq!(version, header["version"].as_u64().unwrap() + 1);
+    let (status, rest) = send(&app, get(&format!("/api/loa/motion?version={version}"))).await;
+    assert_eq!(status, StatusCode::OK);
+    assert_eq!(pack::read_f32(&rest, "positions").unwrap().1, positions);
+    let (status, body) = send(
+        &app,
+        get(&format!("/api/loa/motion?version={}", version - 1)),
+    )
+    .await;
+    assert_eq!(status, StatusCode::CONFLICT);
+    error_of(&body);
     // Exports.
     for (name, what) in [
         ("k.json", "keystrokes"),

@@ -27,11 +27,12 @@ export function parsePack(buffer) {
     const Kind = b.type === 'u32' ? Uint32Array : Float32Array;
     buffers[b.name] = new Kind(buffer, base + b.offset, b.count);
   }
-  return { header, buffers };
+  return { header, buffers, bytes: buffer.byteLength };
 }
 
-export async function getPack(url, body) {
-  const init = body === undefined ? {} : { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body) };
+/** A packed response (POST when `body` is given); `signal` aborts it (an AbortController's). */
+export async function getPack(url, body, signal) {
+  const init = body === undefined ? { signal } : { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body), signal };
   const r = await check(await fetch(url, init));
   return parsePack(await r.arrayBuffer());
 }

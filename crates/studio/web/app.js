@@ -8,7 +8,7 @@ import { StopmoPanel } from './stopmo.js';
 const $ = (id) => document.getElementById(id);
 
 export const studio = {
-  stats: { smear: [], loa: [], errors: [] },
+  stats: { smear: [], smearAll: [], loa: [], loaAll: [], errors: [] },
   info: null,
   file: 0,
   clip: '',
@@ -104,8 +104,9 @@ async function main() {
       acc += dt * studio.timeline.fps;
       if (acc >= 1) { const step = Math.floor(acc); acc -= step; setFrame((studio.frame + step) % studio.timeline.frames); }
     }
-    view.controls.update();
-    view.render();
+    // Render only when something changed: an idle page leaves the CPU to the server (software
+    // GL renders on the CPU).
+    if (view.controls.update() || view.dirty) view.render();
     for (const p of panels) if (p.active && p.draw) p.draw();
     requestAnimationFrame(loop);
   };

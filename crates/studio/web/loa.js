@@ -34,6 +34,7 @@ export class LoaPanel {
 
   deactivate() {
     this.active = false;
+    if (this.restCtl) { this.restCtl.abort(); this.restCtl = null; }
     this.overlay.classList.remove('drawing');
     this.ctx.clearRect(0, 0, this.overlay.width, this.overlay.height);
     this.studio.view.setActionCamera(null);
@@ -63,7 +64,11 @@ export class LoaPanel {
   }
 
   onFrame(f) {
-    if (this.result) this.studio.view.setFrame(f - this.result.header.motion.first_frame);
+    const r = this.result;
+    if (!r) return;
+    // Until the whole motion has arrived the view holds one frame: the one drawn on.
+    const whole = r.buffers.positions.length === r.header.motion.frames * r.header.motion.vertices * 3;
+    this.studio.view.setFrame(whole ? f - r.header.motion.first_frame : 0);
   }
 
   point(e) {
@@ -162,23 +167,47 @@ export class LoaPanel {
         height: this.overlay.clientHeight,
         keystrokes: this.keys.map((k) => ({ frame: k.frame, points: k.points, stiffness: k.stiffness, damping: k.damping, bones: k.bones })),
         wobbles: this.wobbles,
+        frame: s.frame,
       };
+      if (this.restCtl) { this.restCtl.abort(); this.restCtl = null; }
+      // The line (all frames, small) and the character at the current frame first.
       const r = await getPack('/api/loa/animate', body);
       this.result = r;
       s.showError('');
       const h = r.header;
-      s.view.setAnimation({ triangles: r.buffers.triangles, positions: r.buffers.positions, frames: h.motion.frames, vertices: h.motion.vertices }, { frame: false });
+      s.view.setAnimation({ triangles: r.buffers.triangles, positions: r.buffers.positions, frames: h.motion.positions_frames, vertices: h.motion.vertices }, { frame: false });
       s.setTimeline(Math.max(TIMELINE, h.line.first_frame + h.line.frames + 12), 24);
       this.onFrame(s.frame);
       await s.view.rendered();
       const ms = performance.now() - t0;
-      s.stats.loa.push({ ms, server_ms: h.seconds.total * 1000 });
+      s.stats.loa.push({ ms, server_ms: h.seconds.total * 1000, bytes: r.bytes });
+      this.loadRest(r, t0);
       $('loa-report').textContent = `line + character in ${ms.toFixed(0)} ms (line ${(h.seconds.line * 1000).toFixed(0)} ms, motion ${(h.seconds.animate * 1000).toFixed(0)} ms)\n` + JSON.stringify(h.report, null, 1) + (h.warnings.length ? '\n' + h.warnings.join('\n') : '');
     } catch (e) {
       s.showError(e.message);
     } finally {
       this.inflight = false;
       if (this.pending !== undefined && this.pending !== null) { const t = this.pending; this.pending = null; this.update(t); }
+    }
+  }
+
+  /** The character's motion at every frame of answer `r`, in the background (a newer stroke aborts it). */
+  async loadRest(r, t0) {
+    const s = this.studio, h = r.header;
+    const ctl = new AbortController();
+    this.restCtl = ctl;
+    try {
+      const m = await getPack(`/api/loa/motion?version=${h.version}`, undefined, ctl.signal);
+      if (this.result !== r) return;
+      r.buffers.positions = m.buffers.positions;
+      s.view.setAnimation({ triangles: r.buffers.triangles, positions: m.buffers.positions, frames: h.motion.frames, vertices: h.motion.vertices }, { frame: false });
+      this.onFrame(s.frame);
+      await s.view.rendered();
+      s.stats.loaAll.push({ ms: performance.now() - t0, bytes: m.bytes });
+    } catch (e) {
+      if (e.name !== 'AbortError' && this.result === r) s.showError(e.message);
+    } finally {
+      if (this.restCtl === ctl) this.restCtl = null;
     }
   }
 

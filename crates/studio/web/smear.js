@@ -1,8 +1,23 @@
 // The smear panel: presets, β max and multiples/lines fields, the TOML editor with inline
-// errors, the offsets view, exports. Every change restyles the prepared offsets on the server.
+// errors, the offsets view, exports. Every change restyles the prepared offsets on the server:
+// the current frame first, the whole clip after.
 import { getJSON, getPack, postJSON } from './api.js';
 
 const $ = (id) => document.getElementById(id);
+const EMPTY_LINES = { positions: new Float32Array(0), triangles: new Uint32Array(0) };
+
+/** Motion-line set `i` of a stylize answer, per frame: [{positions, triangles}]. */
+function splitLines(buffers, i) {
+  const counts = buffers[`lines${i}.counts`], pos = buffers[`lines${i}.positions`], tri = buffers[`lines${i}.triangles`];
+  const out = [];
+  let v = 0, t = 0;
+  for (let f = 0; f < counts.length / 2; f++) {
+    const nv = counts[2 * f], nt = counts[2 * f + 1];
+    out.push({ positions: pos.subarray(v * 3, (v + nv) * 3), triangles: tri.subarray(t * 3, (t + nt) * 3) });
+    v += nv; t += nt;
+  }
+  return out;
+}
 
 /** The elongation function's `scale` stage (SMEAR Section 5: β max). */
 function scaleStage(style) {
@@ -45,7 +60,14 @@ export class SmearPanel {
     await this.reload();
   }
 
-  deactivate() { this.active = false; this.studio.view.clearEffects(); this.studio.view.setOffsets(null); }
+  deactivate() {
+    this.active = false;
+    if (this.restCtl) { this.restCtl.abort(); this.restCtl = null; }
+    this.gen = (this.gen || 0) + 1;
+    this.body = this.copies = this.lines = null;
+    this.studio.view.clearEffects();
+    this.studio.view.setOffsets(null);
+  }
 
   async reload() {
     const s = this.studio;
@@ -54,6 +76,7 @@ export class SmearPanel {
       this.anim = await s.loadClip(s.file, s.clip);
       this.loadedKey = key;
       this.offsets = null;
+      this.body = this.copies = this.lines = null;
     }
     s.view.setAnimation({ ...this.anim });
     s.setTimeline(this.anim.frames, this.anim.fps);
@@ -62,7 +85,10 @@ export class SmearPanel {
     await this.request({ style: this.style }, performance.now());
   }
 
-  onFrame(f) { this.studio.view.setFrame(f); }
+  onFrame(f) {
+    this.studio.view.setFrame(f);
+    if (this.restCtl && this.fresh && !this.fresh.has(f)) this.loadFrame(f);
+  }
 
   usePreset(name) {
     this.style = structuredClone(this.presets.find((p) => p.name === name).style);
@@ -102,25 +128,38 @@ export class SmearPanel {
     this.request({ style: s }, t0);
   }
 
-  /** Sends a style; while one is in flight only the newest change waits. */
+  /**
+   * Restyles: the current frame first (a one-frame answer, drawn at once), then every frame
+   * in the background (cancelled by the next change); frames scrubbed to meanwhile are asked
+   * for one by one. While a first-frame request is in flight only the newest change waits.
+   */
   async request(body, t0) {
+    this.gen = (this.gen || 0) + 1;
+    if (this.restCtl) { this.restCtl.abort(); this.restCtl = null; }
     if (this.inflight) { this.pending = { body, t0 }; return; }
     this.inflight = true;
     const s = this.studio;
+    const f = s.frame;
     try {
-      const { header, buffers } = await getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...body });
-      $('style-error').textContent = '';
-      s.showError('');
-      this.style = header.style;
-      $('style-toml').value = header.toml;
-      this.syncFields();
-      s.view.setAnimation({ ...this.anim, positions: buffers.body });
-      s.view.setCopies(header.copies.map((c, i) => ({ vertices: c.vertices, positions: buffers[`copy${i}.positions`], alpha: buffers[`copy${i}.alpha`], triangles: buffers[`copy${i}.triangles`] })));
-      s.view.setLines(header.lines.map((l, i) => ({ counts: buffers[`lines${i}.counts`], positions: buffers[`lines${i}.positions`], triangles: buffers[`lines${i}.triangles`], alpha: buffers[`lines${i}.alpha`] })));
-      await s.view.rendered();
-      const ms = performance.now() - t0;
-      s.stats.smear.push({ ms, server_ms: header.seconds * 1000 });
-      $('smear-report').textContent = `restyled in ${ms.toFixed(0)} ms (server ${(header.seconds * 1000).toFixed(0)} ms, offset solves so far: ${header.report.offset_solves})\n` + JSON.stringify(header.report.objects.map((o) => ({ name: o.name, elongation_max: o.elongation_max, multiples: o.multiples, lines_max: o.lines_max })), null, 1);
+      const r = await getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...body, frames: [f, f + 1] });
+      const fetched = performance.now();
+      if (!this.pending) {
+        const gen = this.gen;
+        $('style-error').textContent = '';
+        s.showError('');
+        this.style = r.header.style;
+        $('style-toml').value = r.header.toml;
+        this.syncFields();
+        this.lastBody = { style: this.style };
+        this.fresh = new Set([f]);
+        this.apply(r);
+        const applied = performance.now();
+        await s.view.rendered();
+        const ms = performance.now() - t0;
+        s.stats.smear.push({ ms, server_ms: r.header.seconds * 1000, bytes: r.bytes, fetch_ms: fetched - t0, apply_ms: applied - fetched, draw_ms: performance.now() - applied, render_ms: s.view.renderMs });
+        $('smear-report').textContent = `frame ${f} restyled in ${ms.toFixed(0)} ms (server ${(r.header.seconds * 1000).toFixed(0)} ms, ${(r.bytes / 1024).toFixed(0)} KiB; offset solves so far: ${r.header.report.offset_solves})`;
+        this.loadRest(gen, t0);
+      }
     } catch (e) {
       $('style-error').textContent = e.message;
       s.showError(e.message);
@@ -128,6 +167,78 @@ export class SmearPanel {
       this.inflight = false;
       if (this.pending) { const p = this.pending; this.pending = null; this.request(p.body, p.t0); }
     }
+  }
+
+  /** Every frame of the current style, in the background; a newer change aborts it. */
+  async loadRest(gen, t0) {
+    const s = this.studio;
+    const ctl = new AbortController();
+    this.restCtl = ctl;
+    try {
+      const r = await getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...this.lastBody }, ctl.signal);
+      if (gen !== this.gen) return;
+      this.restCtl = null;
+      this.apply(r);
+      await s.view.rendered();
+      s.stats.smearAll.push({ ms: performance.now() - t0, server_ms: r.header.seconds * 1000, bytes: r.bytes });
+      $('smear-report').textContent += `\nall ${r.header.frames} frames in ${(performance.now() - t0).toFixed(0)} ms (server ${(r.header.seconds * 1000).toFixed(0)} ms, ${(r.bytes / 1048576).toFixed(1)} MiB)\n` + JSON.stringify(r.header.report.objects.map((o) => ({ name: o.name, elongation_max: o.elongation_max, multiples: o.multiples, lines_max: o.lines_max })), null, 1);
+    } catch (e) {
+      if (e.name !== 'AbortError' && gen === this.gen) s.showError(e.message);
+    } finally {
+      if (this.restCtl === ctl) this.restCtl = null;
+    }
+  }
+
+  /** While the background load runs, a frame not restyled yet is asked for alone. */
+  async loadFrame(f) {
+    if (this.frameInflight) { this.frameWant = f; return; }
+    this.frameInflight = true;
+    const s = this.studio, gen = this.gen;
+    try {
+      const r = await getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...this.lastBody, frames: [f, f + 1] });
+      if (gen === this.gen && this.restCtl) { this.fresh.add(f); this.apply(r); }
+    } catch (e) {
+      if (gen === this.gen) s.showError(e.message);
+    } finally {
+      this.frameInflight = false;
+      const w = this.frameWant; this.frameWant = null;
+      if (w !== null && w !== undefined && this.restCtl && !this.fresh.has(w)) this.loadFrame(w);
+    }
+  }
+
+  /**
+   * Draws a stylize answer holding clip frames `first_frame ..+ frames`: written into the
+   * panel's whole-clip buffers (frames not answered yet keep the previous style; copies
+   * there are transparent until they arrive).
+   */
+  apply({ header, buffers }) {
+    const s = this.studio;
+    const total = header.clip_frames, k = header.first_frame, nf = header.frames;
+    const n3 = this.anim.vertices * 3;
+    if (nf === total) this.body = buffers.body;
+    else {
+      if (!this.body || this.body.length !== total * n3) this.body = new Float32Array(this.anim.positions);
+      this.body.set(buffers.body, k * n3);
+    }
+    const same = this.copies && this.copies.length === header.copies.length && this.copies.every((c, i) => c.vertices === header.copies[i].vertices);
+    const copy = (c, i) => ({ vertices: c.vertices, triangles: buffers[`copy${i}.triangles`], positions: buffers[`copy${i}.positions`], alpha: buffers[`copy${i}.alpha`] });
+    let newCopies = !same || nf === total;
+    if (nf === total) this.copies = header.copies.map(copy);
+    else {
+      if (!same) this.copies = header.copies.map((c, i) => ({ ...copy(c, i), positions: new Float32Array(total * c.vertices * 3), alpha: new Float32Array(total * c.vertices) }));
+      header.copies.forEach((c, i) => {
+        this.copies[i].positions.set(buffers[`copy${i}.positions`], k * c.vertices * 3);
+        this.copies[i].alpha.set(buffers[`copy${i}.alpha`], k * c.vertices);
+      });
+    }
+    const sets = header.lines.map((_, i) => splitLines(buffers, i));
+    const sameLines = this.lines && this.lines.length === sets.length && nf !== total;
+    if (!sameLines) this.lines = sets.map((fr) => (fr.length === total ? fr : Array.from({ length: total }, () => EMPTY_LINES)));
+    if (nf !== total) sets.forEach((fr, i) => fr.forEach((x, j) => { this.lines[i][k + j] = x; }));
+    s.view.setAnimation({ ...this.anim, positions: this.body });
+    if (newCopies) s.view.setCopies(this.copies);
+    if (!sameLines) s.view.setLines(this.lines.map((frames) => ({ frames })));
+    s.view.setFrame(s.view.frame);
   }
 
   async showOffsets() {

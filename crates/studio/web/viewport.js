@@ -169,18 +169,15 @@ export class Viewport {
     g.computeVertexNormals();
   }
 
-  /** Motion lines: [{counts (frames × 2), positions, triangles, alpha}] — one mesh per frame. */
+  /** Motion lines: [{frames: [{positions, triangles}]}] — one mesh per clip frame. */
   setLines(lines) {
     for (const l of this.lines) { this.scene.remove(l.mesh); l.mesh.geometry.dispose(); l.mesh.material.dispose(); }
     this.lines = lines.map((l) => {
-      const frames = l.counts.length / 2;
-      const vstart = [0], tstart = [0];
-      for (let f = 0; f < frames; f++) { vstart.push(vstart[f] + l.counts[2 * f]); tstart.push(tstart[f] + l.counts[2 * f + 1]); }
       const m = new THREE.MeshBasicMaterial({ color: 0x111111, transparent: true, opacity: 0.9, side: THREE.DoubleSide });
       const mesh = new THREE.Mesh(new THREE.BufferGeometry(), m);
       mesh.frustumCulled = false;
       this.scene.add(mesh);
-      const o = { ...l, vstart, tstart, mesh };
+      const o = { ...l, mesh };
       this.lineFrame(o);
       return o;
     });
@@ -188,12 +185,10 @@ export class Viewport {
   }
 
   lineFrame(l) {
-    const f = Math.min(this.frame, l.vstart.length - 2);
-    const v0 = l.vstart[f], v1 = l.vstart[f + 1], t0 = l.tstart[f], t1 = l.tstart[f + 1];
+    const fr = l.frames[Math.min(this.frame, l.frames.length - 1)];
     const g = new THREE.BufferGeometry();
-    g.setAttribute('position', new THREE.BufferAttribute(l.positions.slice(v0 * 3, v1 * 3), 3));
-    const idx = l.triangles.slice(t0 * 3, t1 * 3);
-    g.setIndex(new THREE.BufferAttribute(idx, 1));
+    g.setAttribute('position', new THREE.BufferAttribute(fr.positions, 3));
+    g.setIndex(new THREE.BufferAttribute(fr.triangles, 1));
     l.mesh.geometry.dispose();
     l.mesh.geometry = g;
   }
@@ -209,7 +204,9 @@ export class Viewport {
   }
 
   render() {
+    const t = performance.now();
     this.renderer.render(this.scene, this.camera);
+    this.renderMs = performance.now() - t;
     this.dirty = false;
     const done = this.onRendered; this.onRendered = [];
     for (const f of done) f();

@@ -2,6 +2,7 @@
 //! velocities), then [`stylize`] with any number of styles; [`offsets`] alone for
 //! `toonkit smear offsets`.
 
+mod frames;
 mod prepare;
 mod stylize;
 
@@ -9,5 +10,6 @@ pub use prepare::{
     offsets, prepare, ObjectOffsets, PrepareOptions, PrepareReport, Prepared, SceneOffsets,
 };
 pub use stylize::{
-    stylize, CopyReport, ObjectParts, ObjectReport, StylizeReport, StylizeTimings, Stylized,
+    stylize, stylize_frames, CopyReport, ObjectParts, ObjectReport, StylizeReport, StylizeTimings,
+    Stylized,
 };

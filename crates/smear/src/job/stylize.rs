@@ -2,11 +2,13 @@
 //! multiple in-betweens (SMEAR Eqs. 11–12), motion lines (SMEAR Eq. 13) — as a flipbook with
 //! a report. Never solves offsets: everything style-independent comes from [`Prepared`].
 
+use std::ops::Range;
 use std::time::Instant;
 
 use anim::{Aabb, Flipbook, FlipbookPart, MeshAnimation};
 use serde::Serialize;
 
+use super::frames::{animation_at, check_range, elongate_range, lines_range, multiples_range};
 use super::prepare::Prepared;
 use crate::{CompiledEffects, EffectInputs, LineStyle, Result, SmearError, Style, Stylize};
 
@@ -104,7 +106,7 @@ pub struct ObjectParts {
     pub lines: Option<usize>,
 }
 
-/// The result of [`stylize`]: every effect of every object as parts of one flipbook (write
+/// The result of [`stylize`] (or [`stylize_frames`]): every effect of every object as parts of one flipbook (write
 /// it with `tkio::save(path, &tkio::Output::Flipbook(&stylized.flipbook))`, preview it with
 /// `render::flipbook_gif`), and a report.
 #[derive(Debug, Clone)]
@@ -115,6 +117,9 @@ pub struct Stylized {
     pub objects: Vec<ObjectParts>,
     /// Statistics and timings.
     pub report: StylizeReport,
+    /// The clip frame the flipbook's frame 0 is (0 unless [`stylize_frames`] was given a
+    /// later range).
+    pub first_frame: usize,
 }
 
 impl Stylized {
@@ -127,15 +132,15 @@ impl Stylized {
     }
 }
 
-/// Largest and mean vertex displacement between two animations of the same mesh.
-fn displacement(a: &MeshAnimation, b: &MeshAnimation) -> (f32, f64) {
+/// Largest and mean vertex displacement between two position lists of the same mesh.
+fn displacement(a: &[glam::Vec3], b: &[glam::Vec3]) -> (f32, f64) {
     let (mut max, mut sum) = (0.0f32, 0.0f64);
-    for (p, q) in a.positions().iter().zip(b.positions()) {
+    for (p, q) in a.iter().zip(b) {
         let d = p.distance(*q);
         max = max.max(d);
         sum += d as f64;
     }
-    (max, sum / a.positions().len().max(1) as f64)
+    (max, sum / a.len().max(1) as f64)
 }
 
 /// Squashes the frames of `anim` that land on the ground (see [`crate::squash_frames`]).
@@ -165,13 +170,14 @@ fn squash_animation(
 
 /// One multiple in-between, adaptively subdivided per frame (issue #22): every vertex of
 /// copy m moves by β_m(f) = step · m · Δf(f) (Section 4.2); opacities are blended into the
-/// colours' alpha.
+/// colours' alpha. The copy's frame 0 is clip frame `first`.
 fn subdivided_copy(
     inputs: &EffectInputs<'_>,
     options: &crate::MultiplesOptions,
     copy: &crate::MultipleCopy,
     rgb: [f32; 3],
     tol: f32,
+    first: usize,
 ) -> Result<Vec<anim::Mesh>> {
     let tr = inputs.trajectories();
     let anim = &copy.animation;
@@ -179,7 +185,7 @@ fn subdivided_copy(
     let step = options.step.max(1);
     let mut meshes = Vec::with_capacity(frames);
     for f in 0..frames {
-        let h = crate::held_frame(f, step);
+        let h = crate::held_frame(first + f, step);
         let (past, future) = options.counts_at(h as f32);
         let shown = if copy.m < 0 {
             copy.m.unsigned_abs() as usize <= past
@@ -215,7 +221,28 @@ fn subdivided_copy(
 /// Effects are parallel over frames; the motion-line seeds' offsets evaluate the prepared
 /// field at the seeds only (SMEAR Eq. 8), which costs seeds × frames, not a solve.
 pub fn stylize(prepared: &Prepared, style: &Style) -> Result<Stylized> {
+    stylize_frames(prepared, style, 0..prepared.report().frames)
+}
+
+/// [`stylize`] for the clip frames `frames` only (an interactive restyle draws the current
+/// frame first, then the rest): the flipbook holds `frames.len()` frames, frame 0 being clip
+/// frame `frames.start` ([`Stylized::first_frame`]); each frame equals the same frame of
+/// [`stylize`]'s result, and the report covers these frames.
+///
+/// # Errors
+/// As [`stylize`]; [`SmearError::InvalidParameter`] when `frames` is empty or runs past the
+/// clip.
+///
+/// # Performance
+/// Costs the frames asked for: the per-frame effect functions, no whole-clip pass (the
+/// motion-line seeds' offsets still cost seeds × clip frames).
+pub fn stylize_frames(
+    prepared: &Prepared,
+    style: &Style,
+    frames: Range<usize>,
+) -> Result<Stylized> {
     let start = Instant::now();
+    check_range(&frames, prepared.report().frames)?;
     if style.offsets != prepared.options().offsets {
         return Err(SmearError::InvalidParameter {
             name: "style.offsets",
@@ -224,7 +251,7 @@ pub fn stylize(prepared: &Prepared, style: &Style) -> Result<Stylized> {
     }
     let mut book = Flipbook {
         fps: prepared.report().fps,
-        frames: prepared.report().frames,
+        frames: frames.len(),
         parts: Vec::new(),
     };
     let mut objects = Vec::with_capacity(prepared.object_count());
@@ -261,25 +288,28 @@ pub fn stylize(prepared: &Prepared, style: &Style) -> Result<Stylized> {
         };
 
         let t = Instant::now();
+        let n = anim.vertex_count();
+        let input = &anim.positions()[frames.start * n..frames.end * n];
         let mut body = match &fx.elongate {
             Some((f, options)) => {
-                let e = crate::elongate(&inputs, f, options)?;
-                let (max, mean) = displacement(&e, anim);
+                let e = elongate_range(&inputs, f, options, &frames)?;
+                let (max, mean) = displacement(e.positions(), input);
                 stats.elongation_max = Some(max);
                 stats.elongation_mean = Some(mean);
                 e
             }
-            None => anim.clone(),
+            None if frames.len() == anim.frame_count() => anim.clone(),
+            None => animation_at(anim, frames.start, input.to_vec())?,
         };
+        let range_squash = squash.get(frames.clone()).unwrap_or(&[]);
         match (style.subdivide, &fx.elongate) {
             (Some(tol), Some((f, options))) => {
                 let tr = inputs.trajectories();
                 let step = options.step.max(1);
-                let n = anim.vertex_count();
                 let mut beta = vec![0.0f32; n];
-                let mut meshes = Vec::with_capacity(anim.frame_count());
+                let mut meshes = Vec::with_capacity(frames.len());
                 let (mut stretch, mut most) = (0.0f32, 0usize);
-                for frame in 0..anim.frame_count() {
+                for frame in frames.clone() {
                     let h = crate::held_frame(frame, step);
                     for (k, b) in beta.iter_mut().enumerate() {
                         *b = step as f32 * f.eval(&inputs.style_input(h, k));
@@ -301,7 +331,7 @@ pub fn stylize(prepared: &Prepared, style: &Style) -> Result<Stylized> {
                 });
             }
             _ => {
-                squash_animation(&mut body, &squash, ground);
+                squash_animation(&mut body, range_squash, ground);
                 book.parts.push(FlipbookPart::Animation {
                     animation: body,
                     colors: None,
@@ -317,7 +347,7 @@ pub fn stylize(prepared: &Prepared, style: &Style) -> Result<Stylized> {
                 .for_object(name)
                 .multiples
                 .map_or(crate::DEFAULT_MULTIPLE_COLOR, |m| m.color);
-            let copies = crate::multiples(&inputs, f, options)?;
+            let copies = multiples_range(&inputs, f, options, &frames)?;
             let mut visible = 0usize;
             for mut c in copies {
                 let shown = c.alpha.iter().filter(|a| **a > 0.0).count();
@@ -329,14 +359,15 @@ pub fn stylize(prepared: &Prepared, style: &Style) -> Result<Stylized> {
                     total: c.alpha.len(),
                 });
                 if let Some(tol) = style.subdivide {
-                    let meshes = subdivided_copy(&inputs, options, &c, [r, g, b], tol)?;
+                    let meshes =
+                        subdivided_copy(&inputs, options, &c, [r, g, b], tol, frames.start)?;
                     book.parts.push(FlipbookPart::Frames {
                         name: c.animation.mesh.name.clone(),
                         meshes,
                     });
                     continue;
                 }
-                squash_animation(&mut c.animation, &squash, ground);
+                squash_animation(&mut c.animation, range_squash, ground);
                 let colors = c.alpha.iter().map(|&a| [r, g, b, a]).collect();
                 book.parts.push(FlipbookPart::Animation {
                     animation: c.animation,
@@ -376,15 +407,15 @@ pub fn stylize(prepared: &Prepared, style: &Style) -> Result<Stylized> {
                 thickness: &l.thickness,
                 opacity: &l.opacity,
             };
-            let frames = crate::motion_lines(&seeds, &line_style, &l.options)?;
-            let drawn: Vec<usize> = frames.iter().map(|f| f.lines).collect();
+            let line_frames = lines_range(&seeds, &line_style, &l.options, &frames)?;
+            let drawn: Vec<usize> = line_frames.iter().map(|f| f.lines).collect();
             stats.seeds = Some(points.len());
             stats.lines_max = Some(drawn.iter().copied().max().unwrap_or(0));
             stats.lines_per_frame = Some(drawn);
             parts.lines = Some(book.parts.len());
             book.parts.push(FlipbookPart::Frames {
                 name: format!("{name}_lines"),
-                meshes: frames.into_iter().map(|f| f.mesh).collect(),
+                meshes: line_frames.into_iter().map(|f| f.mesh).collect(),
             });
         }
         report.seconds.lines += t.elapsed().as_secs_f64();
@@ -396,5 +427,6 @@ pub fn stylize(prepared: &Prepared, style: &Style) -> Result<Stylized> {
         flipbook: book,
         objects,
         report,
+        first_frame: frames.start,
     })
 }

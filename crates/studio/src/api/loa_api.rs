@@ -101,6 +101,16 @@ pub(crate) struct AnimateRequest {
     /// Drag-to-wobble impulses (`loa::Wobble`).
     #[serde(default)]
     wobbles: Vec<loa::Wobble>,
+    /// The timeline frame on screen: `positions` then holds only that motion frame (clamped
+    /// to the motion) and the page fetches the rest from `GET /api/loa/motion`.
+    #[serde(default)]
+    frame: Option<i64>,
+}
+
+/// `GET /api/loa/motion` query: the `version` of the animate answer the page drew.
+#[derive(Debug, Deserialize)]
+pub(crate) struct MotionQuery {
+    version: u64,
 }
 
 /// The keystroke JSON of `loa line` (what the page's strokes export as).
@@ -123,7 +133,9 @@ fn keystrokes_json(r: &AnimateRequest, fps: f64) -> Value {
 }
 
 /// `POST /api/loa/animate`: buffers `line` (f32, line frames × joints × 2, canvas pixels),
-/// `positions` (f32, motion frames × vertices × 3), `triangles` (u32).
+/// `positions` (f32, motion frames × vertices × 3 — or only the motion frame
+/// `motion.positions_first` when the request names a `frame`), `triangles` (u32); `version`
+/// names the answer for `GET /api/loa/motion`.
 pub(crate) async fn animate(
     State(studio): State<Arc<Studio>>,
     request: Result<Bytes, BytesRejection>,
@@ -198,7 +210,21 @@ pub(crate) async fn animate(
                 .flat_map(|f| f.chain.joints().into_iter().flat_map(|p| [p.x as f32, p.y as f32])),
         );
         pack.u32("triangles", m.mesh.triangles.iter().flatten().copied());
-        pack.f32("positions", m.positions().iter().flat_map(|p| p.to_array()));
+        let positions: Vec<f32> = m.positions().iter().flat_map(|p| p.to_array()).collect();
+        let (motion_frames, n) = (m.frame_count(), m.vertex_count() * 3);
+        let shown = match r.frame {
+            Some(f) => {
+                let k = (f - motion.first_frame).clamp(0, motion_frames.max(1) as i64 - 1) as usize;
+                k..(k + 1).min(motion_frames)
+            }
+            None => 0..motion_frames,
+        };
+        pack.f32(
+            "positions",
+            positions[shown.start * n..shown.end * n].iter().copied(),
+        );
+        let mut session = lock(&studio.loa);
+        let version = session.as_ref().map_or(1, |s| s.version + 1);
         let rep = &motion.report;
         let header = json!({
             "line": {
@@ -212,7 +238,10 @@ pub(crate) async fn animate(
                 "frames": m.frame_count(),
                 "vertices": m.vertex_count(),
                 "fps": motion.fps,
+                "positions_first": shown.start,
+                "positions_frames": shown.len(),
             },
+            "version": version,
             "warnings": line.warnings,
             "report": {
                 "line_distance_mean": rep.line_distance_mean,
@@ -223,15 +252,41 @@ pub(crate) async fn animate(
             "keystrokes": keys_json,
             "seconds": {"line": line_seconds, "animate": animate_seconds, "total": start.elapsed().as_secs_f64()},
         });
-        *lock(&studio.loa) = Some(LoaSession {
+        *session = Some(LoaSession {
             file: r.file,
             keys,
             keys_json: keys_json.to_string(),
             line,
             scene: out,
             motion,
+            positions,
+            version,
         });
         Ok(pack.response(header))
+    })
+    .await
+}
+
+/// `GET /api/loa/motion?version=`: buffer `positions` (f32, every motion frame × vertices × 3)
+/// of the animate answer `version`; a newer answer exists → 409 (the page drops it).
+pub(crate) async fn motion(
+    State(studio): State<Arc<Studio>>,
+    Query(q): Query<MotionQuery>,
+) -> ApiResult<Response> {
+    blocking(move || {
+        let guard = lock(&studio.loa);
+        let s = guard
+            .as_ref()
+            .ok_or_else(|| ApiError::conflict("no line yet: draw keystrokes first"))?;
+        if s.version != q.version {
+            return Err(ApiError::conflict(format!(
+                "motion {} was replaced by motion {}",
+                q.version, s.version
+            )));
+        }
+        let mut pack = Pack::new();
+        pack.f32("positions", s.positions.iter().copied());
+        Ok(pack.response(json!({ "version": s.version })))
     })
     .await
 }

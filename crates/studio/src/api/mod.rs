@@ -6,10 +6,11 @@
 //! | `GET /api/scene?file=&clip=` | the clip's merged mesh: triangles + positions per frame |
 //! | `GET /api/smear/presets` | the example styles (SMEAR Figs. 11–16) |
 //! | `GET /api/smear/offsets?file=&clip=` | motion offsets per frame and vertex (prepared once) |
-//! | `POST /api/smear/stylize` | a style → elongated body, multiples, lines |
+//! | `POST /api/smear/stylize` | a style → elongated body, multiples, lines (all frames or a range) |
 //! | `POST /api/smear/export` | writes the result (glb/usda/usdc/abc) or the style (toml) |
 //! | `GET /api/loa/view?file=` | the action camera the strokes are drawn through |
 //! | `POST /api/loa/animate` | keystrokes → line of action + character motion |
+//! | `GET /api/loa/motion?version=` | the rest of an animate answer's character motion |
 //! | `GET /api/loa/line` | the last line in the CLI's JSON layout |
 //! | `POST /api/loa/export` | keystrokes / line (json, svg) / motion (glb, bvh) |
 //! | `POST /api/stopmo/segment` | part seeds → a segmentation job |
@@ -45,6 +46,7 @@ pub fn routes() -> Router<Arc<Studio>> {
         .route("/api/smear/export", post(smear_api::export))
         .route("/api/loa/view", get(loa_api::view))
         .route("/api/loa/animate", post(loa_api::animate))
+        .route("/api/loa/motion", get(loa_api::motion))
         .route("/api/loa/line", get(loa_api::line))
         .route("/api/loa/export", post(loa_api::export))
         .route("/api/stopmo/segment", post(stopmo_api::segment))

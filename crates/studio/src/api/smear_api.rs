@@ -107,6 +107,10 @@ pub(crate) struct StyleRequest {
     /// Export file name inside the output folder.
     #[serde(default)]
     name: Option<String>,
+    /// `[start, end)`: only these clip frames (`smear::stylize_frames`; the page asks for the
+    /// current frame first, the rest after). All frames when absent; exports ignore it.
+    #[serde(default)]
+    frames: Option<[usize; 2]>,
 }
 
 fn read_style(r: &StyleRequest, prepared: &OffsetOptions) -> ApiResult<Style> {
@@ -129,15 +133,22 @@ fn read_style(r: &StyleRequest, prepared: &OffsetOptions) -> ApiResult<Style> {
     Ok(style)
 }
 
-fn stylized(studio: &Studio, r: &StyleRequest) -> ApiResult<(Style, smear::Stylized)> {
+/// The style of `r` applied to its frames (`all` = every frame, as exports write).
+fn stylized(studio: &Studio, r: &StyleRequest, all: bool) -> ApiResult<(Style, smear::Stylized)> {
     let p = studio.prepared(r.file, &r.clip)?;
     let style = read_style(r, &p.options().offsets)?;
     let label = studio.file(r.file)?.label();
-    let s = smear::stylize(&p, &style).map_err(|e| ApiError::bad(format!("{label}: {e}")))?;
+    let frames = match r.frames {
+        Some([start, end]) if !all => start..end,
+        _ => 0..p.report().frames,
+    };
+    let s = smear::stylize_frames(&p, &style, frames)
+        .map_err(|e| ApiError::bad(format!("{label}: {e}")))?;
     Ok((style, s))
 }
 
-/// `POST /api/smear/stylize`: buffers `body` (f32, frames × vertices × 3, every object's
+/// `POST /api/smear/stylize`: the header's `first_frame` and `frames` say which clip frames
+/// the buffers hold (`clip_frames` in all); buffers `body` (f32, frames × vertices × 3, every object's
 /// elongated in-betweens merged in object order), per copy `copyN.positions`,
 /// `copyN.alpha` (frames × copy vertices), `copyN.triangles`; per line set
 /// `linesN.counts` (u32 per frame: vertices, triangles), `linesN.positions`,
@@ -149,7 +160,7 @@ pub(crate) async fn stylize(
     let r: StyleRequest = body(request)?;
     blocking(move || {
         let start = Instant::now();
-        let (style, s) = stylized(&studio, &r)?;
+        let (style, s) = stylized(&studio, &r, false)?;
         let toml = style.to_toml_string().unwrap_or_default();
         let mut pack = Pack::new();
         let frames = s.flipbook.frames;
@@ -229,6 +240,8 @@ pub(crate) async fn stylize(
         }
         Ok(pack.response(json!({
             "frames": frames,
+            "first_frame": s.first_frame,
+            "clip_frames": studio.prepared(r.file, &r.clip)?.report().frames,
             "style": style,
             "toml": toml,
             "copies": copies,
@@ -268,7 +281,7 @@ pub(crate) async fn export(
                     "{name}: a styled smear is written as .glb, .usda, .usdc, .usdz or .abc (a style as .toml)"
                 )));
             }
-            let (_, s) = stylized(&studio, &r)?;
+            let (_, s) = stylized(&studio, &r, true)?;
             tkio::save(&path, &tkio::Output::Flipbook(&s.flipbook)).map_err(io)?;
         }
         Ok(Json(json!({ "written": path.display().to_string() })))
