@@ -76,6 +76,8 @@
 //!   difference from the offline mode: the smear lags (smoothed offsets by about N/3 frames,
 //!   velocities by half a frame) and the leading half of an elongation is a straight
 //!   extrapolation of the last motion, so it overshoots when the motion stops or turns.
+//!   A stream keeps out of the ground plane and of collider meshes
+//!   ([`Stream::add_collider`]) as the causal mode does.
 //!
 //! # Building blocks
 //! * Simple objects (SMEAR Eq. 1): signed distance to the plane through the area-weighted
