@@ -1,7 +1,8 @@
 //! Adaptive subdivision of smeared frames (issue #22; the paper's limitation "adaptive
 //! subdivision where the displacement gradient is high"): a triangle of a low-poly mesh that
-//! elongation stretches into a long shard is split until no edge is longer than `tolerance`
-//! times its rest length.
+//! elongation stretches into a long shard, or sweeps along a curved path, is split until no
+//! edge is longer than `tolerance` times its rest length and none cuts across the smear's
+//! curve by more than a fraction of it.
 //!
 //! Every vertex of the subdivided mesh is a blend of at most three input vertices (the
 //! corners of the input triangle it lies in). Catmull-Rom is linear in its control points, so
@@ -16,9 +17,9 @@
 //!   `BEND × (tolerance − 1) × r` ([`BEND`]). Where the parents' β differ, the smear of an edge
 //!   is the curve `u ↦ Q_u(h + β_u)` (`Q_u`, `β_u` blended along the edge): a leg swinging
 //!   through an arc is smeared along that arc although its edges barely stretch (a rigid
-//!   rotation keeps hip-to-foot lengths), so the stretch test alone leaves flat shards. Every
-//!   round halves the bend of a smooth curve's pieces about fourfold, so repeated splits
-//!   refine toward the curve.
+//!   rotation keeps hip-to-foot lengths), so the stretch test alone leaves flat shards. A
+//!   split puts the midpoint on the curve and leaves each half about a quarter of the bend,
+//!   so repeated splits refine toward the curve.
 //!
 //! The rest length of an edge is measured on the input frame (the un-smeared drawing): for an
 //! edge lying on an input edge, that edge's length; for an edge inside an input triangle, the
