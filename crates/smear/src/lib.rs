@@ -54,10 +54,11 @@
 //!
 //! # Beyond the paper (issue #22)
 //! * **Adaptive subdivision** ([`Style::subdivide`], [`subdivide_frame`]): output edges longer
-//!   than TOL × their rest length are split, crack-free; a new vertex is a blend of the input
-//!   vertices of its triangle and follows the same blend of their trajectories, displaced by
-//!   the blend of their β (Catmull-Rom is linear in its control points), so it lies on the
-//!   smear. Results then have one mesh per frame (`anim::FlipbookPart::Frames`).
+//!   than TOL × their rest length, or whose smear curves away from them by more than
+//!   [`BEND`] × (TOL − 1) of it (a limb swinging through an arc), are split, crack-free; a new
+//!   vertex is a blend of the input vertices of its triangle and follows the same blend of
+//!   their trajectories, displaced by the blend of their β (Catmull-Rom is linear in its
+//!   control points), so it lies on the smear and repeated splits refine toward its curve. Results then have one mesh per frame (`anim::FlipbookPart::Frames`).
 //! * **Revolving parts** ([`OffsetOptions::revolve`], [`Arcs`], [`fit_screw`]): the paper's
 //!   Fig. 19 limitation. Per frame interval the rigid motion is fitted as a screw; offsets are
 //!   SMEAR Eq. 1 with the plane replaced by the half-plane through the axis (signed arc length
@@ -75,6 +76,8 @@
 //!   difference from the offline mode: the smear lags (smoothed offsets by about N/3 frames,
 //!   velocities by half a frame) and the leading half of an elongation is a straight
 //!   extrapolation of the last motion, so it overshoots when the motion stops or turns.
+//!   A stream keeps out of the ground plane and of collider meshes
+//!   ([`Stream::add_collider`]) as the causal mode does.
 //!
 //! # Building blocks
 //! * Simple objects (SMEAR Eq. 1): signed distance to the plane through the area-weighted
@@ -134,7 +137,7 @@ pub use effects::{
     motion_lines, motion_lines_frame, multiple_opacity, multiples, multiples_frame,
     overlap_spacing, sample_surface, squash_frames, subdivide_frame, surface_point_weights,
     ContactStyle, EffectInputs, ElongateOptions, LineFrame, LineOptions, LineStyle, MultipleCopy,
-    MultiplesOptions, Spacing, Squash, StyleInput, Stylize, SubdivisionStats, Trajectories,
+    MultiplesOptions, Spacing, Squash, StyleInput, Stylize, SubdivisionStats, Trajectories, BEND,
     DEFAULT_FRAME_STEP, DEFAULT_LINE_SAMPLES, DEFAULT_LINE_SIDES, DEFAULT_SEED, DEFAULT_SPACING,
     DEFAULT_SQUASH_FRAMES, MAX_SQUASH, MAX_SUBDIVISION_LEVELS,
 };

@@ -23,8 +23,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::plane::plane_frames;
 use crate::{
-    causal_smoothing_weights, FunctionSpec, Result, SmearError, StyleFunction, StyleInput, Stylize,
-    Trajectories, DEFAULT_SMOOTH, DEFAULT_STILL_TOLERANCE, STILL_ROUNDING_FACTOR,
+    causal_smoothing_weights, Collider, FunctionSpec, Result, SmearError, StyleFunction,
+    StyleInput, Stylize, Trajectories, DEFAULT_SMOOTH, DEFAULT_STILL_TOLERANCE,
+    STILL_ROUNDING_FACTOR,
 };
 
 /// Default number of past frames a [`Stream`] keeps for its trajectories.
@@ -43,9 +44,8 @@ pub struct StreamOptions {
     pub elongate: FunctionSpec,
     /// Past frames kept: β below −(history − 1) clamps to the oldest kept frame.
     pub history: usize,
-    /// A ground plane `y = ground` the result never goes below. (Collider meshes are not
-    /// streamed yet: use [`prepare`](crate::prepare) with
-    /// [`PrepareOptions::colliders`](crate::PrepareOptions::colliders).)
+    /// A ground plane `y = ground` the result never goes below (collider meshes:
+    /// [`Stream::add_collider`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ground: Option<f32>,
 }
@@ -87,6 +87,8 @@ pub struct Stream {
     function: StyleFunction,
     weights: Vec<f32>,
     ground: Option<f32>,
+    /// Meshes the result never enters; pushed frame f meets their frame f.
+    colliders: Vec<Collider>,
     /// The last `kept` frames, oldest first, frame-major (capacity `history` frames).
     positions: Vec<Vec3>,
     kept: usize,
@@ -129,6 +131,7 @@ impl Stream {
             function,
             weights: causal_smoothing_weights(options.smooth),
             ground: options.ground.filter(|g| g.is_finite()),
+            colliders: Vec::new(),
             positions: Vec::with_capacity(options.history * n),
             kept: 0,
             history: options.history,
@@ -140,6 +143,14 @@ impl Stream {
             pushed: 0,
             still: None,
         })
+    }
+
+    /// Adds a mesh the results never enter (issue #22, as
+    /// [`Prepared::add_collider`](crate::Prepared::add_collider) offline): a displacement
+    /// stops where its trajectory enters it and what is inside is pushed out. The `f`-th
+    /// pushed frame (from 0) meets the collider's frame f (its last frame after its end).
+    pub fn add_collider(&mut self, collider: Collider) {
+        self.colliders.push(collider);
     }
 
     /// Frames pushed so far.
@@ -213,7 +224,10 @@ impl Stream {
             }
             *d = acc;
         }
-        let tr = Trajectories::new(&self.positions, self.kept, n)?.shaped(true, self.ground, None);
+        let tr = Trajectories::new(&self.positions, self.kept, n)?
+            .shaped(true, self.ground, None)
+            .with_colliders(&self.colliders)
+            .with_collider_frames_from(self.pushed - now);
         let (delta, rest, frame) = (&self.delta, &self.rest, self.pushed as f32);
         let function = &self.function;
         let current = &self.positions[now * n..];

@@ -102,8 +102,8 @@ pub struct EffectArgs {
     /// e.g. "clamp01(y / 2)".
     #[arg(long)]
     pub weight_expr: Option<String>,
-    /// Adaptive subdivision: split output edges longer than TOL × their rest length (TOL ≥ 1,
-    /// e.g. 2). The mesh then changes per frame: write .glb, .usda, .usdc, .usdz or .abc.
+    /// Adaptive subdivision: split output edges longer than TOL × their rest length, or whose
+    /// smear curves away from them by more than 5 % × (TOL − 1) of it (TOL ≥ 1, e.g. 2). The mesh then changes per frame: write .glb, .usda, .usdc, .usdz or .abc.
     #[arg(long, value_name = "TOL")]
     pub subdivide: Option<f32>,
     /// A ground plane y = Y that the in-betweens never cross.

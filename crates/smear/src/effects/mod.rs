@@ -28,6 +28,6 @@ pub use multiples::{
 };
 pub use seeds::{sample_surface, DEFAULT_SEED};
 pub use stylization::{StyleInput, Stylize};
-pub use subdivide::{subdivide_frame, SubdivisionStats, MAX_SUBDIVISION_LEVELS};
+pub use subdivide::{subdivide_frame, SubdivisionStats, BEND, MAX_SUBDIVISION_LEVELS};
 pub use trajectory::Trajectories;
 pub use weights::{attribute_weights, group_weights, surface_point_weights};

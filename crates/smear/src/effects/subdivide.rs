@@ -1,7 +1,8 @@
 //! Adaptive subdivision of smeared frames (issue #22; the paper's limitation "adaptive
 //! subdivision where the displacement gradient is high"): a triangle of a low-poly mesh that
-//! elongation stretches into a long shard is split until no edge is longer than `tolerance`
-//! times its rest length.
+//! elongation stretches into a long shard, or sweeps along a curved path, is split until no
+//! edge is longer than `tolerance` times its rest length and none cuts across the smear's
+//! curve by more than a fraction of it.
 //!
 //! Every vertex of the subdivided mesh is a blend of at most three input vertices (the
 //! corners of the input triangle it lies in). Catmull-Rom is linear in its control points, so
@@ -10,12 +11,22 @@
 //! displaced parents. Attributes (normals, UVs, colours, scalar attributes, multiples'
 //! opacities) are blended with the same weights.
 //!
+//! An edge is split when either test holds (both measured against its rest length r):
+//! * **stretch** — it is longer than `tolerance × r`;
+//! * **bend** — its midpoint on the smear is off the straight edge by more than
+//!   `BEND × (tolerance − 1) × r` ([`BEND`]). Where the parents' β differ, the smear of an edge
+//!   is the curve `u ↦ Q_u(h + β_u)` (`Q_u`, `β_u` blended along the edge): a leg swinging
+//!   through an arc is smeared along that arc although its edges barely stretch (a rigid
+//!   rotation keeps hip-to-foot lengths), so the stretch test alone leaves flat shards. A
+//!   split puts the midpoint on the curve and leaves each half about a quarter of the bend,
+//!   so repeated splits refine toward the curve.
+//!
 //! The rest length of an edge is measured on the input frame (the un-smeared drawing): for an
 //! edge lying on an input edge, that edge's length; for an edge inside an input triangle, the
 //! triangle's longest edge. Decisions are made per edge, so both triangles of an edge split it
 //! the same way: the result is crack-free (a split edge's midpoint is shared).
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use anim::Mesh;
 use glam::Vec3;
@@ -25,6 +36,13 @@ use super::Trajectories;
 
 /// Most rounds of edge splits per frame (each round at most halves every edge).
 pub const MAX_SUBDIVISION_LEVELS: usize = 8;
+
+/// The bend test's fraction: with `--subdivide TOL` an edge whose smear midpoint is off the
+/// straight edge by more than `BEND × (TOL − 1)` of its rest length is split (5 % at TOL = 2).
+pub const BEND: f32 = 0.05;
+
+/// Bends below this fraction of the rest length are rounding, never split (TOL = 1).
+const BEND_FLOOR: f32 = 1e-4;
 
 /// A vertex of the subdivided mesh: weights of up to three input vertices (unused slots 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -111,10 +129,12 @@ pub struct SubdivisionStats {
 /// * `beta` — β of every input vertex at this frame, in frames.
 /// * `alpha` — optional per-vertex opacities, blended into the output's colour alpha with
 ///   colour `rgb`.
-/// * `tolerance` — split edges longer than `tolerance ×` their rest length (e.g. 2).
+/// * `tolerance` — split edges longer than `tolerance ×` their rest length (e.g. 2), or
+///   whose smear bends away from them by more than [`BEND`]` × (tolerance − 1)` of it.
 ///
 /// # Performance
-/// One trajectory evaluation per parent of every new vertex; hash map of split edges per round.
+/// One trajectory evaluation per parent of every edge's midpoint, per round; hash map of
+/// edges per round.
 pub fn subdivide_frame(
     tr: &Trajectories<'_>,
     mesh: &Mesh,
@@ -162,21 +182,40 @@ pub fn subdivide_frame(
             }
         }
     };
+    let bend = (BEND * (tolerance - 1.0)).max(BEND_FLOOR);
     let mut mids: HashMap<(u32, u32), u32> = HashMap::new();
+    // Edges found short and straight: their ends never move, so they stay unsplit.
+    let mut kept: HashSet<(u32, u32)> = HashSet::new();
     for _ in 0..MAX_SUBDIVISION_LEVELS {
-        let mut split: HashMap<(u32, u32), bool> = HashMap::new();
+        // Per edge: its midpoint (blend and place on the smear) when it is split.
+        let mut split: HashMap<(u32, u32), Option<(Blend, Vec3)>> = HashMap::new();
         let mut any = false;
         for &(t, orig) in &tris {
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
                 let key = (a.min(b), a.max(b));
-                if split.contains_key(&key) {
+                if split.contains_key(&key) || kept.contains(&key) {
                     continue;
                 }
                 let r = reference(&blends, a, b, orig);
-                let long = r > 0.0 && pos[a as usize].distance(pos[b as usize]) > tolerance * r;
-                any |= long;
-                split.insert(key, long);
+                let (pa, pb) = (pos[a as usize], pos[b as usize]);
+                let mut mid = None;
+                if r > 0.0 {
+                    let nb = Blend::mid(&blends[key.0 as usize], &blends[key.1 as usize]);
+                    let q = place(&nb);
+                    let long = pa.distance(pb) > tolerance * r;
+                    let bent = q.distance(0.5 * (pa + pb)) > bend * r;
+                    if long || bent {
+                        mid = Some((nb, q));
+                    }
+                }
+                match mid {
+                    Some(_) => any = true,
+                    None => {
+                        kept.insert(key);
+                    }
+                }
+                split.insert(key, mid);
             }
         }
         if !any {
@@ -188,11 +227,10 @@ pub fn subdivide_frame(
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
                 let key = (a.min(b), a.max(b));
-                if split[&key] {
+                if let Some(Some((nb, q))) = split.get(&key) {
                     m[k] = *mids.entry(key).or_insert_with(|| {
-                        let nb = Blend::mid(&blends[a as usize], &blends[b as usize]);
-                        blends.push(nb);
-                        pos.push(place(&nb));
+                        blends.push(*nb);
+                        pos.push(*q);
                         (blends.len() - 1) as u32
                     });
                 }

@@ -41,6 +41,8 @@ pub struct Trajectories<'a> {
     ground: Option<f32>,
     arcs: Option<&'a Arcs>,
     colliders: &'a [Collider],
+    /// The colliders' frame of position frame 0 (a stream keeps only its last frames).
+    collider_first: usize,
 }
 
 impl<'a> Trajectories<'a> {
@@ -63,6 +65,7 @@ impl<'a> Trajectories<'a> {
             ground: None,
             arcs: None,
             colliders: &[],
+            collider_first: 0,
         })
     }
 
@@ -87,6 +90,7 @@ impl<'a> Trajectories<'a> {
             ground: None,
             arcs: None,
             colliders: &[],
+            collider_first: 0,
         }
     }
 
@@ -96,9 +100,19 @@ impl<'a> Trajectories<'a> {
         Trajectories { colliders, ..self }
     }
 
+    /// The same trajectories with position frame f meeting the colliders' frame `first + f`
+    /// (for a window of the last frames of a longer animation, as [`crate::Stream`] keeps).
+    pub fn with_collider_frames_from(self, first: usize) -> Self {
+        Trajectories {
+            collider_first: first,
+            ..self
+        }
+    }
+
     /// Whether `p` is below the ground or inside a collider at frame `f`.
     #[inline]
     pub fn is_blocked(&self, f: usize, p: Vec3) -> bool {
+        let f = f + self.collider_first;
         self.ground.is_some_and(|g| p.y < g) || self.colliders.iter().any(|c| c.inside(f, p))
     }
 
@@ -110,7 +124,7 @@ impl<'a> Trajectories<'a> {
             p.y = p.y.max(g);
         }
         for c in self.colliders {
-            p = c.push_out(f, p);
+            p = c.push_out(f + self.collider_first, p);
         }
         p
     }

@@ -294,7 +294,8 @@ pub struct Style {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lines: Option<LinesStyle>,
     /// Adaptive subdivision (issue #22): output edges of the elongated and multiple
-    /// in-betweens longer than this × their rest length are split (≥ 1; e.g. 2). The results
+    /// in-betweens longer than this × their rest length, or whose smear bends away from them
+    /// by more than [`crate::BEND`] × (this − 1) of it, are split (≥ 1; e.g. 2). The results
     /// then have one mesh per frame.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub subdivide: Option<f32>,

@@ -1,10 +1,11 @@
 //! `--ground` and colliders: a walk with planted feet never goes through the floor or into a
-//! collider mesh.
+//! collider mesh, offline and streamed.
 
 use anim::{Mesh, MeshAnimation, SampledScene};
 use glam::Vec3;
 use smear::{
-    prepare, stylize, Collider, ContactStyle, MultiplesStyle, Param, PrepareOptions, Style,
+    prepare, stylize, Collider, ContactStyle, FunctionSpec, MultiplesStyle, Param, PrepareOptions,
+    Stream, StreamOptions, Style,
 };
 
 use super::{elongation, legged, part_frames, prepared};
@@ -215,4 +216,56 @@ fn a_walk_onto_a_box_collider_never_enters_it() {
     .unwrap_err()
     .to_string();
     assert!(err.contains("'Ramp'") && err.contains("critter"), "{err}");
+}
+
+#[test]
+fn the_stream_keeps_out_of_a_moving_collider_like_the_causal_mode() {
+    // A platform the walk's feet plant on, rising through them: frame f of the stream must
+    // meet the platform's frame f although the stream keeps only its last few frames.
+    let walk = legged::gait(32, 0.1, 0.25);
+    let (min, max) = (Vec3::new(-2.0, -0.6, -1.0), Vec3::new(6.0, 0.0, 1.0));
+    let platform = split_box("Platform", min, max);
+    let slide = |f: usize| Vec3::Y * (0.02 * f as f32);
+    let moving: Vec<Vec3> = (0..walk.frame_count())
+        .flat_map(|f| platform.positions.iter().map(move |p| *p + slide(f)))
+        .collect();
+    let collider =
+        Collider::from_animation(&MeshAnimation::new(platform, walk.fps, moving).unwrap());
+    let mut offline = prepared(&walk, |o| o.offsets.causal = true);
+    offline.add_collider(collider.clone());
+    let expected = stylize(&offline, &elongation(&offline, 2.0)).unwrap();
+    let body = expected.animation(0).unwrap();
+    let options = StreamOptions {
+        elongate: FunctionSpec::linear(2.0),
+        ..StreamOptions::default()
+    };
+    let mut free = Stream::new(&walk.mesh, &options).unwrap();
+    let mut stream = Stream::new(&walk.mesh, &options).unwrap();
+    stream.add_collider(collider);
+    let inside = |f: usize, p: &Vec3| {
+        let (lo, hi) = (min + slide(f) + 1e-6, max + slide(f) - 1e-6);
+        p.cmpgt(lo).all() && p.cmplt(hi).all()
+    };
+    let (mut entered, mut worst) = (0usize, 0.0f32);
+    for f in 0..walk.frame_count() {
+        entered += free
+            .push(walk.frame(f))
+            .unwrap()
+            .iter()
+            .filter(|p| inside(f, p))
+            .count();
+        let out = stream.push(walk.frame(f)).unwrap();
+        assert_eq!(out.iter().filter(|p| inside(f, p)).count(), 0, "frame {f}");
+        for (s, o) in out.iter().zip(body.frame(f)) {
+            worst = worst.max(s.distance(*o));
+        }
+    }
+    assert!(
+        entered > 0,
+        "nothing entered the platform without the collider"
+    );
+    assert!(
+        worst < 1e-4,
+        "the stream differs from the causal mode by {worst}"
+    );
 }

@@ -11,7 +11,14 @@ const PERIOD: f32 = 8.0;
 const HIP: f32 = 0.7;
 
 /// Appends a box between a bottom and a top centre with half extents `hx`, `hz` in X and Z.
-fn push_box(p: &mut Vec<Vec3>, t: &mut Vec<[u32; 3]>, bottom: Vec3, top: Vec3, hx: f32, hz: f32) {
+pub(crate) fn push_box(
+    p: &mut Vec<Vec3>,
+    t: &mut Vec<[u32; 3]>,
+    bottom: Vec3,
+    top: Vec3,
+    hx: f32,
+    hz: f32,
+) {
     let base = p.len() as u32;
     let ring = [(-hx, -hz), (hx, -hz), (hx, hz), (-hx, hz)];
     for c in [bottom, top] {

@@ -6,6 +6,7 @@ mod contact;
 mod legged;
 mod revolve;
 mod subdivide;
+mod swing;
 
 use anim::{FlipbookPart, MeshAnimation, SampledScene};
 use smear::{prepare, ElongateStyle, FunctionSpec, PrepareOptions, Prepared, Style};

@@ -3,9 +3,10 @@
 use std::collections::HashMap;
 
 use anim::FlipbookPart;
-use smear::{stylize, Style};
+use glam::Vec3;
+use smear::{stylize, subdivide_frame, Style, Trajectories};
 
-use super::{elongation, legged, prepared};
+use super::{elongation, legged, prepared, swing};
 
 /// Largest ratio of an edge's length in `output` to its length in `input`.
 fn edge_ratio_max(input: &[glam::Vec3], output: &[glam::Vec3], tris: &[[u32; 3]]) -> f32 {
@@ -85,4 +86,98 @@ fn subdivide_2_keeps_every_edge_within_twice_its_rest_length() {
         );
     }
     assert!(grew, "nothing was subdivided");
+}
+
+/// Distance from `p` to the triangle `a b c`.
+fn point_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
+    let segment = |a: Vec3, b: Vec3| {
+        let ab = b - a;
+        let s = ((p - a).dot(ab) / ab.length_squared().max(1e-12)).clamp(0.0, 1.0);
+        p.distance(a + ab * s)
+    };
+    let n = (b - a).cross(c - a);
+    if n.length_squared() > 1e-12 {
+        let n = n.normalize();
+        let q = p - n * (p - a).dot(n);
+        let inside = [(a, b), (b, c), (c, a)]
+            .iter()
+            .all(|(u, v)| (*v - *u).cross(q - *u).dot(n) >= 0.0);
+        if inside {
+            return (p - q).length();
+        }
+    }
+    segment(a, b).min(segment(b, c)).min(segment(c, a))
+}
+
+/// Distance from `p` to the nearest triangle of `mesh`.
+fn point_mesh(p: Vec3, positions: &[Vec3], tris: &[[u32; 3]]) -> f32 {
+    tris.iter()
+        .map(|t| t.map(|v| positions[v as usize]))
+        .map(|[a, b, c]| point_triangle(p, a, b, c))
+        .fold(f32::INFINITY, f32::min)
+}
+
+#[test]
+fn subdivision_follows_the_arc_of_a_swinging_leg() {
+    // A low-poly animal whose legs and tail swing through arcs, smeared with β painted along
+    // each limb (0 at its root, 3 frames at its tip): the smear of a limb edge is the curve
+    // u ↦ S(u), the surface point at u along the edge taken at time h + β(u). The limbs are
+    // rigid, so their edges barely stretch (the stretch test alone splits nothing), yet the
+    // straight edges cut across the arc.
+    let frames = 24;
+    let run = swing::run(frames);
+    let tr = Trajectories::of_animation(&run);
+    let n = run.vertex_count();
+    let beta: Vec<f32> = (0..n)
+        .map(|v| if swing::is_tip(v) { 3.0 } else { 0.0 })
+        .collect();
+    let tris = &run.mesh.triangles;
+    let (mut plain_worst, mut sub_worst, mut stretch) = (0.0f32, 0.0f32, 0.0f32);
+    for h in 2..frames - 5 {
+        let plain: Vec<Vec3> = (0..n).map(|v| tr.displaced(h, v, beta[v])).collect();
+        let (sub, stats) = subdivide_frame(&tr, &run.mesh, h, &beta, None, 2.0);
+        stretch = stretch.max(stats.max_stretch);
+        assert_eq!(&sub.positions[..n], plain.as_slice(), "frame {h}");
+        assert!(
+            closed(&sub.triangles),
+            "frame {h}: a crack or a flipped triangle"
+        );
+        // The true smear of every edge whose ends have different β, densely sampled.
+        for t in tris {
+            for k in 0..3 {
+                let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+                if a > b || beta[a] == beta[b] {
+                    continue;
+                }
+                for s in 0..=32 {
+                    let u = s as f32 / 32.0;
+                    let p = swing::pose(h as f32 + (1.0 - u) * beta[a] + u * beta[b]).0;
+                    let truth = p[a] * (1.0 - u) + p[b] * u;
+                    plain_worst = plain_worst.max(point_mesh(truth, &plain, tris));
+                    sub_worst = sub_worst.max(point_mesh(truth, &sub.positions, &sub.triangles));
+                }
+            }
+        }
+    }
+    assert!(stretch <= 2.0, "max stretch {stretch}");
+    assert!(
+        plain_worst > 0.1 * swing::LEG,
+        "the straight edges should cut the arcs: {plain_worst}"
+    );
+    assert!(
+        sub_worst <= 0.5 * plain_worst,
+        "subdivided {sub_worst} vs straight {plain_worst} from the dense-sampled arcs"
+    );
+}
+
+/// Whether every edge is shared by exactly two triangles in opposite directions.
+fn closed(tris: &[[u32; 3]]) -> bool {
+    let mut edges: HashMap<(u32, u32), i32> = HashMap::new();
+    for t in tris {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *edges.entry((a.min(b), a.max(b))).or_default() += if a < b { 1 } else { -1 };
+        }
+    }
+    edges.values().all(|&v| v == 0)
 }
