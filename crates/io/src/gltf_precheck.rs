@@ -2,7 +2,7 @@
 //! assumes without checking (a bad index there would be a panic inside the crate).
 
 /// Checks what gltf-json 1.4 validation assumes without checking: that every mesh
-/// attribute refers to an existing accessor.
+/// attribute refers to an existing accessor, and that every accessor has elements.
 /// The error is the message; the reader wraps it as a malformed-glTF error.
 pub(crate) fn precheck(root: &gltf_json::Root) -> Result<(), String> {
     use gltf_json::validation::Checked;
@@ -24,6 +24,12 @@ pub(crate) fn precheck(root: &gltf_json::Root) -> Result<(), String> {
     }
     // A byte stride shorter than the element would make accessor reads overlap.
     for (k, a) in root.accessors.iter().enumerate() {
+        // glTF 2.0 requires count ≥ 1; the gltf crate's reader computes `count - 1`.
+        if a.count.0 == 0 {
+            return Err(format!(
+                "accessor {k} has count 0 (glTF requires at least one element): remove the accessor or re-export the file"
+            ));
+        }
         let (Checked::Valid(ty), Checked::Valid(ct)) = (&a.type_, &a.component_type) else {
             continue;
         };

@@ -16,3 +16,17 @@ fn fuzz_regressions_are_errors() {
     }
     assert!(n >= 1, "no regression file found in {dir}");
 }
+
+/// A skin's inverse bind matrices in an accessor of count 0 (glTF requires ≥ 1): the gltf
+/// crate computed `count - 1` and overflowed; the precheck names the accessor instead.
+#[test]
+fn accessor_with_count_zero_is_named() {
+    let p = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fuzz/regressions/gltf/gltf_accessor_count_zero.gltf"
+    );
+    let err = tkio::gltf::read_bytes(&std::fs::read(p).unwrap())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("accessor 4 has count 0"), "{err}");
+}
