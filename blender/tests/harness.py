@@ -51,6 +51,24 @@ def world_positions(obj, frame=None):
         ev.to_mesh_clear()
 
 
+def attribute(obj, name, dtype, frame=None):
+    """The evaluated per-vertex attribute `name` of `obj` as a `dtype` array (at `frame` if
+    given)."""
+    import bpy
+
+    if frame is not None:
+        bpy.context.scene.frame_set(frame)
+    dg = bpy.context.evaluated_depsgraph_get()
+    ev = obj.evaluated_get(dg)
+    mesh = ev.to_mesh()
+    try:
+        values = np.empty(len(mesh.vertices), dtype)
+        mesh.attributes[name].data.foreach_get("value", values)
+        return values
+    finally:
+        ev.to_mesh_clear()
+
+
 def run(tests):
     only = os.environ.get("TOONKIT_TESTS")  # comma-separated names: run only those
     if only:

@@ -23,7 +23,7 @@ os.environ.setdefault("BLENDER_USER_RESOURCES", os.path.join(
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from harness import (ASSETS, argv_after_dashes, check, empty_scene, install, rel,  # noqa: E402
+from harness import (ASSETS, argv_after_dashes, attribute, check, empty_scene, install, rel,  # noqa: E402
                      run, tmpdir, world_positions)
 
 ARGS = argv_after_dashes()
@@ -203,12 +203,7 @@ def test_multiples_and_lines_show_with_alpha():
         k = next(i for i, m in enumerate(same) if m is c)
         obj = next(o for o in copies if o["toonkit_source"] == src and o["toonkit_index"] == k)
         for i, f in enumerate(range(scene.frame_start, scene.frame_end + 1, 7)):
-            scene.frame_set(f)
-            dg = bpy.context.evaluated_depsgraph_get()
-            mesh = obj.evaluated_get(dg).to_mesh()
-            alpha = np.empty(len(mesh.vertices), np.float32)
-            mesh.attributes["tk_alpha"].data.foreach_get("value", alpha)
-            obj.evaluated_get(dg).to_mesh_clear()
+            alpha = attribute(obj, "tk_alpha", np.float32, frame=f)
             k_frame = f - scene.frame_start
             np.testing.assert_allclose(alpha, c["alpha"][k_frame], atol=1e-6)
             diag = float(np.ptp(c["positions"][0], axis=0).max()) or 1.0

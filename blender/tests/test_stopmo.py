@@ -28,7 +28,7 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 from mathutils import Vector  # noqa: E402
 
-from harness import (REPO, argv_after_dashes, check, empty_scene, install, run,  # noqa: E402
+from harness import (REPO, argv_after_dashes, attribute, check, empty_scene, install, run,  # noqa: E402
                      tmpdir, world_positions)
 
 ARGS = argv_after_dashes()
@@ -109,12 +109,7 @@ def shows_assembly(scene, folder, ref):
           f"{len(rows)} assembly rows, {len(labels)} labels")
     ids = {(p["part"], p["index"]): p["id"] for p in ref.pieces}
     for k, f in enumerate(range(scene.frame_start, scene.frame_end + 1)):
-        scene.frame_set(f)
-        dg = bpy.context.evaluated_depsgraph_get()
-        mesh = rec.evaluated_get(dg).to_mesh()
-        piece = np.empty(len(mesh.vertices), np.int32)
-        mesh.attributes["piece"].data.foreach_get("value", piece)
-        rec.evaluated_get(dg).to_mesh_clear()
+        piece = attribute(rec, "piece", np.int32, frame=f)
         shown = [ids[(p, int(i))] for p, i in enumerate(labels[k])]
         check(set(shown) <= set(rows[k]), f"frame {f}: {shown} not in {rows[k]}")
         check(set(np.unique(piece)) == set(int(i) for i in labels[k]),
@@ -208,12 +203,7 @@ def test_stopmo_cursor_seeds_suzanne():
     # index of the piece that assembly.csv row k names for the part, and its file exists.
     rec = next(o for o in bpy.data.objects if o.get("toonkit_role") == "stopmo")
     for k, f in enumerate(range(scene.frame_start, scene.frame_end + 1)):
-        scene.frame_set(f)
-        dg = bpy.context.evaluated_depsgraph_get()
-        mesh = rec.evaluated_get(dg).to_mesh()
-        piece = np.empty(len(mesh.vertices), np.int32)
-        mesh.attributes["piece"].data.foreach_get("value", piece)
-        rec.evaluated_get(dg).to_mesh_clear()
+        piece = attribute(rec, "piece", np.int32, frame=f)
         check(len(piece) == sum(sizes.values()), f"{len(piece)} reconstruction vertices")
         at = 0
         for name, n in sizes.items():
