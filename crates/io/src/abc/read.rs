@@ -83,7 +83,7 @@ pub fn read_with_limit(bytes: &[u8], max_decoded_bytes: usize) -> Result<AbcArch
     let mut sampling = None;
     let mut budget = max_decoded_bytes;
     for (name, object) in names.into_iter().zip(children.iter().skip(1)) {
-        let (mesh, ts) = polymesh(&r, *object, name, (&mut budget, max_decoded_bytes))?;
+        let (mesh, ts) = polymesh(&r, *object, name, &mut budget, max_decoded_bytes)?;
         sampling = sampling.or(Some(ts));
         meshes.push(mesh);
     }
@@ -197,12 +197,13 @@ fn property_headers(bytes: &[u8]) -> Result<Vec<PropertyHeader>> {
 }
 
 /// One `PolyMesh` object; also returns the time sampling index of its points. Every decoded
-/// sample is charged to `budget.0`, the bytes left of the whole budget `budget.1`.
+/// sample is charged to `budget`, the bytes left of the archive's whole budget `limit`.
 fn polymesh(
     r: &Reader,
     object: Node,
     name: String,
-    (budget, limit): (&mut usize, usize),
+    budget: &mut usize,
+    limit: usize,
 ) -> Result<(AbcMesh, u32)> {
     let kids = r.children(object)?;
     let props = compound(r, *kids.first().ok_or_else(|| malformed("empty object"))?)?;
