@@ -87,6 +87,74 @@ try {
   await page.waitForTimeout(1500);
   await page.screenshot({ path: join(shots, 'smear-offsets.png') });
 
+  // --- smear keyframes and weight-group picker (#18) ---
+  {
+    await page.evaluate(() => { const c = document.getElementById('show-offsets'); c.checked = false; c.dispatchEvent(new Event('change')); });
+    const smearDone = async (fn, ...args) => {
+      const n = await counts('smear'), nAll = await counts('smearAll');
+      await page.evaluate(fn, ...args);
+      await page.waitForFunction((n) => window.studio.stats.smear.length > n, n, { timeout: 60000 });
+      await page.waitForFunction((n) => window.studio.stats.smearAll.length > n, nAll, { timeout: 120000 });
+    };
+    // β max 0 keyed at frame 10, 20 keyed at frame 40 (the second a keyed field's edit).
+    await smearDone(() => { window.studio.setFrame(10); const s = document.getElementById('beta-max'); s.value = 0; s.dispatchEvent(new Event('input')); });
+    await smearDone(() => document.querySelector('button.key[data-key="beta-max"]').click());
+    await smearDone(() => { window.studio.setFrame(40); const s = document.getElementById('beta-max'); s.value = 20; s.dispatchEvent(new Event('input')); });
+    const markers = await page.evaluate(() => [...document.querySelectorAll('#key-track .key-marker[data-param="beta-max"]')].map((m) => Number(m.dataset.frame)));
+    check('two β-max keys show two markers under the timeline at frames 10 and 40', JSON.stringify(markers) === '[10,40]', JSON.stringify(markers));
+    const toml = await page.evaluate(() => document.getElementById('style-toml').value);
+    check('the style TOML carries the keys', /by = \[\[10\.0, 0\.0\], \[40\.0, 20\.0\]\]/.test(toml), toml.split('\n').filter((l) => l.includes('by')).join(' | '));
+    // The drawn geometry (the viewport mesh's positions) against the input at the two keys
+    // and halfway: β = 0 is the input, β = 20 and the interpolated β = 10 stretch.
+    const drawnDiff = (f) => page.evaluate((f) => {
+      const s = window.studio, p = s.panels.smear;
+      s.setFrame(f);
+      const pos = s.view.mesh.geometry.attributes.position.array;
+      const n = p.anim.vertices * 3, input = p.anim.positions.subarray(f * n, (f + 1) * n);
+      let d = 0;
+      for (let i = 0; i < n; i++) d = Math.max(d, Math.abs(pos[i] - input[i]));
+      return d;
+    }, f);
+    const [d10, d25, d40] = [await drawnDiff(10), await drawnDiff(25), await drawnDiff(40)];
+    check('keyed β: frame 10 (β = 0) draws the input, frames 25 (β = 10) and 40 (β = 20) are stretched', d10 < 1e-5 && d40 > 1e-3 && d25 > 1e-4, `max |Δ| ${d10.toExponential(2)}, ${d25.toExponential(2)}, ${d40.toExponential(2)}`);
+    const field = await page.evaluate(() => { window.studio.setFrame(25); return Number(document.getElementById('beta-max').value); });
+    check('between keys the β field shows the interpolated value', Math.abs(field - 10) < 1e-3, String(field));
+    // A marker click jumps to its frame.
+    await page.click('#key-track .key-marker[data-param="beta-max"][data-frame="10"]');
+    check('clicking a marker jumps to its frame', await page.evaluate(() => window.studio.frame) === 10);
+    // Weight group: the right shoulder and below (the robot's bones, SMEAR Fig. 15b).
+    const options = await page.evaluate(() => [...document.getElementById('weight-source').options].map((o) => o.text));
+    check('the weight-group picker lists the robot\'s bones', options.includes('bone ShoulderR and below') && options.length > 20, `${options.length} options`);
+    await page.evaluate(() => window.studio.setFrame(40));
+    const before40 = await page.evaluate(() => Array.from(window.studio.panels.smear.body.subarray(40 * window.studio.panels.smear.anim.vertices * 3, 41 * window.studio.panels.smear.anim.vertices * 3)));
+    await smearDone(() => {
+      const sel = document.getElementById('weight-source');
+      sel.value = [...sel.options].find((o) => o.text === 'bone ShoulderR and below').value;
+      sel.dispatchEvent(new Event('change'));
+    });
+    await page.waitForFunction(() => window.studio.view.vertexColors, null, { timeout: 30000 });
+    const overlay = await page.evaluate(() => {
+      const c = window.studio.view.mesh.geometry.attributes.color.array;
+      let hot = 0, grey = 0;
+      for (let i = 0; i < c.length; i += 3) { if (c[i] > 0.95 && c[i + 2] < 0.2) hot++; else if (Math.abs(c[i] - 0.78) < 0.01) grey++; }
+      return { hot, grey };
+    });
+    check('the weight overlay colours the arm orange and the rest grey', overlay.hot > 100 && overlay.grey > overlay.hot, JSON.stringify(overlay));
+    const picked = await page.evaluate(() => ({ weights: window.studio.panels.smear.style.weights, toml: document.getElementById('style-toml').value }));
+    check('picking a group sets the style\'s weights', picked.weights && picked.weights.group && picked.weights.group[0] === 'ShoulderR' && picked.toml.includes('ShoulderR'), JSON.stringify(picked.weights));
+    const after40 = await page.evaluate(() => Array.from(window.studio.panels.smear.body.subarray(40 * window.studio.panels.smear.anim.vertices * 3, 41 * window.studio.panels.smear.anim.vertices * 3)));
+    let moved = 0;
+    for (let i = 0; i < after40.length; i++) if (Math.abs(after40[i] - before40[i]) > 1e-4) moved++;
+    check('the weight group restyles the smear (vertices off the arm stop stretching)', moved > 300, `${moved} coordinates changed at frame 40`);
+    await page.waitForTimeout(300);
+    await page.screenshot({ path: join(shots, 'smear-keyframes.png') });
+    // Right-click deletes a key.
+    await page.click('#key-track .key-marker[data-param="beta-max"][data-frame="40"]', { button: 'right' });
+    const left = await page.evaluate(() => [...document.querySelectorAll('#key-track .key-marker[data-param="beta-max"]')].map((m) => Number(m.dataset.frame)));
+    check('right-clicking a marker deletes its key', JSON.stringify(left) === '[10]', JSON.stringify(left));
+    await page.waitForTimeout(500);
+  }
+
   // loa: three strokes at three frames by mouse.
   await page.evaluate(() => window.studio.activate('loa'));
   await page.waitForFunction(() => window.studio.panels.loa.view, null, { timeout: 60000 });

@@ -28,6 +28,12 @@ pub const PAGE: &[(&str, &str, &str)] = &[
     ("api.js", JS, include_str!("../web/api.js")),
     ("viewport.js", JS, include_str!("../web/viewport.js")),
     ("smear.js", JS, include_str!("../web/smear.js")),
+    ("smear_keys.js", JS, include_str!("../web/smear_keys.js")),
+    (
+        "smear_weights.js",
+        JS,
+        include_str!("../web/smear_weights.js"),
+    ),
     ("loa.js", JS, include_str!("../web/loa.js")),
     ("stopmo.js", JS, include_str!("../web/stopmo.js")),
 ];

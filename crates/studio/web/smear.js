@@ -1,7 +1,10 @@
-// The smear panel: presets, β max and multiples/lines fields, the TOML editor with inline
+// The smear panel: presets, β max and multiples/lines fields (keyframeable on the timeline,
+// smear_keys.js), the weight-group picker (smear_weights.js), the TOML editor with inline
 // errors, the offsets view, exports. Every change restyles the prepared offsets on the server:
 // the current frame first, the whole clip after.
 import { getJSON, getPack, postJSON } from './api.js';
+import { KEYABLE, keyable, isCurve, paramAt, setKey, deleteKey, drawKeys } from './smear_keys.js';
+import { WeightPicker } from './smear_weights.js';
 
 const $ = (id) => document.getElementById(id);
 const EMPTY_LINES = { positions: new Float32Array(0), triangles: new Uint32Array(0) };
@@ -19,13 +22,6 @@ function splitLines(buffers, i) {
   return out;
 }
 
-/** The elongation function's `scale` stage (SMEAR Section 5: β max). */
-function scaleStage(style) {
-  const f = style.elongate && style.elongate.function;
-  const stages = f && f.stages;
-  return stages ? stages.find((s) => s.op === 'scale') : null;
-}
-
 export class SmearPanel {
   constructor(studio) {
     this.studio = studio;
@@ -36,10 +32,14 @@ export class SmearPanel {
     this.pending = null;
     this.offsets = null;
     this.loadedKey = null;
-    $('beta-max').addEventListener('input', () => this.edit('beta'));
-    $('mult-past').addEventListener('change', () => this.edit('multiples'));
-    $('mult-future').addEventListener('change', () => this.edit('multiples'));
-    $('line-count').addEventListener('change', () => this.edit('lines'));
+    this.weights = new WeightPicker(studio);
+    $('beta-max').addEventListener('input', () => this.edit('beta-max'));
+    for (const id of ['mult-past', 'mult-future', 'line-count']) $(id).addEventListener('change', () => this.edit(id));
+    for (const b of document.querySelectorAll('button.key')) b.addEventListener('click', () => this.key(b.dataset.key));
+    for (const b of document.querySelectorAll('button.unkey')) b.addEventListener('click', () => this.unkey(b.dataset.key, this.studio.frame));
+    $('weight-source').addEventListener('change', () => this.pickWeights());
+    $('show-weights').addEventListener('change', () => this.weights.showOverlay());
+    window.addEventListener('resize', () => { if (this.active) this.drawKeys(); });
     $('preset').addEventListener('change', () => this.usePreset($('preset').value));
     $('apply-toml').addEventListener('click', () => this.request({ toml: $('style-toml').value }, performance.now()));
     $('show-offsets').addEventListener('change', () => this.showOffsets());
@@ -67,6 +67,8 @@ export class SmearPanel {
     this.body = this.copies = this.lines = null;
     this.studio.view.clearEffects();
     this.studio.view.setOffsets(null);
+    this.studio.view.setVertexColors(null);
+    $('key-track').hidden = true;
   }
 
   async reload() {
@@ -81,12 +83,15 @@ export class SmearPanel {
     s.view.setAnimation({ ...this.anim });
     s.setTimeline(this.anim.frames, this.anim.fps);
     s.setFrame(s.frame);
+    await this.weights.load();
     this.syncFields();
+    this.weights.showOverlay();
     await this.request({ style: this.style }, performance.now());
   }
 
   onFrame(f) {
     this.studio.view.setFrame(f);
+    if (this.style) this.syncFields();
     if (this.restCtl && this.fresh && !this.fresh.has(f)) this.loadFrame(f);
   }
 
@@ -96,36 +101,67 @@ export class SmearPanel {
     this.request({ style: this.style }, performance.now());
   }
 
+  /** The fields show the style's values at the current frame; the keys and the picker too. */
   syncFields() {
-    const st = scaleStage(this.style);
-    if (st && typeof st.by === 'number') { $('beta-max').value = st.by; $('beta-max-value').value = st.by; }
-    const m = this.style.multiples;
-    $('mult-past').value = m && m.enabled !== false ? (typeof m.past === 'number' ? m.past : 0) : 0;
-    $('mult-future').value = m && m.enabled !== false ? (typeof m.future === 'number' ? m.future : 0) : 0;
-    const l = this.style.lines;
-    $('line-count').value = l && l.enabled !== false && typeof l.count === 'number' ? l.count : 0;
+    const f = this.studio.frame;
+    for (const d of KEYABLE) {
+      const p = d.get(this.style);
+      if (p === null || p === undefined) continue;
+      const v = +Number(paramAt(p, f)).toFixed(3);
+      $(d.id).value = v;
+      if (d.id === 'beta-max') $('beta-max-value').value = v;
+    }
+    this.weights.sync(this.style);
+    this.drawKeys();
   }
 
-  edit(what) {
+  drawKeys() {
+    const s = this.studio;
+    drawKeys(this.style, s.frame, s.timeline.frames, { jump: (f) => s.setFrame(f), remove: (id, f) => this.unkey(id, f) });
+  }
+
+  /** A field changed: a keyed parameter gets a key at the current frame, others a constant. */
+  edit(id) {
     const t0 = performance.now();
-    const s = this.style;
-    if (what === 'beta') {
-      const beta = Number($('beta-max').value);
-      $('beta-max-value').value = beta;
-      let st = scaleStage(s);
-      if (!st) {
-        s.elongate = { function: { stages: [{ op: 'speed' }, { op: 'scale', by: beta }] } };
-      } else st.by = beta;
-    } else if (what === 'multiples') {
-      const past = Number($('mult-past').value), future = Number($('mult-future').value);
-      if (past + future === 0) delete s.multiples;
-      else s.multiples = { ...(s.multiples || {}), enabled: true, past, future };
-    } else if (what === 'lines') {
-      const count = Number($('line-count').value);
-      if (count === 0) delete s.lines;
-      else s.lines = { ...(s.lines || {}), enabled: true, count };
+    const d = keyable(id);
+    const v = Number($(id).value);
+    if (id === 'beta-max') $('beta-max-value').value = v;
+    const p = d.get(this.style);
+    d.set(this.style, isCurve(p) ? setKey(p, this.studio.frame, v) : v);
+    this.request({ style: this.style }, t0);
+  }
+
+  /** The field's key button: a key at the current frame with the field's value. */
+  key(id) {
+    const d = keyable(id);
+    d.set(this.style, setKey(d.get(this.style), this.studio.frame, Number($(id).value)));
+    this.drawKeys();
+    this.request({ style: this.style }, performance.now());
+  }
+
+  /** Deletes field `id`'s key at `frame` (the last key's value stays as a constant). */
+  unkey(id, frame) {
+    const d = keyable(id);
+    d.set(this.style, deleteKey(d.get(this.style), frame));
+    this.drawKeys();
+    this.request({ style: this.style }, performance.now());
+  }
+
+  /**
+   * The weight-group picker changed: the server sets the source on the style
+   * (`smear::Style::set_weights`, the effects then read ω) and the overlay shows it.
+   */
+  pickWeights() {
+    const w = this.weights.picked();
+    if (w) {
+      this.style.weights = w;
+      $('show-weights').checked = true;
+      this.request({ style: this.style, weights: w }, performance.now());
+    } else {
+      delete this.style.weights;
+      this.request({ style: this.style }, performance.now());
     }
-    this.request({ style: s }, t0);
+    this.weights.showOverlay();
   }
 
   /**
@@ -136,7 +172,12 @@ export class SmearPanel {
   async request(body, t0) {
     this.gen = (this.gen || 0) + 1;
     if (this.restCtl) { this.restCtl.abort(); this.restCtl = null; }
-    if (this.inflight) { this.pending = { body, t0 }; return; }
+    if (this.inflight) {
+      // Only the newest change waits; a weight source picked meanwhile still gets set.
+      const weights = this.pending && this.pending.body.weights;
+      this.pending = { body: weights && !body.weights && !body.toml ? { ...body, weights } : body, t0 };
+      return;
+    }
     this.inflight = true;
     const s = this.studio;
     const f = s.frame;

@@ -338,6 +338,38 @@ impl Style {
         toml::to_string(self).map_err(|e| StyleError::Syntax(e.to_string()))
     }
 
+    /// Sets the painted weights ω (`None`: ω = 1 everywhere) and makes the style's effects
+    /// read them, as the CLI's `--weight-group` does: every preset chain among the elongation
+    /// function, the lines' length and a given multiples opacity that has no `weight` stage
+    /// gets one (appended, or before the chain's `multiples`/`fade` stage, so ω scales the
+    /// offset and not an opacity curve). Expressions read `weight` themselves and are kept;
+    /// per-object overrides are kept.
+    pub fn set_weights(&mut self, source: Option<WeightSource>) {
+        let weigh = |f: &mut FunctionSpec| {
+            if f.expr.is_some() || f.stages.contains(&Stage::Weight) {
+                return;
+            }
+            let at = f
+                .stages
+                .iter()
+                .position(|s| matches!(s, Stage::Multiples { .. } | Stage::Fade))
+                .unwrap_or(f.stages.len());
+            f.stages.insert(at, Stage::Weight);
+        };
+        if source.is_some() {
+            if let Some(e) = &mut self.elongate {
+                weigh(&mut e.function);
+            }
+            if let Some(o) = self.multiples.as_mut().and_then(|m| m.opacity.as_mut()) {
+                weigh(o);
+            }
+            if let Some(l) = &mut self.lines {
+                weigh(&mut l.length);
+            }
+        }
+        self.weights = source;
+    }
+
     /// Compiles every function and checks every option.
     pub fn validate(&self) -> Result<(), StyleError> {
         if let Some(t) = self.subdivide {

@@ -207,3 +207,85 @@ weights = { group = ["Spine"], descendants = false }
         );
     }
 }
+
+#[test]
+fn set_weights_makes_every_preset_chain_read_the_weights_once() {
+    let mut style = Style::from_toml_str(FIG16).unwrap();
+    style.lines.as_mut().unwrap().length = FunctionSpec::linear(2.0);
+    let group = WeightSource::Group(WeightGroup {
+        group: vec!["ShoulderR".into()],
+        descendants: true,
+    });
+    style.set_weights(Some(group.clone()));
+    assert_eq!(style.weights, Some(group.clone()));
+    let stages = &style.elongate.as_ref().unwrap().function.stages;
+    assert_eq!(stages.last(), Some(&Stage::Weight), "{stages:?}");
+    // In the opacity chain ω goes before S_M (it scales the offset, not the opacity).
+    let opacity = &style
+        .multiples
+        .as_ref()
+        .unwrap()
+        .opacity
+        .as_ref()
+        .unwrap()
+        .stages;
+    assert_eq!(opacity[opacity.len() - 2], Stage::Weight, "{opacity:?}");
+    assert!(matches!(opacity.last(), Some(Stage::Multiples { .. })));
+    assert!(style
+        .lines
+        .as_ref()
+        .unwrap()
+        .length
+        .stages
+        .contains(&Stage::Weight));
+    // Twice adds nothing; an expression is kept as written.
+    let once = style.clone();
+    style.set_weights(Some(group));
+    assert_eq!(style, once);
+    let mut expr = Style::from_toml_str("[elongate]\nfunction = { expr = \"2 * delta\" }").unwrap();
+    expr.set_weights(Some(WeightSource::Attribute(WeightAttribute {
+        attribute: "_SMEAR_WEIGHT".into(),
+    })));
+    assert_eq!(
+        expr.elongate.as_ref().unwrap().function.expr.as_deref(),
+        Some("2 * delta")
+    );
+    // None clears ω (the weight stages then multiply by 1) and the result still validates.
+    style.set_weights(None);
+    assert_eq!(style.weights, None);
+    style.validate().unwrap();
+    Style::from_toml_str(&style.to_toml_string().unwrap()).unwrap();
+}
+
+#[test]
+fn keyframes_survive_the_toml_text_the_studio_shows() {
+    // The studio edits keys on the style's data and shows/exports `to_toml_string`.
+    let mut style = Style::default();
+    style.elongate = Some(ElongateStyle {
+        function: FunctionSpec::stages(vec![
+            Stage::Speed,
+            Stage::Scale {
+                by: Param::Curve(vec![[0.0, 1.0], [40.0, 12.0]]),
+            },
+        ]),
+        ..ElongateStyle::default()
+    });
+    style.multiples = Some(MultiplesStyle {
+        past: Param::Curve(vec![[10.0, 0.0], [30.0, 3.0]]),
+        ..MultiplesStyle::default()
+    });
+    style.lines = Some(LinesStyle {
+        count: Param::Curve(vec![[0.0, 0.0], [20.0, 60.0]]),
+        ..LinesStyle::default()
+    });
+    style.validate().unwrap();
+    let text = style.to_toml_string().unwrap();
+    let back = Style::from_toml_str(&text).unwrap();
+    assert_eq!(back, style, "{text}");
+    let by = match &back.elongate.as_ref().unwrap().function.stages[1] {
+        Stage::Scale { by } => by.clone(),
+        s => panic!("{s:?}"),
+    };
+    assert_eq!((by.at(0.0), by.at(20.0), by.at(40.0)), (1.0, 6.5, 12.0));
+    assert_eq!(back.lines.as_ref().unwrap().count.at(10.0), 30.0);
+}

@@ -77,6 +77,43 @@ impl WeightSource {
         }
     }
 
+    /// Every weight source `scene` offers, for a weight-group picker (paper Fig. 15b): one
+    /// group per joint of the skeleton (with its descendants) when an object is skinned or
+    /// parented to a joint, each scalar vertex attribute of any object (by its name as stored,
+    /// e.g. `_SMEAR_WEIGHT`), and the four `COLOR_0` channels when an object has vertex
+    /// colours. Deterministic order: joints in skeleton order, then attributes by name, then
+    /// colour channels.
+    pub fn available(scene: &SampledScene) -> Vec<WeightSource> {
+        let bound = scene
+            .objects
+            .iter()
+            .any(|o| o.skin.is_some() || o.parent_joint.is_some());
+        let mut out: Vec<WeightSource> = Vec::new();
+        if bound {
+            out.extend(scene.skeleton.joints.iter().map(|j| {
+                WeightSource::Group(WeightGroup {
+                    group: vec![j.name.clone()],
+                    descendants: true,
+                })
+            }));
+        }
+        let names: std::collections::BTreeSet<&String> = scene
+            .objects
+            .iter()
+            .flat_map(|o| o.animation.mesh.attributes.keys())
+            .collect();
+        let attribute = |name: String| WeightSource::Attribute(WeightAttribute { attribute: name });
+        out.extend(names.into_iter().map(|n| attribute(n.clone())));
+        if scene
+            .objects
+            .iter()
+            .any(|o| o.animation.mesh.colors.is_some())
+        {
+            out.extend(["r", "g", "b", "a"].map(|c| attribute(format!("COLOR_0.{c}"))));
+        }
+        out
+    }
+
     /// The weights of every vertex of object `object` of `scene`.
     ///
     /// # Errors
@@ -101,6 +138,27 @@ impl WeightSource {
                 })?;
                 Ok(function_weights(&f, obj.animation.frame(0)))
             }
+        }
+    }
+}
+
+/// A one-line label for pickers and messages: `bone ShoulderR and below`,
+/// `attribute _SMEAR_WEIGHT`, `vertex colour COLOR_0.r`, `function of the rest position`.
+impl std::fmt::Display for WeightSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            WeightSource::Group(g) => write!(
+                f,
+                "{} {}{}",
+                if g.group.len() == 1 { "bone" } else { "bones" },
+                g.group.join(", "),
+                if g.descendants { " and below" } else { "" }
+            ),
+            WeightSource::Attribute(a) if a.attribute.starts_with("COLOR_0.") => {
+                write!(f, "vertex colour {}", a.attribute)
+            }
+            WeightSource::Attribute(a) => write!(f, "attribute {}", a.attribute),
+            WeightSource::Function(_) => write!(f, "function of the rest position"),
         }
     }
 }

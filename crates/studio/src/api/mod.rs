@@ -8,6 +8,8 @@
 //! | `GET /api/smear/offsets?file=&clip=` | motion offsets per frame and vertex (prepared once) |
 //! | `POST /api/smear/stylize` | a style → elongated body, multiples, lines (all frames or a range) |
 //! | `POST /api/smear/export` | writes the result (glb/usda/usdc/abc) or the style (toml) |
+//! | `GET /api/smear/weight-sources?file=&clip=` | the file's weight groups / attributes (picker) |
+//! | `GET /api/smear/weights?file=&clip=&source=` | ω per vertex of one weight source (overlay) |
 //! | `GET /api/loa/view?file=` | the action camera the strokes are drawn through |
 //! | `POST /api/loa/animate` | keystrokes → line of action + character motion |
 //! | `GET /api/loa/motion?version=` | the rest of an animate answer's character motion |
@@ -44,6 +46,8 @@ pub fn routes() -> Router<Arc<Studio>> {
         .route("/api/smear/offsets", get(smear_api::offsets))
         .route("/api/smear/stylize", post(smear_api::stylize))
         .route("/api/smear/export", post(smear_api::export))
+        .route("/api/smear/weight-sources", get(smear_api::weight_sources))
+        .route("/api/smear/weights", get(smear_api::weights))
         .route("/api/loa/view", get(loa_api::view))
         .route("/api/loa/animate", post(loa_api::animate))
         .route("/api/loa/motion", get(loa_api::motion))

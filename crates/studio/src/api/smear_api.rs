@@ -6,13 +6,13 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use axum::body::Bytes;
-use axum::extract::rejection::BytesRejection;
+use axum::extract::rejection::{BytesRejection, QueryRejection};
 use axum::extract::{Query, State};
 use axum::response::Response;
 use axum::Json;
 use serde::Deserialize;
 use serde_json::{json, Value};
-use smear::{OffsetOptions, Style};
+use smear::{OffsetOptions, Style, WeightSource};
 
 use super::scene::ClipQuery;
 use super::{blocking, body};
@@ -111,6 +111,10 @@ pub(crate) struct StyleRequest {
     /// current frame first, the rest after). All frames when absent; exports ignore it.
     #[serde(default)]
     frames: Option<[usize; 2]>,
+    /// A weight source to set on the style (`Style::set_weights`: the effects' preset chains
+    /// then read ω), as the weight-group picker sends it.
+    #[serde(default)]
+    weights: Option<Value>,
 }
 
 fn read_style(r: &StyleRequest, prepared: &OffsetOptions) -> ApiResult<Style> {
@@ -127,6 +131,9 @@ fn read_style(r: &StyleRequest, prepared: &OffsetOptions) -> ApiResult<Style> {
         }
         (None, None) => return Err(ApiError::bad("style: give \"style\" (JSON) or \"toml\"")),
     };
+    if let Some(w) = &r.weights {
+        style.set_weights(Some(weight_source(w)?));
+    }
     if style.offsets == OffsetOptions::default() {
         style.offsets = prepared.clone();
     }
@@ -285,6 +292,93 @@ pub(crate) async fn export(
             tkio::save(&path, &tkio::Output::Flipbook(&s.flipbook)).map_err(io)?;
         }
         Ok(Json(json!({ "written": path.display().to_string() })))
+    })
+    .await
+}
+
+/// A weight source as JSON (the style's `weights` form), validated.
+fn weight_source(v: &Value) -> ApiResult<WeightSource> {
+    let w: WeightSource = serde_json::from_value(v.clone()).map_err(|_| {
+        ApiError::bad(format!(
+            "weights: {v} is not a weight source (give {{\"group\": [\"JOINT\"]}}, {{\"attribute\": \"NAME\"}} or {{\"expr\": \"...\"}})"
+        ))
+    })?;
+    w.validate()
+        .map_err(|e| ApiError::bad(format!("weights: {e}")))?;
+    Ok(w)
+}
+
+/// `GET /api/smear/weight-sources?file=&clip=`: `{"sources": [{"label", "source"}]}`, the
+/// weight groups (one per bone), vertex attributes and colour channels of the file
+/// (`smear::WeightSource::available`, SMEAR Fig. 15b).
+pub(crate) async fn weight_sources(
+    State(studio): State<Arc<Studio>>,
+    Query(q): Query<ClipQuery>,
+) -> ApiResult<Json<Value>> {
+    blocking(move || {
+        let p = studio.prepared(q.file, &q.clip)?;
+        let sources: Vec<Value> = WeightSource::available(p.scene())
+            .into_iter()
+            .map(|w| json!({"label": w.to_string(), "source": w}))
+            .collect();
+        Ok(Json(json!({ "sources": sources })))
+    })
+    .await
+}
+
+/// Longest `source` accepted by [`weights`] (a JSON weight source, not a file).
+const MAX_SOURCE_LEN: usize = 4096;
+
+/// The query of [`weights`].
+#[derive(Debug, Deserialize)]
+pub(crate) struct WeightsQuery {
+    #[serde(default)]
+    file: usize,
+    #[serde(default)]
+    clip: String,
+    /// The weight source as JSON, e.g. `{"group":["ShoulderR"]}`.
+    source: String,
+}
+
+/// `GET /api/smear/weights?file=&clip=&source=`: `weights` (f32 ω ∈ [0, 1] per vertex, every
+/// object's vertices in object order as `body` of the stylize answer) for the overlay.
+pub(crate) async fn weights(
+    State(studio): State<Arc<Studio>>,
+    query: Result<Query<WeightsQuery>, QueryRejection>,
+) -> ApiResult<Response> {
+    let Query(q) = query.map_err(|r| ApiError::bad(format!("query: {}", r.body_text())))?;
+    if q.source.len() > MAX_SOURCE_LEN {
+        return Err(ApiError::bad(format!(
+            "source: {} bytes, at most {MAX_SOURCE_LEN}",
+            q.source.len()
+        )));
+    }
+    let value: Value = serde_json::from_str(&q.source)
+        .map_err(|e| ApiError::bad(format!("source: not JSON ({e})")))?;
+    let source = weight_source(&value)?;
+    blocking(move || {
+        let p = studio.prepared(q.file, &q.clip)?;
+        let label = studio.file(q.file)?.label();
+        let mut all = Vec::new();
+        for i in 0..p.object_count() {
+            let w = p
+                .resolve_weights(&source, i)
+                .map_err(|e| ApiError::bad(format!("{label}: weights: {e}")))?;
+            all.extend(w);
+        }
+        let mut pack = Pack::new();
+        let (lo, hi) = all
+            .iter()
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &w| {
+                (a.min(w), b.max(w))
+            });
+        pack.f32("weights", all.iter().copied());
+        Ok(pack.response(json!({
+            "label": source.to_string(),
+            "vertices": all.len(),
+            "min": if all.is_empty() { 0.0 } else { lo },
+            "max": if all.is_empty() { 0.0 } else { hi },
+        })))
     })
     .await
 }
