@@ -146,6 +146,8 @@ try {
     let moved = 0;
     for (let i = 0; i < after40.length; i++) if (Math.abs(after40[i] - before40[i]) > 1e-4) moved++;
     check('the weight group restyles the smear (vertices off the arm stop stretching)', moved > 300, `${moved} coordinates changed at frame 40`);
+    // The picture at frame 25 (β = 10 between the keys: the arm stretches).
+    await page.evaluate(() => window.studio.setFrame(25));
     await page.waitForTimeout(300);
     await page.screenshot({ path: join(shots, 'smear-keyframes.png') });
     // Right-click deletes a key.
