@@ -260,24 +260,26 @@ fn set_weights_makes_every_preset_chain_read_the_weights_once() {
 #[test]
 fn keyframes_survive_the_toml_text_the_studio_shows() {
     // The studio edits keys on the style's data and shows/exports `to_toml_string`.
-    let mut style = Style::default();
-    style.elongate = Some(ElongateStyle {
-        function: FunctionSpec::stages(vec![
-            Stage::Speed,
-            Stage::Scale {
-                by: Param::Curve(vec![[0.0, 1.0], [40.0, 12.0]]),
-            },
-        ]),
-        ..ElongateStyle::default()
-    });
-    style.multiples = Some(MultiplesStyle {
-        past: Param::Curve(vec![[10.0, 0.0], [30.0, 3.0]]),
-        ..MultiplesStyle::default()
-    });
-    style.lines = Some(LinesStyle {
-        count: Param::Curve(vec![[0.0, 0.0], [20.0, 60.0]]),
-        ..LinesStyle::default()
-    });
+    let style = Style {
+        elongate: Some(ElongateStyle {
+            function: FunctionSpec::stages(vec![
+                Stage::Speed,
+                Stage::Scale {
+                    by: Param::Curve(vec![[0.0, 1.0], [40.0, 12.0]]),
+                },
+            ]),
+            ..ElongateStyle::default()
+        }),
+        multiples: Some(MultiplesStyle {
+            past: Param::Curve(vec![[10.0, 0.0], [30.0, 3.0]]),
+            ..MultiplesStyle::default()
+        }),
+        lines: Some(LinesStyle {
+            count: Param::Curve(vec![[0.0, 0.0], [20.0, 60.0]]),
+            ..LinesStyle::default()
+        }),
+        ..Style::default()
+    };
     style.validate().unwrap();
     let text = style.to_toml_string().unwrap();
     let back = Style::from_toml_str(&text).unwrap();
