@@ -214,7 +214,7 @@ try {
         const ids0 = await page.locator('#stopmo-ids').textContent();
         await page.evaluate((f) => window.studio.setFrame(f), recon.other);
         const ids1 = await page.locator('#stopmo-ids').textContent();
-        check('the piece ids shown change between two frames', ids0 !== ids1 && ids0.includes('part1_'), `${ids0} → ${ids1}`);
+        check('the piece ids shown change between two frames', ids0 !== ids1 && ids0.includes('part1_') && ids1.includes('part2_'), `${ids0} → ${ids1}`);
       } else check('the piece ids shown change between two frames', false, 'every frame shows the same pieces');
       await page.click('#stopmo-export');
       await page.waitForFunction(() => window.studio.panels.stopmo.exported || !document.getElementById('error').hidden, null, { timeout: 300000 });

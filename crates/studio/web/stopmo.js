@@ -53,6 +53,7 @@ export class StopmoPanel {
     s.setTimeline(this.anim.frames, this.anim.fps);
     this.labels = null;
     this.result = null;
+    this.framed = false;
     this.colour(null);
     this.setSeams(null);
     this.clearLibrary();
@@ -237,6 +238,15 @@ export class StopmoPanel {
     const [lo, hi] = header.bbox;
     mesh.position.x = (hi[0] - lo[0]) * 1.15;
     this.studio.view.scene.add(mesh);
+    if (!this.framed) {
+      // Once per clip: orbit around both faces and back off so both are in view.
+      const view = this.studio.view, cam = view.perspective, target = view.controls.target;
+      const away = cam.position.clone().sub(target);
+      target.x += mesh.position.x / 2;
+      cam.position.copy(target).addScaledVector(away, 1.6);
+      view.controls.update();
+      this.framed = true;
+    }
     this.recon = { mesh, header, positions: buffers.positions };
     this.placeReconstruction();
   }
@@ -258,7 +268,7 @@ export class StopmoPanel {
     pos.needsUpdate = true;
     mesh.geometry.computeVertexNormals();
     this.ids = header.frame_ids[f];
-    $('stopmo-ids').textContent = `frame ${f}: ` + header.parts.map((p, i) => `${p} ${this.ids[i]}`).join(' · ');
+    $('stopmo-ids').textContent = `frame ${f} pieces: ${this.ids.join(' · ')}`;
     this.studio.view.dirty = true;
   }
 
