@@ -47,7 +47,7 @@ impl SizeCurve {
         self.points
             .iter()
             .position(|p| p.pieces == pieces)
-            .map(|i| &self.libraries[i])
+            .and_then(|i| self.libraries.get(i))
     }
 }
 
