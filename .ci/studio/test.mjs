@@ -251,6 +251,48 @@ try {
     check('run gives two parts', parts === 2, `${parts} parts`);
     await page.waitForTimeout(300);
     await page.screenshot({ path: join(shots, 'stopmo.png') });
+
+    // stopmo, later half: seams drawn; the size-vs-error curve (three small sizes); a click on
+    // a point builds that library; the reconstruction plays beside the face with piece ids;
+    // the library folder is exported.
+    const stopmoError = () => page.evaluate(() => document.getElementById('error').hidden ? '' : document.getElementById('error').textContent);
+    const seams = await page.evaluate(() => { const s = window.studio.panels.stopmo.seams; return s ? s.vertices.length / 6 : 0; });
+    check('seams are drawn over the face', seams > 10, `${seams} segments`);
+    const tCurve = Date.now();
+    await page.fill('#stopmo-sizes', '1,2,3');
+    await page.click('#stopmo-curve');
+    await page.waitForFunction(() => document.querySelectorAll('#stopmo-chart circle').length > 0 || !document.getElementById('error').hidden, null, { timeout: 600000 });
+    const points = await page.locator('#stopmo-chart circle').count();
+    const labels = await page.locator('#stopmo-chart text').allTextContents();
+    check('the size-vs-error chart shows its points and labelled axes', points === 3 && labels.some((t) => t.includes('pieces')) && labels.some((t) => t.includes('(mm)')), `${points} points; ${await stopmoError()}`);
+    console.log(`stopmo size curve (3 sizes, ${parts} parts): ${((Date.now() - tCurve) / 1000).toFixed(1)} s`);
+    if (points > 0) {
+      const tBuild = Date.now();
+      await page.click('#stopmo-chart circle[data-pieces="2"]');
+      await page.waitForFunction(() => window.studio.panels.stopmo.recon || !document.getElementById('error').hidden, null, { timeout: 600000 });
+      console.log(`stopmo build (2 pieces per part) and reconstruction: ${((Date.now() - tBuild) / 1000).toFixed(1)} s`);
+      const recon = await page.evaluate(() => {
+        const r = window.studio.panels.stopmo.recon;
+        if (!r) return null;
+        const ids = r.header.frame_ids;
+        const other = ids.findIndex((f) => f.join() !== ids[0].join());
+        return { vertices: r.header.vertices, offset: r.mesh.position.x, other };
+      });
+      check('clicking a point builds the library and its reconstruction appears beside the face', recon && recon.vertices > 0 && recon.offset > 0, JSON.stringify(recon) + ' ' + await stopmoError());
+      if (recon && recon.other > 0) {
+        await page.evaluate(() => window.studio.setFrame(0));
+        const ids0 = await page.locator('#stopmo-ids').textContent();
+        await page.evaluate((f) => window.studio.setFrame(f), recon.other);
+        const ids1 = await page.locator('#stopmo-ids').textContent();
+        check('the piece ids shown change between two frames', ids0 !== ids1 && ids0.includes('part1_') && ids1.includes('part2_'), `${ids0} → ${ids1}`);
+      } else check('the piece ids shown change between two frames', false, 'every frame shows the same pieces');
+      await page.click('#stopmo-export');
+      await page.waitForFunction(() => window.studio.panels.stopmo.exported || !document.getElementById('error').hidden, null, { timeout: 300000 });
+      const written = await page.evaluate(() => { const e = window.studio.panels.stopmo.exported; return e ? e.written : []; });
+      check('the library folder is exported', written.includes('stopmo_library/assembly.csv') && written.some((f) => f.endsWith('.stl')), `${written.length} files ${await stopmoError()}`);
+      await page.waitForTimeout(300);
+      await page.screenshot({ path: join(shots, 'stopmo-library.png') });
+    }
   }
   check('no console errors', consoleErrors.length === 0, consoleErrors.join(' | '));
   console.log(`screenshots in ${shots}`);

@@ -11,7 +11,10 @@
 //! * [`library()`] → [`LibraryResult`]: libraries and labels, printable pieces (surface +
 //!   solid), assembly, shooting order, reconstruction, size-versus-error curve, report;
 //! * [`run()`] → [`LibraryResult`]: both, the segmentation kept in
-//!   [`LibraryResult::segmented`].
+//!   [`LibraryResult::segmented`];
+//! * [`size_curve()`] → [`SizeCurve`]: library size versus reconstruction error (StopShop
+//!   Fig. 8), one solve per size, and [`library_of()`]: the whole library job at one of its
+//!   points without solving again.
 //!
 //! [`LibraryResult::files`] lists the output layout (SPEC "Output layouts") as relative paths
 //! and data, so a front end only writes them. The stages are also available one by one in
@@ -101,9 +104,9 @@ pub mod library;
 pub mod segment;
 
 pub use job::{
-    file_safe_name, library, piece_label, run, save_files, saved_segmentation, segment, Error,
-    FileData, LibraryJobOptions, LibraryReport, LibraryResult, OrderReport, OutputFile,
-    PartPrintReport, PartReport, PartSummary, Piece, PieceCount, PlugReport, PrintReport,
-    PrintTime, Result, RunOptions, SegmentJobOptions, SegmentSummary, Segmented, DEFAULT_PIECES,
-    DEFAULT_RESOLUTION_MM,
+    file_safe_name, library, library_of, piece_label, run, save_files, saved_segmentation, segment,
+    size_curve, Error, FileData, LibraryJobOptions, LibraryReport, LibraryResult, OrderReport,
+    OutputFile, PartPrintReport, PartReport, PartSummary, Piece, PieceCount, PlugReport,
+    PrintReport, PrintTime, Result, RunOptions, SegmentJobOptions, SegmentSummary, Segmented,
+    SizeCurve, SizePoint, DEFAULT_PIECES, DEFAULT_RESOLUTION_MM,
 };

@@ -37,6 +37,20 @@ pub struct LoaSession {
     pub version: u64,
 }
 
+/// The last segmentation of the stopmo panel, its size curve and the library built from it
+/// (for the curve, build, reconstruction and export requests).
+#[derive(Debug)]
+pub struct StopmoSession {
+    /// Counts the segmentations: a curve or build of an older one is not stored.
+    pub version: u64,
+    /// Every part as its own animation (named after the part), the library input.
+    pub parts: Arc<Vec<anim::MeshAnimation>>,
+    /// The size-versus-error curve (StopShop Fig. 8) with its solved libraries.
+    pub curve: Option<Arc<stopmo::SizeCurve>>,
+    /// The library built from a point of the curve.
+    pub built: Option<Arc<stopmo::LibraryResult>>,
+}
+
 /// The server's state, shared by every request.
 #[derive(Debug)]
 pub struct Studio {
@@ -51,6 +65,8 @@ pub struct Studio {
     preparing: Mutex<()>,
     /// The last line of action.
     pub loa: Mutex<Option<LoaSession>>,
+    /// The stopmo panel's segmentation, curve and library.
+    pub stopmo: Mutex<Option<StopmoSession>>,
     /// Long jobs (stopmo).
     pub jobs: Jobs,
 }
@@ -66,6 +82,7 @@ impl Studio {
             prepared: Mutex::default(),
             preparing: Mutex::default(),
             loa: Mutex::default(),
+            stopmo: Mutex::default(),
             jobs: Jobs::default(),
         }
     }

@@ -1,6 +1,10 @@
 // The stopmo panel: seeds clicked on the face, the segmentation as a job with progress and
-// cancel (StopShop Section 4); parts coloured, seams (vertices between parts) dark.
-import { getJSON, postJSON } from './api.js';
+// cancel (StopShop Section 4); parts coloured, seams drawn as lines over the face. Then the
+// library size-vs-error curve (StopShop Fig. 8) as a job drawn as a chart; a click on a
+// point builds that library; its reconstruction plays beside the original with the piece
+// id of every part at the current frame; the library folder is exported.
+import * as THREE from 'three';
+import { getJSON, getPack, postJSON } from './api.js';
 
 const $ = (id) => document.getElementById(id);
 const COLORS = [[0.95, 0.55, 0.3], [0.35, 0.6, 0.95], [0.45, 0.85, 0.45], [0.9, 0.8, 0.3], [0.8, 0.45, 0.85], [0.4, 0.85, 0.85]];
@@ -17,6 +21,10 @@ export class StopmoPanel {
     $('stopmo-clear').addEventListener('click', () => { this.seeds = this.seeds.map(() => []); this.list(); this.colour(null); });
     $('stopmo-run').addEventListener('click', () => this.run());
     $('stopmo-cancel').addEventListener('click', () => this.cancel());
+    $('stopmo-curve').addEventListener('click', () => this.curve());
+    $('stopmo-export').addEventListener('click', () => this.exportFolder());
+    this.seams = null;
+    this.recon = null;
   }
 
   async activate() {
@@ -33,7 +41,7 @@ export class StopmoPanel {
     await this.reload();
   }
 
-  deactivate() { this.active = false; this.studio.view.setVertexColors(null); }
+  deactivate() { this.active = false; this.studio.view.setVertexColors(null); this.clearLibrary(); this.setSeams(null); }
 
   async reload() {
     const s = this.studio;
@@ -44,10 +52,18 @@ export class StopmoPanel {
     s.view.setAnimation({ ...this.anim });
     s.setTimeline(this.anim.frames, this.anim.fps);
     this.labels = null;
+    this.result = null;
+    this.framed = false;
     this.colour(null);
+    this.setSeams(null);
+    this.clearLibrary();
   }
 
-  onFrame(f) { this.studio.view.setFrame(f); }
+  onFrame(f) {
+    this.studio.view.setFrame(f);
+    this.placeSeams();
+    this.placeReconstruction();
+  }
 
   click(e) {
     if (!this.active || e.shiftKey) return;
@@ -88,38 +104,179 @@ export class StopmoPanel {
   }
 
   async run() {
+    this.clearLibrary();
+    this.start('/api/stopmo/segment', { file: this.studio.file, clip: this.studio.clip, seeds: this.seeds }, (r) => {
+      this.labels = r.triangle_part;
+      this.result = r;
+      this.colour(this.labels);
+      this.setSeams(r);
+      $('stopmo-curve').disabled = false;
+      $('stopmo-report').textContent += '\n' + JSON.stringify(r.summary, null, 1);
+    });
+  }
+
+  /** Starts a job (POST url body) and calls done(result) when it finishes. */
+  async start(url, body, done) {
     const s = this.studio;
     try {
-      const { job } = await postJSON('/api/stopmo/segment', { file: s.file, clip: s.clip, seeds: this.seeds });
+      const { job } = await postJSON(url, body);
       this.job = job;
       $('stopmo-cancel').disabled = false;
-      this.poll();
+      this.poll(done);
     } catch (e) { s.showError(e.message); }
   }
 
-  async poll() {
+  async poll(done) {
     const s = this.studio;
     const id = this.job;
     if (id === null) return;
     try {
       const st = await getJSON(`/api/jobs/${id}`);
       $('stopmo-progress').value = st.progress;
-      $('stopmo-report').textContent = `job ${id}: ${st.state}, ${st.stage} (${st.seconds.toFixed(1)} s)`;
-      if (st.state === 'running') { setTimeout(() => this.poll(), 200); return; }
+      $('stopmo-report').textContent = `job ${id} (${st.kind}): ${st.state}, ${st.stage} (${st.seconds.toFixed(1)} s)`;
+      if (st.state === 'running') { setTimeout(() => this.poll(done), 200); return; }
       this.job = null;
       $('stopmo-cancel').disabled = true;
       if (st.state === 'failed') s.showError(st.error);
-      if (st.state === 'done') {
-        this.labels = st.result.triangle_part;
-        this.result = st.result;
-        this.colour(this.labels);
-        $('stopmo-report').textContent += '\n' + JSON.stringify(st.result.summary, null, 1);
-      }
+      if (st.state === 'done') await done(st.result);
     } catch (e) { s.showError(e.message); }
   }
 
   async cancel() {
     if (this.job === null) return;
     try { await postJSON(`/api/jobs/${this.job}/cancel`, {}); } catch (e) { this.studio.showError(e.message); }
+  }
+
+  /** Seams as line segments: two points per segment, each Σ w·x of three input vertices. */
+  setSeams(r) {
+    const scene = this.studio.view.scene;
+    if (this.seams) { scene.remove(this.seams.lines); this.seams.lines.geometry.dispose(); this.seams.lines.material.dispose(); this.seams = null; }
+    if (r && r.seam_vertices.length) {
+      const g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(r.seam_vertices.length), 3));
+      const m = new THREE.LineBasicMaterial({ color: 0xffee33, depthTest: false });
+      const lines = new THREE.LineSegments(g, m);
+      lines.frustumCulled = false;
+      lines.renderOrder = 2;
+      scene.add(lines);
+      this.seams = { lines, vertices: r.seam_vertices, weights: r.seam_weights };
+      this.placeSeams();
+    }
+    this.studio.view.dirty = true;
+  }
+
+  placeSeams() {
+    if (!this.seams) return;
+    const { lines, vertices, weights } = this.seams;
+    const a = this.anim, base = this.studio.frame * a.vertices * 3;
+    const out = lines.geometry.attributes.position.array;
+    for (let p = 0; p < vertices.length / 3; p++) {
+      for (let c = 0; c < 3; c++) {
+        let x = 0;
+        for (let k = 0; k < 3; k++) x += weights[p * 3 + k] * a.positions[base + vertices[p * 3 + k] * 3 + c];
+        out[p * 3 + c] = x;
+      }
+    }
+    lines.geometry.attributes.position.needsUpdate = true;
+  }
+
+  /** The size-vs-error curve job, then its chart. */
+  curve() {
+    const sizes = $('stopmo-sizes').value.split(',').map((x) => Number(x.trim())).filter((x) => x > 0);
+    this.clearLibrary();
+    this.start('/api/stopmo/curve', { sizes }, (r) => { this.points = r.points; this.chart(); });
+  }
+
+  /** StopShop Fig. 8: library size (pieces over all parts) against the mean error (mm). */
+  chart() {
+    const pts = this.points || [];
+    const W = 320, H = 200, L = 46, R = 10, T = 10, B = 34;
+    const xmax = Math.max(...pts.map((p) => p.total_pieces), 1), ymax = Math.max(...pts.map((p) => p.mean_error_mm), 1e-9) * 1.1;
+    const x = (v) => L + (W - L - R) * v / xmax, y = (v) => T + (H - T - B) * (1 - v / ymax);
+    const ns = 'http://www.w3.org/2000/svg';
+    const svg = document.createElementNS(ns, 'svg');
+    svg.setAttribute('viewBox', `0 0 ${W} ${H}`);
+    const add = (tag, attrs, text) => { const e = document.createElementNS(ns, tag); for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v); if (text !== undefined) e.textContent = text; svg.appendChild(e); return e; };
+    add('line', { class: 'axis', x1: L, y1: H - B, x2: W - R, y2: H - B });
+    add('line', { class: 'axis', x1: L, y1: T, x2: L, y2: H - B });
+    for (let k = 0; k <= 4; k++) {
+      const v = ymax * k / 4;
+      add('text', { x: L - 4, y: y(v) + 3, 'text-anchor': 'end' }, v.toFixed(v < 1 ? 2 : 1));
+    }
+    for (const p of pts) add('text', { x: x(p.total_pieces), y: H - B + 12, 'text-anchor': 'middle' }, String(p.total_pieces));
+    add('text', { x: (L + W - R) / 2, y: H - 4, 'text-anchor': 'middle' }, 'library size (pieces, all parts)');
+    add('text', { x: 10, y: (T + H - B) / 2, 'text-anchor': 'middle', transform: `rotate(-90 10 ${(T + H - B) / 2})` }, 'mean error (mm)');
+    add('polyline', { points: pts.map((p) => `${x(p.total_pieces)},${y(p.mean_error_mm)}`).join(' '), fill: 'none', stroke: '#4a9fe8' });
+    for (const p of pts) {
+      const c = add('circle', { cx: x(p.total_pieces), cy: y(p.mean_error_mm), r: 6, 'data-pieces': p.pieces });
+      add('title', {}, `${p.pieces} per part, ${p.total_pieces} pieces: mean ${p.mean_error_mm.toFixed(3)} mm, max ${p.max_error_mm.toFixed(3)} mm`);
+      c.addEventListener('click', () => this.build(p.pieces));
+    }
+    $('stopmo-chart').replaceChildren(svg);
+  }
+
+  /** Builds the library of a curve point, then shows its reconstruction beside the face. */
+  build(pieces) {
+    for (const c of document.querySelectorAll('#stopmo-chart circle')) c.classList.toggle('picked', Number(c.dataset.pieces) === pieces);
+    this.start('/api/stopmo/build', { pieces }, async (r) => {
+      const { header, buffers } = await getPack('/api/stopmo/reconstruction');
+      this.setReconstruction(header, buffers);
+      this.built = r;
+      $('stopmo-built').textContent = `library of ${r.pieces} pieces per part (${r.total_pieces} in all): mean error ${r.errors_mm.position_mean.toFixed(3)} mm, max ${r.errors_mm.position_max.toFixed(3)} mm`;
+      $('stopmo-export').disabled = false;
+    });
+  }
+
+  setReconstruction(header, buffers) {
+    this.clearLibrary();
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(header.vertices * 3), 3));
+    g.setIndex(new THREE.BufferAttribute(buffers.triangles, 1));
+    const mesh = new THREE.Mesh(g, new THREE.MeshStandardMaterial({ color: 0xd9c7a3, roughness: 0.8, side: THREE.DoubleSide }));
+    mesh.frustumCulled = false;
+    // Beside the original: shifted by 1.15 × the face's width.
+    const [lo, hi] = header.bbox;
+    mesh.position.x = (hi[0] - lo[0]) * 1.15;
+    this.studio.view.scene.add(mesh);
+    if (!this.framed) {
+      // Once per clip: orbit around both faces and back off so both are in view.
+      const view = this.studio.view, cam = view.perspective, target = view.controls.target;
+      const away = cam.position.clone().sub(target);
+      target.x += mesh.position.x / 2;
+      cam.position.copy(target).addScaledVector(away, 1.6);
+      view.controls.update();
+      this.framed = true;
+    }
+    this.recon = { mesh, header, positions: buffers.positions };
+    this.placeReconstruction();
+  }
+
+  clearLibrary() {
+    if (this.recon) { this.studio.view.scene.remove(this.recon.mesh); this.recon.mesh.geometry.dispose(); this.recon.mesh.material.dispose(); this.recon = null; }
+    this.built = null;
+    $('stopmo-ids').textContent = '';
+    $('stopmo-export').disabled = true;
+    this.studio.view.dirty = true;
+  }
+
+  placeReconstruction() {
+    if (!this.recon) return;
+    const { mesh, header, positions } = this.recon;
+    const f = Math.min(this.studio.frame, header.frames - 1), n = header.vertices * 3;
+    const pos = mesh.geometry.attributes.position;
+    pos.array.set(positions.subarray(f * n, (f + 1) * n));
+    pos.needsUpdate = true;
+    mesh.geometry.computeVertexNormals();
+    this.ids = header.frame_ids[f];
+    $('stopmo-ids').textContent = `frame ${f} pieces: ${this.ids.join(' · ')}`;
+    this.studio.view.dirty = true;
+  }
+
+  async exportFolder() {
+    try {
+      const r = await postJSON('/api/stopmo/export', { folder: $('stopmo-folder').value });
+      this.exported = r;
+      $('stopmo-built').textContent = `wrote ${r.written.length} files to ${r.folder}`;
+    } catch (e) { this.studio.showError(e.message); }
   }
 }

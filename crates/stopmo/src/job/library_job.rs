@@ -237,6 +237,18 @@ fn build(
     inputs: Option<&[&MeshAnimation]>,
 ) -> Result<LibraryResult> {
     let start = Instant::now();
+    let lib = solve(anims, names, opts)?;
+    finish(lib, anims, names, opts, inputs, start)
+}
+
+/// The first half of [`build`]: checks the options and solves StopShop Eq. 10 for every
+/// part (the library's parts renamed `names`). The size-versus-error curve calls it once per
+/// size and keeps the solves for [`finish`].
+pub(super) fn solve(
+    anims: &[&MeshAnimation],
+    names: &[String],
+    opts: &LibraryJobOptions,
+) -> Result<Library> {
     for (i, n) in names.iter().enumerate() {
         if names[..i].contains(n) {
             return Err(Error::option_error(
@@ -277,6 +289,19 @@ fn build(
     for (p, n) in lib.parts.iter_mut().zip(names) {
         p.name.clone_from(n);
     }
+    Ok(lib)
+}
+
+/// The second half of [`build`]: everything printed and shot from a solved library (plugs,
+/// pieces, catalogue, assembly, shooting order, reconstruction, report).
+pub(super) fn finish(
+    lib: Library,
+    anims: &[&MeshAnimation],
+    names: &[String],
+    opts: &LibraryJobOptions,
+    inputs: Option<&[&MeshAnimation]>,
+    start: Instant,
+) -> Result<LibraryResult> {
     let plugs = match &opts.plugs {
         Some(p) => plan_part_plugs(
             &lib,

@@ -11,6 +11,7 @@ mod report;
 mod result;
 mod segment_job;
 mod sheets;
+mod size_curve;
 mod text;
 
 pub use error::{Error, Result};
@@ -23,3 +24,4 @@ pub use print::{
 pub use report::{LibraryReport, OrderReport, PartReport, PlugReport};
 pub use result::LibraryResult;
 pub use segment_job::{saved_segmentation, segment, PartSummary, SegmentSummary, Segmented};
+pub use size_curve::{library_of, size_curve, SizeCurve, SizePoint};

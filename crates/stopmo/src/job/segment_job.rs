@@ -141,6 +141,33 @@ impl Segmented {
         }
     }
 
+    /// The seams: edges of the cut mesh ([`Segmentation::animation`]) that bound triangles of
+    /// two different parts, as vertex pairs of that mesh (sorted, each edge once). Vertices
+    /// that the cut duplicated are matched by their welded class, so an edge counts once
+    /// whichever copy its triangles use. Front ends draw them over the face; every vertex
+    /// is placed from the input by [`CutMesh::sources`](crate::segment::CutMesh::sources).
+    pub fn seam_edges(&self) -> Vec<[u32; 2]> {
+        let s = &self.segmentation;
+        let class = &s.cut.weld_class;
+        let key = |v: u32| class.get(v as usize).copied().unwrap_or(v);
+        // welded edge → (a vertex pair, the first part seen, whether another part shares it)
+        let mut edges: std::collections::BTreeMap<(u32, u32), ([u32; 2], u32, bool)> =
+            std::collections::BTreeMap::new();
+        for (t, part) in s.animation.mesh.triangles.iter().zip(&s.triangle_part) {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let (ka, kb) = (key(a), key(b));
+                let welded = (ka.min(kb), ka.max(kb));
+                let pair = if ka <= kb { [a, b] } else { [b, a] };
+                edges
+                    .entry(welded)
+                    .and_modify(|e| e.2 |= e.1 != *part)
+                    .or_insert((pair, *part, false));
+            }
+        }
+        edges.into_values().filter(|e| e.2).map(|e| e.0).collect()
+    }
+
     /// One line for people: `upper (N triangles), lower (M triangles) over F frames, cut
     /// length L, K seam vertices`.
     pub fn describe(&self) -> String {

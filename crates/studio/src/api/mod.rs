@@ -15,13 +15,18 @@
 //! | `GET /api/loa/motion?version=` | the rest of an animate answer's character motion |
 //! | `GET /api/loa/line` | the last line in the CLI's JSON layout |
 //! | `POST /api/loa/export` | keystrokes / line (json, svg) / motion (glb, bvh) |
-//! | `POST /api/stopmo/segment` | part seeds → a segmentation job |
+//! | `POST /api/stopmo/segment` | part seeds → a segmentation job (parts, seams) |
+//! | `POST /api/stopmo/curve` | library size versus error (StopShop Fig. 8) → a job |
+//! | `POST /api/stopmo/build` | a point of the curve → a job building that library |
+//! | `GET /api/stopmo/reconstruction` | the built library's reconstruction, piece ids per frame |
+//! | `POST /api/stopmo/export` | writes the library folder (the `stopmo run` layout) |
 //! | `GET /api/jobs/{id}`, `POST /api/jobs/{id}/cancel` | progress, result, cancel |
 
 mod loa_api;
 mod scene;
 mod smear_api;
 mod stopmo_api;
+mod stopmo_library;
 
 use std::sync::Arc;
 
@@ -54,6 +59,13 @@ pub fn routes() -> Router<Arc<Studio>> {
         .route("/api/loa/line", get(loa_api::line))
         .route("/api/loa/export", post(loa_api::export))
         .route("/api/stopmo/segment", post(stopmo_api::segment))
+        .route("/api/stopmo/curve", post(stopmo_library::curve))
+        .route("/api/stopmo/build", post(stopmo_library::build))
+        .route(
+            "/api/stopmo/reconstruction",
+            get(stopmo_library::reconstruction),
+        )
+        .route("/api/stopmo/export", post(stopmo_library::export))
         .route("/api/jobs/{id}", get(job))
         .route("/api/jobs/{id}/cancel", post(cancel))
 }

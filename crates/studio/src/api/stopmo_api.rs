@@ -1,6 +1,8 @@
 //! The stopmo panel: part seeds clicked on the mesh → `stopmo::segment` (StopShop Section 4:
 //! multi-label graph cut, StopShop Eqs. 1–3) on a worker thread; the page polls
-//! `/api/jobs/{id}` and colours the input triangles by `triangle_part`.
+//! `/api/jobs/{id}` and colours the input triangles by `triangle_part` and draws the seams.
+//! Then the size-versus-error curve (StopShop Fig. 8) as a job, a library built from one
+//! of its points, its reconstruction and the export of its folder (see `stopmo_library`).
 
 use std::sync::Arc;
 
@@ -16,7 +18,7 @@ use stopmo::SegmentJobOptions;
 use super::body;
 use crate::error::{ApiError, ApiResult};
 use crate::files::merged;
-use crate::state::Studio;
+use crate::state::{lock, StopmoSession, Studio};
 
 /// Most parts a segmentation request may ask for.
 pub(crate) const MAX_PARTS: usize = 16;
@@ -86,12 +88,52 @@ pub(crate) async fn segment(
             .map_err(cancelled)?;
         let s = stopmo::segment(&anim, &options).map_err(|e| format!("{label}: {e}"))?;
         progress.stage("done", 1.0).map_err(cancelled)?;
+        let (seam_vertices, seam_weights) = seam_lines(&s);
+        let version = job_studio.store_segmentation(&s);
         Ok(json!({
             "summary": s.summary(),
             "triangle_part": s.segmentation.input_triangle_part,
             "parts": s.segmentation.part_names,
+            "seam_vertices": seam_vertices,
+            "seam_weights": seam_weights,
+            "segmentation": version,
             "seconds": s.seconds,
         }))
     });
     Ok(Json(json!({ "job": id })))
+}
+
+/// The seams as line segments over the input mesh: point `2i` and `2i + 1` bound segment
+/// `i`; every point is `Σ w_k x_{v_k}` of three input vertices (so the page places it on
+/// any frame of the clip it shows). Returns (vertices, weights), three per point.
+fn seam_lines(s: &stopmo::Segmented) -> (Vec<u32>, Vec<f32>) {
+    use stopmo::segment::VertexSource;
+    let mut vertices = Vec::new();
+    let mut weights = Vec::new();
+    for v in s.seam_edges().into_iter().flatten() {
+        let (v3, w3) = match s.segmentation.cut.sources.get(v as usize) {
+            Some(VertexSource::Original(a)) => ([*a; 3], [1.0, 0.0, 0.0]),
+            Some(VertexSource::Edge { a, b, t }) => ([*a, *b, *b], [1.0 - *t, *t, 0.0]),
+            Some(VertexSource::Interior { v, w }) => (*v, *w),
+            None => ([0; 3], [0.0; 3]),
+        };
+        vertices.extend(v3);
+        weights.extend(w3.map(|w| w as f32));
+    }
+    (vertices, weights)
+}
+
+impl Studio {
+    /// Keeps a finished segmentation's parts for the curve; returns its version.
+    fn store_segmentation(&self, s: &stopmo::Segmented) -> u64 {
+        let mut session = lock(&self.stopmo);
+        let version = session.as_ref().map_or(1, |old| old.version + 1);
+        *session = Some(StopmoSession {
+            version,
+            parts: std::sync::Arc::new(s.parts.iter().map(|p| p.animation.clone()).collect()),
+            curve: None,
+            built: None,
+        });
+        version
+    }
 }

@@ -1,0 +1,223 @@
+//! The stopmo panel's later half, on the last segmentation: the library size versus error
+//! curve (StopShop Fig. 8) as a job, a click on a point builds that library from the
+//! curve's own solve (`stopmo::library_of`), its reconstruction plays beside the original
+//! with the piece id of every part per frame, and the library folder (the `stopmo run`
+//! layout) is exported into the output folder.
+
+use std::sync::Arc;
+
+use axum::body::Bytes;
+use axum::extract::rejection::BytesRejection;
+use axum::extract::State;
+use axum::response::Response;
+use axum::Json;
+use serde::Deserialize;
+use serde_json::{json, Value};
+use stopmo::{LibraryJobOptions, LibraryResult, SizeCurve};
+
+use super::scene::animation_pack;
+use super::{blocking, body};
+use crate::error::{ApiError, ApiResult};
+use crate::files::output_path;
+use crate::state::{lock, Studio};
+
+/// Most sizes one curve request may solve.
+pub(crate) const MAX_SIZES: usize = 32;
+
+/// The sizes of a curve when the page gives none: small libraries, where the curve bends.
+const DEFAULT_SIZES: [usize; 6] = [1, 2, 3, 4, 6, 8];
+
+/// `POST /api/stopmo/curve` body.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct CurveRequest {
+    /// Pieces per part at every point (default 1, 2, 3, 4, 6, 8).
+    #[serde(default)]
+    sizes: Vec<usize>,
+}
+
+/// `POST /api/stopmo/build` body.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct BuildRequest {
+    /// Pieces per part: a point of the curve.
+    pieces: usize,
+}
+
+/// `POST /api/stopmo/export` body.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct ExportRequest {
+    /// The folder to write, relative to the output folder.
+    folder: String,
+}
+
+/// The last segmentation's version and parts, or a conflict error telling what to do.
+fn parts_of(studio: &Studio) -> ApiResult<(u64, Arc<Vec<anim::MeshAnimation>>)> {
+    lock(&studio.stopmo)
+        .as_ref()
+        .map(|s| (s.version, s.parts.clone()))
+        .ok_or_else(|| ApiError::conflict("stopmo: run the segmentation first"))
+}
+
+/// `POST /api/stopmo/curve`: `{"job": id}`; the result is `{"points": [{pieces,
+/// total_pieces, energy, mean_error_mm, max_error_mm}], "segmentation"}`.
+pub(crate) async fn curve(
+    State(studio): State<Arc<Studio>>,
+    request: Result<Bytes, BytesRejection>,
+) -> ApiResult<Json<Value>> {
+    let r: CurveRequest = body(request)?;
+    let sizes = if r.sizes.is_empty() {
+        DEFAULT_SIZES.to_vec()
+    } else {
+        r.sizes
+    };
+    if sizes.len() > MAX_SIZES || sizes.contains(&0) {
+        return Err(ApiError::bad(format!(
+            "sizes: give 1 to {MAX_SIZES} library sizes of at least 1 piece per part"
+        )));
+    }
+    let (version, parts) = parts_of(&studio)?;
+    let frames = parts.first().map_or(0, |p| p.frame_count());
+    if let Some(d) = sizes.iter().find(|&&d| d > frames) {
+        return Err(ApiError::bad(format!(
+            "sizes: {d} pieces per part is more than the clip's {frames} frames"
+        )));
+    }
+    let job_studio = studio.clone();
+    let id = studio.jobs.start("stopmo.curve", move |progress| {
+        let mut on_point = |done: usize, total: usize| {
+            let stage = format!("library size {} of {total}", (done + 1).min(total));
+            progress
+                .stage(&stage, done as f32 / total.max(1) as f32)
+                .is_ok()
+        };
+        let curve =
+            stopmo::size_curve(&parts, &LibraryJobOptions::default(), &sizes, &mut on_point)
+                .map_err(|e| format!("size curve: {e}"))?;
+        if progress.cancelled() {
+            return Err("cancelled".into());
+        }
+        let points = curve.points.clone();
+        if let Some(s) = lock(&job_studio.stopmo).as_mut() {
+            if s.version == version {
+                s.curve = Some(Arc::new(curve));
+                s.built = None;
+            }
+        }
+        Ok(json!({ "points": points, "segmentation": version }))
+    });
+    Ok(Json(json!({ "job": id })))
+}
+
+/// `POST /api/stopmo/build`: `{"job": id}`; the result is `{"pieces", "parts",
+/// "frame_ids" (per frame, the piece id of every part), "errors_mm", "total_pieces"}`.
+pub(crate) async fn build(
+    State(studio): State<Arc<Studio>>,
+    request: Result<Bytes, BytesRejection>,
+) -> ApiResult<Json<Value>> {
+    let r: BuildRequest = body(request)?;
+    let (version, parts, curve): (u64, _, Arc<SizeCurve>) = {
+        let session = lock(&studio.stopmo);
+        let s = session
+            .as_ref()
+            .ok_or_else(|| ApiError::conflict("stopmo: run the segmentation first"))?;
+        let curve = s.curve.clone().ok_or_else(|| {
+            ApiError::conflict("stopmo: compute the size curve first, then pick a point")
+        })?;
+        (s.version, s.parts.clone(), curve)
+    };
+    if curve.library(r.pieces).is_none() {
+        let sizes: Vec<String> = curve.points.iter().map(|p| p.pieces.to_string()).collect();
+        return Err(ApiError::bad(format!(
+            "pieces: {} is not a point of the curve (sizes {})",
+            r.pieces,
+            sizes.join(", ")
+        )));
+    }
+    let job_studio = studio.clone();
+    let id = studio.jobs.start("stopmo.build", move |progress| {
+        let cancelled = |e: crate::jobs::Cancelled| e.to_string();
+        progress
+            .stage("pieces, assembly and reconstruction", 0.1)
+            .map_err(cancelled)?;
+        let solved = curve.library(r.pieces).ok_or("the curve lost its point")?;
+        let result = stopmo::library_of(&parts, &LibraryJobOptions::default(), solved)
+            .map_err(|e| format!("library: {e}"))?;
+        progress.stage("done", 1.0).map_err(cancelled)?;
+        let answer = json!({
+            "pieces": r.pieces,
+            "total_pieces": result.library.total_pieces(),
+            "parts": result.part_names,
+            "frame_ids": result.frame_ids(),
+            "errors_mm": result.library.errors_mm,
+            "segmentation": version,
+        });
+        if let Some(s) = lock(&job_studio.stopmo).as_mut() {
+            if s.version == version {
+                s.built = Some(Arc::new(result));
+            }
+        }
+        Ok(answer)
+    });
+    Ok(Json(json!({ "job": id })))
+}
+
+/// The built library, or a conflict error telling what to do.
+fn built_of(studio: &Studio) -> ApiResult<Arc<LibraryResult>> {
+    lock(&studio.stopmo)
+        .as_ref()
+        .and_then(|s| s.built.clone())
+        .ok_or_else(|| ApiError::conflict("stopmo: build a library from the curve first"))
+}
+
+/// `GET /api/stopmo/reconstruction`: the built library's reconstruction, every part merged
+/// in part order (model units, the clip's frames), as `/api/scene`'s pack; the header adds
+/// `parts` and `frame_ids`.
+pub(crate) async fn reconstruction(State(studio): State<Arc<Studio>>) -> ApiResult<Response> {
+    let built = built_of(&studio)?;
+    blocking(move || {
+        let merged = built
+            .merged_reconstruction()
+            .map_err(|e| ApiError::internal(format!("reconstruction: {e}")))?;
+        Ok(animation_pack(
+            &merged,
+            json!({"parts": built.part_names, "frame_ids": built.frame_ids()}),
+        ))
+    })
+    .await
+}
+
+/// `POST /api/stopmo/export`: writes the built library's folder (the `stopmo run` layout:
+/// pieces, assembly, reconstruction, report) to `folder` inside the output folder.
+pub(crate) async fn export(
+    State(studio): State<Arc<Studio>>,
+    request: Result<Bytes, BytesRejection>,
+) -> ApiResult<Json<Value>> {
+    let r: ExportRequest = body(request)?;
+    let dir = output_path(&studio.out_dir, &r.folder)?;
+    let built = built_of(&studio)?;
+    blocking(move || {
+        if dir.is_file() {
+            return Err(ApiError::bad(format!(
+                "{}: is a file; give a folder name",
+                r.folder
+            )));
+        }
+        let files = built
+            .files()
+            .map_err(|e| ApiError::internal(format!("library files: {e}")))?;
+        let written =
+            stopmo::save_files(&dir, &files).map_err(|e| ApiError::internal(e.to_string()))?;
+        let mut names: Vec<String> = written
+            .iter()
+            .filter_map(|p| p.strip_prefix(&studio.out_dir).ok())
+            .map(|p| p.display().to_string())
+            .collect();
+        names.sort();
+        Ok(Json(
+            json!({ "folder": dir.display().to_string(), "written": names }),
+        ))
+    })
+    .await
+}
