@@ -152,13 +152,14 @@ pub fn save_with(path: &Path, output: &Output<'_>, options: SaveOptions) -> Resu
     };
     // Every file is encoded first, then all are written together (all or nothing).
     let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
-    let mut put = |p: &Path, bytes: &[u8]| -> Result<()> {
-        files.push((p.to_path_buf(), bytes.to_vec()));
+    // Encoded files are moved in, never copied (they can be hundreds of megabytes).
+    let mut put = |p: &Path, bytes: Vec<u8>| -> Result<()> {
+        files.push((p.to_path_buf(), bytes));
         Ok(())
     };
     match *output {
-        Output::Text(text) => put(path, text.as_bytes())?,
-        Output::Bytes(bytes) => put(path, bytes)?,
+        Output::Text(text) => put(path, text.as_bytes().to_vec())?,
+        Output::Bytes(bytes) => put(path, bytes.to_vec())?,
         Output::Field {
             frames,
             vertices,
@@ -167,14 +168,14 @@ pub fn save_with(path: &Path, output: &Output<'_>, options: SaveOptions) -> Resu
             expect_extension(path, Format::Npy, "a per-frame scalar field", ".npy")?;
             put(
                 path,
-                &crate::npy::write_f32(&[frames, vertices], values).map_err(|e| e.at(path))?,
+                crate::npy::write_f32(&[frames, vertices], values).map_err(|e| e.at(path))?,
             )?
         }
         Output::Mesh(mesh) => match output_format(path)? {
             #[cfg(feature = "obj")]
-            Format::Obj => put(path, crate::obj::write(mesh).as_bytes())?,
+            Format::Obj => put(path, crate::obj::write(mesh).into_bytes())?,
             #[cfg(feature = "stl")]
-            Format::Stl => put(path, &crate::stl::write_binary(mesh))?,
+            Format::Stl => put(path, crate::stl::write_binary(mesh))?,
             _ => {
                 let anim =
                     MeshAnimation::new(mesh.clone(), anim::DEFAULT_FPS, mesh.positions.clone())
@@ -190,7 +191,7 @@ pub fn save_with(path: &Path, output: &Output<'_>, options: SaveOptions) -> Resu
                 );
             }
         },
-        Output::Stage(stage) => put(path, &write_stage(path, stage)?)?,
+        Output::Stage(stage) => put(path, write_stage(path, stage)?)?,
         Output::Parts { parts, layout } => {
             if matches!(layout, Layout::Sequence | Layout::Frame(_)) {
                 return Err(IoError::unsupported(format!(
@@ -206,7 +207,7 @@ pub fn save_with(path: &Path, output: &Output<'_>, options: SaveOptions) -> Resu
                 let stage = UsdStage::from_parts(parts).map_err(|e| e.at(path))?;
                 write_stage(path, &stage)?
             };
-            put(path, &bytes)?;
+            put(path, bytes)?;
         }
         Output::Flipbook(book) => {
             let bytes = if output_format(path)? == Format::Glb {
@@ -215,7 +216,7 @@ pub fn save_with(path: &Path, output: &Output<'_>, options: SaveOptions) -> Resu
             } else {
                 write_stage(path, &crate::flipbook::flipbook_stage(book))?
             };
-            put(path, &bytes)?;
+            put(path, bytes)?;
         }
         Output::MotionLines { body, lines } => {
             let bytes = if output_format(path)? == Format::Glb {
@@ -224,7 +225,7 @@ pub fn save_with(path: &Path, output: &Output<'_>, options: SaveOptions) -> Resu
             } else {
                 write_stage(path, &crate::flipbook::lines_stage(body, lines))?
             };
-            put(path, &bytes)?;
+            put(path, bytes)?;
         }
         Output::Animation {
             animation,
@@ -283,7 +284,7 @@ fn write_animation(
     layout: Layout,
     colors: Option<&[[f32; 4]]>,
     glb: crate::gltf::GlbOptions,
-    put: &mut dyn FnMut(&Path, &[u8]) -> Result<()>,
+    put: &mut dyn FnMut(&Path, Vec<u8>) -> Result<()>,
 ) -> Result<()> {
     let format = output_format(path)?;
     if let Layout::Frame(frame) = layout {
@@ -326,7 +327,7 @@ fn write_animation(
             let bytes =
                 crate::gltf::write_animations_with(&[(anim, colors)], gltf_layout(layout), glb)
                     .map_err(|e| e.at(path))?;
-            put(path, &bytes)
+            put(path, bytes)
         }
         Format::Gltf => {
             Err(IoError::unsupported("toonkit writes binary glTF: name the output .glb").at(path))
@@ -337,19 +338,19 @@ fn write_animation(
             } else {
                 crate::mdd::write(anim)
             };
-            put(path, &bytes)?;
+            put(path, bytes)?;
             rest_mesh(path, anim, put)
         }
         #[cfg(feature = "obj")]
-        Format::Obj => put(path, crate::obj::write(&anim.mesh_at(0)).as_bytes()),
+        Format::Obj => put(path, crate::obj::write(&anim.mesh_at(0)).into_bytes()),
         #[cfg(feature = "stl")]
-        Format::Stl => put(path, &crate::stl::write_binary(&anim.mesh_at(0))),
+        Format::Stl => put(path, crate::stl::write_binary(&anim.mesh_at(0))),
         Format::Npy => {
             let flat: Vec<f32> = anim.positions().iter().flat_map(|p| p.to_array()).collect();
             let shape = [anim.frame_count(), anim.vertex_count(), 3];
             put(
                 path,
-                &crate::npy::write_f32(&shape, &flat).map_err(|e| e.at(path))?,
+                crate::npy::write_f32(&shape, &flat).map_err(|e| e.at(path))?,
             )
         }
         Format::Bvh => Err(IoError::unsupported("BVH output holds skeletons, not meshes").at(path)),
@@ -359,7 +360,7 @@ fn write_animation(
         .at(path)),
         Format::Usda | Format::Usdc | Format::Usdz | Format::Abc => {
             let stage = UsdStage::new(anim.fps, vec![UsdMesh::animation(anim, colors)]);
-            put(path, &write_stage(path, &stage)?)
+            put(path, write_stage(path, &stage)?)
         }
         #[allow(unreachable_patterns)]
         _ => Err(IoError::unsupported("this build of toonkit cannot write that format").at(path)),
@@ -372,14 +373,14 @@ fn write_sequence(
     path: &Path,
     format: Format,
     anim: &MeshAnimation,
-    put: &mut dyn FnMut(&Path, &[u8]) -> Result<()>,
+    put: &mut dyn FnMut(&Path, Vec<u8>) -> Result<()>,
 ) -> Result<()> {
     let base = sequence_base(path);
     match format {
         #[cfg(feature = "obj")]
         Format::Obj => {
             for (p, text) in crate::obj::write_sequence(anim, &base) {
-                put(&p, text.as_bytes())?;
+                put(&p, text.into_bytes())?;
             }
         }
         _ => {
@@ -406,11 +407,11 @@ fn write_sequence(
 fn rest_mesh(
     path: &Path,
     anim: &MeshAnimation,
-    put: &mut dyn FnMut(&Path, &[u8]) -> Result<()>,
+    put: &mut dyn FnMut(&Path, Vec<u8>) -> Result<()>,
 ) -> Result<()> {
     put(
         &path.with_extension("obj"),
-        crate::obj::write(&anim.mesh).as_bytes(),
+        crate::obj::write(&anim.mesh).into_bytes(),
     )
 }
 
@@ -418,7 +419,7 @@ fn rest_mesh(
 fn rest_mesh(
     _: &Path,
     _: &MeshAnimation,
-    _: &mut dyn FnMut(&Path, &[u8]) -> Result<()>,
+    _: &mut dyn FnMut(&Path, Vec<u8>) -> Result<()>,
 ) -> Result<()> {
     Ok(())
 }

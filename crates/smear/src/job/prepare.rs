@@ -166,7 +166,7 @@ pub struct SceneOffsets {
     pub report: PrepareReport,
 }
 
-/// Solves the motion offsets of every object of `scene` (SMEAR Eqs. 1–9, smoothed by SMEAR
+/// Solves the motion offsets of every object of `scene` (SMEAR Eqs. 1–9, smoothed by
 /// SMEAR Eq. 2) and merges them in object order — the whole `toonkit smear offsets` job.
 ///
 /// # Errors
@@ -200,8 +200,8 @@ pub fn offsets(scene: &SampledScene, options: &OffsetOptions) -> Result<SceneOff
     })
 }
 
-/// Prepares `scene` for stylization: solves the motion offsets of every object (SMEAR
-/// SMEAR Eqs. 1–9, smoothed by SMEAR Eq. 2), merges them when asked, resolves the camera and the
+/// Prepares `scene` for stylization: solves the motion offsets of every object
+/// (SMEAR Eqs. 1–9, smoothed by SMEAR Eq. 2), merges them when asked, resolves the camera and the
 /// painted weights, and measures the velocities (camera-relative when a camera is selected).
 ///
 /// # Errors
