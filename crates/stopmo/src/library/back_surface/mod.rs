@@ -9,7 +9,9 @@
 //! two along the part boundary. Every piece therefore seats identically on one armature/head,
 //! and the construction is checked (not assumed) with the exact self-intersection test of
 //! [`self_intersecting_triangles`](super::self_intersecting_triangles): where it finds
-//! crossings the back surface is smoothed and pushed back locally until none remain.
+//! crossings the back surface is relaxed tangentially around them (never thinner) for a few
+//! rounds, keeping the state with the fewest ([`ShellStats::self_intersecting_triangles`]
+//! reports what is left; on the ICT face some walls still meet the front at the temples).
 
 use std::collections::HashMap;
 
