@@ -146,8 +146,9 @@ try {
     let moved = 0;
     for (let i = 0; i < after40.length; i++) if (Math.abs(after40[i] - before40[i]) > 1e-4) moved++;
     check('the weight group restyles the smear (vertices off the arm stop stretching)', moved > 300, `${moved} coordinates changed at frame 40`);
-    // The picture at frame 25 (β = 10 between the keys: the arm stretches).
-    await page.evaluate(() => window.studio.setFrame(25));
+    // The picture at frame 25 (β = 10 between the keys: the arm stretches), the generated
+    // "all parameters" block open.
+    await page.evaluate(() => { document.getElementById('all-params-box').open = true; window.studio.setFrame(25); });
     await page.waitForTimeout(300);
     await page.screenshot({ path: join(shots, 'smear-keyframes.png') });
     // Right-click deletes a key.
@@ -155,6 +156,30 @@ try {
     const left = await page.evaluate(() => [...document.querySelectorAll('#key-track .key-marker[data-param="beta-max"]')].map((m) => Number(m.dataset.frame)));
     check('right-clicking a marker deletes its key', JSON.stringify(left) === '[10]', JSON.stringify(left));
     await page.waitForTimeout(500);
+
+    // The "all parameters" block, generated from the style: Fig. 16's preset (elongation,
+    // multiples, lines) lists every leaf; τ_max of its line-length expression (SMEAR Eq. 13,
+    // `length = step(speed - vmin) * tau * delta`), not a quick field, keyed 0 at frame 10 and
+    // 10 at frame 40: τ = 0 draws no line at frame 10, frame 40 keeps the unkeyed lines.
+    await smearDone(() => { const p = document.getElementById('preset'); p.value = 'fig16_combined'; p.dispatchEvent(new Event('change')); });
+    const listed = await page.evaluate(() => [...document.querySelectorAll('#all-params input')].map((i) => i.id));
+    const tau = 'p:lines.length.params.tau';
+    check('the generated block lists every style parameter (≥ 10, τ of the line length among them)', listed.length >= 10 && listed.includes(tau) && listed.includes('p:multiples.overlap') && listed.includes('p:lines.color.0'), `${listed.length} fields`);
+    const lineVerts = (f) => page.evaluate((f) => window.studio.panels.smear.lines.reduce((n, set) => n + set[f].positions.length / 3, 0), f);
+    const [base10, base40] = [await lineVerts(10), await lineVerts(40)];
+    await smearDone((id) => { window.studio.setFrame(10); document.getElementById(id).value = 0; document.querySelector(`button.key[data-key="${id}"]`).click(); }, tau);
+    await smearDone((id) => { window.studio.setFrame(40); const i = document.getElementById(id); i.value = 10; i.dispatchEvent(new Event('change', { bubbles: true })); }, tau);
+    const tauMarkers = await page.evaluate((id) => [...document.querySelectorAll(`#key-track .key-marker[data-param="${id}"]`)].map((m) => Number(m.dataset.frame)), tau);
+    check('two τ keys show two markers under the timeline at frames 10 and 40', JSON.stringify(tauMarkers) === '[10,40]', JSON.stringify(tauMarkers));
+    const tauToml = await page.evaluate(() => document.getElementById('style-toml').value);
+    check('the style TOML carries the τ keys', /tau = \[\[10\.0, 0\.0\], \[40\.0, 10\.0\]\]/.test(tauToml), tauToml.split('\n').filter((l) => l.includes('tau')).join(' | '));
+    const [k10, k40] = [await lineVerts(10), await lineVerts(40)];
+    check('keyed τ: frame 10 (τ = 0) draws no lines, frame 40 (τ = 10) the unkeyed lines', base10 > 0 && k10 === 0 && k40 === base40 && k40 > 0, `line vertices at 10 / 40: ${base10} / ${base40} unkeyed, ${k10} / ${k40} keyed`);
+    const tauField = await page.evaluate((id) => { window.studio.setFrame(25); return Number(document.getElementById(id).value); }, tau);
+    check('between keys the generated τ field shows the interpolated value', Math.abs(tauField - 5) < 1e-3, String(tauField));
+    await page.evaluate(() => window.studio.setFrame(40));
+    await page.waitForTimeout(300);
+    await page.screenshot({ path: join(shots, 'smear-params.png') });
   }
 
   // loa: three strokes at three frames by mouse.

@@ -1,9 +1,10 @@
-// The smear panel: presets, β max and multiples/lines fields (keyframeable on the timeline,
-// smear_keys.js), the weight-group picker (smear_weights.js), the TOML editor with inline
-// errors, the offsets view, exports. Every change restyles the prepared offsets on the server:
-// the current frame first, the whole clip after.
+// The smear panel: presets, β max and multiples/lines fields and a block of every parameter
+// generated from the style's JSON (keyframeable on the timeline, smear_keys.js), the
+// weight-group picker (smear_weights.js), the TOML editor with inline errors, the offsets
+// view, exports. Every change restyles the prepared offsets on the server: the current frame
+// first, the whole clip after.
 import { getJSON, getPack, postJSON } from './api.js';
-import { KEYABLE, keyable, isCurve, paramAt, setKey, deleteKey, drawKeys } from './smear_keys.js';
+import { KEYABLE, keyable, isCurve, paramAt, setKey, deleteKey, drawKeys, styleParams } from './smear_keys.js';
 import { WeightPicker } from './smear_weights.js';
 
 const $ = (id) => document.getElementById(id);
@@ -22,6 +23,27 @@ function splitLines(buffers, i) {
   return out;
 }
 
+/** A row of the "all parameters" block: label, field, and ◇/✕ for a keyable number. */
+function paramRow(d) {
+  const row = document.createElement('label');
+  const name = document.createElement('span');
+  name.textContent = d.label;
+  name.title = d.id.slice(2);
+  const input = document.createElement('input');
+  input.id = d.id;
+  if (d.kind === 'bool') input.type = 'checkbox';
+  else if (d.kind === 'text') { input.readOnly = true; input.title = 'edit in the TOML below'; }
+  else { input.type = 'number'; input.step = d.integer ? '1' : 'any'; }
+  row.append(name, input);
+  if (d.keyed) {
+    const key = document.createElement('button'), unkey = document.createElement('button');
+    key.className = 'key'; key.dataset.key = d.id; key.textContent = '◇'; key.title = 'set a keyframe at the current frame';
+    unkey.className = 'unkey'; unkey.dataset.key = d.id; unkey.textContent = '✕'; unkey.title = 'delete the keyframe at the current frame'; unkey.disabled = true;
+    row.append(key, unkey);
+  }
+  return row;
+}
+
 export class SmearPanel {
   constructor(studio) {
     this.studio = studio;
@@ -37,6 +59,13 @@ export class SmearPanel {
     for (const id of ['mult-past', 'mult-future', 'line-count']) $(id).addEventListener('change', () => this.edit(id));
     for (const b of document.querySelectorAll('button.key')) b.addEventListener('click', () => this.key(b.dataset.key));
     for (const b of document.querySelectorAll('button.unkey')) b.addEventListener('click', () => this.unkey(b.dataset.key, this.studio.frame));
+    // The generated fields are replaced with the style: their events are caught on the block.
+    $('all-params').addEventListener('change', (e) => { if (e.target.id.startsWith('p:')) this.edit(e.target.id); });
+    $('all-params').addEventListener('click', (e) => {
+      const b = e.target.closest('button');
+      if (b && b.classList.contains('key')) this.key(b.dataset.key);
+      else if (b && b.classList.contains('unkey')) this.unkey(b.dataset.key, this.studio.frame);
+    });
     $('weight-source').addEventListener('change', () => this.pickWeights());
     $('show-weights').addEventListener('change', () => this.weights.showOverlay());
     window.addEventListener('resize', () => { if (this.active) this.drawKeys(); });
@@ -111,8 +140,30 @@ export class SmearPanel {
       $(d.id).value = v;
       if (d.id === 'beta-max') $('beta-max-value').value = v;
     }
+    this.syncParams(f);
     this.weights.sync(this.style);
     this.drawKeys();
+  }
+
+  /**
+   * The "all parameters" block: rebuilt when the style's set of parameters changes (preset,
+   * TOML, a section switched on), otherwise only its values are set (a field being edited
+   * keeps its focus).
+   */
+  syncParams(f) {
+    const params = styleParams(this.style);
+    const sig = params.map((d) => `${d.id}:${d.kind}`).join('|');
+    if (sig !== this.paramSig) {
+      this.paramSig = sig;
+      $('all-params').replaceChildren(...params.map((d) => paramRow(d)));
+      $('all-params-count').textContent = params.length;
+    }
+    for (const d of params) {
+      const el = document.getElementById(d.id), p = d.get(this.style);
+      if (d.kind === 'bool') el.checked = p;
+      else if (d.kind === 'text') el.value = Array.isArray(p) ? p.join(', ') : p;
+      else el.value = +Number(paramAt(p, f)).toFixed(4);
+    }
   }
 
   drawKeys() {
@@ -123,7 +174,10 @@ export class SmearPanel {
   /** A field changed: a keyed parameter gets a key at the current frame, others a constant. */
   edit(id) {
     const t0 = performance.now();
-    const d = keyable(id);
+    const d = keyable(id, this.style);
+    if (!d) return;
+    if (d.kind === 'bool') { d.set(this.style, $(id).checked); this.request({ style: this.style }, t0); return; }
+    if ($(id).value === '' || !Number.isFinite(Number($(id).value))) return;
     const v = Number($(id).value);
     if (id === 'beta-max') $('beta-max-value').value = v;
     const p = d.get(this.style);
@@ -133,7 +187,7 @@ export class SmearPanel {
 
   /** The field's key button: a key at the current frame with the field's value. */
   key(id) {
-    const d = keyable(id);
+    const d = keyable(id, this.style);
     d.set(this.style, setKey(d.get(this.style), this.studio.frame, Number($(id).value)));
     this.drawKeys();
     this.request({ style: this.style }, performance.now());
@@ -141,7 +195,7 @@ export class SmearPanel {
 
   /** Deletes field `id`'s key at `frame` (the last key's value stays as a constant). */
   unkey(id, frame) {
-    const d = keyable(id);
+    const d = keyable(id, this.style);
     d.set(this.style, deleteKey(d.get(this.style), frame));
     this.drawKeys();
     this.request({ style: this.style }, performance.now());
@@ -191,6 +245,9 @@ export class SmearPanel {
         this.style = r.header.style;
         $('style-toml').value = r.header.toml;
         this.syncFields();
+        // A preset or TOML may bring or drop weights: the overlay follows the style.
+        const weights = JSON.stringify(this.style.weights);
+        if (weights !== this.shownWeights) { this.shownWeights = weights; this.weights.showOverlay(); }
         this.lastBody = { style: this.style };
         this.fresh = new Set([f]);
         this.apply(r);

@@ -9,6 +9,10 @@ const $ = (id) => document.getElementById(id);
 /** Whether `p` is a keyed curve (not a constant). */
 export const isCurve = (p) => Array.isArray(p);
 
+/** Whether a JSON value has a keyed parameter's form, [[frame, value], ...] (one key or more). */
+const isKeys = (x) => Array.isArray(x) && x.length > 0
+  && x.every((k) => Array.isArray(k) && k.length === 2 && k.every((n) => typeof n === 'number'));
+
 /** The value of `p` at `frame`, as `smear::Param::at` computes it (shown in the fields). */
 export function paramAt(p, frame) {
   if (!isCurve(p)) return p;
@@ -86,8 +90,64 @@ export const KEYABLE = [
   },
 ];
 
-/** The field `id`'s description. */
-export const keyable = (id) => KEYABLE.find((d) => d.id === id);
+// Integer options of the style that are not `smear::Param`s (a curve there is refused).
+const UNKEYED = new Set(['step', 'smooth', 'samples', 'sides', 'seed']);
+const PALETTE = ['#ba68c8', '#4dd0e1', '#fff176', '#a1887f', '#f06292', '#aed581', '#7986cb', '#ff8a65'];
+
+/** The value at `path` (keys and indices) in `style`, or null. */
+const at = (style, path) => path.reduce((o, k) => (o === null || o === undefined ? null : o[k]), style) ?? null;
+
+/**
+ * The description of a generated field (id `p:` + its dotted path in the style), in the
+ * KEYABLE form plus `kind` ('number' | 'bool' | 'text'), `keyed` (may carry keys) and
+ * `integer`.
+ */
+function leaf(style, path, kind, row) {
+  const name = path[path.length - 1];
+  // A function stage is named by its op (`elongate.function.scale.by`), another index (a
+  // colour channel) by [i].
+  const parts = [];
+  path.forEach((k, i) => {
+    if (path[i - 1] === 'stages') parts[parts.length - 1] = at(style, path.slice(0, i + 1)).op || `stage[${k}]`;
+    else if (typeof k === 'number') parts[parts.length - 1] += `[${k}]`;
+    else parts.push(k);
+  });
+  const keyed = kind === 'number' && !UNKEYED.has(name);
+  return {
+    id: `p:${path.join('.')}`, label: parts.join('.'), color: PALETTE[row % PALETTE.length], kind, keyed,
+    integer: UNKEYED.has(name),
+    get: (s) => at(s, path),
+    set: (s, p) => { const o = at(s, path.slice(0, -1)); if (o) o[name] = p; },
+  };
+}
+
+/**
+ * Every parameter of `style`, walked in its JSON: numbers and keyed curves (keyable unless an
+ * integer option), booleans, and expression / group strings (shown read-only; the TOML
+ * editor edits them). `op` names the stage and is not a field.
+ */
+export function styleParams(style) {
+  const out = [];
+  const walk = (v, path) => {
+    if (v === null || v === undefined) return;
+    const name = path[path.length - 1];
+    if (typeof v === 'number' || isKeys(v)) out.push(leaf(style, path, 'number', out.length));
+    else if (typeof v === 'boolean') out.push(leaf(style, path, 'bool', out.length));
+    else if (typeof v === 'string') { if (name !== 'op') out.push(leaf(style, path, 'text', out.length)); }
+    else if (Array.isArray(v) && v.length && v.every((x) => typeof x === 'string')) out.push(leaf(style, path, 'text', out.length));
+    else if (Array.isArray(v)) v.forEach((x, i) => walk(x, [...path, i]));
+    else if (typeof v === 'object') for (const k of Object.keys(v).sort()) walk(v[k], [...path, k]);
+  };
+  walk(style, []);
+  return out;
+}
+
+/** The field `id`'s description: a quick field, or a generated one (`p:` + its path). */
+export function keyable(id, style) {
+  const quick = KEYABLE.find((d) => d.id === id);
+  if (quick || !style) return quick;
+  return styleParams(style).find((d) => d.id === id);
+}
 
 /**
  * Draws the key markers of `style` under the timeline's range input (one row per keyed
@@ -103,14 +163,19 @@ export function drawKeys(style, frame, frames, { jump, remove }) {
   const thumb = 8, span = Math.max(1, range.width - 2 * thumb);
   const x = (f) => range.left - base.left + thumb + span * (frames > 1 ? f / (frames - 1) : 0);
   let row = 0;
-  for (const d of KEYABLE) {
+  // The quick fields, then the generated ones; a curve a quick field already shows (the same
+  // array in the style) gets its buttons updated but no second row of markers.
+  const shown = new Set();
+  const all = [...KEYABLE, ...(style ? styleParams(style).filter((d) => d.keyed) : [])];
+  for (const d of all) {
     const p = style ? d.get(style) : null;
     const button = document.querySelector(`button.key[data-key="${d.id}"]`);
     const keyedHere = isCurve(p) && p.some((k) => k[0] === frame);
     if (button) { button.classList.toggle('keyed', keyedHere); button.textContent = keyedHere ? '◆' : '◇'; }
     const unkey = document.querySelector(`button.unkey[data-key="${d.id}"]`);
     if (unkey) unkey.disabled = !keyedHere;
-    if (!isCurve(p)) continue;
+    if (!isCurve(p) || shown.has(p)) continue;
+    shown.add(p);
     for (const [f, v] of p) {
       const m = document.createElement('button');
       m.className = 'key-marker';
