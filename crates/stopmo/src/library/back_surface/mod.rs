@@ -41,6 +41,7 @@ pub const DEFAULT_CAP_FRACTION: f64 = 0.5;
 /// tests minutes slower) for little gain (ICT face, 8 pieces per part: 538 crossing triangles
 /// of 311,968 without repair, 506 with 12 rounds; 4,591 before the boundary-curve smoothing
 /// and the 14 mm direction field). Raise it in `ShellOptions::repair_rounds` to try.
+pub const DEFAULT_REPAIR_ROUNDS: usize = 0;
 
 /// Repair rounds without fewer crossings before the repair gives up.
 const REPAIR_PATIENCE: usize = 3;
