@@ -2,16 +2,16 @@
 //! returned) → size-versus-error curve job → build a point's library → its reconstruction
 //! with the assembly's piece per frame → export of the library folder, confined to `--out`.
 
-use std::sync::Arc;
 use std::time::Duration;
 
-use axum::body::{to_bytes, Body};
+use axum::body::Body;
 use axum::http::{header, Request, StatusCode};
 use axum::Router;
 use serde_json::{json, Value};
-use studio::files::{output_folder, OpenedFile};
-use studio::{pack, router, Studio};
-use tower::ServiceExt;
+use studio::{pack, router};
+
+mod common;
+use common::{send, studio_with, HOST, PORT};
 
 /// The router with the face opened, answering as the local server on port 8765.
 struct Client {
@@ -20,14 +20,8 @@ struct Client {
 
 impl Client {
     fn face(out: &std::path::Path) -> Client {
-        let face = OpenedFile::open(&testdata::asset("face/ict-face-talk.glb")).unwrap();
-        let studio = Studio::new(
-            vec![face],
-            output_folder(out).unwrap(),
-            studio::web::default_node_modules(),
-        );
         Client {
-            app: router(Arc::new(studio), 8765),
+            app: router(studio_with(&["face/ict-face-talk.glb"], out), PORT),
         }
     }
 
@@ -36,14 +30,11 @@ impl Client {
         let req = Request::builder()
             .method(method)
             .uri(uri)
-            .header(header::HOST, "127.0.0.1:8765")
+            .header(header::HOST, HOST)
             .header(header::CONTENT_TYPE, "application/json")
             .body(body.map_or_else(Body::empty, |b| Body::from(b.to_string())))
             .unwrap();
-        let res = self.app.clone().oneshot(req).await.unwrap();
-        let status = res.status();
-        let bytes = to_bytes(res.into_body(), usize::MAX).await.unwrap();
-        (status, bytes.to_vec())
+        send(&self.app, req).await
     }
 
     /// Starts a job with `POST uri body` and waits for its result.

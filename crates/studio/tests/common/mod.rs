@@ -1,0 +1,69 @@
+//! Helpers shared by the studio's API tests: the router on bundled assets, answering as the
+//! local server, and requests with the local `Host`.
+// Each test binary uses some of these.
+#![allow(dead_code)]
+
+use std::path::Path;
+use std::sync::Arc;
+
+use axum::body::{to_bytes, Body};
+use axum::http::{header, Request, StatusCode};
+use axum::Router;
+use serde_json::Value;
+use studio::files::{output_folder, OpenedFile};
+use studio::{router, Studio};
+use tower::ServiceExt;
+
+pub(crate) const PORT: u16 = 8765;
+pub(crate) const HOST: &str = "127.0.0.1:8765";
+
+pub(crate) fn studio_with(files: &[&str], out: &Path) -> Arc<Studio> {
+    let opened = files
+        .iter()
+        .map(|f| OpenedFile::open(&testdata::asset(f)).unwrap())
+        .collect();
+    Arc::new(Studio::new(
+        opened,
+        output_folder(out).unwrap(),
+        studio::web::default_node_modules(),
+    ))
+}
+
+pub(crate) fn app(out: &Path) -> Router {
+    router(studio_with(&["characters/RobotExpressive.glb"], out), PORT)
+}
+
+pub(crate) async fn send(app: &Router, req: Request<Body>) -> (StatusCode, Vec<u8>) {
+    let res = app.clone().oneshot(req).await.unwrap();
+    let status = res.status();
+    (
+        status,
+        to_bytes(res.into_body(), usize::MAX)
+            .await
+            .unwrap()
+            .to_vec(),
+    )
+}
+
+pub(crate) fn get(uri: &str) -> Request<Body> {
+    Request::get(uri)
+        .header(header::HOST, HOST)
+        .body(Body::empty())
+        .unwrap()
+}
+
+pub(crate) fn post(uri: &str, body: Value) -> Request<Body> {
+    Request::post(uri)
+        .header(header::HOST, HOST)
+        .header(header::CONTENT_TYPE, "application/json")
+        .body(Body::from(body.to_string()))
+        .unwrap()
+}
+
+pub(crate) fn error_of(bytes: &[u8]) -> String {
+    let v: Value = serde_json::from_slice(bytes).expect("a JSON error body");
+    v["error"]
+        .as_str()
+        .expect("an \"error\" string")
+        .to_string()
+}
