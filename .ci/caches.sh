@@ -20,8 +20,9 @@ test -x "$VENV/bin/python" || "$PY" -m venv "$VENV"
 "$VENV/bin/pip" install --quiet --disable-pip-version-check \
     "bpy==4.2.0" "numpy<2" "openjd-cli" "usd-core==26.11"
 
-# --workspace: the same features and profile as `cargo test --workspace`: nothing is rebuilt.
-cargo build --quiet --workspace --bins
+# The binaries `cargo test --workspace` built (`cargo build` would resolve other features
+# without the dev-dependencies and rebuild much of the workspace).
+cargo test --quiet --workspace --no-run
 TK="$ROOT/target/debug/toonkit"
 WORK="$ROOT/target/caches"
 rm -rf "$WORK"

@@ -54,7 +54,7 @@ echo "== toonkit reads them like the plain glTF"
 TOONKIT_IO_EXPORTS="$OUT" cargo test --quiet --workspace --test exporters -- --nocapture
 
 echo "== the Fig. 16 style on the robot's Dance clip: quantized (default) and float"
-cargo build --quiet --workspace --bins
+cargo test --quiet --workspace --no-run
 TK="$ROOT/target/debug/toonkit"
 "$TK" smear assets/characters/RobotExpressive.glb --clip Dance \
     --style examples/smear/fig16_combined.toml -o "$OUT/dance_fig16.glb"

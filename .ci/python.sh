@@ -35,6 +35,7 @@ fi
 (cd /tmp && "$OLDPWD/$VENV/bin/python" -c "import toonkit; print('python: toonkit', toonkit.__version__, 'from', toonkit.__file__)")
 
 # The CLI the tests compare against, from the same tree.
-# --workspace: the same features and profile as `cargo test --workspace`: nothing is rebuilt.
-cargo build --quiet --workspace --bins
+# The binaries `cargo test --workspace` built (`cargo build` would resolve other features
+# without the dev-dependencies and rebuild much of the workspace).
+cargo test --quiet --workspace --no-run
 TOONKIT_CLI="$PWD/target/debug/toonkit" "$VENV/bin/python" -m pytest -q -p no:cacheprovider crates/python/tests

@@ -10,8 +10,9 @@ command -v node >/dev/null || { apt-get update -qq && apt-get install -y -qq nod
 npm ci --prefix crates/studio/web --no-audit --no-fund --loglevel=error
 npm ci --prefix .ci/studio --no-audit --no-fund --loglevel=error
 
-# The binary `cargo test --workspace` built (dev and test share one profile: no rebuild).
-cargo build --quiet --workspace --bins
+# The binaries `cargo test --workspace` built (`cargo build` would resolve other features
+# without the dev-dependencies and rebuild much of the workspace).
+cargo test --quiet --workspace --no-run
 BIN=target/debug/toonkit
 PORT=${STUDIO_PORT:-18765}
 OUT=target/studio-out

@@ -438,6 +438,19 @@ impl<'a> TriangleGrid<'a> {
 
     /// Distance from `p` to the nearest triangle (infinity without triangles).
     pub fn distance(&self, p: Vec3) -> f64 {
+        self.distance_below(p, f64::INFINITY)
+    }
+
+    /// Distance from `p` to the nearest triangle when it is below `limit`; otherwise some value
+    /// `>= limit` (infinity without triangles).
+    ///
+    /// # Performance
+    /// Visits the grid ring by ring (only the cells on each ring's surface) and stops at the
+    /// first ring farther than the best distance found or `limit`: O(d³/cell³) cells for a
+    /// nearest distance d. Folding a minimum over many points with the running minimum as
+    /// `limit` (as [`PartShell::min_wall`](super::PartShell::min_wall) does) keeps every query
+    /// after the first to a few rings.
+    pub fn distance_below(&self, p: Vec3, limit: f64) -> f64 {
         if self.triangles.is_empty() {
             return f64::INFINITY;
         }
@@ -449,29 +462,34 @@ impl<'a> TriangleGrid<'a> {
             .unwrap_or(0)
             + 1;
         let mut best = f64::INFINITY;
+        let visit = |x: i32, y: i32, z: i32, best: &mut f64| {
+            if let Some(list) = self.cells.get(&[x, y, z]) {
+                for &t in list {
+                    let [a, b, cc] = self.triangles[t as usize].map(|v| self.positions[v as usize]);
+                    let d = f64::from(closest_point_on_triangle(p, a, b, cc).distance(p));
+                    *best = best.min(d);
+                }
+            }
+        };
         for r in 0..=max_ring {
+            // Cells of ring r lie at least (r − 1)·cell from p.
+            if f64::from((r - 1).max(0) as f32 * self.cell) >= best.min(limit) {
+                break;
+            }
             for x in c[0] - r..=c[0] + r {
                 for y in c[1] - r..=c[1] + r {
-                    for z in c[2] - r..=c[2] + r {
-                        let on_ring =
-                            (x - c[0]).abs() == r || (y - c[1]).abs() == r || (z - c[2]).abs() == r;
-                        if !on_ring {
-                            continue;
+                    if (x - c[0]).abs() == r || (y - c[1]).abs() == r {
+                        for z in c[2] - r..=c[2] + r {
+                            visit(x, y, z, &mut best);
                         }
-                        if let Some(list) = self.cells.get(&[x, y, z]) {
-                            for &t in list {
-                                let [a, b, cc] =
-                                    self.triangles[t as usize].map(|v| self.positions[v as usize]);
-                                let d =
-                                    f64::from(closest_point_on_triangle(p, a, b, cc).distance(p));
-                                best = best.min(d);
-                            }
+                    } else {
+                        // Inside the ring's x/y extent only the two z faces belong to it.
+                        visit(x, y, c[2] - r, &mut best);
+                        if r > 0 {
+                            visit(x, y, c[2] + r, &mut best);
                         }
                     }
                 }
-            }
-            if best <= f64::from(r as f32 * self.cell) {
-                break;
             }
         }
         best
@@ -554,5 +572,33 @@ mod tests {
             [3, 7, 5],
         ];
         assert_eq!(count(&p, &t), 0);
+    }
+
+    #[test]
+    fn grid_distance_matches_brute_force_near_and_far() {
+        let mut rng = anim::SplitMix64::new(7, 0);
+        let mut r = |s: f32| (rng.next_f32() - 0.5) * s;
+        // A small dense patch, so that far points need many rings.
+        let p: Vec<Vec3> = (0..300)
+            .map(|_| Vec3::new(r(4.0), r(4.0), r(0.4)))
+            .collect();
+        let t: Vec<[u32; 3]> = (0..100).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+        let grid = TriangleGrid::new(&p, &t);
+        for i in 0..200 {
+            let scale = if i % 2 == 0 { 5.0 } else { 40.0 };
+            let q = Vec3::new(r(scale), r(scale), r(scale));
+            let brute = t
+                .iter()
+                .map(|&[a, b, c]| {
+                    let [a, b, c] = [a, b, c].map(|v| p[v as usize]);
+                    f64::from(closest_point_on_triangle(q, a, b, c).distance(q))
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!((grid.distance(q) - brute).abs() < 1e-9, "{q}");
+            // Under a limit: the exact distance when nearer, else at least the limit.
+            let below = grid.distance_below(q, brute * 0.5);
+            assert!(below >= brute * 0.5 - 1e-9);
+            assert!((grid.distance_below(q, brute * 2.0) - brute).abs() < 1e-9);
+        }
     }
 }

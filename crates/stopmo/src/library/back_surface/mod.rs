@@ -486,10 +486,7 @@ impl PartShell {
             shell.stats.self_intersecting_triangles = count;
         }
         shell.stats.repair_rounds = rounds;
-        shell.stats.min_wall_mm = pieces
-            .iter()
-            .map(|p| shell.min_wall(p))
-            .fold(f64::INFINITY, f64::min);
+        shell.stats.min_wall_mm = shell.min_wall_of(pieces);
         Ok(shell)
     }
 
@@ -610,10 +607,17 @@ impl PartShell {
 
     /// Smallest distance (mm) from a front vertex of `piece` to the back surface's triangles.
     pub fn min_wall(&self, piece: &[Vec3]) -> f64 {
+        self.min_wall_of(&[piece])
+    }
+
+    /// Smallest [`min_wall`](Self::min_wall) over `pieces`, with one grid of the back surface.
+    fn min_wall_of(&self, pieces: &[&[Vec3]]) -> f64 {
         let grid = super::intersect::TriangleGrid::new(&self.back, &self.triangles);
-        self.front(piece)
-            .iter()
-            .map(|&p| grid.distance(p))
-            .fold(f64::INFINITY, f64::min)
+        // The running minimum bounds every later query to a few grid rings.
+        pieces.iter().fold(f64::INFINITY, |best, piece| {
+            self.front(piece)
+                .iter()
+                .fold(best, |best, &p| best.min(grid.distance_below(p, best)))
+        })
     }
 }

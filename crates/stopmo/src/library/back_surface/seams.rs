@@ -79,10 +79,7 @@ impl PartShell {
             )));
         }
         self.back = back.to_vec();
-        self.stats.min_wall_mm = pieces
-            .iter()
-            .map(|p| self.min_wall(p))
-            .fold(f64::INFINITY, f64::min);
+        self.stats.min_wall_mm = self.min_wall_of(pieces);
         self.stats.self_intersecting_triangles = self.crossing_vertices(pieces).len();
         Ok(())
     }
