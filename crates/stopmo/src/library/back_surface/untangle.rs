@@ -18,11 +18,40 @@ const STEP_MM: f32 = 0.02;
 const ROUNDS: usize = 150;
 /// Fraction of the way to the neighbours' centroid a crossing vertex moves per round.
 const RELAX: f32 = 0.5;
+/// Rings around the first crossings that the later rounds test.
+const REGION_RINGS: usize = 8;
 
 /// Untangles `front` (positions of the triangles `tris`, `adj` their vertex adjacency) in
 /// place; returns the vertices moved.
 pub(super) fn untangle(front: &mut [Vec3], tris: &[[u32; 3]], adj: &[Vec<u32>]) -> usize {
     let n = front.len();
+    let Some(first) = intersecting_pairs(front, tris) else {
+        return 0;
+    };
+    if first.iter().all(|(i, j)| i == j) {
+        return 0;
+    }
+    // Only the neighbourhood of the first crossings moves (a few rings per round at most):
+    // later rounds test its triangles only, not the whole front again.
+    let mut region = vec![false; n];
+    for &(i, j) in first.iter().filter(|(i, j)| i != j) {
+        for t in [i, j] {
+            for &v in &tris[t as usize] {
+                region[v as usize] = true;
+            }
+        }
+    }
+    for _ in 0..REGION_RINGS {
+        region = (0..n)
+            .map(|v| region[v] || adj[v].iter().any(|&w| region[w as usize]))
+            .collect();
+    }
+    let local: Vec<[u32; 3]> = tris
+        .iter()
+        .filter(|t| t.iter().any(|&v| region[v as usize]))
+        .copied()
+        .collect();
+    let tris = &local[..];
     let mut moved = vec![false; n];
     let mut best: Option<(usize, Vec<Vec3>, Vec<bool>)> = None;
     for round in 0..=ROUNDS {
