@@ -260,19 +260,19 @@ fn printable(pieces: usize) {
 }
 
 #[test]
-#[ignore = "issue 19: crossings left where walls meet the front at the temples and mouth corners (see diagnose_crossings)"]
+#[ignore = "issue 19: crossings left where walls meet the front at the temples and the lower back meets the seam wall under the nose (see diagnose_crossings)"]
 fn eight_pieces_are_printable() {
     printable(8);
 }
 
 #[test]
-#[ignore = "issue 19: crossings left where walls meet the front at the temples and mouth corners (see diagnose_crossings)"]
+#[ignore = "issue 19: crossings left where walls meet the front at the temples and the lower back meets the seam wall under the nose (see diagnose_crossings)"]
 fn twenty_pieces_are_printable() {
     printable(20);
 }
 
 #[test]
-#[ignore = "issue 19: crossings left where walls meet the front at the temples and mouth corners (see diagnose_crossings)"]
+#[ignore = "issue 19: crossings left where walls meet the front at the temples and the lower back meets the seam wall under the nose (see diagnose_crossings)"]
 fn fifty_pieces_are_printable() {
     printable(50);
 }

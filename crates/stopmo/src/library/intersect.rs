@@ -471,10 +471,36 @@ impl<'a> TriangleGrid<'a> {
                 }
             }
         };
+        let mut visited = 0usize;
         for r in 0..=max_ring {
             // Cells of ring r lie at least (r − 1)·cell from p.
             if f64::from((r - 1).max(0) as f32 * self.cell) >= best.min(limit) {
                 break;
+            }
+            // Far from every triangle (a back far behind a thin part, a point outside the
+            // grid) the rings hold mostly empty cells: scan the occupied ones instead.
+            let ring_cells =
+                (2 * r as usize + 1).pow(3) - (2 * r as usize).saturating_sub(1).pow(3);
+            visited += ring_cells;
+            if visited > self.cells.len() {
+                let reach = best.min(limit);
+                for (k, list) in &self.cells {
+                    let lo = self.lo + Vec3::new(k[0] as f32, k[1] as f32, k[2] as f32) * self.cell;
+                    let gap = (lo - p)
+                        .max(p - lo - Vec3::splat(self.cell))
+                        .max(Vec3::ZERO);
+                    if f64::from(gap.length()) >= reach.min(best) {
+                        continue;
+                    }
+                    for &t in list {
+                        let [a, b, cc] =
+                            self.triangles[t as usize].map(|v| self.positions[v as usize]);
+                        best = best.min(f64::from(
+                            closest_point_on_triangle(p, a, b, cc).distance(p),
+                        ));
+                    }
+                }
+                return best;
             }
             for x in c[0] - r..=c[0] + r {
                 for y in c[1] - r..=c[1] + r {
@@ -600,5 +626,24 @@ mod tests {
             assert!(below >= brute * 0.5 - 1e-9);
             assert!((grid.distance_below(q, brute * 2.0) - brute).abs() < 1e-9);
         }
+    }
+
+    #[test]
+    fn grid_distance_far_from_tiny_triangles_scans_the_occupied_cells() {
+        // Cells of 2·10⁻³ and a point 10⁶ cells away: ring by ring this would visit ~10¹⁸
+        // empty cells (the jobs test's tube hung here); it must answer at once, exactly.
+        let p = vec![
+            Vec3::ZERO,
+            Vec3::new(1e-3, 0.0, 0.0),
+            Vec3::new(0.0, 1e-3, 0.0),
+            Vec3::new(0.5, 0.0, 0.0),
+            Vec3::new(0.501, 0.0, 0.0),
+            Vec3::new(0.5, 1e-3, 0.0),
+        ];
+        let t = [[0, 1, 2], [3, 4, 5]];
+        let grid = TriangleGrid::new(&p, &t);
+        let q = Vec3::new(0.0, 0.0, 2000.0);
+        assert!((grid.distance(q) - 2000.0).abs() < 1e-3);
+        assert!(grid.distance_below(q, 1.0) >= 1.0);
     }
 }

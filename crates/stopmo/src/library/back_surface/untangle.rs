@@ -3,7 +3,9 @@
 //! crossing triangles, and a ring around them, retract along their inward normal in small
 //! steps until the exact test finds no crossing. Both sides of a crossing retract, so two
 //! surfaces pressed into each other part where they met, by the least depth that separates
-//! them.
+//! them; the crossing vertices also relax towards their neighbours, which opens folds (a
+//! mouth corner pinched through itself) that retraction alone does not (ICT face, 8 pieces:
+//! 132 crossing pairs left in one lower piece with retraction only, none with both).
 
 use glam::Vec3;
 
@@ -11,13 +13,45 @@ use crate::library::intersect::intersecting_pairs;
 
 /// Retraction per round (mm).
 const STEP_MM: f32 = 0.02;
-/// Rounds at most (`ROUNDS × STEP_MM` = 1 mm of retraction).
-const ROUNDS: usize = 50;
+/// Rounds at most (`ROUNDS × STEP_MM` = 3 mm of retraction; the first round without a
+/// crossing ends it).
+const ROUNDS: usize = 150;
+/// Fraction of the way to the neighbours' centroid a crossing vertex moves per round.
+const RELAX: f32 = 0.5;
+/// Rings around the first crossings that the later rounds test.
+const REGION_RINGS: usize = 8;
 
 /// Untangles `front` (positions of the triangles `tris`, `adj` their vertex adjacency) in
 /// place; returns the vertices moved.
 pub(super) fn untangle(front: &mut [Vec3], tris: &[[u32; 3]], adj: &[Vec<u32>]) -> usize {
     let n = front.len();
+    let Some(first) = intersecting_pairs(front, tris) else {
+        return 0;
+    };
+    if first.iter().all(|(i, j)| i == j) {
+        return 0;
+    }
+    // Only the neighbourhood of the first crossings moves (a few rings per round at most):
+    // later rounds test its triangles only, not the whole front again.
+    let mut region = vec![false; n];
+    for &(i, j) in first.iter().filter(|(i, j)| i != j) {
+        for t in [i, j] {
+            for &v in &tris[t as usize] {
+                region[v as usize] = true;
+            }
+        }
+    }
+    for _ in 0..REGION_RINGS {
+        region = (0..n)
+            .map(|v| region[v] || adj[v].iter().any(|&w| region[w as usize]))
+            .collect();
+    }
+    let local: Vec<[u32; 3]> = tris
+        .iter()
+        .filter(|t| t.iter().any(|&v| region[v as usize]))
+        .copied()
+        .collect();
+    let tris = &local[..];
     let mut moved = vec![false; n];
     let mut best: Option<(usize, Vec<Vec3>, Vec<bool>)> = None;
     for round in 0..=ROUNDS {
@@ -47,6 +81,21 @@ pub(super) fn untangle(front: &mut [Vec3], tris: &[[u32; 3]], adj: &[Vec<u32>]) 
             .map(|v| mark[v] || adj[v].iter().any(|&w| mark[w as usize]))
             .collect();
         let normals = anim::vertex_normals(front, tris);
+        // A fold (the mouth corner pinched through itself) does not open by retraction:
+        // relax the crossing vertices towards their neighbours too.
+        let relaxed: Vec<Vec3> = (0..n)
+            .map(|v| {
+                if !mark[v] || adj[v].is_empty() {
+                    return front[v];
+                }
+                let c = adj[v]
+                    .iter()
+                    .fold(Vec3::ZERO, |a, &w| a + front[w as usize])
+                    / adj[v].len() as f32;
+                front[v] + (c - front[v]) * RELAX
+            })
+            .collect();
+        front.copy_from_slice(&relaxed);
         for v in 0..n {
             if ring[v] {
                 let s = if mark[v] { STEP_MM } else { STEP_MM * 0.5 };
