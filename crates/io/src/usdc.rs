@@ -4,7 +4,7 @@
 //! The layer holds exactly what the `.usda` layer of the same stage holds (see the
 //! [`usda` module documentation](crate::usda) for the layout): the same stage metadata
 //! (`defaultPrim`, `startTimeCode`/`endTimeCode`, `framesPerSecond`/`timeCodesPerSecond`,
-//! `metersPerUnit`, `upAxis = "Y"`), one root `Xform`, one `Mesh` prim per [`UsdMesh`] with the
+//! `metersPerUnit`, `upAxis = "Y"`), one root `Xform`, one `Mesh` prim per [`UsdMesh`](crate::usda::UsdMesh) with the
 //! same names, the same properties (`faceVertexCounts`, `faceVertexIndices`, `points`,
 //! `extent`, `primvars:st`, `primvars:displayColor`, `primvars:displayOpacity`,
 //! `visibility`), and the same time samples: frame `k` at time code `start_time_code + k`, an
@@ -43,7 +43,7 @@ use crate::{IoError, Result};
 /// Writes one point cache as a `.usdc` layer (see [`crate::usda::write_animation`]).
 ///
 /// # Errors
-/// As [`write`].
+/// As [`write()`].
 pub fn write_animation(anim: &MeshAnimation, colors: Option<&[[f32; 4]]>) -> Result<Vec<u8>> {
     write_parts(&[(anim, colors)])
 }
@@ -52,7 +52,7 @@ pub fn write_animation(anim: &MeshAnimation, colors: Option<&[[f32; 4]]>) -> Res
 /// [`crate::usda::write_parts`]).
 ///
 /// # Errors
-/// When there is nothing to write, or as [`write`].
+/// When there is nothing to write, or as [`write()`].
 pub fn write_parts(parts: &[(&MeshAnimation, Option<&[[f32; 4]]>)]) -> Result<Vec<u8>> {
     write(&UsdStage::from_parts(parts)?)
 }
@@ -73,7 +73,7 @@ pub fn write(stage: &UsdStage) -> Result<Vec<u8>> {
 /// uncompressed and 64-byte aligned, as the USDZ specification asks.
 ///
 /// # Errors
-/// As [`write`].
+/// As [`write()`].
 pub fn write_usdz(stage: &UsdStage) -> Result<Vec<u8>> {
     let layer = write(stage)?;
     let mut zip = openusd::usdz::ArchiveWriter::new(Cursor::new(Vec::new()));

@@ -9,8 +9,8 @@
 //! * [`animate()`] — a [`Character`](animate::Character) (skeleton + initial pose, e.g.
 //!   [`Character::from_scene`](animate::Character::from_scene)) and a [`Line`] → the 3D motion
 //!   ([`Motion`](animate::Motion), with its [`AnimateReport`](animate::AnimateReport)).
-//!   Options: [`AnimateOptions`](animate::AnimateOptions). [`Motion::to_scene`]
-//!   (animate::Motion::to_scene) puts the motion back into the character's scene for writing.
+//!   Options: [`AnimateOptions`](animate::AnimateOptions). [`Motion::to_scene`](animate::Motion::to_scene)
+//!   puts the motion back into the character's scene for writing.
 //!
 //! The crate is pure computation: it never touches files.
 //!

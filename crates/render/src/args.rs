@@ -33,7 +33,7 @@ pub struct PreviewFlags {
     #[arg(long, value_enum, default_value_t = ColorArg::None)]
     pub color: ColorArg,
     /// View: front, back, side, top, three-quarter (orthographic, fitted to the whole
-    /// motion), follow[:DIRECTION] (same scale, tracking a travelling subject) or camera:NAME
+    /// motion), follow or follow:DIRECTION (same scale, tracking a travelling subject) or camera:NAME
     /// (a scene camera).
     #[arg(long, default_value = "three-quarter")]
     pub view: String,

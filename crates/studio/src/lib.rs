@@ -6,9 +6,9 @@
 //! * smear — [`smear::prepare`] once per opened file and clip (offsets solved once), then
 //!   [`smear::stylize`] on every slider change; the geometry goes back as float32 buffers.
 //! * loa — keystrokes drawn over the viewport ([`loa::Keystrokes`] from the page's JSON),
-//!   [`loa::line`] then [`loa::animate`]: the dynamic line (LoA Section 3) and the character
+//!   [`loa::line`] then [`loa::animate()`]: the dynamic line (LoA Section 3) and the character
 //!   that follows it (LoA Section 4).
-//! * stopmo — part seeds clicked on the mesh, [`stopmo::segment`] on a worker thread with
+//! * stopmo — part seeds clicked on the mesh, [`stopmo::segment()`] on a worker thread with
 //!   progress polling and cancel (StopShop Section 4).
 //!
 //! Safety: the server binds 127.0.0.1 only, refuses requests whose `Host`/`Origin` is not the

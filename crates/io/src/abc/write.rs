@@ -21,7 +21,7 @@ const FRAME_SAMPLING: u32 = 1;
 /// Writes one point cache as an Alembic archive (see the [module documentation](super)).
 ///
 /// # Errors
-/// As [`write`].
+/// As [`write()`].
 pub fn write_animation(anim: &MeshAnimation, colors: Option<&[[f32; 4]]>) -> Result<Vec<u8>> {
     write_parts(&[(anim, colors)])
 }
@@ -30,7 +30,7 @@ pub fn write_animation(anim: &MeshAnimation, colors: Option<&[[f32; 4]]>) -> Res
 /// cache, the first cache's frame rate.
 ///
 /// # Errors
-/// When there is nothing to write, or as [`write`].
+/// When there is nothing to write, or as [`write()`].
 pub fn write_parts(parts: &[(&MeshAnimation, Option<&[[f32; 4]]>)]) -> Result<Vec<u8>> {
     write(&UsdStage::from_parts(parts)?)
 }

@@ -158,7 +158,7 @@ impl Default for Weights {
     }
 }
 
-/// Options of [`crate::animate`] (and [`animate()`]): keyed inputs, view and solver settings.
+/// Options of [`crate::animate()`] (and [`animate()`]): keyed inputs, view and solver settings.
 /// Serde-ready, so the same options come from CLI flags, a TOML/JSON file or Python keyword
 /// arguments; bone sets are written as on the command line (`"arms"`, `"FootR,Head"`).
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]

@@ -80,7 +80,7 @@ impl MultiplesOptions {
     /// Checks the counts and the spacing at every key.
     ///
     /// # Errors
-    /// [`SmearError::InvalidParameter`] for counts outside [0, [`MAX_MULTIPLES`]], no copy at
+    /// [`SmearError::InvalidParameter`] for counts outside [0, 64], no copy at
     /// all, a non-finite Δf or a bad keyframe curve.
     pub fn check(&self) -> Result<()> {
         let bad = |name: &'static str, e: crate::StyleError| SmearError::InvalidParameter {

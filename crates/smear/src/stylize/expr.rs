@@ -14,7 +14,7 @@ use crate::effects::StyleInput;
 /// Most variables (inputs + parameters) one expression may use.
 pub const MAX_EXPRESSION_VARIABLES: usize = 32;
 
-/// Names of the inputs an expression may read, in the order of [`Input`].
+/// Names of the inputs an expression may read, in the order of the expression slots that read them.
 pub const EXPRESSION_INPUTS: [&str; 13] = [
     "delta", "speed", "weight", "noise", "frame", "m", "t", "vx", "vy", "vz", "x", "y", "z",
 ];
