@@ -8,7 +8,7 @@ use serde_json::{json, Value};
 use studio::{pack, router};
 
 mod common;
-use common::{app, error_of, get, post, send, studio_with, HOST, PORT};
+use common::{app, error_of, get, post, send, send_ok, studio_with, HOST, PORT};
 
 #[tokio::test]
 async fn a_foreign_host_or_origin_is_refused() {
@@ -151,8 +151,7 @@ async fn a_slider_change_restyles_without_solving_offsets_again() {
     let dir = tempfile::tempdir().unwrap();
     let app = app(dir.path());
     let style = |beta: f32| json!({"clip": "Wave", "style": {"elongate": {"function": {"stages": [{"op": "speed"}, {"op": "scale", "by": beta}]}}}});
-    let (status, a) = send(&app, post("/api/smear/stylize", style(0.0))).await;
-    assert_eq!(status, StatusCode::OK, "{}", String::from_utf8_lossy(&a));
+    let a = send_ok(&app, post("/api/smear/stylize", style(0.0))).await;
     let solves = smear::offset_solves();
     let (_, b) = send(&app, post("/api/smear/stylize", style(12.0))).await;
     assert_eq!(
@@ -182,21 +181,14 @@ async fn a_restyle_of_the_current_frame_is_that_frame_of_the_whole_clip() {
     let dir = tempfile::tempdir().unwrap();
     let app = app(dir.path());
     let mut request = json!({"clip": "Wave", "style": {"elongate": {"function": {"stages": [{"op": "speed"}, {"op": "scale", "by": 8}]}}}});
-    let (status, whole) = send(&app, post("/api/smear/stylize", request.clone())).await;
-    assert_eq!(
-        status,
-        StatusCode::OK,
-        "{}",
-        String::from_utf8_lossy(&whole)
-    );
+    let whole = send_ok(&app, post("/api/smear/stylize", request.clone())).await;
     let (hw, all) = pack::read_f32(&whole, "body").unwrap();
     let frames = hw["frames"].as_u64().unwrap() as usize;
     assert_eq!(hw["clip_frames"], hw["frames"]);
     let per_frame = all.len() / frames;
     let f = frames / 2;
     request["frames"] = json!([f, f + 1]);
-    let (status, one) = send(&app, post("/api/smear/stylize", request.clone())).await;
-    assert_eq!(status, StatusCode::OK, "{}", String::from_utf8_lossy(&one));
+    let one = send_ok(&app, post("/api/smear/stylize", request.clone())).await;
     let (h1, body) = pack::read_f32(&one, "body").unwrap();
     assert_eq!(
         (h1["first_frame"].as_u64(), h1["frames"].as_u64()),

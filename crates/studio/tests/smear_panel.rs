@@ -6,7 +6,7 @@ use serde_json::{json, Value};
 use studio::pack;
 
 mod common;
-use common::{app, error_of, get, post, send};
+use common::{app, error_of, get, post, send, send_ok};
 
 /// The largest difference between two buffers.
 fn max_diff(x: &[f32], y: &[f32]) -> f32 {
@@ -27,13 +27,7 @@ async fn keyed_parameters_round_trip_and_restyle_each_frame_as_the_keys_say() {
         "multiples": {"past": [[10, 0.0], [40, 2.0]], "future": 0}
     });
     let request = json!({"clip": "Wave", "style": style});
-    let (status, keyed) = send(&app, post("/api/smear/stylize", request.clone())).await;
-    assert_eq!(
-        status,
-        StatusCode::OK,
-        "{}",
-        String::from_utf8_lossy(&keyed)
-    );
+    let keyed = send_ok(&app, post("/api/smear/stylize", request.clone())).await;
     let (h, body) = pack::read_f32(&keyed, "body").unwrap();
     let (_, scene) = send(&app, get("/api/scene?clip=Wave")).await;
     let (_, input) = pack::read_f32(&scene, "positions").unwrap();
@@ -67,8 +61,7 @@ async fn keyed_parameters_round_trip_and_restyle_each_frame_as_the_keys_say() {
     // The exported .toml carries the keys and the library reads it back to the same style.
     let mut export = request.clone();
     export["name"] = json!("keyed.toml");
-    let (status, res) = send(&app, post("/api/smear/export", export)).await;
-    assert_eq!(status, StatusCode::OK, "{}", String::from_utf8_lossy(&res));
+    send_ok(&app, post("/api/smear/export", export)).await;
     let text = std::fs::read_to_string(dir.path().join("keyed.toml")).unwrap();
     let back = smear::Style::from_toml_str(&text).unwrap();
     let sent: smear::Style = serde_json::from_value(h["style"].clone()).unwrap();

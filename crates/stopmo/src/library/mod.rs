@@ -50,6 +50,7 @@ mod fabricate;
 mod input_errors;
 mod intersect;
 mod metrics;
+mod nearest;
 mod piece_id;
 mod plugs;
 mod problem;
@@ -76,11 +77,9 @@ pub use fabricate::{
     DEFAULT_PRINT_HEIGHT_MM, DEFAULT_THICKNESS_MM, PLA_DENSITY_G_PER_MM3,
 };
 pub use input_errors::compare_frames;
-pub use intersect::{
-    closest_point_on_triangle, intersecting_pairs, self_intersecting_triangles, TriangleGrid,
-    MAX_EXACT_COORDINATE,
-};
+pub use intersect::{intersecting_pairs, self_intersecting_triangles, MAX_EXACT_COORDINATE};
 pub use metrics::{ErrorSummary, FrameErrors};
+pub use nearest::{closest_point_on_triangle, TriangleGrid};
 pub use piece_id::{
     Bitmap, Key, KeyOptions, DEFAULT_ID_RELIEF_MM, DEFAULT_KEYS_PER_SEAM, DEFAULT_KEY_COUNT,
     KEY_HEIGHT_PER_RADIUS, KEY_RADIUS_PER_HEIGHT,

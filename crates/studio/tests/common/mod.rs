@@ -45,6 +45,13 @@ pub(crate) async fn send(app: &Router, req: Request<Body>) -> (StatusCode, Vec<u
     )
 }
 
+/// Sends a request that must succeed (200) and returns the body; a failure shows the body.
+pub(crate) async fn send_ok(app: &Router, req: Request<Body>) -> Vec<u8> {
+    let (status, body) = send(app, req).await;
+    assert_eq!(status, StatusCode::OK, "{}", String::from_utf8_lossy(&body));
+    body
+}
+
 pub(crate) fn get(uri: &str) -> Request<Body> {
     Request::get(uri)
         .header(header::HOST, HOST)

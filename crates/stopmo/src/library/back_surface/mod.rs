@@ -27,10 +27,10 @@ use serde::{Deserialize, Serialize};
 
 use super::error::{LibraryError, Result};
 use super::fabricate::{check_solid, split_fans, DEFAULT_THICKNESS_MM};
-use super::intersect::self_intersecting_triangles;
 
 mod caps;
 mod envelope;
+mod measure;
 mod seams;
 mod untangle;
 
@@ -403,19 +403,20 @@ impl PartShell {
             along[a as usize][1] = b;
             along[b as usize][0] = a;
         }
+        // One smoothing step of a boundary point along its loop (none at a loop's open end).
+        let along_loop = |back: &[Vec3], v: usize| {
+            let [p, q] = along[v];
+            (p != u32::MAX && q != u32::MAX)
+                .then(|| back[v] * 0.5 + (back[p as usize] + back[q as usize]) * 0.25)
+        };
         let smooth = |back: &mut Vec<Vec3>, mask: Option<&[bool]>| {
             let next: Vec<Vec3> = (0..n)
                 .map(|v| {
                     if on_boundary[v] && !opts.smooth_boundary {
-                        let [p, q] = along[v];
-                        if fixed[v].is_some()
-                            || p == u32::MAX
-                            || q == u32::MAX
-                            || mask.is_some_and(|m| !m[v])
-                        {
+                        if fixed[v].is_some() || mask.is_some_and(|m| !m[v]) {
                             return back[v];
                         }
-                        return back[v] * 0.5 + (back[p as usize] + back[q as usize]) * 0.25;
+                        return along_loop(back, v).unwrap_or(back[v]);
                     }
                     if mask.is_some_and(|m| !m[v]) || adj[v].is_empty() {
                         return back[v];
@@ -480,11 +481,7 @@ impl PartShell {
                             return back[v];
                         }
                         if on_boundary[v] {
-                            let [p, q] = along[v];
-                            if p == u32::MAX || q == u32::MAX {
-                                return back[v];
-                            }
-                            return back[v] * 0.5 + (back[p as usize] + back[q as usize]) * 0.25;
+                            return along_loop(back, v).unwrap_or(back[v]);
                         }
                         if adj[v].is_empty() {
                             return back[v];
@@ -507,26 +504,6 @@ impl PartShell {
         shell.stats.repair_rounds = rounds;
         shell.stats.min_wall_mm = shell.min_wall_of(pieces);
         Ok(shell)
-    }
-
-    /// Shell vertices (front or back copies folded onto shell ids) of the triangles that
-    /// cross another triangle in some piece's solid.
-    fn crossing_vertices(&self, pieces: &[&[Vec3]]) -> Vec<u32> {
-        let n = self.back.len() as u32;
-        use rayon::prelude::*;
-        let mut out: Vec<u32> = pieces
-            .par_iter()
-            .flat_map_iter(|p| {
-                let solid = self.solid_unchecked(p, "");
-                let hits = self_intersecting_triangles(&solid.positions, &solid.triangles);
-                hits.unwrap_or_default()
-                    .into_iter()
-                    .flat_map(move |t| solid.triangles[t as usize].map(|v| v % n))
-            })
-            .collect();
-        out.sort_unstable();
-        out.dedup();
-        out
     }
 
     /// Back surface positions of the shell vertices (millimetres).
@@ -623,71 +600,7 @@ impl PartShell {
         }
         Ok(solid)
     }
-
-    /// Smallest distance (mm) from a front vertex of `piece` to the back surface's triangles.
-    pub fn min_wall(&self, piece: &[Vec3]) -> f64 {
-        self.min_wall_of(&[piece])
-    }
-
-    /// Smallest [`min_wall`](Self::min_wall) over `pieces`, with one grid of the back surface.
-    fn min_wall_of(&self, pieces: &[&[Vec3]]) -> f64 {
-        let grid = super::intersect::TriangleGrid::new(&self.back, &self.triangles);
-        // The running minimum bounds every later query to a few grid rings.
-        pieces.iter().fold(f64::INFINITY, |best, piece| {
-            self.front(piece)
-                .iter()
-                .fold(best, |best, &p| best.min(grid.distance_below(p, best)))
-        })
-    }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A 1 mm grid over a 20 × 20 mm saddle: corners where the boundary turns sharply.
-    fn saddle() -> (Mesh, Vec<Vec3>) {
-        let k = 21;
-        let positions: Vec<Vec3> = (0..k * k)
-            .map(|i| {
-                let (x, y) = ((i % k) as f32 - 10.0, (i / k) as f32 - 10.0);
-                Vec3::new(x, y, 0.03 * (x * x - y * y))
-            })
-            .collect();
-        let mut tris = Vec::new();
-        for r in 0..k - 1 {
-            for c in 0..k - 1 {
-                let v = (r * k + c) as u32;
-                let (right, up) = (v + 1, v + k as u32);
-                tris.push([v, right, up + 1]);
-                tris.push([v, up + 1, up]);
-            }
-        }
-        (Mesh::new("saddle", positions.clone(), tris), positions)
-    }
-
-    #[test]
-    fn wall_rungs_lean_no_more_than_the_rung_slope_at_sharp_boundary_corners() {
-        let (mesh, avg) = saddle();
-        let lifted: Vec<Vec3> = avg.iter().map(|p| *p + Vec3::Z * 0.2).collect();
-        let shell =
-            PartShell::new(&mesh, &avg, &[&avg, &lifted], &ShellOptions::default()).expect("shell");
-        let mut worst = 0.0f32;
-        for &(a, _) in shell.boundary_edges() {
-            let v = a as usize;
-            let (d, e) = (
-                shell.direction(v),
-                shell.back()[v] - avg[shell.sources()[v] as usize],
-            );
-            let depth = -e.dot(d);
-            assert!(depth > 0.0, "vertex {v}: back in front of the front");
-            worst = worst.max((e + d * depth).length() / depth);
-        }
-        assert!(
-            worst <= RUNG_SLOPE + 1e-3,
-            "a rung leans {worst} mm per mm of depth"
-        );
-        assert_eq!(shell.stats.self_intersecting_triangles, 0);
-        assert!(shell.stats.min_wall_mm >= ShellOptions::default().wall_mm * 0.99);
-    }
-}
+mod tests;
