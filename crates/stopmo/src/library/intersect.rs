@@ -6,10 +6,10 @@
 //! triangles sharing a vertex (or an edge) only count when they meet anywhere else. A grid of
 //! cells about the size of the mean triangle limits the exact tests to nearby pairs.
 
-use std::collections::HashMap;
-
 use glam::Vec3;
 use rayon::prelude::*;
+
+use super::nearest::TriangleGrid;
 
 /// Largest coordinate magnitude (in the mesh's units) the exact test accepts: `2¹²`, so snapped
 /// coordinates fit 36 bits and orientation determinants fit `i128`.
@@ -271,35 +271,9 @@ pub fn intersecting_pairs(positions: &[Vec3], tris: &[[u32; 3]]) -> Option<Vec<(
         return Some(Vec::new());
     }
     let snapped: Vec<P> = positions.iter().map(|&p| snap(p)).collect();
-    let boxes: Vec<(Vec3, Vec3)> = tris
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|v| positions[v as usize]);
-            (a.min(b).min(c), a.max(b).max(c))
-        })
-        .collect();
-    let mean_size = boxes
-        .iter()
-        .map(|(lo, hi)| (*hi - *lo).max_element())
-        .sum::<f32>()
-        / tris.len() as f32;
-    let lo = boxes.iter().fold(Vec3::INFINITY, |m, b| m.min(b.0));
-    let cell = (mean_size * 2.0).max(1e-6);
-    let key = |p: Vec3| -> [i32; 3] {
-        let q = ((p - lo) / cell).floor();
-        [q.x as i32, q.y as i32, q.z as i32]
-    };
-    let mut grid: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
-    for (t, (a, b)) in boxes.iter().enumerate() {
-        let (ka, kb) = (key(*a), key(*b));
-        for x in ka[0]..=kb[0] {
-            for y in ka[1]..=kb[1] {
-                for z in ka[2]..=kb[2] {
-                    grid.entry([x, y, z]).or_default().push(t as u32);
-                }
-            }
-        }
-    }
+    // Cells of about twice the mean triangle size limit the exact tests to nearby pairs.
+    let grid = TriangleGrid::new(positions, tris);
+    let boxes = grid.boxes();
     let degenerate: Vec<u32> = tris
         .iter()
         .enumerate()
@@ -310,7 +284,7 @@ pub fn intersecting_pairs(positions: &[Vec3], tris: &[[u32; 3]]) -> Option<Vec<(
         })
         .map(|(t, _)| t as u32)
         .collect();
-    let cells: Vec<(&[i32; 3], &Vec<u32>)> = grid.iter().collect();
+    let cells: Vec<(&[i32; 3], &[u32])> = grid.cells().collect();
     let mut hits: Vec<(u32, u32)> = cells
         .par_iter()
         .flat_map_iter(|(cell_key, list)| {
@@ -322,7 +296,7 @@ pub fn intersecting_pairs(positions: &[Vec3], tris: &[[u32; 3]]) -> Option<Vec<(
                         continue;
                     }
                     // Test each pair once: in the first cell of their boxes' overlap.
-                    if key(bi.0.max(bj.0)) != **cell_key {
+                    if grid.key(bi.0.max(bj.0)) != **cell_key {
                         continue;
                     }
                     if pair_intersects(tris, &snapped, i as usize, j as usize) {

@@ -43,7 +43,14 @@ pub fn closest_point_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
     (a + ab * v + ac * w).as_vec3()
 }
 
-/// A uniform grid of triangles for nearest-distance queries.
+/// Cell of `p` in a grid of cube size `cell` anchored at `lo`.
+fn cell_of(p: Vec3, lo: Vec3, cell: f32) -> [i32; 3] {
+    let q = ((p - lo) / cell).floor();
+    [q.x as i32, q.y as i32, q.z as i32]
+}
+
+/// A uniform grid of triangles for nearest-distance queries (and the exact intersection
+/// test's pair search).
 #[derive(Debug, Clone)]
 pub struct TriangleGrid<'a> {
     positions: &'a [Vec3],
@@ -51,6 +58,8 @@ pub struct TriangleGrid<'a> {
     lo: Vec3,
     cell: f32,
     dims: [i32; 3],
+    /// Bounding box of every triangle.
+    boxes: Vec<(Vec3, Vec3)>,
     cells: HashMap<[i32; 3], Vec<u32>>,
 }
 
@@ -72,10 +81,7 @@ impl<'a> TriangleGrid<'a> {
             .sum::<f32>()
             / triangles.len().max(1) as f32;
         let cell = (2.0 * mean).max(1e-6);
-        let key = |p: Vec3| -> [i32; 3] {
-            let q = ((p - lo) / cell).floor();
-            [q.x as i32, q.y as i32, q.z as i32]
-        };
+        let key = |p: Vec3| cell_of(p, lo, cell);
         let mut cells: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
         for (t, (a, b)) in boxes.iter().enumerate() {
             let (ka, kb) = (key(*a), key(*b));
@@ -98,8 +104,24 @@ impl<'a> TriangleGrid<'a> {
             lo,
             cell,
             dims,
+            boxes,
             cells,
         }
+    }
+
+    /// The cell holding `p`.
+    pub(crate) fn key(&self, p: Vec3) -> [i32; 3] {
+        cell_of(p, self.lo, self.cell)
+    }
+
+    /// Bounding box of every triangle, in triangle order.
+    pub(crate) fn boxes(&self) -> &[(Vec3, Vec3)] {
+        &self.boxes
+    }
+
+    /// The occupied cells and the triangles whose boxes overlap each (any order).
+    pub(crate) fn cells(&self) -> impl Iterator<Item = (&[i32; 3], &[u32])> {
+        self.cells.iter().map(|(k, v)| (k, v.as_slice()))
     }
 
     /// Distance from `p` to the nearest triangle (infinity without triangles).
