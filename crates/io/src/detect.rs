@@ -227,7 +227,7 @@ fn load_as(
     let plain = |l: Loaded| (l, Vec::new());
     match format {
         Format::Glb | Format::Gltf => {
-            crate::gltf_read::read_full(bytes, path.parent(), options.scene.as_deref()).map(scene)
+            crate::gltf::read::read_full(bytes, path.parent(), options.scene.as_deref()).map(scene)
         }
         #[cfg(feature = "fbx")]
         Format::Fbx => crate::fbx::read(bytes).map(scene),

@@ -37,30 +37,10 @@ pub use save::{save, save_with, Layout, Output, SaveOptions};
 
 mod detect;
 mod flipbook;
-mod gltf_accessors;
-mod gltf_attributes;
-mod gltf_draco;
-mod gltf_flipbook;
-mod gltf_meshopt;
-mod gltf_precheck;
-mod gltf_prepare;
-mod gltf_quantize;
-mod gltf_read;
-mod gltf_scenes;
-mod gltf_values;
-mod gltf_write;
 
 #[cfg(feature = "fbx")]
 pub mod fbx;
 
-/// glTF 2.0: read `.gltf`/`.glb` into a scene, write scenes and point caches as `.glb`.
-pub mod gltf {
-    pub use crate::gltf_flipbook::{
-        write_animation, write_animations, write_animations_with, AnimationLayout,
-    };
-    pub use crate::gltf_quantize::{GlbOptions, MAX_ERROR};
-    pub use crate::gltf_read::{read, read_bytes};
-    pub use crate::gltf_write::{write_glb, write_glb_with};
-}
+pub mod gltf;
 
 pub use detect::{detect, load, load_with_notes, Format, LoadOptions, Loaded};

@@ -3,7 +3,7 @@
 //! Parsing and validation of the JSON is the `gltf` crate's; this module maps the document
 //! onto the data model and checks what that crate assumes (accessor component types, counts,
 //! buffer ranges) so that bad bytes give an error, never a panic. Application-specific scalar
-//! attributes (`_NAME`) go to [`anim::Mesh::attributes`] (see `gltf_attributes`).
+//! attributes (`_NAME`) go to [`anim::Mesh::attributes`] (see `attributes`).
 
 use std::path::Path;
 
@@ -15,7 +15,7 @@ use anim::{
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 
-use crate::gltf_values::{vec2s, vec3s};
+use crate::gltf::values::{vec2s, vec3s};
 use crate::{read_file, IoError, Result};
 
 const FORMAT: &str = "glTF";
@@ -55,8 +55,8 @@ pub(crate) fn read_full(
             b
         }
     });
-    let prepared = crate::gltf_prepare::prepare(bytes, base)?;
-    crate::gltf_precheck::precheck(&prepared.root).map_err(bad)?;
+    let prepared = crate::gltf::prepare::prepare(bytes, base)?;
+    crate::gltf::precheck::precheck(&prepared.root).map_err(bad)?;
     let mut notes = prepared.notes;
     // gltf-json's validation indexes some arrays unchecked; `precheck` covers the known
     // cases and this guard turns any other panic into an error.
@@ -68,7 +68,7 @@ pub(crate) fn read_full(
     // The gltf crate unwraps some fields it validated loosely; a panic there is bad input.
     let mut scene = std::panic::catch_unwind(|| convert(&doc, &data))
         .map_err(|_| bad("the document is inconsistent (rejected while reading)"))??;
-    if let Some(note) = crate::gltf_scenes::select(&doc, &mut scene, choice)? {
+    if let Some(note) = crate::gltf::scenes::select(&doc, &mut scene, choice)? {
         notes.push(note);
     }
     scene.validate()?;
@@ -286,7 +286,7 @@ fn read_mesh(mesh: &gltf::Mesh, buffers: &[&[u8]]) -> Result<SceneMesh> {
                     .collect(),
             );
         }
-        part.attributes = crate::gltf_attributes::read_attributes(&prim, buffers, n)?;
+        part.attributes = crate::gltf::attributes::read_attributes(&prim, buffers, n)?;
         check_len(&part, n)?;
         // Joint influences over every JOINTS_n / WEIGHTS_n pair.
         let mut influences: Vec<Vec<(u32, f32)>> = vec![Vec::new(); n];

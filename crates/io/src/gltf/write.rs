@@ -1,7 +1,7 @@
 //! glTF 2.0 binary (`.glb`) writer: a whole [`anim::Scene`] (nodes, meshes with morph targets
 //! and skins, cameras, clips). Writing is building `gltf-json` structures; the binary chunk
 //! holds tightly packed, 4-byte aligned buffer views with correct accessor bounds, identical
-//! data stored once (`gltf_accessors`), so that the Khronos validator accepts every file.
+//! data stored once (`accessors`), so that the Khronos validator accepts every file.
 
 use anim::glam::{Mat4, Quat, Vec3};
 use anim::{Interpolation, Mesh, Projection, Property, Scene, SceneMesh, VertexWeights};
@@ -9,9 +9,9 @@ use gltf_json as json;
 use json::validation::Checked::Valid;
 use serde_json::json as js;
 
-use crate::gltf_accessors::{Builder, Usage};
-use crate::gltf_quantize::Dequant;
-use crate::gltf_quantize::GlbOptions;
+use crate::gltf::accessors::{Builder, Usage};
+use crate::gltf::quantize::Dequant;
+use crate::gltf::quantize::GlbOptions;
 use crate::{IoError, Result};
 
 /// The extension quantized meshes need.
@@ -213,7 +213,7 @@ pub fn write_glb(scene: &Scene) -> Result<Vec<u8>> {
 
 /// Writes a whole scene as `.glb` bytes; with `options.quantize`, unskinned meshes are
 /// written with `KHR_mesh_quantization`, all with one dequantization, unless the position
-/// error would exceed [`MAX_ERROR`](crate::gltf_quantize::MAX_ERROR) of their bounding-box diagonal (see
+/// error would exceed [`MAX_ERROR`](crate::gltf::quantize::MAX_ERROR) of their bounding-box diagonal (see
 /// [`GlbOptions`]).
 ///
 /// # Errors
@@ -222,11 +222,11 @@ pub fn write_glb_with(scene: &Scene, options: GlbOptions) -> Result<Vec<u8>> {
     scene.validate()?;
     let mut b = Builder::new();
     let plan = if options.quantize {
-        crate::gltf_quantize::plan(scene)
+        crate::gltf::quantize::plan(scene)
     } else {
         vec![None; scene.meshes.len()]
     };
-    let animated = crate::gltf_quantize::trs_animated(scene);
+    let animated = crate::gltf::quantize::trs_animated(scene);
     let mut meshes = Vec::new();
     for (sm, q) in scene.meshes.iter().zip(&plan) {
         meshes.push(b.mesh_with(sm, *q)?);

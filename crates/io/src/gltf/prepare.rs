@@ -1,8 +1,8 @@
 //! Turns the glTF files animators have into what the `gltf` crate validates: required
 //! extensions that do not change geometry or animation are accepted (and noted),
 //! `EXT_meshopt_compression` buffer views are decoded into plain buffers,
-//! `KHR_draco_mesh_compression` primitives are decoded (`gltf_draco`), `KHR_mesh_quantization`
-//! integer attributes are left for `gltf_values` to read as floats, and what cannot be read
+//! `KHR_draco_mesh_compression` primitives are decoded (`draco`), `KHR_mesh_quantization`
+//! integer attributes are left for `values` to read as floats, and what cannot be read
 //! (an unknown extension that replaces the geometry) is refused in one line naming the
 //! extension and how to convert the file.
 //!
@@ -324,8 +324,8 @@ pub(crate) fn prepare(bytes: &[u8], base: Option<&Path>) -> Result<Prepared> {
         unreachable!("checked above")
     };
     strip(map, &mut notes);
-    crate::gltf_meshopt::decode(map, &mut buffers)?;
-    crate::gltf_draco::decode(map, &mut buffers)?;
+    crate::gltf::meshopt::decode(map, &mut buffers)?;
+    crate::gltf::draco::decode(map, &mut buffers)?;
     zero_views(map, &mut buffers);
     let root: gltf_json::Root = serde_json::from_value(value).map_err(|e| bad(e.to_string()))?;
     Ok(Prepared {

@@ -8,9 +8,9 @@ use anim::glam::{Quat, Vec3};
 use anim::{Channel, Clip, Interpolation, MeshAnimation, Property, SceneMesh};
 use gltf_json as json;
 
-use crate::gltf_accessors::Builder;
-use crate::gltf_quantize::{Dequant, GlbOptions};
-use crate::gltf_write::{frame_mesh, trs_node, write_clip};
+use crate::gltf::accessors::Builder;
+use crate::gltf::quantize::{Dequant, GlbOptions};
+use crate::gltf::write::{frame_mesh, trs_node, write_clip};
 use crate::{IoError, Result};
 
 /// How a point cache is laid out in glTF.
@@ -265,7 +265,7 @@ fn morph_mesh(anim: &MeshAnimation, colors: Option<&[[f32; 4]]>, midrange: bool)
 }
 
 /// The dequantization every part and frame of one output shares, when the position error
-/// stays within [`MAX_ERROR`](crate::gltf_quantize::MAX_ERROR) of their common bounding-box diagonal.
+/// stays within [`MAX_ERROR`](crate::gltf::quantize::MAX_ERROR) of their common bounding-box diagonal.
 fn shared_dequant(
     parts: &[(&MeshAnimation, Option<&[[f32; 4]]>)],
     layout: AnimationLayout,

@@ -14,7 +14,7 @@ use gltf::accessor::{DataType, Dimensions, Item, Iter};
 use gltf_json as json;
 use json::mesh::Semantic;
 
-use crate::gltf_accessors::{Builder, Usage};
+use crate::gltf::accessors::{Builder, Usage};
 use crate::{IoError, Result};
 
 /// The glTF semantic (with its leading `_`) under which attribute `name` is written.
