@@ -50,6 +50,7 @@ impl Error {
             Error::Option { option, .. } => Some(option),
             Error::Library(LibraryError::BadSaliency { .. }) => Some("saliency"),
             Error::Library(LibraryError::BadFixedPiece { .. }) => Some("fixed"),
+            Error::Library(LibraryError::PrintedBack { .. }) => Some("fixed"),
             _ => None,
         }
     }

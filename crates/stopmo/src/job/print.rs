@@ -12,8 +12,9 @@ use serde::Serialize;
 
 use super::error::{Error, Result};
 use crate::library::{
-    add_plugs, material, piece_id, Bitmap, Key, KeyOptions, Library, MaterialEstimate, PartShell,
-    Plug, ShellOptions, ShellStats, DEFAULT_ID_RELIEF_MM,
+    add_plugs, build_shells, material, piece_id, self_intersecting_triangles, Bitmap, Key,
+    KeyOptions, Library, MaterialEstimate, PartShell, Plug, ShellInput, ShellOptions, ShellStats,
+    DEFAULT_ID_RELIEF_MM,
 };
 
 /// Resin layer height assumed by the print-time estimate (mm).
@@ -51,7 +52,8 @@ pub(crate) struct Printed {
     pub(crate) pieces: Vec<Piece>,
     /// `report.json` `"printing"`.
     pub(crate) report: PrintReport,
-    /// Warnings (pieces below the printer resolution, thin walls on a printed back).
+    /// Warnings (pieces below the printer resolution, walls thinner than asked, pieces whose
+    /// solid crosses itself).
     pub(crate) warnings: Vec<String>,
     /// The back surface of every part before keys and IDs (`pieces/<part>_back.obj`).
     pub(crate) backs: Vec<Mesh>,
@@ -157,43 +159,43 @@ pub(crate) fn print_pieces(
     let mut parts_report = Vec::new();
     let mut warnings = Vec::new();
     let mut pieces_out: Vec<Piece> = Vec::new();
-    // One back surface per part, seam walls shared with the parts built before.
-    let mut shared: Vec<(Vec3, Vec3)> = Vec::new();
+    // One back surface per part, seam walls shared between the parts that meet.
+    let averages: Vec<Vec<Vec3>> = anims
+        .iter()
+        .map(|a| a.average_positions().iter().map(|x| *x * mm).collect())
+        .collect();
+    let pieces_of: Vec<Vec<Vec<Vec3>>> = lib
+        .parts
+        .iter()
+        .map(|part| {
+            part.solution
+                .pieces
+                .iter()
+                .map(|q| q.iter().map(|x| *x * mm).collect())
+                .collect()
+        })
+        .collect();
+    let inputs: Vec<ShellInput<'_>> = anims
+        .iter()
+        .enumerate()
+        .map(|(p, a)| ShellInput {
+            topology: &a.mesh,
+            average: &averages[p],
+            pieces: pieces_of[p].iter().map(Vec::as_slice).collect(),
+            printed_back: s.backs.get(&lib.parts[p].name).map(Vec::as_slice),
+        })
+        .collect();
+    let shell_opts = ShellOptions {
+        wall_mm: s.thickness_mm,
+        ..ShellOptions::default()
+    };
+    let built = build_shells(&inputs, &shell_opts)?;
+    drop(inputs);
     let mut shells: Vec<BuiltShell> = Vec::new();
     let mut backs: Vec<Mesh> = Vec::new();
-    for (p, a) in anims.iter().enumerate() {
-        let avg: Vec<Vec3> = a.average_positions().iter().map(|x| *x * mm).collect();
-        let pieces_mm: Vec<Vec<Vec3>> = lib.parts[p]
-            .solution
-            .pieces
-            .iter()
-            .map(|q| q.iter().map(|x| *x * mm).collect())
-            .collect();
-        let refs: Vec<&[Vec3]> = pieces_mm.iter().map(Vec::as_slice).collect();
-        let shell_opts = ShellOptions {
-            wall_mm: s.thickness_mm,
-            ..ShellOptions::default()
-        };
-        let mut shell = PartShell::new_sharing(&a.mesh, &avg, &refs, &shell_opts, &shared)?;
-        if let Some(back) = s.backs.get(&lib.parts[p].name) {
-            shell.use_back(back, &refs).map_err(|e| {
-                Error::option_error("fixed", format!("part {}: {e}", lib.parts[p].name))
-            })?;
-            if shell.stats.min_wall_mm < s.thickness_mm * 0.99
-                || shell.stats.self_intersecting_triangles > 0
-            {
-                warnings.push(format!(
-                    "part {}: the new pieces come within {:.2} mm of the printed back surface ({} crossing triangles); the wall is {} mm",
-                    lib.parts[p].name,
-                    shell.stats.min_wall_mm,
-                    shell.stats.self_intersecting_triangles,
-                    s.thickness_mm
-                ));
-            }
-        }
-        backs.push(shell.back_mesh(&format!("{}_back", lib.parts[p].name)));
+    for ((shell, avg), pieces_mm) in built.into_iter().zip(averages).zip(pieces_of) {
+        backs.push(shell.back_mesh(&format!("{}_back", lib.parts[shells.len()].name)));
         let pairs = shell.boundary_pairs(&avg);
-        shared.extend(pairs.iter().copied());
         shells.push(BuiltShell {
             shell,
             average: avg,
@@ -218,9 +220,9 @@ pub(crate) fn print_pieces(
             Vec::new()
         };
         let pixel = (s.print_height_mm * 0.02).clamp(0.3, 1.0);
-        let made: Vec<Piece> = (0..pieces_mm.len())
+        let made: Vec<(Piece, usize)> = (0..pieces_mm.len())
             .into_par_iter()
-            .map(|k| -> Result<Piece> {
+            .map(|k| -> Result<(Piece, usize)> {
                 let surface = lib.piece_surface(p, k, &a.mesh).ok_or_else(|| {
                     Error::option_error("pieces", format!("no piece {k} of part {p}"))
                 })?;
@@ -237,16 +239,56 @@ pub(crate) fn print_pieces(
                     DEFAULT_ID_RELIEF_MM,
                     &keys,
                 )?;
+                // Measured on what is written (keys and ID included), not assumed: a
+                // coordinate beyond the exact test's range counts every triangle.
+                let crossing = self_intersecting_triangles(&solid.positions, &solid.triangles)
+                    .map_or(solid.triangles.len(), |t| t.len());
                 let solid = add_plugs(&solid, p, s.plugs, s.plug_segments);
-                Ok(Piece {
+                let piece = Piece {
                     id: surface.name.clone(),
                     part: p,
                     index: k,
                     surface,
                     solid,
-                })
+                };
+                Ok((piece, crossing))
             })
             .collect::<Result<_>>()?;
+        let crossing_pieces: Vec<String> = made
+            .iter()
+            .filter(|(_, c)| *c > 0)
+            .map(|(piece, c)| format!("{} ({c})", piece.id))
+            .collect();
+        shell.stats.self_intersecting_triangles = made.iter().map(|(_, c)| c).sum();
+        let refs: Vec<&[Vec3]> = pieces_mm.iter().map(Vec::as_slice).collect();
+        let thinnest = shell.thinnest_wall(&refs);
+        if let Some(t) = thinnest {
+            shell.stats.min_wall_mm = t.mm;
+        }
+        if let Some(t) = thinnest.filter(|t| t.mm < s.thickness_mm * 0.99) {
+            warnings.push(format!(
+                "part {}: the wall is {:.2} mm thin in piece {} at ({:.1}, {:.1}, {:.1}) mm{}, under the {} mm wall; a printer may leave a hole there",
+                part.name,
+                t.mm,
+                piece_label(p, t.piece),
+                t.at.x,
+                t.at.y,
+                t.at.z,
+                if t.on_boundary { " (on the part boundary)" } else { "" },
+                s.thickness_mm
+            ));
+        }
+        if !crossing_pieces.is_empty() {
+            warnings.push(format!(
+                "part {}: {} triangles of {} of {} pieces cross the solid's own surface (a slicer may misprint there): {}",
+                part.name,
+                shell.stats.self_intersecting_triangles,
+                crossing_pieces.len(),
+                made.len(),
+                crossing_pieces.join(", ")
+            ));
+        }
+        let made: Vec<Piece> = made.into_iter().map(|(piece, _)| piece).collect();
         let (close, nearest) = below_resolution(&part.name, &pieces_mm, s.resolution_mm);
         let n = pieces_mm.len();
         if !close.is_empty() {

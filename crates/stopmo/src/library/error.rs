@@ -47,6 +47,15 @@ pub enum LibraryError {
         /// Smallest feasible budget.
         minimum: usize,
     },
+    /// A printed back surface (`pieces/<part>_back.obj` of an earlier run) does not fit its
+    /// part. Give the back printed for this part of this mesh and segmentation.
+    #[error("part '{part}': {reason}")]
+    PrintedBack {
+        /// Name of the part.
+        part: String,
+        /// What is wrong.
+        reason: String,
+    },
     /// A parameter is out of range (negative or non-finite λ, zero restarts, non-positive print
     /// height or thickness, …). The message names the parameter and its valid range.
     #[error("invalid parameter: {0}")]

@@ -65,8 +65,9 @@ pub use assembly::{
     DEFAULT_TWO_OPT_PASSES,
 };
 pub use back_surface::{
-    PartShell, ShellOptions, ShellStats, DEFAULT_BACK_SMOOTHING_ITERATIONS, DEFAULT_CAP_FRACTION,
-    DEFAULT_NORMAL_SMOOTHING_MM, DEFAULT_REPAIR_ROUNDS,
+    build_shells, PartShell, ShellInput, ShellOptions, ShellStats, ThinnestWall,
+    DEFAULT_BACK_SMOOTHING_ITERATIONS, DEFAULT_CAP_FRACTION, DEFAULT_NORMAL_SMOOTHING_MM,
+    DEFAULT_REPAIR_ROUNDS,
 };
 pub use build::{
     build_library, print_scale, Library, LibraryOptions, LibrarySize, Method, PartInput, PartResult,

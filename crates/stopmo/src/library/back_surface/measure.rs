@@ -8,6 +8,19 @@ use super::PartShell;
 use crate::library::intersect::self_intersecting_triangles;
 use crate::library::nearest::TriangleGrid;
 
+/// Where a shell's wall is thinnest ([`PartShell::thinnest_wall`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ThinnestWall {
+    /// Distance from the front vertex to the back surface (mm).
+    pub mm: f64,
+    /// Index of the piece.
+    pub piece: usize,
+    /// The front vertex (mm, the piece's coordinates).
+    pub at: Vec3,
+    /// Whether the vertex lies on the part boundary (next to a wall).
+    pub on_boundary: bool,
+}
+
 impl PartShell {
     /// Smallest distance (mm) from a front vertex of `piece` to the back surface's triangles.
     pub fn min_wall(&self, piece: &[Vec3]) -> f64 {
@@ -16,31 +29,57 @@ impl PartShell {
 
     /// Smallest [`min_wall`](Self::min_wall) over `pieces`, with one grid of the back surface.
     pub(super) fn min_wall_of(&self, pieces: &[&[Vec3]]) -> f64 {
+        self.thinnest_wall(pieces).map_or(f64::INFINITY, |t| t.mm)
+    }
+
+    /// Where the wall is thinnest over `pieces`: the front vertex closest to the back surface
+    /// (`None` without pieces or triangles).
+    ///
+    /// # Performance
+    /// One grid of the back surface; the running minimum bounds every later query to a few
+    /// grid rings, so the cost is close to one nearest-triangle query per front vertex.
+    pub fn thinnest_wall(&self, pieces: &[&[Vec3]]) -> Option<ThinnestWall> {
         let grid = TriangleGrid::new(&self.back, &self.triangles);
-        // The running minimum bounds every later query to a few grid rings.
-        pieces.iter().fold(f64::INFINITY, |best, piece| {
-            self.front(piece)
-                .iter()
-                .fold(best, |best, &p| best.min(grid.distance_below(p, best)))
-        })
+        let mut best: Option<ThinnestWall> = None;
+        for (k, piece) in pieces.iter().enumerate() {
+            for (v, &p) in self.front(piece).iter().enumerate() {
+                let limit = best.as_ref().map_or(f64::INFINITY, |b| b.mm);
+                let d = grid.distance_below(p, limit);
+                if d < limit {
+                    best = Some(ThinnestWall {
+                        mm: d,
+                        piece: k,
+                        at: p,
+                        on_boundary: self.on_boundary.get(v).copied().unwrap_or(false),
+                    });
+                }
+            }
+        }
+        best
     }
 
     /// Shell vertices (front or back copies folded onto shell ids) of the triangles that
-    /// cross another triangle in some piece's solid.
-    pub(super) fn crossing_vertices(&self, pieces: &[&[Vec3]]) -> Vec<u32> {
+    /// cross another triangle in some piece's solid, and how many triangles cross, summed
+    /// over the pieces.
+    pub(super) fn crossings(&self, pieces: &[&[Vec3]]) -> (Vec<u32>, usize) {
         let n = self.back.len() as u32;
-        let mut out: Vec<u32> = pieces
+        let per_piece: Vec<(Vec<u32>, usize)> = pieces
             .par_iter()
-            .flat_map_iter(|p| {
+            .map(|p| {
                 let solid = self.solid_unchecked(p, "");
-                let hits = self_intersecting_triangles(&solid.positions, &solid.triangles);
-                hits.unwrap_or_default()
-                    .into_iter()
-                    .flat_map(move |t| solid.triangles[t as usize].map(|v| v % n))
+                let hits = self_intersecting_triangles(&solid.positions, &solid.triangles)
+                    .unwrap_or_default();
+                let vertices = hits
+                    .iter()
+                    .flat_map(|&t| solid.triangles[t as usize].map(|v| v % n))
+                    .collect();
+                (vertices, hits.len())
             })
             .collect();
+        let count = per_piece.iter().map(|(_, c)| c).sum();
+        let mut out: Vec<u32> = per_piece.into_iter().flat_map(|(v, _)| v).collect();
         out.sort_unstable();
         out.dedup();
-        out
+        (out, count)
     }
 }

@@ -34,6 +34,9 @@ mod measure;
 mod seams;
 mod untangle;
 
+pub use measure::ThinnestWall;
+pub use seams::{build_shells, ShellInput};
+
 /// Radius over which the offset direction field is smoothed, in millimetres: at 8 mm the
 /// directions still converge behind the nose enough to fold the back there (measured on the
 /// ICT face: 103 back/back crossing pairs per upper piece at 8 mm, none at 14 mm).
@@ -55,6 +58,10 @@ pub const DEFAULT_REPAIR_ROUNDS: usize = 0;
 const REPAIR_PATIENCE: usize = 3;
 /// Relaxation steps per repair round.
 const REPAIR_STEPS: usize = 10;
+
+/// How far along a seam the neighbours of a shared back point that had to move deeper
+/// follow it, in walls.
+const SEAM_SPREAD_WALLS: f64 = 3.0;
 
 /// Radius of the column under a front vertex the back must stay behind, in walls.
 const ENVELOPE_LATERAL_WALLS: f64 = 2.0;
@@ -98,7 +105,9 @@ impl Default for ShellOptions {
 pub struct ShellStats {
     /// Repair rounds used.
     pub repair_rounds: usize,
-    /// Self-intersecting triangles left over all pieces after the repair (0 when printable).
+    /// Self-intersecting triangles over all pieces' solids, summed (0 when printable): after
+    /// the repair for a bare shell; of the written solids (keys and IDs included) in a
+    /// library job's report.
     pub self_intersecting_triangles: usize,
     /// Smallest distance from a front vertex of any piece to the back surface (mm).
     pub min_wall_mm: f64,
@@ -126,6 +135,9 @@ pub struct PartShell {
     on_boundary: Vec<bool>,
     /// Vertex adjacency of the front triangles.
     adjacency: Vec<Vec<u32>>,
+    /// Deepest the back may sit along the direction field at every shell vertex (the wall
+    /// behind every piece: `back · direction ≤ limit`).
+    limits: Vec<f32>,
     /// Measurements.
     pub stats: ShellStats,
 }
@@ -357,16 +369,50 @@ impl PartShell {
             .iter()
             .map(|(a, b)| (a.to_array().map(f32::to_bits), *b))
             .collect();
-        let fixed: Vec<Option<Vec3>> = (0..n)
-            .map(|v| {
-                if on_boundary[v] {
+        let mut along: Vec<[u32; 2]> = vec![[u32::MAX; 2]; n];
+        for &(a, b) in &boundary {
+            along[a as usize][1] = b;
+            along[b as usize][0] = a;
+        }
+        let shared_point = |v: usize| {
+            on_boundary[v]
+                .then(|| {
                     shared_at
                         .get(&front[v].to_array().map(f32::to_bits))
                         .copied()
-                } else {
-                    None
+                })
+                .flatten()
+        };
+        // A shared point within this part's wall moves deeper (build_shells moves it in the
+        // earlier parts too), and its neighbours along the seam follow by a tent that falls
+        // to zero over `spread` mm, so the seam's back curve stays smooth.
+        let spread = (SEAM_SPREAD_WALLS * opts.wall_mm) as f32;
+        let mut deeper = vec![0.0f32; n];
+        for v in 0..n {
+            let Some(p) = shared_point(v) else { continue };
+            let excess = p.dot(normals[v]) - limit[v];
+            if excess <= 0.0 {
+                continue;
+            }
+            deeper[v] = deeper[v].max(excess);
+            for side in 0..2 {
+                let (mut u, mut walked) = (v, 0.0f32);
+                loop {
+                    let w = along[u][side];
+                    if w == u32::MAX || w as usize == v || shared_point(w as usize).is_none() {
+                        break;
+                    }
+                    walked += front[u].distance(front[w as usize]);
+                    if walked >= spread {
+                        break;
+                    }
+                    u = w as usize;
+                    deeper[u] = deeper[u].max(excess * (1.0 - walked / spread));
                 }
-            })
+            }
+        }
+        let fixed: Vec<Option<Vec3>> = (0..n)
+            .map(|v| shared_point(v).map(|p| p - normals[v] * deeper[v]))
             .collect();
         let enforce = |back: &mut [Vec3]| {
             for v in 0..n {
@@ -398,11 +444,6 @@ impl PartShell {
         // them (positions, not only depths) so the wall strip between the front's boundary
         // and it neither zigzags where the depth needed changes nor loops where the boundary
         // bends tighter than the depth (an inward offset curve would: its rungs cross).
-        let mut along: Vec<[u32; 2]> = vec![[u32::MAX; 2]; n];
-        for &(a, b) in &boundary {
-            along[a as usize][1] = b;
-            along[b as usize][0] = a;
-        }
         // One smoothing step of a boundary point along its loop (none at a loop's open end).
         let along_loop = |back: &[Vec3], v: usize| {
             let [p, q] = along[v];
@@ -441,6 +482,7 @@ impl PartShell {
             normals: normals.clone(),
             on_boundary: on_boundary.clone(),
             adjacency: adj.clone(),
+            limits: limit.clone(),
             stats: ShellStats::default(),
         };
         // Repair where the exact test still finds crossings: around them, relax the back
@@ -451,8 +493,7 @@ impl PartShell {
         let mut best: Option<(usize, Vec<Vec3>)> = None;
         let mut stale = 0;
         loop {
-            let bad_vertices = shell.crossing_vertices(pieces);
-            let count = bad_vertices.len();
+            let (bad_vertices, count) = shell.crossings(pieces);
             if best.as_ref().is_none_or(|b| count < b.0) {
                 best = Some((count, shell.back.clone()));
                 stale = 0;
