@@ -497,7 +497,17 @@ fn diagnose_crossings() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(8);
-    let anims = part_animations(segmentation());
+    // STOPMO_AUTO_PARTS=N: N automatic parts instead of the README's seeds.
+    let auto: Option<usize> = std::env::var("STOPMO_AUTO_PARTS")
+        .ok()
+        .and_then(|s| s.parse().ok());
+    let anims = match auto {
+        Some(n) => {
+            let parts = auto_parts(face(), n).expect("auto parts");
+            part_animations(&segment(face(), &parts, &SegmentOptions::default()).expect("segment"))
+        }
+        None => part_animations(segmentation()),
+    };
     let refs: Vec<&MeshAnimation> = anims.iter().collect();
     let inputs: Vec<PartInput<'_>> = anims
         .iter()
