@@ -130,6 +130,10 @@ def read_pc2(path):
     return data[: frames * points * 3].reshape(frames, points, 3)
 
 
+WARNINGS = "toonkit_warnings"
+"""Custom property of the reconstruction object: the job's warnings, one per line."""
+
+
 def run(context, obj):
     """Runs the job on `obj` and shows the reconstruction; returns the library."""
     toonkit = job._toonkit()
@@ -149,7 +153,10 @@ def run(context, obj):
         lib.save(folder)
     except (toonkit.ToonkitError, ValueError, OSError) as e:
         raise job.JobError(job._one_line(e)) from e
-    show(context.scene, obj, folder, lib, taken.frame_start)
+    rec = show(context.scene, obj, folder, lib, taken.frame_start)
+    # The job's warnings (pieces below the printer resolution, thin walls, crossing
+    # triangles) stay with the result, one per line; the operator reports them.
+    rec[WARNINGS] = "\n".join(lib.report.get("warnings", []))
     return lib
 
 

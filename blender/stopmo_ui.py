@@ -30,6 +30,8 @@ class TOONKIT_OT_stopmo_run(bpy.types.Operator):
         except job.JobError as e:
             self.report({"ERROR"}, f"stopmo: {e}")
             return {"CANCELLED"}
+        for warning in lib.report.get("warnings", []):
+            self.report({"WARNING"}, f"stopmo: {warning}")
         self.report({"INFO"}, f"stopmo: {len(lib.pieces)} pieces in {s.directory}")
         return {"FINISHED"}
 

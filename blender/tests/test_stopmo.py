@@ -94,6 +94,14 @@ def test_stopmo_run_matches_the_module():
     shows_assembly(scene, folder, ref)
     check(bpy.data.images.get("toonkit error curve") is not None or s.count == "EACH",
           "no size-vs-error image")
+    # The job's warnings reach the user (the operator reports them) and stay with the result.
+    rec = next(o for o in bpy.data.objects if o.get("toonkit_role") == "stopmo")
+    warnings = ref.report["warnings"]
+    check(rec.get(stopmo.WARNINGS) == "\n".join(warnings),
+          f"warnings {rec.get(stopmo.WARNINGS)!r} vs the module's {warnings}")
+    check(any("cross the solid" in w for w in warnings) == any(
+        p["shell"]["self_intersecting_triangles"] > 0 for p in ref.report["printing"]["parts"]),
+        f"crossing warning vs report: {warnings}")
 
 
 def shows_assembly(scene, folder, ref):
