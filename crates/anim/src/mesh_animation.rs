@@ -57,6 +57,23 @@ impl MeshAnimation {
         })
     }
 
+    /// [`MeshAnimation::new`] for a buffer its producer already checked: whole frames of
+    /// finite positions, a positive frame rate (the sampler checks each frame while it is in
+    /// cache, instead of a second pass over the whole buffer).
+    pub(crate) fn from_finite(mesh: Mesh, fps: f32, positions: Vec<Vec3>) -> MeshAnimation {
+        debug_assert!(
+            positions.len().is_multiple_of(mesh.vertex_count().max(1))
+                && fps.is_finite()
+                && fps > 0.0
+        );
+        MeshAnimation {
+            mesh,
+            fps,
+            start_time: 0.0,
+            positions,
+        }
+    }
+
     /// A one-frame cache holding the mesh's own positions.
     pub fn still(mesh: Mesh) -> MeshAnimation {
         let positions = mesh.positions.clone();

@@ -312,21 +312,31 @@ fn sample_object(
     }
 
     let mut positions = vec![Vec3::ZERO; poses.len() * nv];
-    positions
+    // Each frame is checked for non-finite positions while it is still in cache, instead of
+    // a second pass over the whole buffer in `MeshAnimation::new`.
+    let finite = positions
         .par_chunks_mut(nv.max(1))
         .zip(poses.par_iter())
-        .for_each_init(
+        .map_init(
             || (Vec::new(), Vec::new()),
             |(morphed, mats): &mut (Vec<Vec3>, Vec<Mat4>), (out, (world, weights))| {
-                morphed.clear();
-                morphed.extend_from_slice(rest);
-                for (t, &w) in sm.morph_targets.iter().zip(&weights[node]) {
-                    if w != 0.0 {
-                        for (m, d) in morphed.iter_mut().zip(&t.positions) {
-                            *m += w * *d;
+                // Without an active morph target the rest positions are skinned as they are
+                // (no per-frame copy).
+                let active = || sm.morph_targets.iter().zip(&weights[node]);
+                let source: &[Vec3] = if active().any(|(_, &w)| w != 0.0) {
+                    morphed.clear();
+                    morphed.extend_from_slice(rest);
+                    for (t, &w) in active() {
+                        if w != 0.0 {
+                            for (m, d) in morphed.iter_mut().zip(&t.positions) {
+                                *m += w * *d;
+                            }
                         }
                     }
-                }
+                    &morphed[..]
+                } else {
+                    rest
+                };
                 match (&skin, &sm.joint_weights) {
                     (Some(s), Some(w)) => {
                         mats.clear();
@@ -336,21 +346,28 @@ fn sample_object(
                                 .zip(&s.inverse_bind)
                                 .map(|(&j, ib)| world[j] * *ib),
                         );
-                        skin_positions(w, mats, morphed, out);
+                        skin_positions(w, mats, source, out);
                     }
                     _ => {
                         let m = world[node];
-                        for (o, p) in out.iter_mut().zip(morphed.iter()) {
+                        for (o, p) in out.iter_mut().zip(source) {
                             *o = m.transform_point3(*p);
                         }
                     }
                 }
+                out.iter().all(|p| p.is_finite())
             },
-        );
+        )
+        .all(|ok| ok);
+    if !finite {
+        return Err(AnimError::NonFinite {
+            what: format!("point cache of '{name}'"),
+        });
+    }
     let mut mesh = sm.mesh.clone();
     mesh.name = name.clone();
     mesh.normals = None; // normals of the bind pose are wrong once deformed
-    let mut animation = MeshAnimation::new(mesh, fps, positions)?;
+    let mut animation = MeshAnimation::from_finite(mesh, fps, positions);
     animation.start_time = start;
     let first = animation.frame(0).to_vec();
     animation.mesh.positions = first;
@@ -366,4 +383,44 @@ fn sample_object(
 /// Local transform of a node at the scene's rest pose, for writers.
 pub fn rest_transform(scene: &Scene, node: usize) -> Transform {
     scene.nodes[node].transform
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Mesh, Node, SceneMesh};
+
+    /// One mesh node scaled by `scale` whose only vertex lies at x = 3e38 (finite data).
+    fn far_vertex(scale: f32) -> Scene {
+        Scene {
+            nodes: vec![Node {
+                mesh: Some(0),
+                transform: Transform {
+                    scale: Vec3::splat(scale),
+                    ..Transform::default()
+                },
+                ..Node::default()
+            }],
+            meshes: vec![SceneMesh {
+                mesh: Mesh {
+                    positions: vec![Vec3::new(3e38, 0.0, 0.0)],
+                    ..Mesh::default()
+                },
+                ..SceneMesh::default()
+            }],
+            ..Scene::default()
+        }
+    }
+
+    #[test]
+    fn sampled_positions_that_overflow_are_an_error() {
+        let ok = sample(&far_vertex(1.0), &SampleOptions::default()).unwrap();
+        assert_eq!(
+            ok.objects[0].animation.frame(0),
+            &[Vec3::new(3e38, 0.0, 0.0)]
+        );
+        // Finite input, infinite world position (3e38 × 10): checked per frame while sampling.
+        let err = sample(&far_vertex(10.0), &SampleOptions::default()).unwrap_err();
+        assert!(matches!(err, AnimError::NonFinite { .. }), "{err}");
+    }
 }

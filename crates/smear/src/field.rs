@@ -124,9 +124,7 @@ impl Field {
                 || Scratch::new(rig.max_hood_len(), vertices, rig.has_runs()),
                 |sc, (f, (dst, mx))| {
                     let pos = &positions[f * vertices..(f + 1) * vertices];
-                    sc.acc.fill(0.0);
-                    sc.wsum.fill(0.0);
-                    sc.transpose(pos);
+                    sc.start_frame(pos);
                     for (k, m) in mx.iter_mut().enumerate() {
                         if let Some(rib) = &ribbons[f * joints + k] {
                             *m = sc.bone(rib, rig.hood(k), pos, collinear);
@@ -176,12 +174,17 @@ struct Scratch {
     px: Vec<f32>,
     py: Vec<f32>,
     pz: Vec<f32>,
+    /// Whether some neighbourhood is evaluated by runs (the columns then hold whole frames).
+    runs: bool,
 }
 
 impl Scratch {
+    /// Columns for neighbourhoods of up to `hood` vertices; the per-vertex buffers are filled
+    /// per frame ([`Scratch::start_frame`]), so they are not zeroed here (a zeroed allocation
+    /// is a memset of reused memory for every rayon job).
     fn new(hood: usize, vertices: usize, runs: bool) -> Scratch {
         let col = || vec![0.0f32; hood];
-        let pcol = || vec![0.0f32; if runs { vertices } else { 0 }];
+        let pcol = || Vec::with_capacity(if runs { vertices } else { 0 });
         Scratch {
             xs: col(),
             ys: col(),
@@ -189,28 +192,32 @@ impl Scratch {
             raw: col(),
             u: col(),
             coll: col(),
-            acc: vec![0.0; vertices],
-            wsum: vec![0.0; vertices],
+            acc: Vec::with_capacity(vertices),
+            wsum: Vec::with_capacity(vertices),
             px: pcol(),
             py: pcol(),
             pz: pcol(),
+            runs,
         }
     }
 
-    /// Fills the position columns with a frame (when some neighbourhood is run-based).
-    fn transpose(&mut self, pos: &[Vec3]) {
-        if self.px.len() != pos.len() {
+    /// Zeroes SMEAR Eq. 7's sums and fills the position columns with a frame (when some
+    /// neighbourhood is run-based).
+    fn start_frame(&mut self, pos: &[Vec3]) {
+        for sum in [&mut self.acc, &mut self.wsum] {
+            sum.clear();
+            sum.resize(pos.len(), 0.0);
+        }
+        if !self.runs {
             return;
         }
-        for (((x, y), z), p) in self
-            .px
-            .iter_mut()
-            .zip(&mut self.py)
-            .zip(&mut self.pz)
-            .zip(pos)
-        {
-            (*x, *y, *z) = (p.x, p.y, p.z);
-        }
+        let fill = |col: &mut Vec<f32>, axis: fn(&Vec3) -> f32| {
+            col.clear();
+            col.extend(pos.iter().map(axis));
+        };
+        fill(&mut self.px, |p| p.x);
+        fill(&mut self.py, |p| p.y);
+        fill(&mut self.pz, |p| p.z);
     }
 
     /// Evaluates one bone's ribbon over its neighbourhood (batched, SMEAR Eqs. 3–6), accumulates
@@ -229,7 +236,7 @@ impl Scratch {
             }
             rib.eval_batch(xs, ys, zs, raw, u, coll);
         } else {
-            // Straight from the frame's columns (filled by `transpose`), run by run.
+            // Straight from the frame's columns (filled by `start_frame`), run by run.
             let mut o = 0;
             for &(v, len) in hood.runs {
                 let (v, len) = (v as usize, len as usize);

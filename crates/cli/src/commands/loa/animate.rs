@@ -16,7 +16,8 @@ use loa::animate::{ActionCamera, Character};
 use loa::args::MotionFlags;
 use serde_json::json;
 
-use super::{extension, read_keystrokes, warn, Context, LineFlags};
+use super::{read_keystrokes, warn, Context, LineFlags};
+use crate::output::extension;
 
 /// Arguments of `toonkit loa animate`.
 #[derive(Debug, Args)]

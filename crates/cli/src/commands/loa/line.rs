@@ -7,7 +7,8 @@ use anyhow::{bail, Context as _, Result};
 use clap::Args;
 use serde_json::json;
 
-use super::{extension, read_keystrokes, warn, Context, LineFlags};
+use super::{read_keystrokes, warn, Context, LineFlags};
+use crate::output::extension;
 
 /// Arguments of `toonkit loa line`.
 #[derive(Debug, Args)]

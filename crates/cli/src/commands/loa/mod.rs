@@ -48,8 +48,3 @@ fn warn(line: &loa::Line, keys: &Path) {
         eprintln!("warning: {}: {w}", keys.display());
     }
 }
-
-/// The lower-case extension of `path`.
-fn extension(path: &Path) -> String {
-    crate::output::extension(path)
-}

@@ -1,4 +1,4 @@
-//! A global allocator that puts large buffers on transparent huge pages (Linux).
+//! The `toonkit` binary's global allocator: large buffers on transparent huge pages (Linux).
 //!
 //! A whole `toonkit` job touches tens of megabytes of fresh memory (a sampled clip's
 //! positions, the motion offsets, the encoded output): with 4 KiB pages that is thousands of
@@ -10,9 +10,23 @@
 //! system allocator. Without huge pages the mapping still works, with 4 KiB pages.
 //!
 //! glibc's `glibc.malloc.hugetlb=1` tunable does the same, but only through an environment
-//! variable read before `main`; this does it for every run of the binary.
+//! variable read before `main`; this does it for every run of the binary. mimalloc (with or
+//! without its large-OS-page option) was measured against it on the benchmark tube (issue
+//! #14): as fast for `smear offsets`, slower for `convert` (more system time), so this stays.
+//!
+//! Its own crate, apart from the CLI and the libraries: only the binary installs it (the
+//! libraries and the Python module keep their host's allocator), and it is the one place of
+//! the workspace that needs `unsafe`.
+//!
+//! ```no_run
+//! #[cfg(target_os = "linux")]
+//! #[global_allocator]
+//! static ALLOCATOR: toonkit_alloc::HugePageAlloc = toonkit_alloc::HugePageAlloc;
+//! # fn main() {}
+//! ```
 
-// The allocator interface itself is unsafe; this is the one module of the workspace that needs it.
+#![cfg(target_os = "linux")]
+// The allocator interface itself is unsafe; this is the one crate of the workspace that needs it.
 #![allow(unsafe_code)]
 
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -23,12 +37,12 @@ const HUGE_PAGE: usize = 2 << 20;
 
 /// Smallest allocation that gets its own huge-page mapping: below it, the rounding up to whole
 /// huge pages would waste more than it saves.
-const THRESHOLD: usize = 1 << 20;
+pub const THRESHOLD: usize = 1 << 20;
 
 /// [`System`] for small allocations; 2 MiB-aligned anonymous mappings advised
 /// `MADV_HUGEPAGE` for those of [`THRESHOLD`] bytes or more.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct HugePageAlloc;
+pub struct HugePageAlloc;
 
 /// Whether a layout gets its own mapping (the same answer at allocation and release, as
 /// `GlobalAlloc` hands back the same layout).
