@@ -295,7 +295,11 @@ fn auto_parts_keep_the_wall_where_a_later_part_is_deeper_at_the_seam() {
 
 #[test]
 fn eight_pieces_keep_the_wall_and_are_keyed_on_every_seam() {
-    walls_and_keys(&close_pieces(8), 8);
+    let m = close_pieces(8);
+    walls_and_keys(&m, 8);
+    // Not 0 yet (issue 19), but the shell's repair round must keep straightening the
+    // crossing wall rungs: 308 crossing triangles without it, 247 with it.
+    assert!(m.crossing <= 260, "{m:?}");
 }
 
 /// The issue's acceptance: no self-intersecting triangle either.
