@@ -52,7 +52,7 @@ const RUNG_SLOPE: f32 = 0.3;
 /// exact test over every piece (and the wall measure), so one by default: it straightens the
 /// crossing wall rungs, which does most of the gain (ICT face, README seeds, 8 pieces per
 /// part: 308 crossing triangles of 311,968 without repair, 247 with 1 round, 247 with 8;
-/// 20 pieces: 833 → 733 with 1 round, 654 with 8 at twice the time). Raise it in
+/// 20 pieces: 833 → 816 with 1 round; 50: 2,363 → 2,235; 8 rounds cost twice the time). Raise it in
 /// `ShellOptions::repair_rounds` for more.
 pub const DEFAULT_REPAIR_ROUNDS: usize = 1;
 
