@@ -48,7 +48,7 @@ const SEAM_RELAX_STEPS: usize = 60;
 /// One shell construction per part; a part whose seam points moved is measured again.
 pub fn build_shells(inputs: &[ShellInput<'_>], opts: &ShellOptions) -> Result<Vec<PartShell>> {
     let key = |p: Vec3| p.to_array().map(f32::to_bits);
-    // Seam points decided so far: (average, back, printed), and where each key sits.
+    // Seam points decided so far (average, back), where each key sits, which are printed.
     let mut shared: Vec<(Vec3, Vec3)> = Vec::new();
     let mut printed_keys: HashSet<[u32; 3]> = HashSet::new();
     let mut at: HashMap<[u32; 3], usize> = HashMap::new();
