@@ -205,6 +205,11 @@ async fn segment_curve_build_reconstruct_and_export_the_library_folder() {
             "{f}: {written:?}"
         );
     }
+    // The build answer carries the printing warnings the exported report has.
+    let report: Value =
+        serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
+    assert!(built["warnings"].is_array(), "{built}");
+    assert_eq!(built["warnings"], report["warnings"]);
     let csv = std::fs::read_to_string(dir.join("assembly.csv")).unwrap();
     assert!(csv.starts_with("frame,part1,part2\n"), "{csv:.80}");
     assert_eq!(csv.lines().count(), frames + 1);

@@ -222,7 +222,7 @@ export class StopmoPanel {
       const { header, buffers } = await getPack('/api/stopmo/reconstruction');
       this.setReconstruction(header, buffers);
       this.built = r;
-      $('stopmo-built').textContent = `library of ${r.pieces} pieces per part (${r.total_pieces} in all): mean error ${r.errors_mm.position_mean.toFixed(3)} mm, max ${r.errors_mm.position_max.toFixed(3)} mm`;
+      $('stopmo-built').textContent = `library of ${r.pieces} pieces per part (${r.total_pieces} in all): mean error ${r.errors_mm.position_mean.toFixed(3)} mm, max ${r.errors_mm.position_max.toFixed(3)} mm` + (r.warnings.length ? '\n' + r.warnings.join('\n') : '');
       $('stopmo-export').disabled = false;
     });
   }

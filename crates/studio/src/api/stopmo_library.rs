@@ -151,6 +151,8 @@ pub(crate) async fn build(
             "parts": result.part_names,
             "frame_ids": result.frame_ids(),
             "errors_mm": result.library.errors_mm,
+            // Thin walls, crossing triangles, pieces below the printer resolution.
+            "warnings": result.report.warnings,
             "segmentation": version,
         });
         if let Some(s) = lock(&job_studio.stopmo).as_mut() {
