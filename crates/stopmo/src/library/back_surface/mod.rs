@@ -22,39 +22,27 @@
 
 use std::collections::HashMap;
 
+use super::error::{LibraryError, Result};
+use super::fabricate::{check_solid, split_fans};
 use anim::Mesh;
 use glam::Vec3;
-use serde::{Deserialize, Serialize};
-
-use super::error::{LibraryError, Result};
-use super::fabricate::{check_solid, split_fans, DEFAULT_THICKNESS_MM};
 
 mod caps;
 mod envelope;
 mod measure;
+mod options;
 mod seams;
 mod untangle;
 
 pub use measure::ThinnestWall;
+pub use options::{
+    ShellOptions, ShellStats, DEFAULT_BACK_SMOOTHING_ITERATIONS, DEFAULT_CAP_FRACTION,
+    DEFAULT_NORMAL_SMOOTHING_MM, DEFAULT_REPAIR_ROUNDS,
+};
 pub use seams::{build_shells, ShellInput};
 
-/// Radius over which the offset direction field is smoothed, in millimetres: at 8 mm the
-/// directions still converge behind the nose enough to fold the back there (measured on the
-/// ICT face: 103 back/back crossing pairs per upper piece at 8 mm, none at 14 mm).
-pub const DEFAULT_NORMAL_SMOOTHING_MM: f64 = 14.0;
-/// Laplacian smoothing steps of the back surface.
-pub const DEFAULT_BACK_SMOOTHING_ITERATIONS: usize = 300;
-/// Boundary loops shorter than this fraction of the longest one are capped.
-pub const DEFAULT_CAP_FRACTION: f64 = 0.5;
 /// Largest sideways slide of a back boundary point per millimetre of wall depth.
 const RUNG_SLOPE: f32 = 0.3;
-/// Rounds of local repair where the exact test still finds crossings. Each round re-runs the
-/// exact test over every piece (and the wall measure), so one by default: it straightens the
-/// crossing wall rungs, which does most of the gain (ICT face, README seeds, 8 pieces per
-/// part: 308 crossing triangles of 311,968 without repair, 247 with 1 round, 247 with 8;
-/// 20 pieces: 833 → 816 with 1 round; 50: 2,363 → 2,235; 8 rounds cost twice the time). Raise it in
-/// `ShellOptions::repair_rounds` for more.
-pub const DEFAULT_REPAIR_ROUNDS: usize = 1;
 
 /// Repair rounds without fewer crossings before the repair gives up.
 const REPAIR_PATIENCE: usize = 3;
@@ -69,51 +57,6 @@ const SEAM_SPREAD_WALLS: f64 = 3.0;
 const ENVELOPE_LATERAL_WALLS: f64 = 2.0;
 /// How far behind a front vertex the column reaches, in walls.
 const ENVELOPE_REACH_WALLS: f64 = 3.0;
-
-/// Options of the shared back surface (millimetres, like the printable pieces).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct ShellOptions {
-    /// Minimum wall between any piece's front and the back surface.
-    pub wall_mm: f64,
-    /// Radius over which the inward direction field is smoothed.
-    pub normal_smoothing_mm: f64,
-    /// Laplacian smoothing steps of the back surface.
-    pub smoothing_iterations: usize,
-    /// Rounds of local repair driven by the exact intersection test.
-    pub repair_rounds: usize,
-    /// Boundary loops shorter than this fraction of the longest loop (eye and mouth
-    /// openings) are capped instead of walled.
-    pub cap_fraction: f64,
-    /// Smooth the back surface's boundary too (walls may lean inward).
-    pub smooth_boundary: bool,
-}
-
-impl Default for ShellOptions {
-    fn default() -> Self {
-        ShellOptions {
-            wall_mm: DEFAULT_THICKNESS_MM,
-            normal_smoothing_mm: DEFAULT_NORMAL_SMOOTHING_MM,
-            smoothing_iterations: DEFAULT_BACK_SMOOTHING_ITERATIONS,
-            repair_rounds: DEFAULT_REPAIR_ROUNDS,
-            cap_fraction: DEFAULT_CAP_FRACTION,
-            smooth_boundary: false,
-        }
-    }
-}
-
-/// Measurements of a [`PartShell`].
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
-pub struct ShellStats {
-    /// Repair rounds used.
-    pub repair_rounds: usize,
-    /// Self-intersecting triangles over all pieces' solids, summed (0 when printable): after
-    /// the repair for a bare shell; of the written solids (keys and IDs included) in a
-    /// library job's report.
-    pub self_intersecting_triangles: usize,
-    /// Smallest distance from a front vertex of any piece to the back surface (mm).
-    pub min_wall_mm: f64,
-}
 
 /// The shared back surface of one part and how pieces are closed onto it.
 #[derive(Debug, Clone)]
@@ -160,6 +103,19 @@ fn front_positions(source: &[u32], caps: &[Vec<u32>], piece: &[Vec3]) -> Vec<Vec
         out.push(c);
     }
     out
+}
+
+/// Exact key of a position (welding, seam matching): its bits.
+fn position_key(p: Vec3) -> [u32; 3] {
+    p.to_array().map(f32::to_bits)
+}
+
+/// Centroid of the points `around` (non-empty) of `points`.
+fn centroid(points: &[Vec3], around: &[u32]) -> Vec3 {
+    around
+        .iter()
+        .fold(Vec3::ZERO, |a, &w| a + points[w as usize])
+        / around.len() as f32
 }
 
 /// Vertex adjacency (sorted, deduplicated) of a triangle list.
@@ -253,7 +209,7 @@ impl PartShell {
                     return Err(bad(format!("index {i} out of range ({nv} vertices)")));
                 }
                 if class[i] == u32::MAX {
-                    let key = average[i].to_array().map(f32::to_bits);
+                    let key = position_key(average[i]);
                     class[i] = *by_bits.entry(key).or_insert_with(|| {
                         source.push(i as u32);
                         (source.len() - 1) as u32
@@ -272,15 +228,11 @@ impl PartShell {
         if front.len() > src.len() {
             let mut at: HashMap<[u32; 3], u32> = HashMap::new();
             for (i, &s) in source.iter().enumerate() {
-                at.insert(front[i].to_array().map(f32::to_bits), s);
+                at.insert(position_key(front[i]), s);
                 let _ = i;
             }
             for p in &front[source.len()..] {
-                src.push(
-                    at.get(&p.to_array().map(f32::to_bits))
-                        .copied()
-                        .unwrap_or(0),
-                );
+                src.push(at.get(&position_key(*p)).copied().unwrap_or(0));
             }
         }
         let mut directed: HashMap<(u32, u32), ()> = HashMap::with_capacity(tris.len() * 3);
@@ -367,55 +319,30 @@ impl PartShell {
             (ENVELOPE_LATERAL_WALLS * opts.wall_mm) as f32,
             (ENVELOPE_REACH_WALLS * opts.wall_mm) as f32,
         );
-        let shared_at: HashMap<[u32; 3], Vec3> = shared
-            .iter()
-            .map(|(a, b)| (a.to_array().map(f32::to_bits), *b))
-            .collect();
+        let shared_at: HashMap<[u32; 3], Vec3> =
+            shared.iter().map(|(a, b)| (position_key(*a), *b)).collect();
         let mut along: Vec<[u32; 2]> = vec![[u32::MAX; 2]; n];
         for &(a, b) in &boundary {
             along[a as usize][1] = b;
             along[b as usize][0] = a;
         }
-        let shared_point = |v: usize| {
-            on_boundary[v]
-                .then(|| {
-                    shared_at
-                        .get(&front[v].to_array().map(f32::to_bits))
-                        .copied()
-                })
-                .flatten()
-        };
-        // A shared point within this part's wall moves deeper (build_shells moves it in the
-        // earlier parts too), and its neighbours along the seam follow by a tent that falls
-        // to zero over `spread` mm, so the seam's back curve stays smooth.
-        let spread = (SEAM_SPREAD_WALLS * opts.wall_mm) as f32;
-        let mut deeper = vec![0.0f32; n];
-        for v in 0..n {
-            let Some(p) = shared_point(v) else { continue };
-            let excess = p.dot(normals[v]) - limit[v];
-            if excess <= 0.0 {
-                continue;
-            }
-            deeper[v] = deeper[v].max(excess);
-            for side in 0..2 {
-                let (mut u, mut walked) = (v, 0.0f32);
-                loop {
-                    let w = along[u][side];
-                    if w == u32::MAX || w as usize == v || shared_point(w as usize).is_none() {
-                        break;
-                    }
-                    walked += front[u].distance(front[w as usize]);
-                    if walked >= spread {
-                        break;
-                    }
-                    u = w as usize;
-                    deeper[u] = deeper[u].max(excess * (1.0 - walked / spread));
-                }
-            }
-        }
-        let fixed: Vec<Option<Vec3>> = (0..n)
-            .map(|v| shared_point(v).map(|p| p - normals[v] * deeper[v]))
+        // This part's boundary vertices on a seam with an earlier part, and their back points
+        // (moved deeper where they lie within this part's wall).
+        let shared_points: Vec<Option<Vec3>> = (0..n)
+            .map(|v| {
+                on_boundary[v]
+                    .then(|| shared_at.get(&position_key(front[v])).copied())
+                    .flatten()
+            })
             .collect();
+        let fixed = seams::deepen_shared(
+            &shared_points,
+            &front,
+            &normals,
+            &limit,
+            &along,
+            (SEAM_SPREAD_WALLS * opts.wall_mm) as f32,
+        );
         let enforce = |back: &mut [Vec3]| {
             for v in 0..n {
                 if let Some(p) = fixed[v] {
@@ -464,8 +391,7 @@ impl PartShell {
                     if mask.is_some_and(|m| !m[v]) || adj[v].is_empty() {
                         return back[v];
                     }
-                    let c = adj[v].iter().fold(Vec3::ZERO, |a, &w| a + back[w as usize])
-                        / adj[v].len() as f32;
+                    let c = centroid(back, &adj[v]);
                     back[v] + (c - back[v]) * 0.5
                 })
                 .collect();
@@ -589,8 +515,7 @@ impl PartShell {
                         if adj[v].is_empty() {
                             return back[v];
                         }
-                        let c = adj[v].iter().fold(Vec3::ZERO, |a, &w| a + back[w as usize])
-                            / adj[v].len() as f32;
+                        let c = centroid(back, &adj[v]);
                         let (d, nv) = (c - back[v], normals[v]);
                         let along_n = d.dot(nv);
                         back[v] + (d - nv * along_n + nv * along_n.min(0.0)) * 0.5

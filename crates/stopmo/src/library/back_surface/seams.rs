@@ -7,7 +7,7 @@ use std::collections::{HashMap, HashSet};
 use anim::Mesh;
 use glam::Vec3;
 
-use super::{PartShell, ShellOptions};
+use super::{centroid, position_key, PartShell, ShellOptions};
 use crate::library::error::{LibraryError, Result};
 
 /// One part's input to [`build_shells`] (millimetres).
@@ -47,7 +47,6 @@ const SEAM_RELAX_STEPS: usize = 60;
 /// # Performance
 /// One shell construction per part; a part whose seam points moved is measured again.
 pub fn build_shells(inputs: &[ShellInput<'_>], opts: &ShellOptions) -> Result<Vec<PartShell>> {
-    let key = |p: Vec3| p.to_array().map(f32::to_bits);
     // Seam points decided so far (average, back), where each key sits, which are printed.
     let mut shared: Vec<(Vec3, Vec3)> = Vec::new();
     let mut printed_keys: HashSet<[u32; 3]> = HashSet::new();
@@ -72,7 +71,7 @@ pub fn build_shells(inputs: &[ShellInput<'_>], opts: &ShellOptions) -> Result<Ve
         let mut moved: HashMap<[u32; 3], Vec3> = HashMap::new();
         let mut restore: HashMap<[u32; 3], Vec3> = HashMap::new();
         for (average, back) in shell.boundary_pairs(input.average) {
-            let k = key(average);
+            let k = position_key(average);
             match at.get(&k) {
                 Some(&i) if shared[i].1 != back => {
                     if printed_keys.contains(&k) {
@@ -107,6 +106,51 @@ pub fn build_shells(inputs: &[ShellInput<'_>], opts: &ShellOptions) -> Result<Ve
     Ok(out)
 }
 
+/// Back points of a part's shared seam vertices (`shared[v]`, the earlier part's point),
+/// each moved deeper along the direction field where it lies within this part's wall
+/// (`point · normals[v] > limit[v]`), its neighbours along the seam (`along`, the boundary
+/// loops' previous and next vertex) following by a tent that falls to zero over `spread` mm,
+/// so the seam's back curve stays smooth. [`build_shells`] moves them in the earlier parts
+/// too.
+pub(super) fn deepen_shared(
+    shared: &[Option<Vec3>],
+    front: &[Vec3],
+    normals: &[Vec3],
+    limit: &[f32],
+    along: &[[u32; 2]],
+    spread: f32,
+) -> Vec<Option<Vec3>> {
+    let mut deeper = vec![0.0f32; shared.len()];
+    for (v, p) in shared.iter().enumerate() {
+        let Some(p) = p else { continue };
+        let excess = p.dot(normals[v]) - limit[v];
+        if excess <= 0.0 {
+            continue;
+        }
+        deeper[v] = deeper[v].max(excess);
+        for side in 0..2 {
+            let (mut u, mut walked) = (v, 0.0f32);
+            loop {
+                let w = along[u][side] as usize;
+                if w == u32::MAX as usize || w == v || shared[w].is_none() {
+                    break;
+                }
+                walked += front[u].distance(front[w]);
+                if walked >= spread {
+                    break;
+                }
+                u = w;
+                deeper[u] = deeper[u].max(excess * (1.0 - walked / spread));
+            }
+        }
+    }
+    shared
+        .iter()
+        .zip(normals.iter().zip(&deeper))
+        .map(|(p, (n, d))| p.map(|p| p - *n * *d))
+        .collect()
+}
+
 impl PartShell {
     /// `(average front position, back position)` of every boundary vertex, to share the seam
     /// walls with the next part ([`PartShell::new_sharing`]).
@@ -134,7 +178,7 @@ impl PartShell {
             let Some(a) = average.get(self.source[v] as usize) else {
                 continue;
             };
-            if let Some(&p) = points.get(&a.to_array().map(f32::to_bits)) {
+            if let Some(&p) = points.get(&position_key(*a)) {
                 if self.back[v] != p {
                     changed.push(v as u32);
                 }
@@ -168,8 +212,7 @@ impl PartShell {
                     if !mask[v] || self.on_boundary[v] || adj.is_empty() {
                         return back[v];
                     }
-                    let c = adj.iter().fold(Vec3::ZERO, |a, &w| a + back[w as usize])
-                        / adj.len() as f32;
+                    let c = centroid(back, adj);
                     let p = back[v] + (c - back[v]) * 0.5;
                     let (d, h) = (self.normals[v], p.dot(self.normals[v]));
                     p - d * (h - self.limits[v]).max(0.0)
@@ -189,16 +232,13 @@ impl PartShell {
     /// position (`average`, this part's) is the first element of a pair in `other` (that
     /// part's [`PartShell::boundary_pairs`]).
     pub fn seam_vertices(&self, average: &[Vec3], other: &[(Vec3, Vec3)]) -> Vec<u32> {
-        let theirs: HashSet<[u32; 3]> = other
-            .iter()
-            .map(|(a, _)| a.to_array().map(f32::to_bits))
-            .collect();
+        let theirs: HashSet<[u32; 3]> = other.iter().map(|(a, _)| position_key(*a)).collect();
         (0..self.back.len())
             .filter(|&v| self.on_boundary[v])
             .filter(|&v| {
                 average
                     .get(self.source[v] as usize)
-                    .is_some_and(|a| theirs.contains(&a.to_array().map(f32::to_bits)))
+                    .is_some_and(|a| theirs.contains(&position_key(*a)))
             })
             .map(|v| v as u32)
             .collect()
