@@ -206,10 +206,32 @@ fn overlap_across_edge(a: [P; 3], opposite_a: P, b: [P; 3], opposite_b: P) -> bo
 /// they share.
 fn pair_intersects(tris: &[[u32; 3]], snapped: &[P], i: usize, j: usize) -> bool {
     let (ti, tj) = (tris[i], tris[j]);
-    let (a, b) = (
+    pair_meets(
+        ti,
         ti.map(|v| snapped[v as usize]),
+        tj,
         tj.map(|v| snapped[v as usize]),
-    );
+    )
+}
+
+/// Whether triangles with vertex ids `ti` and `tj` (corners `a` and `b`, in the mesh's units)
+/// intersect anywhere but in the vertices and edges they share: the test of
+/// [`intersecting_pairs`] for one pair, for callers that move vertices and test again.
+/// Corners must be finite and within [`MAX_EXACT_COORDINATE`].
+pub(crate) fn triangles_cross(ti: [u32; 3], a: [Vec3; 3], tj: [u32; 3], b: [Vec3; 3]) -> bool {
+    pair_meets(ti, a.map(snap), tj, b.map(snap))
+}
+
+/// Whether the triangle with corners `t` has zero area on the exact grid (it counts as
+/// crossing in [`intersecting_pairs`]).
+pub(crate) fn degenerate(t: [Vec3; 3]) -> bool {
+    let [a, b, c] = t.map(snap);
+    let (u, v) = (sub(b, a), sub(c, a));
+    u[1] * v[2] == u[2] * v[1] && u[2] * v[0] == u[0] * v[2] && u[0] * v[1] == u[1] * v[0]
+}
+
+/// [`pair_intersects`] on snapped corners.
+fn pair_meets(ti: [u32; 3], a: [P; 3], tj: [u32; 3], b: [P; 3]) -> bool {
     let shared: Vec<(usize, usize)> = (0..3)
         .flat_map(|x| (0..3).map(move |y| (x, y)))
         .filter(|&(x, y)| ti[x] == tj[y])

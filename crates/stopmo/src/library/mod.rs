@@ -67,7 +67,7 @@ pub use assembly::{
 pub use back_surface::{
     build_shells, PartShell, ShellInput, ShellOptions, ShellStats, ThinnestWall,
     DEFAULT_BACK_SMOOTHING_ITERATIONS, DEFAULT_CAP_FRACTION, DEFAULT_NORMAL_SMOOTHING_MM,
-    DEFAULT_REPAIR_ROUNDS,
+    DEFAULT_REPAIR_ROUNDS, DEFAULT_RESOLVE_ROUNDS,
 };
 pub use build::{
     build_library, print_scale, Library, LibraryOptions, LibrarySize, Method, PartInput, PartResult,

@@ -31,13 +31,14 @@ mod caps;
 mod envelope;
 mod measure;
 mod options;
+mod resolve;
 mod seams;
 mod untangle;
 
 pub use measure::ThinnestWall;
 pub use options::{
     ShellOptions, ShellStats, DEFAULT_BACK_SMOOTHING_ITERATIONS, DEFAULT_CAP_FRACTION,
-    DEFAULT_NORMAL_SMOOTHING_MM, DEFAULT_REPAIR_ROUNDS,
+    DEFAULT_NORMAL_SMOOTHING_MM, DEFAULT_REPAIR_ROUNDS, DEFAULT_RESOLVE_ROUNDS,
 };
 pub use seams::{build_shells, ShellInput};
 
@@ -83,6 +84,9 @@ pub struct PartShell {
     /// Deepest the back may sit along the direction field at every shell vertex (the wall
     /// behind every piece: `back · direction ≤ limit`).
     limits: Vec<f32>,
+    /// Shift of every piece's front at each shell vertex (mm, at most the printer
+    /// resolution; zero but where a front folds over a wall).
+    nudge: Vec<Vec3>,
     /// Measurements.
     pub stats: ShellStats,
 }
@@ -411,6 +415,7 @@ impl PartShell {
             on_boundary: on_boundary.clone(),
             adjacency: adj.clone(),
             limits: limit.clone(),
+            nudge: vec![Vec3::ZERO; n],
             stats: ShellStats::default(),
         };
         // Repair where the exact test still finds crossings. A crossing wall rung is set
@@ -583,13 +588,16 @@ impl PartShell {
     fn front(&self, piece: &[Vec3]) -> Vec<Vec3> {
         let mut f = front_positions(&self.source, &self.caps, piece);
         untangle::untangle(&mut f, &self.triangles, &self.adjacency);
+        for (p, d) in f.iter_mut().zip(&self.nudge) {
+            *p += *d;
+        }
         f
     }
 
-    fn solid_unchecked(&self, piece: &[Vec3], name: &str) -> Mesh {
+    /// Triangles of every piece's solid over the front (shell vertex `v`) and the back
+    /// (`v + back.len()`): front, back reversed, then two wall triangles per boundary edge.
+    fn solid_topology(&self) -> Vec<[u32; 3]> {
         let m = self.back.len() as u32;
-        let mut positions = self.front(piece);
-        positions.extend_from_slice(&self.back);
         let mut tris = self.triangles.clone();
         tris.extend(
             self.triangles
@@ -600,7 +608,13 @@ impl PartShell {
             tris.push([b, a, a + m]);
             tris.push([b, a + m, b + m]);
         }
-        Mesh::new(name, positions, tris)
+        tris
+    }
+
+    fn solid_unchecked(&self, piece: &[Vec3], name: &str) -> Mesh {
+        let mut positions = self.front(piece);
+        positions.extend_from_slice(&self.back);
+        Mesh::new(name, positions, self.solid_topology())
     }
 
     /// Piece `piece` (millimetres, input vertex order) closed onto the back surface: the

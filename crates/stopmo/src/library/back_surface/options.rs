@@ -21,6 +21,12 @@ pub const DEFAULT_CAP_FRACTION: f64 = 0.5;
 /// `ShellOptions::repair_rounds` for more.
 pub const DEFAULT_REPAIR_ROUNDS: usize = 1;
 
+/// Rounds of the last search that moves single back vertices where the exact test still
+/// finds crossings after the repair ([`PartShell::resolve_crossings`](super::PartShell)):
+/// each round runs the exact test on every piece, then tries every crossing back vertex
+/// once.
+pub const DEFAULT_RESOLVE_ROUNDS: usize = 8;
+
 /// Options of the shared back surface (millimetres, like the printable pieces).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -33,6 +39,9 @@ pub struct ShellOptions {
     pub smoothing_iterations: usize,
     /// Rounds of local repair driven by the exact intersection test.
     pub repair_rounds: usize,
+    /// Rounds of the search that moves single back vertices where crossings are left
+    /// (0: none).
+    pub resolve_rounds: usize,
     /// Boundary loops shorter than this fraction of the longest loop (eye and mouth
     /// openings) are capped instead of walled.
     pub cap_fraction: f64,
@@ -47,6 +56,7 @@ impl Default for ShellOptions {
             normal_smoothing_mm: DEFAULT_NORMAL_SMOOTHING_MM,
             smoothing_iterations: DEFAULT_BACK_SMOOTHING_ITERATIONS,
             repair_rounds: DEFAULT_REPAIR_ROUNDS,
+            resolve_rounds: DEFAULT_RESOLVE_ROUNDS,
             cap_fraction: DEFAULT_CAP_FRACTION,
             smooth_boundary: false,
         }
@@ -58,6 +68,11 @@ impl Default for ShellOptions {
 pub struct ShellStats {
     /// Repair rounds used.
     pub repair_rounds: usize,
+    /// Rounds of the last search (moving single back vertices) used.
+    pub resolve_rounds: usize,
+    /// Front points shifted (by at most the printer resolution, 0.05 mm, in every piece)
+    /// where the front folds over a wall.
+    pub front_nudged_points: usize,
     /// Self-intersecting triangles over all pieces' solids, summed (0 when printable): after
     /// the repair for a bare shell; of the written solids (keys and IDs included) in a
     /// library job's report.

@@ -7,6 +7,7 @@ use std::collections::{HashMap, HashSet};
 use anim::Mesh;
 use glam::Vec3;
 
+use super::resolve::resolve_crossings;
 use super::{centroid, position_key, PartShell, ShellOptions};
 use crate::library::error::{LibraryError, Result};
 
@@ -102,6 +103,21 @@ pub fn build_shells(inputs: &[ShellInput<'_>], opts: &ShellOptions) -> Result<Ve
             }
         }
         out.push(shell);
+    }
+    // Last, the search that moves single back vertices where solids still cross (a seam's
+    // point in both parts); a printed back stays whole.
+    if out.iter().any(|s| s.stats.self_intersecting_triangles > 0) {
+        let averages: Vec<&[Vec3]> = inputs.iter().map(|i| i.average).collect();
+        let pieces: Vec<Vec<&[Vec3]>> = inputs.iter().map(|i| i.pieces.clone()).collect();
+        let frozen: Vec<bool> = inputs.iter().map(|i| i.printed_back.is_some()).collect();
+        resolve_crossings(
+            &mut out,
+            &averages,
+            &pieces,
+            &frozen,
+            opts.wall_mm,
+            opts.resolve_rounds,
+        );
     }
     Ok(out)
 }
@@ -223,7 +239,7 @@ impl PartShell {
     }
 
     /// Measures the wall and the crossings again after the back changed.
-    fn measure(&mut self, pieces: &[&[Vec3]]) {
+    pub(super) fn measure(&mut self, pieces: &[&[Vec3]]) {
         self.stats.min_wall_mm = self.min_wall_of(pieces);
         self.stats.self_intersecting_triangles = self.crossings(pieces).1;
     }
