@@ -362,6 +362,10 @@ impl Patient {
     }
 }
 
+/// One part's share of a move: the moved solid vertices (group of the unit, solid vertex),
+/// the triangles incident to them, and what those may meet in every piece.
+type PartMoves = (Vec<(usize, usize)>, Vec<u32>, Vec<Near>);
+
 /// What moving triangles may meet in one piece ([`Patient::neighbourhood`]).
 struct Near {
     /// Solid triangles that do not move (sorted).
@@ -508,7 +512,7 @@ pub(super) fn resolve_crossings(
             // Per part: the moved solid vertices (member index, vertex), the moving
             // triangles and what they may meet (with `all`, under any rule; else where they
             // are now).
-            let local = |all: bool| -> Vec<Option<(Vec<(usize, usize)>, Vec<u32>, Vec<Near>)>> {
+            let local = |all: bool| -> Vec<Option<PartMoves>> {
                 (0..patients.len())
                     .map(|p| {
                         let pt = &patients[p];
@@ -538,10 +542,7 @@ pub(super) fn resolve_crossings(
             };
             // New points of the unit's groups (one per group) → crossing count over parts
             // (or with `thin`, 1 when the wall would be too thin somewhere).
-            let count_in = |local: &[Option<(Vec<(usize, usize)>, Vec<u32>, Vec<Near>)>],
-                            points: &[Vec3],
-                            thin: bool|
-             -> usize {
+            let count_in = |local: &[Option<PartMoves>], points: &[Vec3], thin: bool| -> usize {
                 let mut total = 0;
                 for (p, l) in local.iter().enumerate() {
                     let Some((at, moving, near)) = l else {
