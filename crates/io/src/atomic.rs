@@ -9,7 +9,22 @@ use crate::{IoError, Result};
 /// Writes `bytes` to `path` atomically: a reader never sees a half-written file, and a failed
 /// write leaves any previous file untouched. Parent directories are created.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let tmp = stage(path, bytes)?;
+    write_atomic_with(path, |f| {
+        f.write_all(bytes).map_err(|e| IoError::io(path, e))
+    })
+}
+
+/// [`write_atomic`] for a file written piece by piece: `write` fills the temporary file (a
+/// large result is streamed to it instead of being encoded in memory first); on success it is
+/// synced and renamed over `path`, on any error it is removed and `path` is left untouched.
+///
+/// # Errors
+/// `write`'s error (with `path` attached when it has none), or the file system's.
+pub fn write_atomic_with(
+    path: &Path,
+    write: impl FnOnce(&mut fs::File) -> Result<()>,
+) -> Result<()> {
+    let tmp = stage_with(path, write)?;
     commit(&tmp, path)
 }
 
@@ -44,6 +59,13 @@ pub fn write_atomic_all(files: &[(PathBuf, Vec<u8>)]) -> Result<()> {
 /// Writes `bytes` in full to the temporary file of `path` (synced to disk) and returns its
 /// path; on failure nothing is left behind.
 fn stage(path: &Path, bytes: &[u8]) -> Result<PathBuf> {
+    stage_with(path, |f| {
+        f.write_all(bytes).map_err(|e| IoError::io(path, e))
+    })
+}
+
+/// [`stage`] with the contents written by `write`.
+fn stage_with(path: &Path, write: impl FnOnce(&mut fs::File) -> Result<()>) -> Result<PathBuf> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         fs::create_dir_all(dir).map_err(|e| IoError::io(dir, e))?;
     }
@@ -55,15 +77,15 @@ fn stage(path: &Path, bytes: &[u8]) -> Result<PathBuf> {
     }
     let tmp = temp_path(path);
     let result = (|| {
-        let mut f = fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()
+        let mut f = fs::File::create(&tmp).map_err(|e| IoError::io(path, e))?;
+        write(&mut f).map_err(|e| e.at(path))?;
+        f.sync_all().map_err(|e| IoError::io(path, e))
     })();
     match result {
         Ok(()) => Ok(tmp),
         Err(e) => {
             let _ = fs::remove_file(&tmp);
-            Err(IoError::io(path, e))
+            Err(e)
         }
     }
 }
@@ -129,6 +151,25 @@ mod tests {
         assert_eq!(fs::read(&p).unwrap(), b"two");
         let names: Vec<_> = fs::read_dir(p.parent().unwrap()).unwrap().collect();
         assert_eq!(names.len(), 1);
+    }
+
+    #[test]
+    fn streamed_write_failing_midway_keeps_the_previous_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("out.npy");
+        write_atomic_with(&p, |f| f.write_all(b"old").map_err(|e| IoError::io(&p, e))).unwrap();
+        let err = write_atomic_with(&p, |f| {
+            f.write_all(b"half").map_err(|e| IoError::io(&p, e))?;
+            Err(IoError::unsupported("no more"))
+        })
+        .unwrap_err();
+        // The error names the target, the old file is intact and no temporary is left.
+        assert!(
+            err.to_string().starts_with(&p.display().to_string()),
+            "{err}"
+        );
+        assert_eq!(fs::read(&p).unwrap(), b"old");
+        assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
     #[test]
