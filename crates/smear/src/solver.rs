@@ -425,6 +425,28 @@ impl SolvedField {
         self.slots.iter().map(|s| self.slot_offsets(s)).collect()
     }
 
+    /// [`SolvedField::all`], consuming the field: an object alone in its group is smoothed in
+    /// its group's raw buffer, which becomes its offsets (no second `frames × vertices`
+    /// buffer, no copy).
+    pub(crate) fn into_all(mut self) -> Vec<MotionOffsets> {
+        let (frames, smooth, causal) = (self.frames, self.smooth, self.causal);
+        let mut out = Vec::with_capacity(self.slots.len());
+        for slot in &self.slots {
+            let alone = self.slots.iter().filter(|s| s.group == slot.group).count() == 1;
+            let grp = &mut self.groups[slot.group];
+            if alone && slot.vertices == grp.vertices {
+                let mut values = std::mem::take(&mut grp.raw);
+                crate::smooth::smooth_in_place(&mut values, frames, grp.vertices, smooth, causal);
+                out.push(
+                    MotionOffsets::new(frames, slot.vertices, values).expect("frames × vertices"),
+                );
+            } else {
+                out.push(self.slot_offsets(slot));
+            }
+        }
+        out
+    }
+
     /// Smoothed offsets at surface points of object `i`; `objects` are the caches the field
     /// was solved on (scene order).
     pub(crate) fn surface_offsets(
