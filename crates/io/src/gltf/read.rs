@@ -64,7 +64,7 @@ pub(crate) fn read_full(
     let doc = std::panic::catch_unwind(|| gltf::Document::from_json(root))
         .map_err(|_| bad("the document is inconsistent (rejected during validation)"))?
         .map_err(|e| bad(e.to_string()))?;
-    let data: Vec<&[u8]> = prepared.buffers.iter().map(Vec::as_slice).collect();
+    let data: Vec<&[u8]> = prepared.buffers.iter().map(|b| &**b).collect();
     // The gltf crate unwraps some fields it validated loosely; a panic there is bad input.
     let mut scene = std::panic::catch_unwind(|| convert(&doc, &data))
         .map_err(|_| bad("the document is inconsistent (rejected while reading)"))??;
