@@ -42,7 +42,7 @@ pub use human::human_number;
 pub use mesh::{triangulate_polygon, vertex_normals, Aabb, Mesh};
 pub use mesh_animation::{MeshAnimation, DEFAULT_FPS};
 pub use rng::{mix, SplitMix64};
-pub use sample::{rest_transform, sample, MeshObject, SampleOptions, SampledScene};
+pub use sample::{rest_transform, sample, sample_owned, MeshObject, SampleOptions, SampledScene};
 pub use scene::{MorphTarget, Node, Scene, SceneCamera, SceneMesh, SkinDef};
 pub use skeleton::{bones, Bone, Joint, SkeletalAnimation, Skeleton};
 pub use skin::{skin_positions, Skin, VertexWeights};

@@ -4,7 +4,7 @@ use glam::{Mat4, Vec3};
 use rayon::prelude::*;
 
 use crate::{
-    clip::frame_count, skin_positions, AnimError, Bone, Camera, MeshAnimation, Result, Scene,
+    clip::frame_count, skin_positions, AnimError, Bone, Camera, Mesh, MeshAnimation, Result, Scene,
     SkeletalAnimation, Skeleton, Skin, Transform, DEFAULT_FPS,
 };
 
@@ -129,6 +129,45 @@ impl SampledScene {
 /// When the scene is invalid, the clip index is out of range, or a mesh filter matches
 /// nothing.
 pub fn sample(scene: &Scene, options: &SampleOptions) -> Result<SampledScene> {
+    sample_with(scene, options, &mut [])
+}
+
+/// [`sample`], consuming the scene: the geometry of a mesh that one node draws (triangles,
+/// texture coordinates, colours, attributes) moves into its object instead of being copied.
+///
+/// # Errors
+/// As [`sample`].
+pub fn sample_owned(mut scene: Scene, options: &SampleOptions) -> Result<SampledScene> {
+    scene.validate()?;
+    let mut uses = vec![0usize; scene.meshes.len()];
+    for m in scene.nodes.iter().filter_map(|n| n.mesh) {
+        if let Some(u) = uses.get_mut(m) {
+            *u += 1;
+        }
+    }
+    // Sampling still reads the name and rest positions: they stay in the scene.
+    let mut spare: Vec<Option<Mesh>> = scene
+        .meshes
+        .iter_mut()
+        .zip(&uses)
+        .map(|(sm, &u)| {
+            (u == 1).then(|| {
+                let mut geometry = std::mem::take(&mut sm.mesh);
+                sm.mesh.name = geometry.name.clone();
+                sm.mesh.positions = std::mem::take(&mut geometry.positions);
+                geometry
+            })
+        })
+        .collect();
+    sample_with(&scene, options, &mut spare)
+}
+
+/// [`sample`] taking each object's geometry from `spare` (by mesh index) where it holds one.
+fn sample_with(
+    scene: &Scene,
+    options: &SampleOptions,
+    spare: &mut [Option<Mesh>],
+) -> Result<SampledScene> {
     scene.validate()?;
     if !(options.fps.is_finite() && options.fps > 0.0) {
         return Err(AnimError::Invalid(format!(
@@ -217,6 +256,10 @@ pub fn sample(scene: &Scene, options: &SampleOptions) -> Result<SampledScene> {
         if !options.meshes.is_empty() && !options.meshes.contains(&name) {
             continue;
         }
+        let geometry = scene.nodes[node]
+            .mesh
+            .and_then(|m| spare.get_mut(m))
+            .and_then(Option::take);
         objects.push(sample_object(
             scene,
             node,
@@ -225,6 +268,7 @@ pub fn sample(scene: &Scene, options: &SampleOptions) -> Result<SampledScene> {
             &joint_of_node,
             fps,
             start,
+            geometry,
         )?);
     }
     if !options.meshes.is_empty() && objects.is_empty() {
@@ -277,6 +321,7 @@ fn sample_object(
     joint_of_node: &[Option<usize>],
     fps: f32,
     start: f32,
+    geometry: Option<Mesh>,
 ) -> Result<MeshObject> {
     let n = &scene.nodes[node];
     let sm = &scene.meshes[n.mesh.expect("mesh node")];
@@ -364,13 +409,26 @@ fn sample_object(
             what: format!("point cache of '{name}'"),
         });
     }
-    let mut mesh = sm.mesh.clone();
+    // Everything but the positions (which become frame 0's), moved when the caller owns it.
+    let mut mesh = geometry.unwrap_or_else(|| {
+        let m = &sm.mesh;
+        Mesh {
+            name: String::new(),
+            positions: Vec::new(),
+            triangles: m.triangles.clone(),
+            polygons: m.polygons.clone(),
+            normals: None,
+            uvs: m.uvs.clone(),
+            extra_uvs: m.extra_uvs.clone(),
+            colors: m.colors.clone(),
+            attributes: m.attributes.clone(),
+        }
+    });
     mesh.name = name.clone();
     mesh.normals = None; // normals of the bind pose are wrong once deformed
+    mesh.positions = positions[..nv.min(positions.len())].to_vec();
     let mut animation = MeshAnimation::from_finite(mesh, fps, positions);
     animation.start_time = start;
-    let first = animation.frame(0).to_vec();
-    animation.mesh.positions = first;
     Ok(MeshObject {
         node,
         name,
@@ -388,7 +446,7 @@ pub fn rest_transform(scene: &Scene, node: usize) -> Transform {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Mesh, Node, SceneMesh};
+    use crate::{Node, SceneMesh};
 
     /// One mesh node scaled by `scale` whose only vertex lies at x = 3e38 (finite data).
     fn far_vertex(scale: f32) -> Scene {
@@ -422,5 +480,26 @@ mod tests {
         // Finite input, infinite world position (3e38 × 10): checked per frame while sampling.
         let err = sample(&far_vertex(10.0), &SampleOptions::default()).unwrap_err();
         assert!(matches!(err, AnimError::NonFinite { .. }), "{err}");
+    }
+
+    /// Consuming the scene gives the same sampled scene: geometry moved for a mesh drawn
+    /// once, copied for a mesh two nodes draw, the object names unchanged.
+    #[test]
+    fn owned_sampling_equals_borrowed_sampling() {
+        let mut scene = far_vertex(1.0);
+        let m = &mut scene.meshes[0].mesh;
+        m.name = "tri".into();
+        m.positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+        m.triangles = vec![[0, 1, 2]];
+        m.uvs = Some(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+        let opts = SampleOptions::default();
+        let want = sample(&scene, &opts).unwrap();
+        assert_eq!(sample_owned(scene.clone(), &opts).unwrap(), want);
+        assert_eq!(want.objects[0].name, "tri");
+        assert_eq!(want.objects[0].animation.mesh.triangles, [[0, 1, 2]]);
+        scene.nodes.push(scene.nodes[0].clone());
+        let twice = sample(&scene, &opts).unwrap();
+        assert_eq!(twice.objects.len(), 2);
+        assert_eq!(sample_owned(scene, &opts).unwrap(), twice);
     }
 }

@@ -92,19 +92,10 @@ pub fn load_with_notes(path: &Path, args: &InputArgs) -> Result<(Loaded, Vec<Str
 
 /// Samples what was loaded into per-object point caches (and skeleton, cameras).
 pub fn sample(path: &Path, loaded: &Loaded, args: &InputArgs) -> Result<SampledScene> {
-    let with_path = |e: anim::AnimError| ArgsError::Flag(format!("{}: {e}", path.display()));
     match loaded {
         Loaded::Scene(scene) => {
-            let clip = match &args.clip {
-                Some(name) => Some(scene.find_clip(name).map_err(with_path)?),
-                None => None,
-            };
-            let options = SampleOptions {
-                fps: args.fps(),
-                clip,
-                meshes: args.mesh.clone(),
-            };
-            anim::sample(scene, &options).map_err(with_path)
+            let options = sample_options(path, scene, args)?;
+            anim::sample(scene, &options).map_err(with_path(path))
         }
         Loaded::Cache(cache) => Ok(SampledScene::from_animation(cache.clone())),
         Loaded::Mesh(mesh) => Ok(SampledScene::from_animation(MeshAnimation::still(
@@ -113,10 +104,34 @@ pub fn sample(path: &Path, loaded: &Loaded, args: &InputArgs) -> Result<SampledS
     }
 }
 
-/// Loads and samples in one call.
+/// An animation error as one line naming the input.
+fn with_path(path: &Path) -> impl Fn(anim::AnimError) -> ArgsError + '_ {
+    move |e| ArgsError::Flag(format!("{}: {e}", path.display()))
+}
+
+/// What `--clip`, `--fps` and `--mesh` ask to sample of `scene`.
+fn sample_options(path: &Path, scene: &anim::Scene, args: &InputArgs) -> Result<SampleOptions> {
+    let clip = match &args.clip {
+        Some(name) => Some(scene.find_clip(name).map_err(with_path(path))?),
+        None => None,
+    };
+    Ok(SampleOptions {
+        fps: args.fps(),
+        clip,
+        meshes: args.mesh.clone(),
+    })
+}
+
+/// Loads and samples in one call (the loaded scene's geometry moves into the result).
 pub fn open(path: &Path, args: &InputArgs) -> Result<SampledScene> {
-    let loaded = load(path, args)?;
-    sample(path, &loaded, args)
+    match load(path, args)? {
+        // The loaded scene is not kept: its geometry moves into the sampled objects.
+        Loaded::Scene(scene) => {
+            let options = sample_options(path, &scene, args)?;
+            anim::sample_owned(*scene, &options).map_err(with_path(path))
+        }
+        loaded => sample(path, &loaded, args),
+    }
 }
 
 /// All mesh objects merged into one point cache (the vertex order every per-vertex output

@@ -31,7 +31,9 @@ pub mod stl;
 pub mod usda;
 pub mod usdc;
 
-pub use atomic::{read_file, remove_stale_temps, write_atomic, write_atomic_all};
+pub use atomic::{
+    read_file, remove_stale_temps, write_atomic, write_atomic_all, write_atomic_with, SYNC_ENV,
+};
 pub use error::{describe_io, FilePath, IoError, Result};
 pub use save::{save, save_with, Layout, Output, SaveOptions};
 

@@ -24,12 +24,52 @@ pub const ALIGNMENT: usize = 64;
 /// # Errors
 /// [`IoError::Unsupported`] when `data.len()` is not the product of `shape`.
 pub fn write_f32(shape: &[usize], data: &[f32]) -> Result<Vec<u8>> {
+    let mut out = header_f32(shape, data.len())?;
+    out.reserve_exact(4 * data.len());
+    for v in data {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    Ok(out)
+}
+
+/// Values per block of [`write_f32_to`]: 64 KiB of bytes, converted in cache and written.
+const BLOCK: usize = 16 * 1024;
+
+/// Writes the float32 array of [`write_f32`] (the same bytes) to `w` block by block, without
+/// encoding the whole file in memory first: a result of megabytes goes to the file as it is
+/// converted, with no second copy of it (and no fresh pages for one).
+///
+/// # Errors
+/// [`IoError::Unsupported`] when `data.len()` is not the product of `shape`; the first write
+/// error of `w` as [`IoError::Io`] (without a path: the caller knows it).
+pub fn write_f32_to(w: &mut impl std::io::Write, shape: &[usize], data: &[f32]) -> Result<()> {
+    let header = header_f32(shape, data.len())?;
+    let io = |e| IoError::io(std::path::Path::new(""), e);
+    w.write_all(&header).map_err(io)?;
+    let mut block = vec![0u8; 4 * BLOCK.min(data.len())];
+    for chunk in data.chunks(BLOCK) {
+        // Fixed-size stores into a sized block: a plain copy on little-endian machines.
+        let bytes = &mut block[..4 * chunk.len()];
+        for (b, v) in bytes.chunks_exact_mut(4).zip(chunk) {
+            b.copy_from_slice(&v.to_le_bytes());
+        }
+        w.write_all(bytes).map_err(io)?;
+    }
+    Ok(())
+}
+
+/// The NPY 1.0 header (magic, version, length, dictionary) of a float32 array of `shape`
+/// holding `len` values.
+///
+/// # Errors
+/// [`IoError::Unsupported`] when `len` is not the product of `shape`, or the header does not
+/// fit NPY 1.0.
+fn header_f32(shape: &[usize], len: usize) -> Result<Vec<u8>> {
     let count = shape.iter().try_fold(1usize, |a, &d| a.checked_mul(d));
-    if count != Some(data.len()) {
+    if count != Some(len) {
         return Err(IoError::unsupported(format!(
-            "array of shape {shape:?} needs {} values, got {}",
+            "array of shape {shape:?} needs {} values, got {len}",
             count.map_or_else(|| "more than 2^64".to_string(), |c| c.to_string()),
-            data.len()
         )));
     }
     let dims = match shape {
@@ -51,14 +91,11 @@ pub fn write_f32(shape: &[usize], data: &[f32]) -> Result<Vec<u8>> {
     header.push('\n');
     let header_len = u16::try_from(header.len())
         .map_err(|_| IoError::unsupported("array has too many dimensions for NPY 1.0"))?;
-    let mut out = Vec::with_capacity(10 + header.len() + 4 * data.len());
+    let mut out = Vec::with_capacity(10 + header.len());
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&[1, 0]);
     out.extend_from_slice(&header_len.to_le_bytes());
     out.extend_from_slice(header.as_bytes());
-    for v in data {
-        out.extend_from_slice(&v.to_le_bytes());
-    }
     Ok(out)
 }
 
@@ -239,6 +276,21 @@ mod tests {
             assert_eq!(bytes[10 + header_len - 1], b'\n');
             assert_eq!(read_f32(&bytes).unwrap(), (shape, data));
         }
+    }
+
+    /// The streamed writer gives the bytes of the in-memory one, across block boundaries,
+    /// and refuses a shape that does not match before writing anything.
+    #[test]
+    fn streamed_array_has_the_same_bytes() {
+        // Two whole blocks and a partial one.
+        let m = BLOCK - BLOCK / 3 + 5;
+        let data: Vec<f32> = (0..3 * m).map(|i| (i as f32).sin()).collect();
+        let mut streamed = Vec::new();
+        write_f32_to(&mut streamed, &[3, m], &data).unwrap();
+        assert_eq!(streamed, write_f32(&[3, m], &data).unwrap());
+        let mut none = Vec::new();
+        assert!(write_f32_to(&mut none, &[2, 2], &data).is_err());
+        assert!(none.is_empty());
     }
 
     fn with_header(header: &str, data: &[u8]) -> Vec<u8> {

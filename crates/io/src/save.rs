@@ -166,10 +166,12 @@ pub fn save_with(path: &Path, output: &Output<'_>, options: SaveOptions) -> Resu
             values,
         } => {
             expect_extension(path, Format::Npy, "a per-frame scalar field", ".npy")?;
-            put(
-                path,
-                crate::npy::write_f32(&[frames, vertices], values).map_err(|e| e.at(path))?,
-            )?
+            // One file, streamed: no encoded copy of a field of megabytes.
+            let shape = [frames, vertices];
+            crate::atomic::write_atomic_with(path, |f| {
+                crate::npy::write_f32_to(f, &shape, values)
+            })?;
+            return Ok(vec![path.to_path_buf()]);
         }
         Output::Mesh(mesh) => match output_format(path)? {
             #[cfg(feature = "obj")]

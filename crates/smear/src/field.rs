@@ -62,6 +62,8 @@ impl Field {
     /// The SMEAR Eqs. 3–9 field of a skinned group, and the (unsmoothed) offsets of its vertices.
     ///
     /// # Arguments
+    /// * `raw` — the buffer the offsets are written to (resized to `frames × vertices`;
+    ///   its pages may be mapped beforehand, see `touched_zeros`).
     /// * `bones` — bones of the whole skeleton, frame-major `frames × joints`.
     ///
     /// # Returns
@@ -79,6 +81,7 @@ impl Field {
     /// vertex.
     pub(crate) fn ribbons(
         rig: Rig,
+        mut raw: Vec<f32>,
         positions: &[Vec3],
         frames: usize,
         bones: &[Bone],
@@ -88,7 +91,10 @@ impl Field {
     ) -> (Field, Vec<f32>) {
         let joints = rig.joint_count();
         let vertices = rig.vertex_count();
-        let mut raw = vec![0.0f32; frames * vertices];
+        if raw.len() != frames * vertices {
+            raw.clear();
+            raw.resize(frames * vertices, 0.0);
+        }
         let mut ribbons = vec![None; frames * joints];
         let mut maxima = vec![[0.0f32; 2]; frames * joints];
         if joints == 0 || vertices == 0 {

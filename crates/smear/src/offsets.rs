@@ -1,6 +1,11 @@
 //! The per-frame, per-vertex motion offsets δ_i(f) container.
 
+use rayon::prelude::*;
+
 use crate::{smooth_in_time, Result, SmearError};
+
+/// Values per job of [`MotionOffsets::range`]'s parallel pass.
+const RANGE_CHUNK: usize = 1 << 16;
 
 /// Motion offsets δ_i(f) of one object: `frames × vertices` values, frame-major and
 /// contiguous (frame `f` is `values[f * vertices..(f + 1) * vertices]`).
@@ -81,15 +86,20 @@ impl MotionOffsets {
     }
 
     /// Smallest and largest value, `(0, 0)` when empty.
+    ///
+    /// # Performance
+    /// Parallel over blocks of values (one pass over a clip's offsets is serial time
+    /// otherwise, at the end of every offsets job).
     pub fn range(&self) -> (f32, f32) {
         if self.values.is_empty() {
             return (0.0, 0.0);
         }
+        let fold = |(lo, hi): (f32, f32), &v: &f32| (lo.min(v), hi.max(v));
+        let empty = (f32::INFINITY, f32::NEG_INFINITY);
         self.values
-            .iter()
-            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &v| {
-                (lo.min(v), hi.max(v))
-            })
+            .par_chunks(RANGE_CHUNK)
+            .map(|c| c.iter().fold(empty, fold))
+            .reduce(|| empty, |(a, b), (c, d)| (a.min(c), b.max(d)))
     }
 
     /// Temporal smoothing of SMEAR Eq. 2 with half-window `n` (0 returns a copy).
@@ -142,5 +152,18 @@ mod tests {
         assert_eq!(c.get(1, 2), Some(6.0));
         assert_eq!(c.range(), (1.0, 6.0));
         assert!(MotionOffsets::new(2, 2, vec![0.0; 3]).is_err());
+    }
+
+    /// The parallel range over several blocks finds extremes in any block and ignores NaN.
+    #[test]
+    fn range_over_blocks() {
+        let n = 3 * RANGE_CHUNK + 7;
+        let mut v: Vec<f32> = (0..n).map(|i| (i as f32 * 0.001).sin() * 0.5).collect();
+        v[RANGE_CHUNK + 3] = -0.9;
+        v[n - 1] = 0.8;
+        v[5] = f32::NAN;
+        let d = MotionOffsets::new(1, n, v).unwrap();
+        assert_eq!(d.range(), (-0.9, 0.8));
+        assert_eq!(MotionOffsets::zeros(0, 4).range(), (0.0, 0.0));
     }
 }

@@ -97,6 +97,101 @@ pub(crate) fn smooth_columns(
     out
 }
 
+/// [`smooth_columns`] over every column of a frame-major `frames × width` buffer, in place:
+/// the same values bit for bit, without a second `frames × width` buffer (whose fresh pages
+/// the kernel would clear first).
+///
+/// # Performance
+/// Parallel over contiguous runs of frames, one per worker. Each run keeps the originals it
+/// still needs once they are overwritten — its last N frames in a ring — and, copied before
+/// any run starts, the N frames before it and after it that its neighbours overwrite.
+pub(crate) fn smooth_in_place(
+    values: &mut [f32],
+    frames: usize,
+    width: usize,
+    n: usize,
+    causal: bool,
+) {
+    let per_run = frames.div_ceil(rayon::current_num_threads().max(1));
+    smooth_runs(values, frames, width, n, causal, per_run);
+}
+
+/// [`smooth_in_place`] in runs of `per_run` frames.
+fn smooth_runs(
+    values: &mut [f32],
+    frames: usize,
+    width: usize,
+    n: usize,
+    causal: bool,
+    per_run: usize,
+) {
+    if n == 0 || frames <= 1 || width == 0 || per_run == 0 || values.len() < frames * width {
+        return;
+    }
+    let w = if causal {
+        causal_smoothing_weights(n)
+    } else {
+        smoothing_weights(n)
+    };
+    let frame = |v: &[f32], g: usize| v[g * width..(g + 1) * width].to_vec();
+    // Per run starting at frame a: the originals of frames a − N..a (the ring's first
+    // contents) and of the N frames after it, taken before any run writes.
+    let halos: Vec<(Vec<f32>, Vec<f32>)> = (0..frames)
+        .step_by(per_run)
+        .map(|a| {
+            let b = (a + per_run).min(frames);
+            let mut ring = vec![0.0f32; (n + 1) * width];
+            for g in a.saturating_sub(n)..a {
+                let slot = g % (n + 1);
+                ring[slot * width..(slot + 1) * width].copy_from_slice(&frame(values, g));
+            }
+            let ahead: Vec<f32> = (b..(b + n).min(frames))
+                .flat_map(|g| frame(values, g))
+                .collect();
+            (ring, ahead)
+        })
+        .collect();
+    values[..frames * width]
+        .par_chunks_mut(per_run * width)
+        .zip(halos)
+        .enumerate()
+        .for_each(|(r, (run, (mut ring, ahead)))| {
+            let a = r * per_run;
+            let b = a + run.len() / width;
+            for f in a..b {
+                // Frame f's original joins the ring (the slot of frame f − N − 1, no longer
+                // read), then frame f is overwritten by its smoothed values.
+                let slot = f % (n + 1);
+                let local = (f - a) * width;
+                ring[slot * width..(slot + 1) * width].copy_from_slice(&run[local..local + width]);
+                let (_, rest) = run.split_at_mut(local);
+                let (dst, after) = rest.split_at_mut(width);
+                for (k, &wk) in w.iter().enumerate() {
+                    let g = (f as i64 + k as i64 - n as i64).clamp(0, frames as i64 - 1) as usize;
+                    let src: &[f32] = if g <= f {
+                        let s = g % (n + 1);
+                        &ring[s * width..(s + 1) * width]
+                    } else if g < b {
+                        let o = (g - f - 1) * width;
+                        &after[o..o + width]
+                    } else {
+                        let o = (g - b) * width;
+                        &ahead[o..o + width]
+                    };
+                    if k == 0 {
+                        for (d, s) in dst.iter_mut().zip(src) {
+                            *d = wk * s;
+                        }
+                    } else {
+                        for (d, s) in dst.iter_mut().zip(src) {
+                            *d += wk * s;
+                        }
+                    }
+                }
+            }
+        });
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -143,6 +238,35 @@ mod tests {
         assert!((c[3] - w[2]).abs() < 1e-6 && (c[5] - 1.0).abs() < 1e-6);
         assert!(smooth_in_time(&v, 6, 1, 2)[2] > 0.0);
         assert_eq!(smooth_in_time_causal(&v, 6, 1, 0), v);
+    }
+
+    /// In place, in runs of frames with rings and halos, gives the bits of the buffer-to-buffer
+    /// smoothing, offline and causal, for runs shorter and longer than the window.
+    #[test]
+    fn smoothing_in_place_equals_smoothing_into_a_new_buffer() {
+        let (width, n) = (5, 2);
+        for frames in [2, 3, 7, 40] {
+            let v: Vec<f32> = (0..frames * width)
+                .map(|i| ((i * 7919) % 101) as f32 / 50.0 - 1.0)
+                .collect();
+            for causal in [false, true] {
+                let want = smooth_columns(&v, frames, width, 0..width, n, causal);
+                let mut got = v.clone();
+                smooth_in_place(&mut got, frames, width, n, causal);
+                assert_eq!(got, want, "{frames} frames, causal {causal}");
+                for per_run in [1, 2, 3, 16] {
+                    let mut got = v.clone();
+                    smooth_runs(&mut got, frames, width, n, causal, per_run);
+                    assert_eq!(
+                        got, want,
+                        "{frames} frames, runs of {per_run}, causal {causal}"
+                    );
+                }
+            }
+        }
+        let mut single = vec![1.0, 2.0];
+        smooth_in_place(&mut single, 1, 2, n, false);
+        assert_eq!(single, [1.0, 2.0]);
     }
 
     #[test]

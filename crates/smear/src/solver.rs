@@ -203,6 +203,17 @@ fn merged_triangles(parts: &[&MeshAnimation]) -> Vec<[u32; 3]> {
     out
 }
 
+/// `len` zeros whose pages are already mapped: one store per 4 KiB page (the value hidden
+/// from the optimizer, which would drop stores of zero into zeroed memory) makes the kernel
+/// map and clear each page here, on the calling thread.
+fn touched_zeros(len: usize) -> Vec<f32> {
+    let mut v = vec![0.0f32; len];
+    for x in v.iter_mut().step_by(1024) {
+        *x = std::hint::black_box(0.0);
+    }
+    v
+}
+
 /// Checks that the scene's buffers agree (bones per frame, frames per object, skin slots).
 fn check_scene(scene: &SampledScene) -> Result<()> {
     let frames = scene.frame_count;
@@ -291,9 +302,15 @@ impl SolvedField {
                     .iter()
                     .filter_map(|&i| scene.objects[i].skin.as_ref())
                     .collect();
-                let rig = Rig::new(&scene.skeleton, &pruned, &skins)?;
+                // The rig is built on one core while the other maps the output's fresh pages
+                // (the kernel clears them on first touch): both serial costs at once.
+                let (rig, raw) = rayon::join(
+                    || Rig::new(&scene.skeleton, &pruned, &skins),
+                    || touched_zeros(frames * vertices),
+                );
                 Field::ribbons(
-                    rig,
+                    rig?,
+                    raw,
                     positions,
                     frames,
                     &scene.bones,
@@ -423,6 +440,28 @@ impl SolvedField {
     /// Smoothed offsets of every object, in object order.
     pub(crate) fn all(&self) -> Vec<MotionOffsets> {
         self.slots.iter().map(|s| self.slot_offsets(s)).collect()
+    }
+
+    /// [`SolvedField::all`], consuming the field: an object alone in its group is smoothed in
+    /// its group's raw buffer, which becomes its offsets (no second `frames × vertices`
+    /// buffer, no copy).
+    pub(crate) fn into_all(mut self) -> Vec<MotionOffsets> {
+        let (frames, smooth, causal) = (self.frames, self.smooth, self.causal);
+        let mut out = Vec::with_capacity(self.slots.len());
+        for slot in &self.slots {
+            let alone = self.slots.iter().filter(|s| s.group == slot.group).count() == 1;
+            let grp = &mut self.groups[slot.group];
+            if alone && slot.vertices == grp.vertices {
+                let mut values = std::mem::take(&mut grp.raw);
+                crate::smooth::smooth_in_place(&mut values, frames, grp.vertices, smooth, causal);
+                out.push(
+                    MotionOffsets::new(frames, slot.vertices, values).expect("frames × vertices"),
+                );
+            } else {
+                out.push(self.slot_offsets(slot));
+            }
+        }
+        out
     }
 
     /// Smoothed offsets at surface points of object `i`; `objects` are the caches the field

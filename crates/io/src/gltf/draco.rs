@@ -3,6 +3,8 @@
 //! its accessors are pointed at them. The decoded attribute keeps Draco's component type
 //! (quantized positions come back as floats); the primitive becomes an ordinary one.
 
+use std::borrow::Cow;
+
 use draco_core::{DataType, DecoderBuffer, FaceIndex, Mesh, MeshDecoder, PointIndex};
 use serde_json::{json, Map, Value};
 
@@ -34,7 +36,7 @@ fn component(t: DataType) -> Option<(u32, usize)> {
 /// The compressed bytes of buffer view `view`.
 fn view_bytes<'a>(
     root: &Map<String, Value>,
-    buffers: &'a [Vec<u8>],
+    buffers: &'a [Cow<'_, [u8]>],
     view: usize,
 ) -> Option<&'a [u8]> {
     let v = root.get("bufferViews")?.as_array()?.get(view)?;
@@ -71,7 +73,10 @@ fn push_view(
 /// # Errors
 /// When a bitstream lies outside its buffer or does not decode, or an attribute it names is
 /// missing from it.
-pub(crate) fn decode(root: &mut Map<String, Value>, buffers: &mut Vec<Vec<u8>>) -> Result<bool> {
+pub(crate) fn decode(
+    root: &mut Map<String, Value>,
+    buffers: &mut Vec<Cow<'_, [u8]>>,
+) -> Result<bool> {
     let buffer = buffers.len();
     let mut out = Vec::new();
     let mut views: Vec<Value> = root
@@ -193,6 +198,6 @@ pub(crate) fn decode(root: &mut Map<String, Value>, buffers: &mut Vec<Vec<u8>>) 
     if let Some(list) = list.as_array_mut() {
         list.push(json!({ "byteLength": out.len() }));
     }
-    buffers.push(out);
+    buffers.push(Cow::Owned(out));
     Ok(true)
 }

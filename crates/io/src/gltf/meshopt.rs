@@ -3,6 +3,8 @@
 //! `meshoptimizer-rs` codec (a Rust port of meshoptimizer's decoders, filters included) into a
 //! new plain buffer, and the view is pointed at it. What remains is an ordinary glTF document.
 
+use std::borrow::Cow;
+
 use meshoptimizer_rs::codec::{BufferView, Filter, Mode};
 use meshoptimizer_rs::Workspace;
 use serde_json::{json, Map, Value};
@@ -28,7 +30,10 @@ fn field(ext: &Value, key: &str) -> Option<usize> {
 /// # Errors
 /// When a view's compressed range lies outside its buffer, its mode or filter is unknown,
 /// or the data does not decode.
-pub(crate) fn decode(root: &mut Map<String, Value>, buffers: &mut Vec<Vec<u8>>) -> Result<()> {
+pub(crate) fn decode(
+    root: &mut Map<String, Value>,
+    buffers: &mut Vec<Cow<'_, [u8]>>,
+) -> Result<()> {
     let mut workspace = Workspace::default();
     let mut new_buffers = Vec::new();
     let first_new = buffers.len();
@@ -95,6 +100,6 @@ pub(crate) fn decode(root: &mut Map<String, Value>, buffers: &mut Vec<Vec<u8>>) 
             list.push(json!({ "byteLength": b.len() }));
         }
     }
-    buffers.extend(new_buffers);
+    buffers.extend(new_buffers.into_iter().map(Cow::Owned));
     Ok(())
 }

@@ -11,6 +11,7 @@
 //! geometry is present and the extension is ignored with a note; otherwise the file is
 //! refused naming the extension.
 
+use std::borrow::Cow;
 use std::path::Path;
 
 use serde_json::{json, Map, Value};
@@ -18,11 +19,12 @@ use serde_json::{json, Map, Value};
 use crate::{IoError, Result};
 
 /// A document ready for the `gltf` crate, its buffers, and what was accepted on the way.
-pub(crate) struct Prepared {
+pub(crate) struct Prepared<'a> {
     /// The JSON root, without materials, textures and the extension lists.
     pub root: gltf_json::Root,
-    /// One byte vector per buffer of `root` (decoded meshopt buffers appended).
-    pub buffers: Vec<Vec<u8>>,
+    /// The bytes of every buffer of `root` (decoded meshopt buffers appended); the GLB binary
+    /// chunk is borrowed from the file's bytes, not copied.
+    pub buffers: Vec<Cow<'a, [u8]>>,
     /// One line per extension the file uses and what toonkit did with it.
     pub notes: Vec<String>,
 }
@@ -66,8 +68,11 @@ fn how_to_convert(ext: &str) -> String {
     )
 }
 
+/// The JSON and (GLB) binary chunk of a glTF file, borrowed from its bytes.
+type Chunks<'a> = (Cow<'a, [u8]>, Option<Cow<'a, [u8]>>);
+
 /// Splits `.glb` bytes into JSON and binary chunk; `.gltf` is all JSON.
-fn split(bytes: &[u8]) -> Result<(Vec<u8>, Option<Vec<u8>>)> {
+fn split(bytes: &[u8]) -> Result<Chunks<'_>> {
     if bytes.starts_with(b"glTF") {
         // gltf 1.4 subtracts the 12-byte header from the declared length unchecked.
         let declared = bytes
@@ -79,9 +84,9 @@ fn split(bytes: &[u8]) -> Result<(Vec<u8>, Option<Vec<u8>>)> {
             )));
         }
         let glb = gltf::binary::Glb::from_slice(bytes).map_err(|e| bad(e.to_string()))?;
-        Ok((glb.json.into_owned(), glb.bin.map(|b| b.into_owned())))
+        Ok((glb.json, glb.bin))
     } else {
-        Ok((bytes.to_vec(), None))
+        Ok((Cow::Borrowed(bytes), None))
     }
 }
 
@@ -188,12 +193,12 @@ fn strip(root: &mut Map<String, Value>, notes: &mut Vec<String>) {
 
 /// Reads buffer `i`'s bytes: the GLB chunk, a `data:` URI, or a file beside the document.
 /// A meshopt fallback buffer (no URI, no data) is empty.
-fn load_buffer(
+fn load_buffer<'a>(
     i: usize,
     buffer: &Value,
-    bin: &mut Option<Vec<u8>>,
+    bin: &mut Option<Cow<'a, [u8]>>,
     base: Option<&Path>,
-) -> Result<Vec<u8>> {
+) -> Result<Cow<'a, [u8]>> {
     if let Some(uri) = buffer.get("uri").and_then(Value::as_str) {
         // gltf 1.4 unwraps this decoding of a relative URI (a panic on "%FF").
         if !uri.contains(':') && urlencoding::decode(uri).is_err() {
@@ -219,7 +224,7 @@ fn load_buffer(
                     e => bad(format!("buffer {i}: {e}")),
                 }
             })?;
-        return Ok(data.0);
+        return Ok(Cow::Owned(data.0));
     }
     let fallback = buffer
         .get("extensions")
@@ -228,7 +233,7 @@ fn load_buffer(
         .and_then(Value::as_bool)
         .unwrap_or(false);
     if fallback {
-        return Ok(Vec::new());
+        return Ok(Cow::Borrowed(&[]));
     }
     match (i, bin.take()) {
         (0, Some(b)) => Ok(b),
@@ -240,7 +245,7 @@ fn load_buffer(
 
 /// Accessors without a buffer view or sparse values are zeros (glTF 2.0 §3.6.2.1; exporters
 /// write all-zero morph targets so): they get a zero-filled view, which the `gltf` crate needs.
-fn zero_views(root: &mut Map<String, Value>, buffers: &mut Vec<Vec<u8>>) {
+fn zero_views(root: &mut Map<String, Value>, buffers: &mut Vec<Cow<'_, [u8]>>) {
     let mut zeros: Vec<u8> = Vec::new();
     let buffer = buffers.len();
     let mut new_views = Vec::new();
@@ -292,11 +297,11 @@ fn zero_views(root: &mut Map<String, Value>, buffers: &mut Vec<Vec<u8>>) {
     {
         list.push(json!({ "byteLength": zeros.len() }));
     }
-    buffers.push(zeros);
+    buffers.push(Cow::Owned(zeros));
 }
 
 /// Prepares `bytes` (a `.glb`, or `.gltf` whose external buffers are found in `base`).
-pub(crate) fn prepare(bytes: &[u8], base: Option<&Path>) -> Result<Prepared> {
+pub(crate) fn prepare<'a>(bytes: &'a [u8], base: Option<&Path>) -> Result<Prepared<'a>> {
     let (json, mut bin) = split(bytes)?;
     let mut value: Value = serde_json::from_slice(&json).map_err(|e| bad(e.to_string()))?;
     if !value.is_object() {

@@ -64,7 +64,7 @@ pub(crate) fn read_full(
     let doc = std::panic::catch_unwind(|| gltf::Document::from_json(root))
         .map_err(|_| bad("the document is inconsistent (rejected during validation)"))?
         .map_err(|e| bad(e.to_string()))?;
-    let data: Vec<&[u8]> = prepared.buffers.iter().map(Vec::as_slice).collect();
+    let data: Vec<&[u8]> = prepared.buffers.iter().map(|b| &**b).collect();
     // The gltf crate unwraps some fields it validated loosely; a panic there is bad input.
     let mut scene = std::panic::catch_unwind(|| convert(&doc, &data))
         .map_err(|_| bad("the document is inconsistent (rejected while reading)"))??;
@@ -288,8 +288,9 @@ fn read_mesh(mesh: &gltf::Mesh, buffers: &[&[u8]]) -> Result<SceneMesh> {
         }
         part.attributes = crate::gltf::attributes::read_attributes(&prim, buffers, n)?;
         check_len(&part, n)?;
-        // Joint influences over every JOINTS_n / WEIGHTS_n pair.
-        let mut influences: Vec<Vec<(u32, f32)>> = vec![Vec::new(); n];
+        // Joint influences over every JOINTS_n / WEIGHTS_n pair, read set by set and joined
+        // per vertex below (no list per vertex).
+        let mut sets: Vec<InfluenceSet> = Vec::new();
         let mut set = 0;
         while let (Some(ja), Some(wa)) = (
             prim.get(&gltf::Semantic::Joints(set)),
@@ -320,9 +321,7 @@ fn read_mesh(mesh: &gltf::Mesh, buffers: &[&[u8]]) -> Result<SceneMesh> {
             if j.len() != n || w.len() != n {
                 return Err(bad("JOINTS/WEIGHTS count differs from POSITION count"));
             }
-            for (v, (jj, ww)) in j.iter().zip(&w).enumerate() {
-                influences[v].extend(jj.iter().zip(ww).map(|(&a, &b)| (a as u32, b)));
-            }
+            sets.push((j, w));
             any_weights = true;
             set += 1;
         }
@@ -362,7 +361,11 @@ fn read_mesh(mesh: &gltf::Mesh, buffers: &[&[u8]]) -> Result<SceneMesh> {
         for (t, d) in out.morph_targets.iter_mut().zip(targets) {
             t.positions.extend(d);
         }
-        weights.append(&VertexWeights::from_influences(influences));
+        let sets = &sets;
+        weights.append(&VertexWeights::from_influences((0..n).map(|v| {
+            sets.iter()
+                .flat_map(move |(j, w)| j[v].iter().zip(&w[v]).map(|(&a, &b)| (u32::from(a), b)))
+        })));
         if first {
             out.mesh = part;
         } else {
@@ -378,6 +381,9 @@ fn read_mesh(mesh: &gltf::Mesh, buffers: &[&[u8]]) -> Result<SceneMesh> {
     out.default_weights.resize(out.morph_targets.len(), 0.0);
     Ok(out)
 }
+
+/// One `JOINTS_n` / `WEIGHTS_n` pair of a primitive: four joint slots and weights per vertex.
+type InfluenceSet = (Vec<[u16; 4]>, Vec<[f32; 4]>);
 
 fn check_len(m: &Mesh, n: usize) -> Result<()> {
     let lens = [

@@ -123,7 +123,7 @@ fn take_colliders(scene: &mut SampledScene, names: &[String]) -> Result<Vec<Coll
 /// Per-object offset reports.
 fn object_reports(
     scene: &SampledScene,
-    field: &SolvedField,
+    mode: impl Fn(usize) -> Option<OffsetMode>,
     per_object: &[MotionOffsets],
 ) -> Vec<ObjectOffsets> {
     scene
@@ -136,7 +136,7 @@ fn object_reports(
             ObjectOffsets {
                 name: o.name.clone(),
                 vertices: d.vertex_count(),
-                mode: field.mode(i).unwrap_or(OffsetMode::Simple),
+                mode: mode(i).unwrap_or(OffsetMode::Simple),
                 min,
                 max,
             }
@@ -178,9 +178,11 @@ pub fn offsets(scene: &SampledScene, options: &OffsetOptions) -> Result<SceneOff
     let start = Instant::now();
     let field = SolvedField::new(scene, options)?;
     let revolving = revolving_objects(scene, &options.revolve)?;
-    let per_object = replace_offsets(scene, options, &revolving, field.all());
+    let modes: Vec<Option<OffsetMode>> = (0..field.object_count()).map(|i| field.mode(i)).collect();
+    // The field is not kept: objects alone in their group are smoothed in their raw buffer.
+    let per_object = replace_offsets(scene, options, &revolving, field.into_all());
     let solve_seconds = start.elapsed().as_secs_f64();
-    let objects = object_reports(scene, &field, &per_object);
+    let objects = object_reports(scene, |i| modes.get(i).copied().flatten(), &per_object);
     let offsets = if per_object.len() == 1 {
         per_object.into_iter().next().expect("one object")
     } else {
@@ -219,7 +221,7 @@ pub fn prepare(mut scene: SampledScene, options: &PrepareOptions) -> Result<Prep
     let revolving = revolving_objects(&scene, &options.offsets.revolve)?;
     let per_object = replace_offsets(&scene, &options.offsets, &revolving, field.all());
     let solve_seconds = start.elapsed().as_secs_f64();
-    let objects = object_reports(&scene, &field, &per_object);
+    let objects = object_reports(&scene, |i| field.mode(i), &per_object);
     let causal = options.offsets.causal;
     let velocities = |anim: &MeshAnimation| {
         let (p, f, n) = (anim.positions(), anim.frame_count(), anim.vertex_count());
