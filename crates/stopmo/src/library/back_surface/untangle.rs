@@ -22,8 +22,16 @@ const RELAX: f32 = 0.5;
 const REGION_RINGS: usize = 8;
 
 /// Untangles `front` (positions of the triangles `tris`, `adj` their vertex adjacency) in
-/// place; returns the vertices moved.
-pub(super) fn untangle(front: &mut [Vec3], tris: &[[u32; 3]], adj: &[Vec<u32>]) -> usize {
+/// place, never moving a `pinned` vertex (the part boundary: a seam's front must stay the
+/// same curve in every piece of every part that meets there, an open border where the input
+/// puts it); returns the vertices moved.
+pub(super) fn untangle(
+    front: &mut [Vec3],
+    tris: &[[u32; 3]],
+    adj: &[Vec<u32>],
+    pinned: &[bool],
+) -> usize {
+    let free = |v: usize| !pinned.get(v).copied().unwrap_or(false);
     let n = front.len();
     let Some(first) = intersecting_pairs(front, tris) else {
         return 0;
@@ -85,7 +93,7 @@ pub(super) fn untangle(front: &mut [Vec3], tris: &[[u32; 3]], adj: &[Vec<u32>]) 
         // relax the crossing vertices towards their neighbours too.
         let relaxed: Vec<Vec3> = (0..n)
             .map(|v| {
-                if !mark[v] || adj[v].is_empty() {
+                if !mark[v] || adj[v].is_empty() || !free(v) {
                     return front[v];
                 }
                 let c = adj[v]
@@ -97,7 +105,7 @@ pub(super) fn untangle(front: &mut [Vec3], tris: &[[u32; 3]], adj: &[Vec<u32>]) 
             .collect();
         front.copy_from_slice(&relaxed);
         for v in 0..n {
-            if ring[v] {
+            if ring[v] && free(v) {
                 let s = if mark[v] { STEP_MM } else { STEP_MM * 0.5 };
                 front[v] -= normals[v] * s;
                 moved[v] = true;
