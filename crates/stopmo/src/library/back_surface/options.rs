@@ -24,7 +24,7 @@ pub const DEFAULT_REPAIR_ROUNDS: usize = 1;
 /// Rounds of the last search of [`build_shells`](super::build_shells) that moves single
 /// points where the exact test still finds crossings after the repair: each round runs the
 /// exact test on every piece, then tries every crossing point once (ICT face, README seeds,
-/// 8 / 20 / 50 pieces per part: 247 / 816 / 2,235 crossing triangles → 20 / 40 / 94; 2–3
+/// 8 / 20 / 50 pieces per part: 247 / 816 / 2,235 crossing triangles → 20 / 40 / 95; 2–3
 /// rounds end it there, a round without a move ends it; `stopmo run` 8 pieces 13.2 → 14.1 s,
 /// 50 pieces 51 → 66 s, release).
 pub const DEFAULT_RESOLVE_ROUNDS: usize = 8;

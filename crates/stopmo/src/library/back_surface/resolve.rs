@@ -378,8 +378,9 @@ struct Near {
     back_tris: Vec<u32>,
 }
 
-/// Moves back vertices of `shells`, one at a time (a seam's point in every part sharing it),
-/// where pieces' solids still cross themselves, and measures the shells again.
+/// Moves back points of `shells` (a seam's point in every part sharing it, alone or with its
+/// neighbours along the boundary), and shifts front points by at most [`FRONT_NUDGE_MM`] in
+/// every piece, where pieces' solids still cross themselves; measures the shells again.
 ///
 /// # Arguments
 /// * `shells`, `averages`, `pieces` — the parts, their average surfaces and pieces
@@ -390,7 +391,7 @@ struct Near {
 /// * `rounds` — rounds at most ([`DEFAULT_RESOLVE_ROUNDS`](super::DEFAULT_RESOLVE_ROUNDS)).
 ///
 /// # Returns
-/// Back points moved (a seam point counts once).
+/// Points moved (a seam point counts once).
 ///
 /// # Performance
 /// Per round one exact test and one box grid per piece; each candidate position is tested
