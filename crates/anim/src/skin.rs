@@ -163,8 +163,11 @@ impl Skin {
 /// (the w lane is dropped at the end): the same per-lane operations, in the same order, as
 /// `x * M.transform_point3(p)` summed in a `Vec3`, so the same bits with fewer instructions.
 pub fn skin_positions(weights: &VertexWeights, matrices: &[Mat4], rest: &[Vec3], out: &mut [Vec3]) {
-    for (v, (p, o)) in rest.iter().zip(out.iter_mut()).enumerate() {
-        let (slots, w) = weights.influences(v);
+    // Consecutive offsets bound each vertex's influences (no per-vertex index into `offsets`).
+    let spans = weights.offsets.windows(2);
+    for ((p, o), ab) in rest.iter().zip(out.iter_mut()).zip(spans) {
+        let (a, b) = (ab[0] as usize, ab[1] as usize);
+        let (slots, w) = (&weights.joints[a..b], &weights.weights[a..b]);
         if slots.is_empty() {
             *o = *p;
             continue;
