@@ -279,6 +279,14 @@ impl Scratch {
 /// [`Hood::in_tip`]: NaN (and ±inf outside the set, masked to NaN) are ignored, 0 when none.
 /// Same value as folding `f32::max` over the flagged entries, in lanes the compiler vectorizes.
 fn masked_maxima(raw: &[f32], in_root: &[f32], in_tip: &[f32]) -> [f32; 2] {
+    // One pass per mask: with both in one loop the compiler pairs (root, tip) per point in
+    // half-empty registers instead of filling them with 4 points (callgrind: ~2× the
+    // instructions). `raw` (one neighbourhood) is still in L1 for the second pass.
+    [masked_max(raw, in_root), masked_max(raw, in_tip)]
+}
+
+/// max |raw| over the entries flagged 1 in `mask` (see [`masked_maxima`]).
+fn masked_max(raw: &[f32], mask: &[f32]) -> f32 {
     const L: usize = 8;
     #[inline(always)]
     fn lane(m: &mut f32, x: f32) {
@@ -287,27 +295,22 @@ fn masked_maxima(raw: &[f32], in_root: &[f32], in_tip: &[f32]) -> [f32; 2] {
             *m = x;
         }
     }
-    let (mut mr, mut mt) = ([0.0f32; L], [0.0f32; L]);
-    let (rc, ac, bc) = (
-        raw.chunks_exact(L),
-        in_root.chunks_exact(L),
-        in_tip.chunks_exact(L),
-    );
-    let (rr, ar, br) = (rc.remainder(), ac.remainder(), bc.remainder());
-    for ((r, a), b) in rc.zip(ac).zip(bc) {
-        for l in 0..L {
-            let x = r[l].abs();
-            lane(&mut mr[l], x * a[l]);
-            lane(&mut mt[l], x * b[l]);
+    // Two accumulators of 4 lanes (one SSE register each) map one to one onto vector maxima.
+    let (mut m, mut m2) = ([0.0f32; 4], [0.0f32; 4]);
+    let (rc, ac) = (raw.chunks_exact(L), mask.chunks_exact(L));
+    let (rr, ar) = (rc.remainder(), ac.remainder());
+    for (r, a) in rc.zip(ac) {
+        for l in 0..4 {
+            lane(&mut m[l], r[l].abs() * a[l]);
+        }
+        for l in 0..4 {
+            lane(&mut m2[l], r[4 + l].abs() * a[4 + l]);
         }
     }
-    for (l, ((r, a), b)) in rr.iter().zip(ar).zip(br).enumerate() {
-        let x = r.abs();
-        lane(&mut mr[l], x * a);
-        lane(&mut mt[l], x * b);
+    for (r, a) in rr.iter().zip(ar) {
+        lane(&mut m[0], r.abs() * a);
     }
-    let fold = |m: [f32; L]| m.iter().fold(0.0f32, |a, &b| a.max(b));
-    [fold(mr), fold(mt)]
+    m.iter().chain(&m2).fold(0.0f32, |a, &b| a.max(b))
 }
 
 /// SMEAR Eq. 8 with SMEAR Eq. 9's normalizer M = (1 − u)·max_{V_k,r} + u·max_{V_k,t} (SPEC.md's
@@ -343,6 +346,41 @@ impl RibbonField {
             acc / wsum
         } else {
             0.0
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The lane-split maxima equal a plain fold of `f32::max` over the flagged entries, for
+    /// every length around the block size (tails), with the extreme in every position, NaN
+    /// anywhere and infinities outside the sets.
+    #[test]
+    fn masked_maxima_equal_plain_fold() {
+        let plain = |raw: &[f32], mask: &[f32]| {
+            raw.iter()
+                .zip(mask)
+                .filter(|(_, &m)| m == 1.0)
+                .fold(0.0f32, |a, (&r, _)| a.max(r.abs()))
+        };
+        for n in 0..=27usize {
+            for peak in 0..n.max(1) {
+                let mut raw: Vec<f32> = (0..n).map(|i| ((i * 7 % 5) as f32 - 2.0) * 0.1).collect();
+                let in_root: Vec<f32> = (0..n).map(|i| f32::from(i % 3 != 1)).collect();
+                let in_tip: Vec<f32> = (0..n).map(|i| f32::from(i % 2 == 0)).collect();
+                if n > 0 {
+                    raw[peak] = -0.9;
+                    raw[(peak + 1) % n] = f32::NAN;
+                    if in_root[(peak + 2) % n] == 0.0 && in_tip[(peak + 2) % n] == 0.0 {
+                        raw[(peak + 2) % n] = f32::INFINITY;
+                    }
+                }
+                let got = masked_maxima(&raw, &in_root, &in_tip);
+                let want = [plain(&raw, &in_root), plain(&raw, &in_tip)];
+                assert_eq!(got, want, "n {n}, peak {peak}");
+            }
         }
     }
 }

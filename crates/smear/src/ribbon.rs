@@ -305,11 +305,12 @@ impl Ribbon {
         }
     }
 
-    /// The loop of [`Ribbon::eval_batch`] for v(u) = a·P + b·Q, `dir(u) = (a, b, |v|²)`, by
-    /// blocks of [`BATCH_LANES`] points: a block entirely beyond the bone's ends (most of the
-    /// neighbours of a bone, spatially coherent in vertex order) only needs SMEAR Eq. 6's dot
-    /// product with the end normals; other blocks run [`Ribbon::beyond_ends`] and
-    /// [`Ribbon::finish`] written as selects. Both give the same bits.
+    /// The loops of [`Ribbon::eval_batch`] for v(u) = a·P + b·Q, `dir(u) = (a, b, |v|²)`: first
+    /// every point as beyond the bone's ends (SMEAR Eq. 6's dot product with the end normals;
+    /// most of the neighbours of a bone), in one loop over whole columns; then each block of
+    /// [`BATCH_LANES`] points holding a point within the span (spatially coherent in vertex
+    /// order, so few blocks) runs [`Ribbon::beyond_ends`] and [`Ribbon::finish`] written as
+    /// selects. Both give the bits of [`Ribbon::eval`].
     #[inline(always)]
     fn batch(
         &self,
@@ -324,33 +325,54 @@ impl Ribbon {
         let n = xs.len();
         let (ys, zs) = (&ys[..n], &zs[..n]);
         let (raw, us, colls) = (&mut raw[..n], &mut us[..n], &mut colls[..n]);
+        // Pass 1, every point as if beyond an end (most of a bone's neighbours are): one
+        // branch-free loop the compiler vectorizes over whole columns. `u` is 0 or 1 there and
+        // ½ marks a point within the bone's span for pass 2.
+        let (o, a, n0, n1) = (self.root, self.axis, self.n0, self.n1);
+        let (inv_len, coll0, coll1) = (self.inv_len, self.coll0, self.coll1);
+        for i in 0..n {
+            // `project` and `lane_ends` spelled per coordinate (same operations and order,
+            // so the same bits as `Vec3::dot`).
+            let (dx, dy, dz) = (xs[i] - o.x, ys[i] - o.y, zs[i] - o.z);
+            let t = (dx * a.x + dy * a.y + dz * a.z) * inv_len;
+            let r0 = dx * n0.x + dy * n0.y + dz * n0.z;
+            let r1 = dx * n1.x + dy * n1.y + dz * n1.z;
+            let (lo, hi) = (t <= 0.0, t >= 1.0);
+            raw[i] = if lo { r0 } else { r1 };
+            us[i] = if lo {
+                0.0
+            } else if hi {
+                1.0
+            } else {
+                0.5
+            };
+            colls[i] = if lo { coll0 } else { coll1 };
+        }
+        // Pass 2: blocks holding a point within the span run `lane` (selects, vectorized).
         const L: usize = BATCH_LANES;
         let blocks = n / L * L;
         for s in (0..blocks).step_by(L) {
-            let col = |c: &[f32]| -> [f32; L] { c[s..s + L].try_into().expect("L points") };
-            let (x, y, z) = (col(xs), col(ys), col(zs));
-            let (r, u, c) = (lanes_mut(raw, s), lanes_mut(us, s), lanes_mut(colls, s));
-            let at = |l: usize| self.project(Vec3::new(x[l], y[l], z[l]));
+            let u = lanes_mut(us, s);
             let mut inside = 0u32;
-            for l in 0..L {
-                let t = at(l).2;
-                inside |= u32::from(!(t <= 0.0 || t >= 1.0));
+            for &u in u.iter() {
+                inside |= u32::from(u == 0.5);
             }
             if inside == 0 {
-                for l in 0..L {
-                    let (d, _, t) = at(l);
-                    (r[l], u[l], c[l]) = self.lane_ends(d, t);
-                }
-            } else {
-                for l in 0..L {
-                    let (d, db, t) = at(l);
-                    (r[l], u[l], c[l]) = self.lane(d, db, t, &dir);
-                }
+                continue;
+            }
+            let col = |c: &[f32]| -> [f32; L] { c[s..s + L].try_into().expect("L points") };
+            let (x, y, z) = (col(xs), col(ys), col(zs));
+            let (r, c) = (lanes_mut(raw, s), lanes_mut(colls, s));
+            for l in 0..L {
+                let (d, db, t) = self.project(Vec3::new(x[l], y[l], z[l]));
+                (r[l], u[l], c[l]) = self.lane(d, db, t, &dir);
             }
         }
         for i in blocks..n {
-            let (d, db, t) = self.project(Vec3::new(xs[i], ys[i], zs[i]));
-            (raw[i], us[i], colls[i]) = self.lane(d, db, t, &dir);
+            if us[i] == 0.5 {
+                let (d, db, t) = self.project(Vec3::new(xs[i], ys[i], zs[i]));
+                (raw[i], us[i], colls[i]) = self.lane(d, db, t, &dir);
+            }
         }
     }
 
