@@ -132,7 +132,8 @@ impl Tri<'_> {
     }
 
     /// Crossing of parts (j, l) on local edge e, computed from the edge's ends only, in the
-    /// orientation of the welded ids, so both triangles of an edge agree bit for bit.
+    /// orientation of the welded ids, so both triangles of an edge agree bit for bit. Never
+    /// snapped here: [`Tri::snapped`] moves it once the regions are known.
     fn edge_crossing(&self, e: usize, j: usize, l: usize) -> Pt {
         let (c0, c1) = (e, (e + 1) % 3);
         let (first, second) = if self.welded[c0] <= self.welded[c1] {
@@ -148,11 +149,6 @@ impl Tri<'_> {
             (g0 / (g0 - g1)).clamp(0.0, 1.0)
         };
         let line = Line::Pair(j as u8, l as u8);
-        if t <= self.snap || t >= 1.0 - self.snap {
-            let mut p = corner(if t <= self.snap { first } else { second });
-            p.lines[2] = line;
-            return p;
-        }
         let mut bary = [0.0; 3];
         bary[first] = 1.0 - t;
         bary[second] = t;
@@ -249,8 +245,69 @@ impl Tri<'_> {
             }
             poly = out;
         }
+        let mut poly: Vec<Pt> = poly.into_iter().map(|p| self.snapped(p)).collect();
+        poly.dedup_by(|a, b| a.key == b.key);
+        while poly.len() > 1 && poly.first().map(|p| p.key) == poly.last().map(|p| p.key) {
+            poly.pop();
+        }
         poly
     }
+
+    /// A crossing on an input edge within the snapping threshold of an end, moved onto that
+    /// end (it depends on the edge's ends only, so both triangles of the edge snap alike).
+    /// Snapping after clipping, not during it, keeps the regions a partition: every
+    /// region's side through a snapped crossing moves with it, where snapping inside the
+    /// clip let a later clip of another part run along the input edge instead and leave a
+    /// hole at a three-part corner.
+    fn snapped(&self, p: Pt) -> Pt {
+        let Key::Edge(e, ..) = p.key else {
+            return p;
+        };
+        let (c0, c1) = (e as usize, (e as usize + 1) % 3);
+        let (first, second) = if self.welded[c0] <= self.welded[c1] {
+            (c0, c1)
+        } else {
+            (c1, c0)
+        };
+        let t = p.bary[second];
+        if t <= self.snap {
+            corner(first)
+        } else if t >= 1.0 - self.snap {
+            corner(second)
+        } else {
+            p
+        }
+    }
+}
+
+/// Smallest barycentric area (twice) of a triangle of a region's triangulation.
+const MIN_AREA: f64 = 1e-12;
+
+/// Twice the area of a triangle in barycentric coordinates.
+fn bary_area(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
+    ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])).abs()
+}
+
+/// The corner a convex region is fanned from: the first whose fan has no degenerate
+/// triangle. A region often has a point in the middle of a straight side (a crossing on an
+/// input edge whose other side snapped to a corner): fanning from a corner on the line of
+/// that side would give a zero-area triangle, and dropping it leaves the point out of this
+/// triangle's side while the neighbour across the edge uses it — a T-junction, a crack in
+/// the cut mesh and two parts whose seams differ.
+fn fan_apex(ids: &[(u32, [f64; 3])]) -> usize {
+    let n = ids.len();
+    let min_area = |apex: usize| {
+        (1..n - 1)
+            .map(|k| bary_area(ids[apex].1, ids[(apex + k) % n].1, ids[(apex + k + 1) % n].1))
+            .fold(f64::INFINITY, f64::min)
+    };
+    if min_area(0) >= MIN_AREA {
+        return 0;
+    }
+    // No fan without one (several points on one side): the fan losing the least.
+    (0..n)
+        .find(|&a| min_area(a) >= MIN_AREA)
+        .unwrap_or_else(|| (0..n).fold(0, |b, a| if min_area(a) > min_area(b) { a } else { b }))
 }
 
 /// Cuts every triangle along the boundaries of the maximum vote.
@@ -359,14 +416,11 @@ pub(super) fn cut_mesh(
                     (id, p.bary)
                 })
                 .collect();
-            for k in 1..ids.len() - 1 {
-                let (a, b, c) = (ids[0], ids[k], ids[k + 1]);
-                if a.0 == b.0 || b.0 == c.0 || a.0 == c.0 {
-                    continue;
-                }
-                let area =
-                    (b.1[0] - a.1[0]) * (c.1[1] - a.1[1]) - (b.1[1] - a.1[1]) * (c.1[0] - a.1[0]);
-                if area.abs() < 1e-12 {
+            let apex = fan_apex(&ids);
+            let n = ids.len();
+            for k in 1..n - 1 {
+                let (a, b, c) = (ids[apex], ids[(apex + k) % n], ids[(apex + k + 1) % n]);
+                if a.0 == b.0 || b.0 == c.0 || a.0 == c.0 || bary_area(a.1, b.1, c.1) < MIN_AREA {
                     continue;
                 }
                 out.triangles.push([a.0, b.0, c.0]);
@@ -379,4 +433,79 @@ pub(super) fn cut_mesh(
     out.weld_class = class;
     out.welded_count = welded_count;
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    /// Area of the cut mesh's triangles and length of its edges used by one triangle only,
+    /// with the input vertices at `x`.
+    fn area_and_border(cut: &CutMesh, x: &[Vec3]) -> (f32, f32) {
+        let p: Vec<Vec3> = cut.sources.iter().map(|s| s.eval(x)).collect();
+        let mut area = 0.0;
+        let mut uses: HashMap<(u32, u32), u32> = HashMap::new();
+        for t in &cut.triangles {
+            let [a, b, c] = t.map(|i| p[i as usize]);
+            area += 0.5 * (b - a).cross(c - a).length();
+            for k in 0..3 {
+                let (u, v) = (t[k], t[(k + 1) % 3]);
+                *uses.entry((u.min(v), u.max(v))).or_default() += 1;
+            }
+        }
+        let border = uses
+            .iter()
+            .filter(|(_, &n)| n == 1)
+            .map(|(&(u, v), _)| p[u as usize].distance(p[v as usize]))
+            .sum();
+        (area, border)
+    }
+
+    /// The alar crease of the ICT face (README seeds): the tie line crosses the shared edge
+    /// B–C 6.6 % from C, and snaps to C on A–C and to B on D–B, so each triangle of the edge
+    /// keeps the crossing on one side of a straight region side. Dropping it there (a
+    /// zero-area fan triangle) left a T-junction: the seams of the two parts differed and the
+    /// printed walls crossed.
+    #[test]
+    fn alar_crease_has_no_t_junction() {
+        // A, B, C, D in a unit square; triangles A B C and B D C share B–C.
+        let x = [
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+        ];
+        let votes = [
+            0.293_138, 0.706_862, // A: lower part
+            0.492_463, 0.507_537, // B: lower, barely
+            0.500_534, 0.499_466, // C: upper, barely
+            0.727_025, 0.272_975, // D: upper
+        ];
+        let cut = cut_mesh(&[[0, 1, 2], [1, 3, 2]], &[0, 1, 2, 3], 4, &votes, 2, DEFAULT_SNAP);
+        let (area, border) = area_and_border(&cut, &x);
+        assert!((area - 1.0).abs() < 1e-5, "area {area}");
+        assert!((border - 4.0).abs() < 1e-5, "open edges {border}: a crack inside");
+        assert!(cut.triangle_part.contains(&0) && cut.triangle_part.contains(&1));
+    }
+
+    /// A corner of three parts where the tie of two snaps onto a corner: the regions must
+    /// still cover the triangle (snapping during the clip left a hole between the three).
+    #[test]
+    fn three_part_corner_with_a_snapped_tie_has_no_hole() {
+        let x = [
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        ];
+        let votes = [
+            0.345_510, 0.333_369, 0.321_120, // wins part 0, barely
+            0.210_751, 0.221_881, 0.567_368, // part 2
+            0.152_555, 0.432_862, 0.414_583, // part 1
+        ];
+        let cut = cut_mesh(&[[0, 1, 2]], &[0, 1, 2], 3, &votes, 3, DEFAULT_SNAP);
+        let (area, border) = area_and_border(&cut, &x);
+        assert!((area - 0.5).abs() < 1e-6, "area {area}: a hole");
+        assert!((border - (2.0 + 2f32.sqrt())).abs() < 1e-5, "open edges {border}");
+    }
 }
