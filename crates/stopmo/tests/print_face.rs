@@ -325,16 +325,6 @@ fn auto_parts_keep_the_wall_where_a_later_part_is_deeper_at_the_seam() {
     keeps_the_wall(&close_pieces_of(&seg, 5));
 }
 
-#[test]
-fn eight_pieces_keep_the_wall_and_are_keyed_on_every_seam() {
-    let m = close_pieces(8);
-    walls_and_keys(&m, 8);
-    // Not 0 yet (issue 19), but the repair round and the last search must keep clearing
-    // the crossing walls: 308 crossing triangles with neither, 247 with the repair round,
-    // about 20 with the search too.
-    assert!(m.crossing <= 40, "{m:?}");
-}
-
 /// The issue's acceptance: no self-intersecting triangle either.
 fn printable(pieces: usize) {
     let m = close_pieces(pieces);
@@ -343,21 +333,86 @@ fn printable(pieces: usize) {
 }
 
 #[test]
-#[ignore = "issue 19: crossings left where walls meet the front at the temples and the lower back meets the seam wall under the nose (see diagnose_crossings)"]
 fn eight_pieces_are_printable() {
     printable(8);
 }
 
 #[test]
-#[ignore = "issue 19: crossings left where walls meet the front at the temples and the lower back meets the seam wall under the nose (see diagnose_crossings)"]
+#[ignore = "slow in a debug build (minutes): cargo test --release -p toonkit-stopmo --test print_face -- --include-ignored"]
 fn twenty_pieces_are_printable() {
     printable(20);
 }
 
 #[test]
-#[ignore = "issue 19: crossings left where walls meet the front at the temples and the lower back meets the seam wall under the nose (see diagnose_crossings)"]
+#[ignore = "slow in a debug build (minutes): cargo test --release -p toonkit-stopmo --test print_face -- --include-ignored"]
 fn fifty_pieces_are_printable() {
     printable(50);
+}
+
+/// Boundary vertices of every part that lie neither on the input's open border nor on
+/// another part's boundary at the same point, and the seam vertices (on another part's
+/// boundary), over all parts.
+fn unshared_seam_points(seg: &Segmentation) -> (usize, usize) {
+    let key = |p: Vec3| p.to_array().map(f32::to_bits);
+    let boundary = |tris: &[[u32; 3]], at: &dyn Fn(u32) -> [u32; 3]| {
+        let mut uses: HashMap<([u32; 3], [u32; 3]), u32> = HashMap::new();
+        for t in tris {
+            for k in 0..3 {
+                let (a, b) = (at(t[k]), at(t[(k + 1) % 3]));
+                *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        uses.into_iter()
+            .filter(|(_, n)| *n == 1)
+            .flat_map(|((a, b), _)| [a, b])
+            .collect::<std::collections::HashSet<[u32; 3]>>()
+    };
+    let avg_in = face().average_positions();
+    let open = boundary(&face().mesh.triangles, &|v| key(avg_in[v as usize]));
+    let parts: Vec<std::collections::HashSet<[u32; 3]>> = part_animations(seg)
+        .iter()
+        .map(|a| {
+            let avg = a.average_positions();
+            boundary(&a.mesh.triangles, &|v| key(avg[v as usize]))
+        })
+        .collect();
+    let (mut unshared, mut seam) = (0, 0);
+    for (p, points) in parts.iter().enumerate() {
+        for k in points {
+            if parts
+                .iter()
+                .enumerate()
+                .any(|(q, o)| q != p && o.contains(k))
+            {
+                seam += 1;
+            } else if !open.contains(k) {
+                unshared += 1;
+            }
+        }
+    }
+    (unshared, seam)
+}
+
+/// The seams of the parts are one curve: every point where a part ends is on another part
+/// or on the face's own open border. The cut left T-junctions (a crossing kept on one side
+/// of an input edge, dropped on the other) and, at a three-part corner, a hole: 7 points of
+/// one part missing from the other on the README's cut, 1 with three automatic parts, and
+/// the printed walls crossed there (the nose wing, the lips).
+#[test]
+fn seams_of_the_parts_are_one_curve() {
+    let (unshared, seam) = unshared_seam_points(segmentation());
+    assert_eq!(
+        unshared, 0,
+        "README cut: {unshared} unshared of {seam} seam points"
+    );
+    assert!(seam >= 2 * 150, "README cut: {seam} seam points");
+    let parts = auto_parts(face(), 3).expect("auto parts");
+    let seg = segment(face(), &parts, &SegmentOptions::default()).expect("segment");
+    let (unshared, seam) = unshared_seam_points(&seg);
+    assert_eq!(
+        unshared, 0,
+        "three parts: {unshared} unshared of {seam} seam points"
+    );
 }
 
 /// Welded open-border vertices of the cut mesh that are not on the seam.
@@ -432,6 +487,9 @@ fn homogenization_keeps_open_borders_and_pieces_agree_there() {
     .expect("library");
     let border_set: std::collections::HashSet<u32> = border.iter().copied().collect();
     let mut worst_excess = 0.0f64;
+    // Borders moving less than this in the input count as still (mm).
+    const STILL_MM: f64 = 0.05;
+    let (mut worst_still, mut worst_moving) = (0.0f64, 0.0f64);
     for (p, part) in parts.iter().enumerate() {
         for (local, &v) in part.vertices.iter().enumerate() {
             if !border_set.contains(&v) {
@@ -454,9 +512,25 @@ fn homogenization_keeps_open_borders_and_pieces_agree_there() {
                 .map(|q| q[local])
                 .collect();
             let between = spread(&pieces);
-            worst_excess = worst_excess.max(f64::from(between - own) * mm);
+            let excess = f64::from(between - own) * mm;
+            if f64::from(own) * mm <= STILL_MM {
+                worst_still = worst_still.max(excess);
+            } else {
+                worst_moving = worst_moving.max(excess / (f64::from(own) * mm));
+            }
+            worst_excess = worst_excess.max(excess);
+            // Where the input is still (the neck, the scalp) the pieces stay within 0.01 mm
+            // of each other — a fifth of a 0.05 mm printer resolution — so they seat on one
+            // body. Where it moves (the inner lip edge, 5 mm) the pieces are not convex
+            // combinations of frames (StopShop Eq. 10's temporal term extrapolates), so they
+            // may spread a few per cent more than the input: 2.9 % at 20 pieces.
+            let allowed = if f64::from(own) * mm <= STILL_MM {
+                0.01
+            } else {
+                0.01 + 0.05 * f64::from(own) * mm
+            };
             assert!(
-                f64::from(between - own) * mm <= 0.01, // below a 0.05 mm printer resolution
+                excess <= allowed,
                 "part {}: border vertex {v}: pieces differ by {:.4} mm, input moves {:.4} mm",
                 part.name,
                 f64::from(between) * mm,
@@ -464,7 +538,11 @@ fn homogenization_keeps_open_borders_and_pieces_agree_there() {
             );
         }
     }
-    eprintln!("pieces' border spread minus input spread: at most {worst_excess:.2e} mm");
+    eprintln!(
+        "pieces' border spread minus input spread: at most {worst_excess:.2e} mm; \
+         {worst_still:.2e} mm where the input is still, {:.2} % of the motion where it moves",
+        worst_moving * 100.0
+    );
 }
 
 #[test]

@@ -298,7 +298,13 @@ fn fan_apex(ids: &[(u32, [f64; 3])]) -> usize {
     let n = ids.len();
     let min_area = |apex: usize| {
         (1..n - 1)
-            .map(|k| bary_area(ids[apex].1, ids[(apex + k) % n].1, ids[(apex + k + 1) % n].1))
+            .map(|k| {
+                bary_area(
+                    ids[apex].1,
+                    ids[(apex + k) % n].1,
+                    ids[(apex + k + 1) % n].1,
+                )
+            })
             .fold(f64::INFINITY, f64::min)
     };
     if min_area(0) >= MIN_AREA {
@@ -482,10 +488,20 @@ mod tests {
             0.500_534, 0.499_466, // C: upper, barely
             0.727_025, 0.272_975, // D: upper
         ];
-        let cut = cut_mesh(&[[0, 1, 2], [1, 3, 2]], &[0, 1, 2, 3], 4, &votes, 2, DEFAULT_SNAP);
+        let cut = cut_mesh(
+            &[[0, 1, 2], [1, 3, 2]],
+            &[0, 1, 2, 3],
+            4,
+            &votes,
+            2,
+            DEFAULT_SNAP,
+        );
         let (area, border) = area_and_border(&cut, &x);
         assert!((area - 1.0).abs() < 1e-5, "area {area}");
-        assert!((border - 4.0).abs() < 1e-5, "open edges {border}: a crack inside");
+        assert!(
+            (border - 4.0).abs() < 1e-5,
+            "open edges {border}: a crack inside"
+        );
         assert!(cut.triangle_part.contains(&0) && cut.triangle_part.contains(&1));
     }
 
@@ -506,6 +522,9 @@ mod tests {
         let cut = cut_mesh(&[[0, 1, 2]], &[0, 1, 2], 3, &votes, 3, DEFAULT_SNAP);
         let (area, border) = area_and_border(&cut, &x);
         assert!((area - 0.5).abs() < 1e-6, "area {area}: a hole");
-        assert!((border - (2.0 + 2f32.sqrt())).abs() < 1e-5, "open edges {border}");
+        assert!(
+            (border - (2.0 + 2f32.sqrt())).abs() < 1e-5,
+            "open edges {border}"
+        );
     }
 }
