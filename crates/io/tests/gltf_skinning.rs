@@ -137,3 +137,38 @@ fn cesium_man_walks_on_the_ground() {
         .fold(0.0, f32::max);
     assert!(d > 0.05);
 }
+
+/// Influence sets whose counts differ from the positions', or from each other, are an error
+/// naming them (the joints and the geometry are read on different threads: the counts are
+/// checked after both, and between sets before they are joined per vertex).
+#[test]
+fn influence_counts_that_differ_are_an_error() {
+    let path = data("characters/SimpleSkin.gltf");
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(tkio::gltf::read_bytes(text.as_bytes()).is_ok());
+    let doc: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let attrs = &doc["meshes"][0]["primitives"][0]["attributes"];
+    let weights = attrs["WEIGHTS_0"].as_u64().unwrap() as usize;
+    // A copy of WEIGHTS_0's accessor one vertex short.
+    let mut short = doc["accessors"][weights].clone();
+    short["count"] = (short["count"].as_u64().unwrap() - 1).into();
+    let short_index = doc["accessors"].as_array().unwrap().len();
+
+    // One set, short of the positions.
+    let mut one = doc.clone();
+    one["accessors"].as_array_mut().unwrap().push(short.clone());
+    one["meshes"][0]["primitives"][0]["attributes"]["WEIGHTS_0"] = short_index.into();
+    // Two sets, the second one short of the first.
+    let mut two = doc.clone();
+    two["accessors"].as_array_mut().unwrap().push(short);
+    let a = &mut two["meshes"][0]["primitives"][0]["attributes"];
+    a["JOINTS_1"] = a["JOINTS_0"].clone();
+    a["WEIGHTS_1"] = short_index.into();
+    for bad in [one, two] {
+        let err = tkio::gltf::read_bytes(bad.to_string().as_bytes()).unwrap_err();
+        assert!(
+            err.to_string().contains("JOINTS/WEIGHTS count differs"),
+            "{err}"
+        );
+    }
+}

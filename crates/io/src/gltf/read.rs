@@ -225,106 +225,28 @@ fn read_mesh(mesh: &gltf::Mesh, buffers: &[&[u8]]) -> Result<SceneMesh> {
         ) {
             continue; // points and lines carry no surface
         }
-        let reader = prim.reader(|b| buffers.get(b.index()).copied());
         let Some(pos_acc) = prim.get(&gltf::Semantic::Positions) else {
             continue;
         };
-        // KHR_mesh_quantization: integer positions, normals, texture coordinates.
-        let positions: Vec<Vec3> = vec3s(&pos_acc, buffers, "POSITION")?
-            .into_iter()
-            .map(Vec3::from_array)
-            .collect();
-        let n = positions.len();
-        let indices: Vec<u32> = match prim.indices() {
-            Some(acc) => {
-                expect(
-                    &acc,
-                    &[DataType::U8, DataType::U16, DataType::U32],
-                    Dimensions::Scalar,
-                    "indices",
-                )?;
-                reader
-                    .read_indices()
-                    .ok_or_else(|| outside("index"))?
-                    .into_u32()
-                    .collect()
-            }
-            None => (0..n as u32).collect(),
-        };
-        let triangles = assemble(mode, &indices);
-        let mut part = Mesh::new(name.clone(), positions, triangles);
-        if let Some(acc) = prim.get(&gltf::Semantic::Normals) {
-            let normals = vec3s(&acc, buffers, "NORMAL")?;
-            part.normals = Some(normals.into_iter().map(Vec3::from_array).collect());
-        }
-        if let Some(acc) = prim.get(&gltf::Semantic::TexCoords(0)) {
-            part.uvs = Some(vec2s(&acc, buffers, "TEXCOORD_0")?);
-        }
-        // Further sets (TEXCOORD_1, …) are numbered without gaps (glTF 2.0 §3.7.2.1).
-        let mut set = 1;
-        while let Some(acc) = prim.get(&gltf::Semantic::TexCoords(set)) {
-            let name = format!("TEXCOORD_{set}");
-            part.extra_uvs.push(vec2s(&acc, buffers, &name)?);
-            set += 1;
-        }
-        if let Some(acc) = prim.get(&gltf::Semantic::Colors(0)) {
-            let dims = acc.dimensions();
-            if dims != Dimensions::Vec3 && dims != Dimensions::Vec4 {
-                return Err(bad("COLOR_0 must be VEC3 or VEC4"));
-            }
-            expect(
-                &acc,
-                &[DataType::U8, DataType::U16, DataType::F32],
-                dims,
-                "COLOR_0",
-            )?;
-            part.colors = Some(
-                reader
-                    .read_colors(0)
-                    .ok_or_else(|| outside("COLOR_0"))?
-                    .into_rgba_f32()
-                    .collect(),
-            );
-        }
-        part.attributes = crate::gltf::attributes::read_attributes(&prim, buffers, n)?;
-        check_len(&part, n)?;
-        // Joint influences over every JOINTS_n / WEIGHTS_n pair, read set by set and joined
-        // per vertex below (no list per vertex).
-        let mut sets: Vec<InfluenceSet> = Vec::new();
-        let mut set = 0;
-        while let (Some(ja), Some(wa)) = (
-            prim.get(&gltf::Semantic::Joints(set)),
-            prim.get(&gltf::Semantic::Weights(set)),
-        ) {
-            expect(
-                &ja,
-                &[DataType::U8, DataType::U16],
-                Dimensions::Vec4,
-                "JOINTS",
-            )?;
-            expect(
-                &wa,
-                &[DataType::U8, DataType::U16, DataType::F32],
-                Dimensions::Vec4,
-                "WEIGHTS",
-            )?;
-            let j: Vec<[u16; 4]> = reader
-                .read_joints(set)
-                .ok_or_else(|| outside("JOINTS"))?
-                .into_u16()
-                .collect();
-            let w: Vec<[f32; 4]> = reader
-                .read_weights(set)
-                .ok_or_else(|| outside("WEIGHTS"))?
-                .into_f32()
-                .collect();
-            if j.len() != n || w.len() != n {
+        // The geometry and the joint influences are independent reads of the buffers (about
+        // half of the load each): one core each, instead of the load's serial time on one
+        // (issue #14).
+        let (geometry, influences) = rayon::join(
+            || primitive_geometry(&prim, mode, &pos_acc, buffers, &name),
+            || primitive_influences(&prim, buffers),
+        );
+        let part = geometry?;
+        let n = part.positions.len();
+        let part_weights = match influences? {
+            Some(w) if w.vertex_count() != n => {
                 return Err(bad("JOINTS/WEIGHTS count differs from POSITION count"));
             }
-            sets.push((j, w));
-            any_weights = true;
-            set += 1;
-        }
+            Some(w) => {
+                any_weights = true;
+                w
+            }
+            None => VertexWeights::from_influences((0..n).map(|_| std::iter::empty())),
+        };
         // Morph targets: all primitives of a mesh have the same number.
         let mut targets = Vec::new();
         for t in prim.morph_targets() {
@@ -361,11 +283,7 @@ fn read_mesh(mesh: &gltf::Mesh, buffers: &[&[u8]]) -> Result<SceneMesh> {
         for (t, d) in out.morph_targets.iter_mut().zip(targets) {
             t.positions.extend(d);
         }
-        let sets = &sets;
-        weights.append(&VertexWeights::from_influences((0..n).map(|v| {
-            sets.iter()
-                .flat_map(move |(j, w)| j[v].iter().zip(&w[v]).map(|(&a, &b)| (u32::from(a), b)))
-        })));
+        weights.append(&part_weights);
         if first {
             out.mesh = part;
         } else {
@@ -380,6 +298,131 @@ fn read_mesh(mesh: &gltf::Mesh, buffers: &[&[u8]]) -> Result<SceneMesh> {
     out.default_weights = mesh.weights().map(<[f32]>::to_vec).unwrap_or_default();
     out.default_weights.resize(out.morph_targets.len(), 0.0);
     Ok(out)
+}
+
+/// The mesh of one primitive: positions, triangles and every vertex attribute but the joint
+/// influences (see [`primitive_influences`]) and morph targets.
+fn primitive_geometry(
+    prim: &gltf::Primitive,
+    mode: Mode,
+    pos_acc: &gltf::Accessor,
+    buffers: &[&[u8]],
+    name: &str,
+) -> Result<Mesh> {
+    let reader = prim.reader(|b| buffers.get(b.index()).copied());
+    // KHR_mesh_quantization: integer positions, normals, texture coordinates.
+    let positions: Vec<Vec3> = vec3s(pos_acc, buffers, "POSITION")?
+        .into_iter()
+        .map(Vec3::from_array)
+        .collect();
+    let n = positions.len();
+    let indices: Vec<u32> = match prim.indices() {
+        Some(acc) => {
+            expect(
+                &acc,
+                &[DataType::U8, DataType::U16, DataType::U32],
+                Dimensions::Scalar,
+                "indices",
+            )?;
+            reader
+                .read_indices()
+                .ok_or_else(|| outside("index"))?
+                .into_u32()
+                .collect()
+        }
+        None => (0..n as u32).collect(),
+    };
+    let triangles = assemble(mode, &indices);
+    let mut part = Mesh::new(name.to_string(), positions, triangles);
+    if let Some(acc) = prim.get(&gltf::Semantic::Normals) {
+        let normals = vec3s(&acc, buffers, "NORMAL")?;
+        part.normals = Some(normals.into_iter().map(Vec3::from_array).collect());
+    }
+    if let Some(acc) = prim.get(&gltf::Semantic::TexCoords(0)) {
+        part.uvs = Some(vec2s(&acc, buffers, "TEXCOORD_0")?);
+    }
+    // Further sets (TEXCOORD_1, …) are numbered without gaps (glTF 2.0 §3.7.2.1).
+    let mut set = 1;
+    while let Some(acc) = prim.get(&gltf::Semantic::TexCoords(set)) {
+        let name = format!("TEXCOORD_{set}");
+        part.extra_uvs.push(vec2s(&acc, buffers, &name)?);
+        set += 1;
+    }
+    if let Some(acc) = prim.get(&gltf::Semantic::Colors(0)) {
+        let dims = acc.dimensions();
+        if dims != Dimensions::Vec3 && dims != Dimensions::Vec4 {
+            return Err(bad("COLOR_0 must be VEC3 or VEC4"));
+        }
+        expect(
+            &acc,
+            &[DataType::U8, DataType::U16, DataType::F32],
+            dims,
+            "COLOR_0",
+        )?;
+        part.colors = Some(
+            reader
+                .read_colors(0)
+                .ok_or_else(|| outside("COLOR_0"))?
+                .into_rgba_f32()
+                .collect(),
+        );
+    }
+    part.attributes = crate::gltf::attributes::read_attributes(prim, buffers, n)?;
+    check_len(&part, n)?;
+    Ok(part)
+}
+
+/// The joint influences of one primitive, `None` when it has no `JOINTS_n` / `WEIGHTS_n`
+/// pair.
+fn primitive_influences(
+    prim: &gltf::Primitive,
+    buffers: &[&[u8]],
+) -> Result<Option<VertexWeights>> {
+    let reader = prim.reader(|b| buffers.get(b.index()).copied());
+    // Joint influences over every JOINTS_n / WEIGHTS_n pair, read set by set and joined
+    // per vertex (no list per vertex).
+    let mut sets: Vec<InfluenceSet> = Vec::new();
+    let mut set = 0;
+    while let (Some(ja), Some(wa)) = (
+        prim.get(&gltf::Semantic::Joints(set)),
+        prim.get(&gltf::Semantic::Weights(set)),
+    ) {
+        expect(
+            &ja,
+            &[DataType::U8, DataType::U16],
+            Dimensions::Vec4,
+            "JOINTS",
+        )?;
+        expect(
+            &wa,
+            &[DataType::U8, DataType::U16, DataType::F32],
+            Dimensions::Vec4,
+            "WEIGHTS",
+        )?;
+        let j: Vec<[u16; 4]> = reader
+            .read_joints(set)
+            .ok_or_else(|| outside("JOINTS"))?
+            .into_u16()
+            .collect();
+        let w: Vec<[f32; 4]> = reader
+            .read_weights(set)
+            .ok_or_else(|| outside("WEIGHTS"))?
+            .into_f32()
+            .collect();
+        sets.push((j, w));
+        set += 1;
+    }
+    let Some(len) = sets.first().map(|(j, _)| j.len()) else {
+        return Ok(None);
+    };
+    if sets.iter().any(|(j, w)| j.len() != len || w.len() != len) {
+        return Err(bad("JOINTS/WEIGHTS count differs from POSITION count"));
+    }
+    let sets = &sets;
+    Ok(Some(VertexWeights::from_influences((0..len).map(|v| {
+        sets.iter()
+            .flat_map(move |(j, w)| j[v].iter().zip(&w[v]).map(|(&a, &b)| (u32::from(a), b)))
+    }))))
 }
 
 /// One `JOINTS_n` / `WEIGHTS_n` pair of a primitive: four joint slots and weights per vertex.
