@@ -142,10 +142,14 @@ fn commit(tmp: &Path, path: &Path) -> Result<()> {
 /// on the benchmark VM (issue #14), against 0.2 ms for the exchange and the removal of the old
 /// file. The price: like a fresh file, the replaced one is no longer written back early, so
 /// after a crash it may be empty on ext4 too (see the module; [`SYNC_ENV`] syncs it first).
+///
+/// Only a regular file is exchanged: a directory (or anything else) at the target would trade
+/// places with the staged file and end up under its name, where a rename fails instead.
 #[cfg(target_os = "linux")]
 fn swapped_into_place(tmp: &Path, path: &Path) -> bool {
     use rustix::fs::{renameat_with, RenameFlags, CWD};
-    renameat_with(CWD, tmp, CWD, path, RenameFlags::EXCHANGE).is_ok()
+    fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_file())
+        && renameat_with(CWD, tmp, CWD, path, RenameFlags::EXCHANGE).is_ok()
 }
 
 /// Only Linux exchanges names in one step: elsewhere the caller renames.
@@ -236,6 +240,28 @@ mod tests {
         assert_eq!(fs::read(&p).unwrap(), b"two");
         assert_eq!(fs::read(&link).unwrap(), b"one");
         assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 2);
+    }
+
+    /// A directory where the output should go is an error, and stays where it is with its
+    /// contents (an exchange of names would have moved it under the temporary name).
+    #[test]
+    fn a_directory_at_the_target_is_an_error_and_stays() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("out.npy");
+        fs::create_dir(&p).unwrap();
+        fs::write(p.join("inside.txt"), b"keep").unwrap();
+        assert!(write_atomic(&p, b"new").is_err());
+        assert_eq!(fs::read(p.join("inside.txt")).unwrap(), b"keep");
+        assert_eq!(
+            fs::read_dir(dir.path()).unwrap().count(),
+            1,
+            "no temporary file left"
+        );
+        // The exchange itself refuses (the check before staging could race).
+        let tmp = dir.path().join("staged");
+        fs::write(&tmp, b"new").unwrap();
+        assert!(!swapped_into_place(&tmp, &p));
+        assert_eq!(fs::read(p.join("inside.txt")).unwrap(), b"keep");
     }
 
     #[test]
