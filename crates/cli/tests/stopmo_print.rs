@@ -98,7 +98,10 @@ fn readme_example_prints_and_a_second_clip_extends_the_library() {
     let (solids, crossing) = assert_printable(&first);
     assert_eq!(solids, 16);
     // Issue 19's acceptance: no solid crosses itself (MeshLab agrees: .ci/meshlab.sh).
-    assert_eq!(crossing, 0, "crossing triangles in the README example's solids");
+    assert_eq!(
+        crossing, 0,
+        "crossing triangles in the README example's solids"
+    );
     let rep = report(&first);
     let printing = &rep["printing"];
     // The report counts the crossings of the written solids, and says so in a warning.
