@@ -186,7 +186,12 @@ pub fn build_library(parts: &[PartInput<'_>], opts: &LibraryOptions) -> Result<L
             Method::Uniform => p.uniform(d, lambda)?,
             _ => p.solve(d, &method_opts)?,
         };
-        if opts.method == Method::KMeans {
+        let confine = opts.method == Method::StopShop && lambda > 0.0;
+        if confine {
+            // The velocity term lets pieces leave the input's range; not where a part ends.
+            p.confine_borders(&mut s);
+        }
+        if confine || opts.method == Method::KMeans {
             s.energy = evaluate(p, &s.pieces, &s.labels, lambda).0;
         }
         Ok(s)

@@ -44,6 +44,7 @@
 
 mod assembly;
 mod back_surface;
+mod borders;
 mod build;
 mod error;
 mod fabricate;
@@ -69,6 +70,7 @@ pub use back_surface::{
     DEFAULT_BACK_SMOOTHING_ITERATIONS, DEFAULT_CAP_FRACTION, DEFAULT_NORMAL_SMOOTHING_MM,
     DEFAULT_REPAIR_ROUNDS, DEFAULT_RESOLVE_ROUNDS,
 };
+pub use borders::BORDER_RINGS;
 pub use build::{
     build_library, print_scale, Library, LibraryOptions, LibrarySize, Method, PartInput, PartResult,
 };
