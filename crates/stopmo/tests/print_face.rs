@@ -317,12 +317,19 @@ fn keeps_the_wall(m: &Measured) {
 /// part's surface lies deeper at a seam than the earlier part's back point there, taking
 /// that point as is left 1.29 and 0.90 mm walls under the 1.5 mm minimum; the shared seam
 /// points now move deeper in every part that meets there (and [`shells`] checks that the
-/// parts still agree on them).
+/// parts still agree on them). Every seam gets two keys on each side there too.
 #[test]
 fn auto_parts_keep_the_wall_where_a_later_part_is_deeper_at_the_seam() {
     let parts = auto_parts(face(), 3).expect("auto parts");
     let seg = segment(face(), &parts, &SegmentOptions::default()).expect("segment");
-    keeps_the_wall(&close_pieces_of(&seg, 5));
+    let m = close_pieces_of(&seg, 5);
+    keeps_the_wall(&m);
+    // Every seam keyed twice on each side, the short one between parts 2 and 3 (15 mm) too:
+    // its strict band had room for one key.
+    let key = KeyOptions::for_print_height(HEIGHT_MM);
+    assert!(m.min_keys_per_seam >= 2, "{m:?}");
+    assert!(m.min_seam_key_spacing >= 2.0 * key.radius_mm, "{m:?}");
+    assert!(m.min_key_spread >= key.radius_mm * key.radius_mm, "{m:?}");
 }
 
 /// The acceptance: no self-intersecting triangle either.

@@ -26,6 +26,10 @@ pub const DEFAULT_KEYS_PER_SEAM: usize = 2;
 pub const KEY_RADIUS_PER_HEIGHT: f64 = 0.035;
 /// Key height as a fraction of its radius.
 pub const KEY_HEIGHT_PER_RADIUS: f64 = 0.5;
+/// Where a seam's keys may go, tried in order until one fits: how much nearer another
+/// boundary may be than the seam, and how far apart keys stay (both in key radii). Two radii
+/// apart, two domes just touch.
+const SEAM_KEY_TRIES: [(f32, f32); 3] = [(0.25, 2.5), (1.0, 2.5), (1.0, 2.0)];
 /// Relief of an embossed ID in millimetres.
 pub const DEFAULT_ID_RELIEF_MM: f64 = 0.4;
 
@@ -184,21 +188,25 @@ impl PartShell {
                 if pts.is_empty() {
                     continue;
                 }
-                // A band just inside the seam: the seam is the nearest boundary.
+                // A band just inside the seam: the seam is the nearest boundary (within
+                // `margin` radii).
                 let from_seam = distances(self.back(), &pts);
-                let band: Vec<usize> = (0..n)
-                    .filter(|&v| allowed[v] && from_seam[v] <= from_boundary[v] + 0.25 * r)
-                    .filter(|&v| from_seam[v] <= 3.0 * r)
-                    .collect();
+                let band = |margin: f32| -> Vec<usize> {
+                    (0..n)
+                        .filter(|&v| allowed[v] && from_seam[v] <= from_boundary[v] + margin * r)
+                        .filter(|&v| from_seam[v] <= 3.0 * r)
+                        .collect()
+                };
+                let bands = SEAM_KEY_TRIES.map(|(margin, _)| band(margin));
                 for _ in 0..opts.per_seam {
                     let near = distances(self.back(), &centres);
                     // Farthest from the keys already placed (the first: from the seam's
                     // centroid, i.e. towards one end), preferring the inner edge of the band.
                     let anchor = pts.iter().copied().sum::<Vec3>() / pts.len() as f32;
-                    let best =
+                    let pick = |band: &[usize], spacing: f32| {
                         band.iter()
                             .copied()
-                            .filter(|&v| near[v] >= 2.5 * r)
+                            .filter(|&v| near[v] >= spacing * r)
                             .max_by(|&a, &b| {
                                 let s = |v: usize| {
                                     let d = if centres.is_empty() {
@@ -209,7 +217,15 @@ impl PartShell {
                                     d - (from_seam[v] - 2.0 * r).abs()
                                 };
                                 s(a).total_cmp(&s(b))
-                            });
+                            })
+                    };
+                    // A short seam between two others (three automatic parts on the face:
+                    // 15 mm) has room for one key in the strict band: nearer the seams it
+                    // meets, then closer together, before it gets fewer keys.
+                    let best = SEAM_KEY_TRIES
+                        .iter()
+                        .zip(&bands)
+                        .find_map(|(&(_, spacing), band)| pick(band, spacing));
                     let Some(v) = best else { break };
                     keys.push(key_at(v, Some(i)));
                     centres.push(self.back()[v]);
