@@ -10,33 +10,35 @@
 //! leaves their hull, so pieces differ by no more than the input moves — blending back to the
 //! Eq. 10 solution over [`BORDER_RINGS`] rings of vertices, so no step appears.
 
-use std::collections::HashMap;
-
 use glam::{DVec3, Vec3};
 
 use super::problem::PartProblem;
 use super::solver::PartSolution;
+use crate::segment::{open_border, Topology, Weld};
 
 /// Rings of vertices over which a piece blends from the frames' mean at the part's border
 /// back to the StopShop Eq. 10 solution.
 pub const BORDER_RINGS: usize = 3;
 
 impl PartProblem<'_> {
+    /// The vertices within [`BORDER_RINGS`] of the part's border and the weight of the
+    /// frames' mean there (see [`PartProblem::confine_borders`]); once per part.
+    pub(crate) fn border_weights(&self) -> Vec<(usize, f32)> {
+        border_weights(&self.anim.mesh.positions, &self.anim.mesh.triangles)
+            .into_iter()
+            .enumerate()
+            .filter(|(_, w)| *w > 0.0)
+            .collect()
+    }
+
     /// Confines the free pieces of `solution` at the part's border (see the module): the
-    /// border's vertices take the mean of the frames each piece shows, their rings a blend.
+    /// vertices of `near` ([`PartProblem::border_weights`]) take the mean of the frames each
+    /// piece shows, by their weight.
     ///
     /// # Performance
-    /// One pass over the frames for the vertices within [`BORDER_RINGS`] of the border.
-    pub(crate) fn confine_borders(&self, solution: &mut PartSolution) {
+    /// One pass over the frames for the vertices of `near`.
+    pub(crate) fn confine_borders(&self, solution: &mut PartSolution, near: &[(usize, f32)]) {
         let anim = self.anim;
-        let m = anim.vertex_count();
-        let weights = border_weights(&anim.mesh.positions, &anim.mesh.triangles);
-        let near: Vec<(usize, f32)> = weights
-            .iter()
-            .enumerate()
-            .filter(|(_, w)| **w > 0.0)
-            .map(|(v, w)| (v, *w))
-            .collect();
         if near.is_empty() {
             return;
         }
@@ -53,17 +55,18 @@ impl PartProblem<'_> {
             let x = anim.frame(f);
             for (s, &(v, _)) in sums[k * near.len()..(k + 1) * near.len()]
                 .iter_mut()
-                .zip(&near)
+                .zip(near)
             {
                 *s += x[v].as_dvec3();
             }
         }
+        let m = anim.vertex_count();
         for (k, piece) in solution.pieces.iter_mut().enumerate().skip(self.fixed) {
             if counts[k] == 0 || piece.len() != m {
                 continue;
             }
             let n = counts[k] as f64;
-            for (s, &(v, w)) in sums[k * near.len()..(k + 1) * near.len()].iter().zip(&near) {
+            for (s, &(v, w)) in sums[k * near.len()..(k + 1) * near.len()].iter().zip(near) {
                 let (mean, now) = (*s / n, piece[v].as_dvec3());
                 piece[v] = (now + (mean - now) * f64::from(w)).as_vec3();
             }
@@ -75,47 +78,26 @@ impl PartProblem<'_> {
 /// welding vertices at the same position, so UV seams are not borders), falling linearly to
 /// 0 at [`BORDER_RINGS`] rings from it.
 fn border_weights(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<f32> {
-    let n = positions.len();
-    let mut class = vec![0u32; n];
-    let mut by_bits: HashMap<[u32; 3], u32> = HashMap::new();
-    for (v, p) in positions.iter().enumerate() {
-        let next = by_bits.len() as u32;
-        class[v] = *by_bits
-            .entry(p.to_array().map(f32::to_bits))
-            .or_insert(next);
-    }
-    let classes = by_bits.len();
-    let mut uses: HashMap<(u32, u32), u32> = HashMap::new();
-    let mut adjacency: Vec<Vec<u32>> = vec![Vec::new(); classes];
-    for t in triangles {
-        if t.iter().any(|&v| v as usize >= n) {
-            continue;
-        }
-        for k in 0..3 {
-            let (a, b) = (class[t[k] as usize], class[t[(k + 1) % 3] as usize]);
-            if a != b {
-                *uses.entry((a.min(b), a.max(b))).or_default() += 1;
-                adjacency[a as usize].push(b);
-                adjacency[b as usize].push(a);
-            }
-        }
-    }
-    let mut ring = vec![usize::MAX; classes];
+    let weld = Weld::new(positions, 0.0);
+    let tris: Vec<[u32; 3]> = triangles
+        .iter()
+        .filter(|t| t.iter().all(|&v| (v as usize) < positions.len()))
+        .copied()
+        .collect();
+    let tris = weld.triangles(&tris);
+    let neighbors = Topology::new(weld.len(), &tris).neighbors;
+    let mut ring = vec![usize::MAX; weld.len()];
     let mut front: Vec<u32> = Vec::new();
-    for (&(a, b), &u) in &uses {
-        if u == 1 {
-            for c in [a, b] {
-                if ring[c as usize] == usize::MAX {
-                    ring[c as usize] = 0;
-                    front.push(c);
-                }
-            }
+    for (c, on) in open_border(weld.len(), &tris).into_iter().enumerate() {
+        if on {
+            ring[c] = 0;
+            front.push(c as u32);
         }
     }
     for d in 1..BORDER_RINGS {
         let mut next = Vec::new();
         for &c in &front {
-            for &w in &adjacency[c as usize] {
+            for &w in neighbors.row(c as usize) {
                 if ring[w as usize] == usize::MAX {
                     ring[w as usize] = d;
                     next.push(w);
@@ -124,7 +106,7 @@ fn border_weights(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<f32> {
         }
         front = next;
     }
-    class
+    weld.class
         .iter()
         .map(|&c| match ring[c as usize] {
             usize::MAX => 0.0,

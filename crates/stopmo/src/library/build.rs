@@ -180,16 +180,27 @@ pub fn build_library(parts: &[PartInput<'_>], opts: &LibraryOptions) -> Result<L
         },
         _ => opts.solve,
     };
+    let confine = opts.method == Method::StopShop && lambda > 0.0;
+    // Where each part ends (once per part: the searches below solve many sizes).
+    let borders: Vec<Vec<(usize, f32)>> = problems
+        .iter()
+        .map(|p| {
+            if confine {
+                p.border_weights()
+            } else {
+                Vec::new()
+            }
+        })
+        .collect();
     let solve_one = |i: usize, d: usize| -> Result<PartSolution> {
         let p = &problems[i];
         let mut s = match opts.method {
             Method::Uniform => p.uniform(d, lambda)?,
             _ => p.solve(d, &method_opts)?,
         };
-        let confine = opts.method == Method::StopShop && lambda > 0.0;
         if confine {
             // The velocity term lets pieces leave the input's range; not where a part ends.
-            p.confine_borders(&mut s);
+            p.confine_borders(&mut s, &borders[i]);
         }
         if confine || opts.method == Method::KMeans {
             s.energy = evaluate(p, &s.pieces, &s.labels, lambda).0;

@@ -26,10 +26,13 @@ pub const DEFAULT_KEYS_PER_SEAM: usize = 2;
 pub const KEY_RADIUS_PER_HEIGHT: f64 = 0.035;
 /// Key height as a fraction of its radius.
 pub const KEY_HEIGHT_PER_RADIUS: f64 = 0.5;
-/// Where a seam's keys may go, tried in order until one fits: how much nearer another
-/// boundary may be than the seam, and how far apart keys stay (both in key radii). Two radii
-/// apart, two domes just touch.
-const SEAM_KEY_TRIES: [(f32, f32); 3] = [(0.25, 2.5), (1.0, 2.5), (1.0, 2.0)];
+/// How much nearer another boundary may be than the seam where a seam's keys go (key
+/// radii): the strict band first, then the loose one.
+const SEAM_BAND_MARGINS: [f32; 2] = [0.25, 1.0];
+/// Where a seam's keys may go, tried in order until one fits: the band (index into
+/// [`SEAM_BAND_MARGINS`]) and how far apart keys stay (key radii; two radii apart, two domes
+/// just touch).
+const SEAM_KEY_TRIES: [(usize, f32); 3] = [(0, 2.5), (1, 2.5), (1, 2.0)];
 /// Relief of an embossed ID in millimetres.
 pub const DEFAULT_ID_RELIEF_MM: f64 = 0.4;
 
@@ -197,7 +200,7 @@ impl PartShell {
                         .filter(|&v| from_seam[v] <= 3.0 * r)
                         .collect()
                 };
-                let bands = SEAM_KEY_TRIES.map(|(margin, _)| band(margin));
+                let bands = SEAM_BAND_MARGINS.map(band);
                 for _ in 0..opts.per_seam {
                     let near = distances(self.back(), &centres);
                     // Farthest from the keys already placed (the first: from the seam's
@@ -224,8 +227,7 @@ impl PartShell {
                     // meets, then closer together, before it gets fewer keys.
                     let best = SEAM_KEY_TRIES
                         .iter()
-                        .zip(&bands)
-                        .find_map(|(&(_, spacing), band)| pick(band, spacing));
+                        .find_map(|&(b, spacing)| pick(&bands[b], spacing));
                     let Some(v) = best else { break };
                     keys.push(key_at(v, Some(i)));
                     centres.push(self.back()[v]);

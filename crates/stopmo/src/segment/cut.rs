@@ -113,6 +113,15 @@ fn corner(k: usize) -> Pt {
     }
 }
 
+/// Removes repeated points of a closed polygon (consecutive ones, and the last when it
+/// repeats the first).
+fn dedup_ring(poly: &mut Vec<Pt>) {
+    poly.dedup_by(|a, b| a.key == b.key);
+    while poly.len() > 1 && poly.first().map(|p| p.key) == poly.last().map(|p| p.key) {
+        poly.pop();
+    }
+}
+
 /// Per-triangle scores `score[c * parts + j]` of the three corners.
 struct Tri<'a> {
     parts: usize,
@@ -239,17 +248,11 @@ impl Tri<'_> {
                     out.push(self.intersect(p, q, fp, fq, j, l));
                 }
             }
-            out.dedup_by(|a, b| a.key == b.key);
-            while out.len() > 1 && out.first().map(|p| p.key) == out.last().map(|p| p.key) {
-                out.pop();
-            }
+            dedup_ring(&mut out);
             poly = out;
         }
         let mut poly: Vec<Pt> = poly.into_iter().map(|p| self.snapped(p)).collect();
-        poly.dedup_by(|a, b| a.key == b.key);
-        while poly.len() > 1 && poly.first().map(|p| p.key) == poly.last().map(|p| p.key) {
-            poly.pop();
-        }
+        dedup_ring(&mut poly);
         poly
     }
 

@@ -91,6 +91,7 @@ pub use seeds::{
     DEFAULT_AUTO_SAMPLES, DEFAULT_AUTO_SEED_RADIUS,
 };
 pub use smooth::{DEFAULT_SMOOTH_ITERATIONS, DEFAULT_SMOOTH_STEP};
+pub(crate) use topology::{open_border, Topology};
 pub use transfer::DEFAULT_MIN_PART_FRACTION;
 pub use weld::{Weld, DEFAULT_WELD_EPSILON};
 

@@ -11,7 +11,7 @@ use super::homogenize::{HomogenizeStats, Homogenizer};
 use super::problem::{SegmentationProblem, DEFAULT_GAMMA};
 use super::seeds::{auto_seeds, resolve_seeds, PartSpec, Seed};
 use super::smooth::{smooth_votes, vertex_votes, DEFAULT_SMOOTH_ITERATIONS, DEFAULT_SMOOTH_STEP};
-use super::topology::Topology;
+use super::topology::{open_border, Topology};
 use super::weld::{Weld, DEFAULT_WELD_EPSILON};
 
 /// Parameters of [`segment`].
@@ -415,26 +415,6 @@ pub(super) fn finish(
         homogenization,
         reference,
     })
-}
-
-/// Vertices on an edge used by a single triangle (open mesh borders).
-fn open_border(n: usize, tris: &[[u32; 3]]) -> Vec<bool> {
-    let mut count: std::collections::HashMap<(u32, u32), u32> =
-        std::collections::HashMap::with_capacity(tris.len() * 3);
-    for t in tris {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            *count.entry((a.min(b), a.max(b))).or_default() += 1;
-        }
-    }
-    let mut out = vec![false; n];
-    for (&(a, b), &c) in &count {
-        if c == 1 {
-            out[a as usize] = true;
-            out[b as usize] = true;
-        }
-    }
-    out
 }
 
 fn representatives(class: &[u32], count: usize) -> Vec<u32> {

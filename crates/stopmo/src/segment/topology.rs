@@ -145,6 +145,27 @@ pub(super) fn vertex_components(neighbors: &Csr) -> (Vec<u32>, usize) {
     (comp, count as usize)
 }
 
+/// Vertices on an edge used by a single triangle (open mesh borders) of `tris` over `n`
+/// vertices.
+pub(crate) fn open_border(n: usize, tris: &[[u32; 3]]) -> Vec<bool> {
+    let mut count: std::collections::HashMap<(u32, u32), u32> =
+        std::collections::HashMap::with_capacity(tris.len() * 3);
+    for t in tris {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *count.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    let mut out = vec![false; n];
+    for (&(a, b), &c) in &count {
+        if c == 1 {
+            out[a as usize] = true;
+            out[b as usize] = true;
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
