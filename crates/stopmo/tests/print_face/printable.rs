@@ -1,0 +1,46 @@
+//! The acceptance: closed, oriented, single-shell solids with the wall and keys, and no self-intersecting triangle (README parts at 8, 20, 50 pieces; three automatic parts).
+
+use super::*;
+
+/// A segmentation the back surface was not tuned on (three automatic parts): where a later
+/// part's surface lies deeper at a seam than the earlier part's back point there, taking
+/// that point as is left 1.29 and 0.90 mm walls under the 1.5 mm minimum; the shared seam
+/// points now move deeper in every part that meets there (and [`shells`] checks that the
+/// parts still agree on them). Every seam gets two keys on each side there too.
+#[test]
+fn auto_parts_keep_the_wall_where_a_later_part_is_deeper_at_the_seam() {
+    let parts = auto_parts(face(), 3).expect("auto parts");
+    let seg = segment(face(), &parts, &SegmentOptions::default()).expect("segment");
+    let m = close_pieces_of(&seg, 5);
+    keeps_the_wall(&m);
+    // Every seam keyed twice on each side, the short one between parts 2 and 3 (15 mm) too:
+    // its strict band had room for one key.
+    let key = KeyOptions::for_print_height(HEIGHT_MM);
+    assert!(m.min_keys_per_seam >= 2, "{m:?}");
+    assert!(m.min_seam_key_spacing >= 2.0 * key.radius_mm, "{m:?}");
+    assert!(m.min_key_spread >= key.radius_mm * key.radius_mm, "{m:?}");
+}
+
+/// The acceptance: no self-intersecting triangle either.
+fn printable(pieces: usize) {
+    let m = close_pieces(pieces);
+    walls_and_keys(&m, pieces);
+    assert_eq!(m.crossing, 0, "{m:?}");
+}
+
+#[test]
+fn eight_pieces_are_printable() {
+    printable(8);
+}
+
+#[test]
+#[ignore = "slow in a debug build (minutes): cargo test --release -p toonkit-stopmo --test print_face -- --include-ignored"]
+fn twenty_pieces_are_printable() {
+    printable(20);
+}
+
+#[test]
+#[ignore = "slow in a debug build (minutes): cargo test --release -p toonkit-stopmo --test print_face -- --include-ignored"]
+fn fifty_pieces_are_printable() {
+    printable(50);
+}
