@@ -23,22 +23,7 @@ fn diagnose_crossings() {
         None => part_animations(segmentation()),
     };
     let refs: Vec<&MeshAnimation> = anims.iter().collect();
-    let inputs: Vec<PartInput<'_>> = anims
-        .iter()
-        .map(|a| PartInput {
-            animation: a,
-            setup: PartSetup::default(),
-        })
-        .collect();
-    let lib = build_library(
-        &inputs,
-        &LibraryOptions {
-            size: LibrarySize::Pieces(pieces),
-            print_height_mm: HEIGHT_MM,
-            ..LibraryOptions::default()
-        },
-    )
-    .expect("library");
+    let lib = library_of(&anims, pieces);
     let mm = print_scale(&refs, HEIGHT_MM) as f32;
     let all_mm = in_mm(&lib, mm);
     for (p, (shell, keys, _)) in shells(&anims, &all_mm, mm).into_iter().enumerate() {

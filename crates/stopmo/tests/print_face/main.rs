@@ -211,10 +211,9 @@ fn close_pieces(pieces: usize) -> Measured {
     close_pieces_of(segmentation(), pieces)
 }
 
-/// [`close_pieces`] for any segmentation of the face.
-fn close_pieces_of(seg: &Segmentation, pieces: usize) -> Measured {
-    let anims = part_animations(seg);
-    let refs: Vec<&MeshAnimation> = anims.iter().collect();
+/// The library of the parts `anims` of one cut, `pieces` pieces per part, at the
+/// acceptance's print height.
+fn library_of(anims: &[MeshAnimation], pieces: usize) -> stopmo::library::Library {
     let inputs: Vec<PartInput<'_>> = anims
         .iter()
         .map(|a| PartInput {
@@ -227,7 +226,14 @@ fn close_pieces_of(seg: &Segmentation, pieces: usize) -> Measured {
         print_height_mm: HEIGHT_MM,
         ..LibraryOptions::default()
     };
-    let lib = build_library(&inputs, &opts).expect("library");
+    build_library(&inputs, &opts).expect("library")
+}
+
+/// [`close_pieces`] for any segmentation of the face.
+fn close_pieces_of(seg: &Segmentation, pieces: usize) -> Measured {
+    let anims = part_animations(seg);
+    let refs: Vec<&MeshAnimation> = anims.iter().collect();
+    let lib = library_of(&anims, pieces);
     let mm = print_scale(&refs, HEIGHT_MM) as f32;
     let pieces_mm = in_mm(&lib, mm);
     let mut m = Measured {

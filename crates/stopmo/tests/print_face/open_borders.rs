@@ -56,22 +56,7 @@ fn homogenization_keeps_open_borders_and_pieces_agree_there() {
     // Pieces of a part differ on the open borders by no more than the input moves there.
     let anims = part_animations(seg);
     let parts = seg.parts().expect("parts");
-    let inputs: Vec<PartInput<'_>> = anims
-        .iter()
-        .map(|a| PartInput {
-            animation: a,
-            setup: PartSetup::default(),
-        })
-        .collect();
-    let lib = build_library(
-        &inputs,
-        &LibraryOptions {
-            size: LibrarySize::Pieces(20),
-            print_height_mm: HEIGHT_MM,
-            ..LibraryOptions::default()
-        },
-    )
-    .expect("library");
+    let lib = library_of(&anims, 20);
     let border_set: std::collections::HashSet<u32> = border.iter().copied().collect();
     let mut worst_excess = 0.0f64;
     for (p, part) in parts.iter().enumerate() {

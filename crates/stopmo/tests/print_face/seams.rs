@@ -87,21 +87,7 @@ fn reused_segmentation_puts_seams_of_two_clips_together() {
     let mut worst = 0.0f32;
     for (seg, clip) in [(&seg_a, &a), (&seg_b, &b)] {
         let anims = part_animations(seg);
-        let inputs: Vec<PartInput<'_>> = anims
-            .iter()
-            .map(|x| PartInput {
-                animation: x,
-                setup: PartSetup::default(),
-            })
-            .collect();
-        let lib = build_library(
-            &inputs,
-            &LibraryOptions {
-                size: LibrarySize::Pieces(8),
-                ..LibraryOptions::default()
-            },
-        )
-        .expect("library");
+        let lib = library_of(&anims, 8);
         assert_eq!(clip.vertex_count(), m);
         for (p, part) in seg.parts().expect("parts").iter().enumerate() {
             for (local, &v) in part.vertices.iter().enumerate() {
