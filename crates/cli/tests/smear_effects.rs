@@ -248,7 +248,7 @@ fn fig10_multiples_bouncing_ball_overlap_gives_unit_spacing() {
     let copies = v["copies"].as_array().unwrap();
     assert_eq!(copies.len(), 2);
     for c in copies {
-        // Eq. 12: each copy shows only the side facing its direction in time (about half).
+        // SMEAR Eq. 12: each copy shows only the side facing its direction in time (about half).
         let f = c["visible_fraction"].as_f64().unwrap();
         assert!(f > 0.3 && f < 0.55, "copy {}: visible fraction {f}", c["m"]);
     }

@@ -76,7 +76,7 @@ pub struct Line {
 }
 
 /// The whole 2D job: prepares the keystrokes (orientation, smoothing), fits them (LoA
-/// Eq. 1), interpolates them with the chosen mode (physics: LoA Section 3.2 and Eq. 2),
+/// Eq. 1), interpolates them with the chosen mode (physics: LoA Section 3.2 and LoA Eq. 2),
 /// adds the settle frames and applies the wobbles.
 ///
 /// Orientation: a keystroke's start is the end that pairs better with the previous

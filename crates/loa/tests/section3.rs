@@ -326,7 +326,7 @@ fn eq2_t_star_is_the_closest_simulated_frame() {
     let options = PhysicsOptions::default();
     let physics = interpolate_physics(&poses, &options).unwrap();
     assert_eq!(physics.retargets.len(), 2);
-    // First interval starts at rest: reproduce the simulation and brute-force Eq. 2.
+    // First interval starts at rest: reproduce the simulation and brute-force LoA Eq. 2.
     let r = &physics.retargets[0];
     let sim = simulate(&poses[0], poses[1].chain.angles(), &[0.0; 10], 40, &options).unwrap();
     let target = poses[1].chain.angles();

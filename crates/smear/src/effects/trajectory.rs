@@ -197,7 +197,8 @@ impl<'a> Trajectories<'a> {
         } else if time >= last as f32 {
             return self.positions[last * self.points + i];
         }
-        let k = (time.floor() as usize).min(last - 1);
+        // 0 < time < last here, so truncation is the floor (and needs no libm call).
+        let k = (time as usize).min(last - 1);
         let t = time - k as f32;
         if let Some(screws) = arcs {
             let (p1, p2) = (

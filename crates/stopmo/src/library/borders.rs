@@ -8,7 +8,7 @@
 //! that breaks the promise that pieces seat on one body and meet their neighbours as the
 //! input does. There, every free piece becomes the mean of the frames it shows — a mean never
 //! leaves their hull, so pieces differ by no more than the input moves — blending back to the
-//! Eq. 10 solution over [`BORDER_RINGS`] rings of vertices, so no step appears.
+//! StopShop Eq. 10 solution over [`BORDER_RINGS`] rings of vertices, so no step appears.
 
 use glam::{DVec3, Vec3};
 
