@@ -95,6 +95,9 @@ impl Stage {
             Stage::Scale { by } => x * by.at(i.frame),
             Stage::Speed => x * i.speed,
             Stage::Weight => x * i.weight,
+            // F1 is finite, so a zero (a past-only stage's future, a still vertex) stays
+            // the same zero without the 27 cell hashes.
+            Stage::Noise { .. } if x == 0.0 => x,
             Stage::Noise { kappa, seed } => x * voronoi_f1(i.rest, kappa.at(i.frame), *seed),
             Stage::Threshold { min_speed } => {
                 if i.speed >= min_speed.at(i.frame) {
