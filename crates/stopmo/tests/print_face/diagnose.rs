@@ -3,7 +3,8 @@
 use super::*;
 
 /// Diagnostics: which parts of the solids cross (run with `--ignored --nocapture`;
-/// `STOPMO_PIECES` sets the library size, default 8).
+/// `STOPMO_PIECES` sets the library size, default 8; `STOPMO_AUTO_PARTS=N` cuts N automatic
+/// parts, `STOPMO_SEEDS="x,y,z;x,y,z"` one part per point seed).
 #[test]
 #[ignore]
 fn diagnose_crossings() {
@@ -15,12 +16,31 @@ fn diagnose_crossings() {
     let auto: Option<usize> = std::env::var("STOPMO_AUTO_PARTS")
         .ok()
         .and_then(|s| s.parse().ok());
-    let anims = match auto {
-        Some(n) => {
+    // STOPMO_SEEDS="x,y,z;x,y,z": one part per point seed (mm of the input) instead.
+    let seeds: Option<Vec<PartSpec>> = std::env::var("STOPMO_SEEDS").ok().map(|s| {
+        s.split(';')
+            .enumerate()
+            .map(|(k, p)| {
+                let c: Vec<f32> = p
+                    .split(',')
+                    .map(|x| x.trim().parse().expect("x,y,z"))
+                    .collect();
+                PartSpec::new(
+                    format!("p{k}"),
+                    vec![Seed::Point(Vec3::new(c[0], c[1], c[2]))],
+                )
+            })
+            .collect()
+    });
+    let anims = match (auto, seeds) {
+        (_, Some(parts)) => {
+            part_animations(&segment(face(), &parts, &SegmentOptions::default()).expect("segment"))
+        }
+        (Some(n), None) => {
             let parts = auto_parts(face(), n).expect("auto parts");
             part_animations(&segment(face(), &parts, &SegmentOptions::default()).expect("segment"))
         }
-        None => part_animations(segmentation()),
+        (None, None) => part_animations(segmentation()),
     };
     let refs: Vec<&MeshAnimation> = anims.iter().collect();
     let lib = library_of(&anims, pieces);
