@@ -27,12 +27,12 @@ pub const KEY_RADIUS_PER_HEIGHT: f64 = 0.035;
 /// Key height as a fraction of its radius.
 pub const KEY_HEIGHT_PER_RADIUS: f64 = 0.5;
 /// How much nearer another boundary may be than the seam where a seam's keys go (key
-/// radii): the strict band first, then the loose one.
-const SEAM_BAND_MARGINS: [f32; 2] = [0.25, 1.0];
+/// radii): the strict band first, then the loose ones.
+const SEAM_BAND_MARGINS: [f32; 3] = [0.25, 1.0, 2.0];
 /// Where a seam's keys may go, tried in order until one fits: the band (index into
 /// [`SEAM_BAND_MARGINS`]) and how far apart keys stay (key radii; two radii apart, two domes
 /// just touch).
-const SEAM_KEY_TRIES: [(usize, f32); 3] = [(0, 2.5), (1, 2.5), (1, 2.0)];
+const SEAM_KEY_TRIES: [(usize, f32); 4] = [(0, 2.5), (1, 2.5), (1, 2.0), (2, 2.0)];
 /// Relief of an embossed ID in millimetres.
 pub const DEFAULT_ID_RELIEF_MM: f64 = 0.4;
 
@@ -201,6 +201,7 @@ impl PartShell {
                         .collect()
                 };
                 let bands = SEAM_BAND_MARGINS.map(band);
+                let before = keys.len();
                 for _ in 0..opts.per_seam {
                     let near = distances(self.back(), &centres);
                     // Farthest from the keys already placed (the first: from the seam's
@@ -232,6 +233,16 @@ impl PartShell {
                     keys.push(key_at(v, Some(i)));
                     centres.push(self.back()[v]);
                 }
+                if opts.per_seam >= 2 && keys.len() - before < 2 {
+                    if let Some(pair) = self.spaced_pair(&bands, &centres[..before], r) {
+                        keys.truncate(before);
+                        centres.truncate(before);
+                        for v in pair {
+                            keys.push(key_at(v, Some(i)));
+                            centres.push(self.back()[v]);
+                        }
+                    }
+                }
             }
         }
         while keys.len() < opts.count {
@@ -259,6 +270,32 @@ impl PartShell {
             });
         }
         Ok(keys)
+    }
+
+    /// Two keys for a short seam crowded by another seam's keys, where the greedy first key
+    /// left no room for a second (three automatic parts on the ICT face, the 15 mm seam
+    /// between the nose-and-eyes part and a cheek, once the back there moved by a few tenths
+    /// of a millimetre): the farthest-apart pair of the loosest band's vertices that keeps
+    /// the loosest spacing from each other and from the keys `placed` already.
+    fn spaced_pair(&self, bands: &[Vec<usize>], placed: &[Vec3], r: f32) -> Option<[usize; 2]> {
+        let (loosest, spacing) = *SEAM_KEY_TRIES.last()?;
+        let near = distances(self.back(), placed);
+        let band: Vec<usize> = bands
+            .get(loosest)?
+            .iter()
+            .copied()
+            .filter(|&v| near[v] >= spacing * r)
+            .collect();
+        let mut best: Option<(f32, [usize; 2])> = None;
+        for (k, &a) in band.iter().enumerate() {
+            for &b in &band[k + 1..] {
+                let d = self.back()[a].distance(self.back()[b]);
+                if d >= spacing * r && best.is_none_or(|x| d > x.0) {
+                    best = Some((d, [a, b]));
+                }
+            }
+        }
+        best.map(|b| b.1)
     }
 
     /// Piece `piece` closed onto the back surface with `id` raised `relief_mm` out of the

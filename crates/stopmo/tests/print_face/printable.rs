@@ -44,3 +44,58 @@ fn twenty_pieces_are_printable() {
 fn fifty_pieces_are_printable() {
     printable(50);
 }
+
+/// Two automatic parts put the seam through the mouth corners, so the lip edges are walled
+/// boundaries of a part. Offset along directions diffused over edge rings (which smooth ~3×
+/// less on the fine lip mesh than on the chin), the back hooked behind the lips: 1,032 and
+/// 1,360 back/back crossing pairs over 8 pieces before the local search; averaged over
+/// millimetres along the surface, 80 and 80. (The walls at the lip edges still cross: see
+/// the README's known limit.)
+#[test]
+#[ignore = "slow in a debug build (minutes): cargo test --release -p toonkit-stopmo --test print_face -- --include-ignored"]
+fn two_automatic_parts_keep_the_back_unfolded_behind_the_lips() {
+    let parts = auto_parts(face(), 2).expect("auto parts");
+    let anims =
+        part_animations(&segment(face(), &parts, &SegmentOptions::default()).expect("segment"));
+    let refs: Vec<&MeshAnimation> = anims.iter().collect();
+    let lib = library_of(&anims, 8);
+    let mm = print_scale(&refs, HEIGHT_MM) as f32;
+    let pieces_mm = in_mm(&lib, mm);
+    let averages: Vec<Vec<Vec3>> = anims
+        .iter()
+        .map(|a| a.average_positions().iter().map(|x| *x * mm).collect())
+        .collect();
+    let inputs: Vec<ShellInput<'_>> = anims
+        .iter()
+        .zip(&averages)
+        .zip(&pieces_mm)
+        .map(|((a, average), pieces)| ShellInput {
+            topology: &a.mesh,
+            average,
+            pieces: pieces.iter().map(Vec::as_slice).collect(),
+            printed_back: None,
+        })
+        .collect();
+    // The construction alone (no local search): what the direction field decides.
+    let opts = ShellOptions {
+        resolve_rounds: 0,
+        ..ShellOptions::default()
+    };
+    let built = build_shells(&inputs, &opts).expect("shells");
+    for (shell, pieces) in built.iter().zip(&pieces_mm) {
+        let t = shell.triangles().len() as u32;
+        let is_back = |x: u32| (t..2 * t).contains(&x);
+        let back_back: usize = pieces
+            .par_iter()
+            .map(|piece| {
+                let solid = shell.solid(piece, "x").expect("solid");
+                stopmo::library::intersecting_pairs(&solid.positions, &solid.triangles)
+                    .expect("coordinates in range")
+                    .iter()
+                    .filter(|&&(i, j)| is_back(i) && is_back(j))
+                    .count()
+            })
+            .sum();
+        assert!(back_back <= 200, "{back_back} back/back crossing pairs");
+    }
+}

@@ -27,16 +27,18 @@
 use std::collections::HashMap;
 
 use super::error::{LibraryError, Result};
-use super::fabricate::{check_solid, split_fans};
+use super::fabricate::check_solid;
 use anim::Mesh;
 use glam::Vec3;
 
 mod caps;
+mod direction;
 mod envelope;
 mod measure;
 mod options;
 mod resolve;
 mod seams;
+mod topology;
 mod untangle;
 
 pub use measure::ThinnestWall;
@@ -204,76 +206,13 @@ impl PartShell {
         if topology.triangles.is_empty() {
             return Err(bad("no triangle".into()));
         }
-        // Weld exact duplicates of the average (glTF UV seams), compact to used vertices.
-        let mut by_bits: HashMap<[u32; 3], u32> = HashMap::new();
-        let mut class = vec![u32::MAX; nv];
-        let mut source: Vec<u32> = Vec::new();
-        let mut tris = Vec::with_capacity(topology.triangles.len());
-        for t in &topology.triangles {
-            let mut out = [0u32; 3];
-            for (o, &i) in out.iter_mut().zip(t) {
-                let i = i as usize;
-                if i >= nv {
-                    return Err(bad(format!("index {i} out of range ({nv} vertices)")));
-                }
-                if class[i] == u32::MAX {
-                    let key = position_key(average[i]);
-                    class[i] = *by_bits.entry(key).or_insert_with(|| {
-                        source.push(i as u32);
-                        (source.len() - 1) as u32
-                    });
-                }
-                *o = class[i];
-            }
-            if out[0] != out[1] && out[1] != out[2] && out[0] != out[2] {
-                tris.push(out);
-            }
-        }
-        let front: Vec<Vec3> = source.iter().map(|&s| average[s as usize]).collect();
-        let (front, tris) = split_fans(front, tris);
-        // Copies made by the fan split come after the welded vertices: find their source.
-        let mut src = source.clone();
-        if front.len() > src.len() {
-            let mut at: HashMap<[u32; 3], u32> = HashMap::new();
-            for (i, &s) in source.iter().enumerate() {
-                at.insert(position_key(front[i]), s);
-                let _ = i;
-            }
-            for p in &front[source.len()..] {
-                src.push(at.get(&position_key(*p)).copied().unwrap_or(0));
-            }
-        }
-        let mut directed: HashMap<(u32, u32), ()> = HashMap::with_capacity(tris.len() * 3);
-        for t in &tris {
-            for k in 0..3 {
-                let e = (t[k], t[(k + 1) % 3]);
-                if directed.insert(e, ()).is_some() {
-                    return Err(bad(format!(
-                        "edge {}–{} used twice in the same direction",
-                        e.0, e.1
-                    )));
-                }
-            }
-        }
-        let mut boundary: Vec<(u32, u32)> = tris
-            .iter()
-            .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
-            .filter(|&(a, b)| !directed.contains_key(&(b, a)))
-            .collect();
-        boundary.sort_unstable();
-        // Cap the small boundary loops (eye and mouth openings): a fan from the loop's
-        // centroid, so only the outer boundary (seams, neck, scalp) needs a wall.
-        let (mut front, mut tris) = (front, tris);
-        let caps = caps::cap_loops(&front, &mut boundary, opts.cap_fraction);
-        let regular = front.len();
-        for (i, lp) in caps.iter().enumerate() {
-            let c = (regular + i) as u32;
-            front.push(lp.iter().map(|&v| front[v as usize]).sum::<Vec3>() / lp.len() as f32);
-            for k in 0..lp.len() {
-                let (a, b) = (lp[k], lp[(k + 1) % lp.len()]);
-                tris.push([b, a, c]);
-            }
-        }
+        let topology::ShellTopology {
+            source: src,
+            front,
+            triangles: tris,
+            boundary,
+            caps,
+        } = topology::weld(topology, average, opts.cap_fraction)?;
         let n = front.len();
         let adj = neighbours(n, &tris);
         let on_boundary = {
@@ -284,30 +223,9 @@ impl PartShell {
             }
             m
         };
-        // Inward direction field: vertex normals diffused over the smoothing radius.
-        let mean_edge = {
-            let (s, c) = tris.iter().fold((0.0f64, 0usize), |(s, c), t| {
-                let l = (0..3)
-                    .map(|k| front[t[k] as usize].distance(front[t[(k + 1) % 3] as usize]) as f64)
-                    .sum::<f64>();
-                (s + l, c + 3)
-            });
-            (s / c.max(1) as f64).max(1e-9)
-        };
-        let steps = ((opts.normal_smoothing_mm / mean_edge).powi(2)).ceil() as usize;
-        let steps = steps.min(4000);
-        let mut normals = anim::vertex_normals(&front, &tris);
-        for _ in 0..steps {
-            let next: Vec<Vec3> = (0..n)
-                .map(|v| {
-                    let s = adj[v]
-                        .iter()
-                        .fold(normals[v], |acc, &w| acc + normals[w as usize]);
-                    s.try_normalize().unwrap_or(normals[v])
-                })
-                .collect();
-            normals = next;
-        }
+        // Inward direction field: the normals averaged over a geodesic disc (millimetres).
+        let normals =
+            direction::smoothed_directions(&front, &tris, &adj, opts.normal_smoothing_mm as f32);
         let fronts: Vec<Vec<Vec3>> = pieces
             .iter()
             .map(|p| {

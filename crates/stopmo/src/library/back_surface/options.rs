@@ -4,10 +4,12 @@ use serde::{Deserialize, Serialize};
 
 use crate::library::fabricate::DEFAULT_THICKNESS_MM;
 
-/// Radius over which the offset direction field is smoothed, in millimetres: at 8 mm the
-/// directions still converge behind the nose enough to fold the back there (measured on the
-/// ICT face: 103 back/back crossing pairs per upper piece at 8 mm, none at 14 mm).
-pub const DEFAULT_NORMAL_SMOOTHING_MM: f64 = 14.0;
+/// Width (Gaussian σ, millimetres along the surface) over which the offset direction field
+/// averages the front's normals. Narrower or wider, the directions fold the back behind the
+/// nose on the ICT face (README seeds, `upper` part, crossing triangles left: 792 at 7 mm
+/// and 8 pieces, 160 at 14 mm and 20 pieces, 240 at 21 mm and 8 pieces; none at 17.5 mm
+/// for 8, 20 and 50 pieces).
+pub const DEFAULT_NORMAL_SMOOTHING_MM: f64 = 17.5;
 /// Laplacian smoothing steps of the back surface.
 pub const DEFAULT_BACK_SMOOTHING_ITERATIONS: usize = 300;
 /// Boundary loops shorter than this fraction of the longest one are capped.
@@ -35,7 +37,8 @@ pub const DEFAULT_RESOLVE_ROUNDS: usize = 8;
 pub struct ShellOptions {
     /// Minimum wall between any piece's front and the back surface.
     pub wall_mm: f64,
-    /// Radius over which the inward direction field is smoothed.
+    /// Width (Gaussian σ, millimetres along the surface) over which the inward direction
+    /// field averages the front's normals.
     pub normal_smoothing_mm: f64,
     /// Laplacian smoothing steps of the back surface.
     pub smoothing_iterations: usize,
