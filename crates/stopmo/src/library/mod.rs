@@ -66,9 +66,9 @@ pub use assembly::{
     DEFAULT_TWO_OPT_PASSES,
 };
 pub use back_surface::{
-    build_shells, PartShell, ShellInput, ShellOptions, ShellStats, ThinnestWall,
-    DEFAULT_BACK_SMOOTHING_ITERATIONS, DEFAULT_CAP_FRACTION, DEFAULT_NORMAL_SMOOTHING_MM,
-    DEFAULT_REPAIR_ROUNDS, DEFAULT_RESOLVE_ROUNDS,
+    build_shells, DirectionField, PartShell, ShellInput, ShellOptions, ShellStats, ThinnestWall,
+    DEFAULT_BACK_SMOOTHING_ITERATIONS, DEFAULT_CAP_FRACTION, DEFAULT_EDGE_RING_RADIUS_MM,
+    DEFAULT_NORMAL_SMOOTHING_MM, DEFAULT_REPAIR_ROUNDS, DEFAULT_RESOLVE_ROUNDS,
 };
 pub use borders::BORDER_RINGS;
 pub use build::{

@@ -120,20 +120,23 @@ fn in_mm(lib: &stopmo::library::Library, mm: f32) -> Vec<Vec<Vec<Vec3>>> {
         .collect()
 }
 
-/// The shells of every part ([`build_shells`]), with keys on every seam; checks that parts
-/// meeting at a seam share its back points (their walls there are one surface).
-fn shells(
-    anims: &[MeshAnimation],
-    pieces_mm: &[Vec<Vec<Vec3>>],
-    mm: f32,
-) -> Vec<(PartShell, Vec<stopmo::library::Key>, usize)> {
-    let averages: Vec<Vec<Vec3>> = anims
+/// Every part's average surface in millimetres.
+fn averages_mm(anims: &[MeshAnimation], mm: f32) -> Vec<Vec<Vec3>> {
+    anims
         .iter()
         .map(|a| a.average_positions().iter().map(|x| *x * mm).collect())
-        .collect();
-    let inputs: Vec<ShellInput<'_>> = anims
+        .collect()
+}
+
+/// [`build_shells`]'s input for every part (no printed back).
+fn shell_inputs<'a>(
+    anims: &'a [MeshAnimation],
+    averages: &'a [Vec<Vec3>],
+    pieces_mm: &'a [Vec<Vec<Vec3>>],
+) -> Vec<ShellInput<'a>> {
+    anims
         .iter()
-        .zip(&averages)
+        .zip(averages)
         .zip(pieces_mm)
         .map(|((a, average), pieces)| ShellInput {
             topology: &a.mesh,
@@ -141,8 +144,22 @@ fn shells(
             pieces: pieces.iter().map(Vec::as_slice).collect(),
             printed_back: None,
         })
-        .collect();
-    let built = build_shells(&inputs, &ShellOptions::default()).expect("shells");
+        .collect()
+}
+
+/// The shells of every part ([`build_shells`]), with keys on every seam; checks that parts
+/// meeting at a seam share its back points (their walls there are one surface).
+fn shells(
+    anims: &[MeshAnimation],
+    pieces_mm: &[Vec<Vec<Vec3>>],
+    mm: f32,
+) -> Vec<(PartShell, Vec<stopmo::library::Key>, usize)> {
+    let averages = averages_mm(anims, mm);
+    let built = build_shells(
+        &shell_inputs(anims, &averages, pieces_mm),
+        &ShellOptions::default(),
+    )
+    .expect("shells");
     let boundaries: Vec<Vec<(Vec3, Vec3)>> = built
         .iter()
         .zip(&averages)

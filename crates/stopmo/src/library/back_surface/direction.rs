@@ -9,8 +9,13 @@
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
+use anim::Mesh;
 use glam::Vec3;
 use rayon::prelude::*;
+
+use super::options::{DEFAULT_EDGE_RING_RADIUS_MM, DEFAULT_NORMAL_SMOOTHING_MM};
+use super::{DirectionField, PartShell, ShellOptions};
+use crate::library::error::Result;
 
 /// Radius of the disc averaged over, in Gaussian widths (its edge weighs e⁻²).
 const DISC_SIGMAS: f32 = 2.0;
@@ -100,6 +105,87 @@ pub(super) fn smoothed_directions(
             },
         )
         .collect()
+}
+
+/// Unit outward direction at every vertex of `front`: the vertex normals diffused over
+/// `(radius_mm / mean edge)²` edge rings (at most 4,000), each step the normalized sum of a
+/// vertex's and its neighbours' directions ([`super::DirectionField::EdgeRings`]).
+///
+/// # Performance
+/// O(steps × edges), serial.
+pub(super) fn edge_ring_directions(
+    front: &[Vec3],
+    tris: &[[u32; 3]],
+    adj: &[Vec<u32>],
+    radius_mm: f64,
+) -> Vec<Vec3> {
+    let n = front.len();
+    let mean_edge = {
+        let (s, c) = tris.iter().fold((0.0f64, 0usize), |(s, c), t| {
+            let l = (0..3)
+                .map(|k| front[t[k] as usize].distance(front[t[(k + 1) % 3] as usize]) as f64)
+                .sum::<f64>();
+            (s + l, c + 3)
+        });
+        (s / c.max(1) as f64).max(1e-9)
+    };
+    let steps = ((radius_mm / mean_edge).powi(2)).ceil() as usize;
+    let steps = steps.min(4000);
+    let mut normals = anim::vertex_normals(front, tris);
+    for _ in 0..steps {
+        let next: Vec<Vec3> = (0..n)
+            .map(|v| {
+                let s = adj[v]
+                    .iter()
+                    .fold(normals[v], |acc, &w| acc + normals[w as usize]);
+                s.try_normalize().unwrap_or(normals[v])
+            })
+            .collect();
+        normals = next;
+    }
+    normals
+}
+
+impl PartShell {
+    /// [`PartShell::new_sharing`] with [`DirectionField::Best`]: the part's back along both
+    /// fields (at their default widths, on the two cores), keeping the one with fewer
+    /// crossing triangles, then one whose wall holds the minimum; a tie keeps the edge rings.
+    pub(super) fn new_with_better_field(
+        topology: &Mesh,
+        average: &[Vec3],
+        pieces: &[&[Vec3]],
+        opts: &ShellOptions,
+        shared: &[(Vec3, Vec3)],
+    ) -> Result<PartShell> {
+        let with = |direction| {
+            let o = ShellOptions { direction, ..*opts };
+            Self::new_sharing(topology, average, pieces, &o, shared)
+        };
+        let (rings, disc) = rayon::join(
+            || {
+                with(DirectionField::EdgeRings {
+                    radius_mm: DEFAULT_EDGE_RING_RADIUS_MM,
+                })
+            },
+            || {
+                with(DirectionField::Geodesic {
+                    sigma_mm: DEFAULT_NORMAL_SMOOTHING_MM,
+                })
+            },
+        );
+        let (rings, disc) = (rings?, disc?);
+        let key = |s: &PartShell| {
+            (
+                s.stats.self_intersecting_triangles,
+                s.stats.min_wall_mm < opts.wall_mm - 1e-6,
+            )
+        };
+        Ok(if key(&disc) < key(&rings) {
+            disc
+        } else {
+            rings
+        })
+    }
 }
 
 #[cfg(test)]

@@ -43,8 +43,9 @@ mod untangle;
 
 pub use measure::ThinnestWall;
 pub use options::{
-    ShellOptions, ShellStats, DEFAULT_BACK_SMOOTHING_ITERATIONS, DEFAULT_CAP_FRACTION,
-    DEFAULT_NORMAL_SMOOTHING_MM, DEFAULT_REPAIR_ROUNDS, DEFAULT_RESOLVE_ROUNDS,
+    DirectionField, ShellOptions, ShellStats, DEFAULT_BACK_SMOOTHING_ITERATIONS,
+    DEFAULT_CAP_FRACTION, DEFAULT_EDGE_RING_RADIUS_MM, DEFAULT_NORMAL_SMOOTHING_MM,
+    DEFAULT_REPAIR_ROUNDS, DEFAULT_RESOLVE_ROUNDS,
 };
 pub use seams::{build_shells, ShellInput};
 
@@ -190,10 +191,16 @@ impl PartShell {
                 opts.wall_mm
             )));
         }
-        if !(opts.normal_smoothing_mm.is_finite() && opts.normal_smoothing_mm >= 0.0) {
+        let width = match opts.direction {
+            DirectionField::EdgeRings { radius_mm: w }
+            | DirectionField::Geodesic { sigma_mm: w } => w,
+            DirectionField::Best => {
+                return Self::new_with_better_field(topology, average, pieces, opts, shared)
+            }
+        };
+        if !(width.is_finite() && width >= 0.0) {
             return Err(LibraryError::InvalidParameter(format!(
-                "normal smoothing must be finite and >= 0 mm, got {}",
-                opts.normal_smoothing_mm
+                "normal smoothing must be finite and >= 0 mm, got {width}"
             )));
         }
         let nv = topology.positions.len();
@@ -223,9 +230,13 @@ impl PartShell {
             }
             m
         };
-        // Inward direction field: the normals averaged over a geodesic disc (millimetres).
-        let normals =
-            direction::smoothed_directions(&front, &tris, &adj, opts.normal_smoothing_mm as f32);
+        // Inward direction field (see `DirectionField`).
+        let normals = match opts.direction {
+            DirectionField::Geodesic { .. } => {
+                direction::smoothed_directions(&front, &tris, &adj, width as f32)
+            }
+            _ => direction::edge_ring_directions(&front, &tris, &adj, width),
+        };
         let fronts: Vec<Vec<Vec3>> = pieces
             .iter()
             .map(|p| {
