@@ -39,7 +39,7 @@ pub use clip::{frame_count, Channel, Clip, Interpolation, Property, MAX_FRAMES};
 pub use error::{AnimError, Result};
 pub use flipbook::{Flipbook, FlipbookPart};
 pub use human::human_number;
-pub use mesh::{triangulate_polygon, vertex_normals, Aabb, Mesh};
+pub use mesh::{area_normals, triangulate_polygon, vertex_normals, Aabb, Mesh};
 pub use mesh_animation::{MeshAnimation, DEFAULT_FPS};
 pub use rng::{mix, SplitMix64};
 pub use sample::{rest_transform, sample, sample_owned, MeshObject, SampleOptions, SampledScene};

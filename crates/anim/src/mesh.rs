@@ -237,6 +237,16 @@ fn tri_polys(tris: &[[u32; 3]], base: u32) -> Vec<Vec<u32>> {
 /// Area-weighted vertex normals of `positions` over `triangles` (indices must be valid).
 /// Vertices on no triangle, or only on degenerate or non-finite ones, get +Y.
 pub fn vertex_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+    area_normals(positions, triangles)
+        .into_iter()
+        .map(|n| n.try_normalize().unwrap_or(Vec3::Y))
+        .collect()
+}
+
+/// Unnormalized [`vertex_normals`]: per vertex, the sum of its triangles' normals scaled by
+/// twice their area (zero on no triangle; degenerate or non-finite triangles add nothing),
+/// for weighting normals by area over several vertices.
+pub fn area_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
     let mut acc = vec![Vec3::ZERO; positions.len()];
     for t in triangles {
         let [a, b, c] = t.map(|i| i as usize);
@@ -247,9 +257,7 @@ pub fn vertex_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
             acc[c] += n;
         }
     }
-    acc.into_iter()
-        .map(|n| n.try_normalize().unwrap_or(Vec3::Y))
-        .collect()
+    acc
 }
 
 /// Fan-triangulates a polygon (indices into the vertex array). Polygons with fewer than

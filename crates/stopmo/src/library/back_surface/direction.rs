@@ -9,13 +9,10 @@
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
-use anim::Mesh;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::options::{DEFAULT_EDGE_RING_RADIUS_MM, DEFAULT_NORMAL_SMOOTHING_MM};
-use super::{DirectionField, PartShell, ShellOptions};
-use crate::library::error::Result;
+use super::PartShell;
 
 /// Radius of the disc averaged over, in Gaussian widths (its edge weighs e⁻²).
 const DISC_SIGMAS: f32 = 2.0;
@@ -53,17 +50,7 @@ pub(super) fn smoothed_directions(
     sigma: f32,
 ) -> Vec<Vec3> {
     let n = front.len();
-    // Area-weighted vertex normals (twice the area of every incident triangle).
-    let mut area_normals = vec![Vec3::ZERO; n];
-    for t in tris {
-        let [a, b, c] = t.map(|i| i as usize);
-        let m = (front[b] - front[a]).cross(front[c] - front[a]);
-        if m.is_finite() {
-            area_normals[a] += m;
-            area_normals[b] += m;
-            area_normals[c] += m;
-        }
-    }
+    let area_normals = anim::area_normals(front, tris);
     let own = |v: usize| area_normals[v].try_normalize().unwrap_or(Vec3::Z);
     if !(sigma.is_finite() && sigma > 0.0) {
         return (0..n).map(own).collect();
@@ -146,45 +133,19 @@ pub(super) fn edge_ring_directions(
     normals
 }
 
-impl PartShell {
-    /// [`PartShell::new_sharing`] with [`DirectionField::Best`]: the part's back along both
-    /// fields (at their default widths, on the two cores), keeping the one with fewer
-    /// crossing triangles, then one whose wall holds the minimum; a tie keeps the edge rings.
-    pub(super) fn new_with_better_field(
-        topology: &Mesh,
-        average: &[Vec3],
-        pieces: &[&[Vec3]],
-        opts: &ShellOptions,
-        shared: &[(Vec3, Vec3)],
-    ) -> Result<PartShell> {
-        let with = |direction| {
-            let o = ShellOptions { direction, ..*opts };
-            Self::new_sharing(topology, average, pieces, &o, shared)
-        };
-        let (rings, disc) = rayon::join(
-            || {
-                with(DirectionField::EdgeRings {
-                    radius_mm: DEFAULT_EDGE_RING_RADIUS_MM,
-                })
-            },
-            || {
-                with(DirectionField::Geodesic {
-                    sigma_mm: DEFAULT_NORMAL_SMOOTHING_MM,
-                })
-            },
-        );
-        let (rings, disc) = (rings?, disc?);
-        let key = |s: &PartShell| {
-            (
-                s.stats.self_intersecting_triangles,
-                s.stats.min_wall_mm < opts.wall_mm - 1e-6,
-            )
-        };
-        Ok(if key(&disc) < key(&rings) {
-            disc
-        } else {
-            rings
-        })
+/// Of two backs of one part ([`DirectionField::Best`]), the one with fewer crossing
+/// triangles, then the one whose wall holds `wall_mm`; a tie keeps `rings` (the edge rings).
+pub(super) fn better(rings: PartShell, disc: PartShell, wall_mm: f64) -> PartShell {
+    let key = |s: &PartShell| {
+        (
+            s.stats.self_intersecting_triangles,
+            s.stats.min_wall_mm < wall_mm - 1e-6,
+        )
+    };
+    if key(&disc) < key(&rings) {
+        disc
+    } else {
+        rings
     }
 }
 
@@ -214,7 +175,7 @@ mod tests {
                 tris.push([v, up + 1, up]);
             }
         }
-        let adj = super::super::neighbours(positions.len(), &tris);
+        let adj = super::super::topology::neighbours(positions.len(), &tris);
         (positions, tris, adj)
     }
 

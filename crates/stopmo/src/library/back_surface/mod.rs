@@ -129,23 +129,6 @@ fn centroid(points: &[Vec3], around: &[u32]) -> Vec3 {
         / around.len() as f32
 }
 
-/// Vertex adjacency (sorted, deduplicated) of a triangle list.
-fn neighbours(n: usize, tris: &[[u32; 3]]) -> Vec<Vec<u32>> {
-    let mut adj = vec![Vec::new(); n];
-    for t in tris {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            adj[a as usize].push(b);
-            adj[b as usize].push(a);
-        }
-    }
-    for a in &mut adj {
-        a.sort_unstable();
-        a.dedup();
-    }
-    adj
-}
-
 impl PartShell {
     /// Builds the back surface of a part.
     ///
@@ -191,17 +174,14 @@ impl PartShell {
                 opts.wall_mm
             )));
         }
-        let width = match opts.direction {
-            DirectionField::EdgeRings { radius_mm: w }
-            | DirectionField::Geodesic { sigma_mm: w } => w,
-            DirectionField::Best => {
-                return Self::new_with_better_field(topology, average, pieces, opts, shared)
+        if let DirectionField::EdgeRings { radius_mm: w }
+        | DirectionField::Geodesic { sigma_mm: w } = opts.direction
+        {
+            if !(w.is_finite() && w >= 0.0) {
+                return Err(LibraryError::InvalidParameter(format!(
+                    "normal smoothing must be finite and >= 0 mm, got {w}"
+                )));
             }
-        };
-        if !(width.is_finite() && width >= 0.0) {
-            return Err(LibraryError::InvalidParameter(format!(
-                "normal smoothing must be finite and >= 0 mm, got {width}"
-            )));
         }
         let nv = topology.positions.len();
         if average.len() != nv || pieces.iter().any(|p| p.len() != nv) {
@@ -213,44 +193,68 @@ impl PartShell {
         if topology.triangles.is_empty() {
             return Err(bad("no triangle".into()));
         }
-        let topology::ShellTopology {
-            source: src,
-            front,
-            triangles: tris,
-            boundary,
-            caps,
-        } = topology::weld(topology, average, opts.cap_fraction)?;
+        let frame = topology::PartFrame::new(topology, average, pieces, opts.cap_fraction)?;
+        // Inward direction field (see `DirectionField`); the frame is shared by both fields.
+        let (front, tris, adj) = (&frame.topo.front, &frame.topo.triangles, &frame.adj);
+        let rings = |radius_mm| direction::edge_ring_directions(front, tris, adj, radius_mm);
+        let disc =
+            |sigma_mm: f64| direction::smoothed_directions(front, tris, adj, sigma_mm as f32);
+        match opts.direction {
+            DirectionField::EdgeRings { radius_mm } => {
+                Ok(Self::along(&frame, rings(radius_mm), pieces, opts, shared))
+            }
+            DirectionField::Geodesic { sigma_mm } => {
+                Ok(Self::along(&frame, disc(sigma_mm), pieces, opts, shared))
+            }
+            DirectionField::Best => {
+                let (a, b) = rayon::join(
+                    || {
+                        Self::along(
+                            &frame,
+                            rings(DEFAULT_EDGE_RING_RADIUS_MM),
+                            pieces,
+                            opts,
+                            shared,
+                        )
+                    },
+                    || {
+                        Self::along(
+                            &frame,
+                            disc(DEFAULT_NORMAL_SMOOTHING_MM),
+                            pieces,
+                            opts,
+                            shared,
+                        )
+                    },
+                );
+                Ok(direction::better(a, b, opts.wall_mm))
+            }
+        }
+    }
+
+    /// The back surface of the part `frame` along the direction field `normals`: the
+    /// envelope, the shared seam points, the smoothing and the repair of [`PartShell::new_sharing`].
+    fn along(
+        frame: &topology::PartFrame,
+        normals: Vec<Vec3>,
+        pieces: &[&[Vec3]],
+        opts: &ShellOptions,
+        shared: &[(Vec3, Vec3)],
+    ) -> PartShell {
+        let topology::PartFrame {
+            topo,
+            adj,
+            on_boundary,
+            fronts,
+        } = frame;
+        let (front, tris, boundary) = (&topo.front, &topo.triangles, &topo.boundary);
         let n = front.len();
-        let adj = neighbours(n, &tris);
-        let on_boundary = {
-            let mut m = vec![false; n];
-            for &(a, b) in &boundary {
-                m[a as usize] = true;
-                m[b as usize] = true;
-            }
-            m
-        };
-        // Inward direction field (see `DirectionField`).
-        let normals = match opts.direction {
-            DirectionField::Geodesic { .. } => {
-                direction::smoothed_directions(&front, &tris, &adj, width as f32)
-            }
-            _ => direction::edge_ring_directions(&front, &tris, &adj, width),
-        };
-        let fronts: Vec<Vec<Vec3>> = pieces
-            .iter()
-            .map(|p| {
-                let mut f = front_positions(&src, &caps, p);
-                untangle::untangle(&mut f, &tris, &adj, &on_boundary);
-                f
-            })
-            .collect();
         // Deepest point any piece reaches in a column around the direction field, per
         // vertex, minus the wall.
         let wall = opts.wall_mm as f32;
         let limit = envelope::envelope_limits(
-            &front,
-            &fronts,
+            front,
+            fronts,
             &normals,
             wall,
             (ENVELOPE_LATERAL_WALLS * opts.wall_mm) as f32,
@@ -259,7 +263,7 @@ impl PartShell {
         let shared_at: HashMap<[u32; 3], Vec3> =
             shared.iter().map(|(a, b)| (position_key(*a), *b)).collect();
         let mut along: Vec<[u32; 2]> = vec![[u32::MAX; 2]; n];
-        for &(a, b) in &boundary {
+        for &(a, b) in boundary {
             along[a as usize][1] = b;
             along[b as usize][0] = a;
         }
@@ -274,7 +278,7 @@ impl PartShell {
             .collect();
         let fixed = seams::deepen_shared(
             &shared_points,
-            &front,
+            front,
             &normals,
             &limit,
             &along,
@@ -339,10 +343,10 @@ impl PartShell {
             enforce(&mut back);
         }
         let mut shell = PartShell {
-            source: src,
-            caps,
-            triangles: tris,
-            boundary,
+            source: topo.source.clone(),
+            caps: topo.caps.clone(),
+            triangles: tris.clone(),
+            boundary: boundary.clone(),
             back,
             normals: normals.clone(),
             on_boundary: on_boundary.clone(),
@@ -469,7 +473,7 @@ impl PartShell {
             shell.stats.min_wall_mm = wall;
         }
         shell.stats.repair_rounds = rounds;
-        Ok(shell)
+        shell
     }
 
     /// Back surface positions of the shell vertices (millimetres).

@@ -7,7 +7,7 @@ use std::collections::HashMap;
 use anim::Mesh;
 use glam::Vec3;
 
-use super::{caps, position_key};
+use super::{caps, front_positions, position_key, untangle};
 use crate::library::error::{LibraryError, Result};
 use crate::library::fabricate::split_fans;
 
@@ -114,4 +114,70 @@ pub(super) fn weld(topology: &Mesh, average: &[Vec3], cap_fraction: f64) -> Resu
         boundary,
         caps,
     })
+}
+
+/// Vertex adjacency (sorted, deduplicated) of a triangle list.
+pub(super) fn neighbours(n: usize, tris: &[[u32; 3]]) -> Vec<Vec<u32>> {
+    let mut adj = vec![Vec::new(); n];
+    for t in tris {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            adj[a as usize].push(b);
+            adj[b as usize].push(a);
+        }
+    }
+    for a in &mut adj {
+        a.sort_unstable();
+        a.dedup();
+    }
+    adj
+}
+
+/// What a part's back surfaces share whatever their direction field: the shell topology,
+/// its adjacency and boundary, and every piece's (untangled) front over it.
+pub(super) struct PartFrame {
+    /// The welded, capped shell topology and average front.
+    pub topo: ShellTopology,
+    /// Vertex adjacency of the front triangles.
+    pub adj: Vec<Vec<u32>>,
+    /// Whether a shell vertex lies on the (uncapped) boundary.
+    pub on_boundary: Vec<bool>,
+    /// Every piece's front over the shell vertices, untangled where it crosses itself.
+    pub fronts: Vec<Vec<Vec3>>,
+}
+
+impl PartFrame {
+    /// [`weld`]s the part and lays every piece's front over it.
+    ///
+    /// # Errors
+    /// As [`weld`].
+    pub(super) fn new(
+        topology: &Mesh,
+        average: &[Vec3],
+        pieces: &[&[Vec3]],
+        cap_fraction: f64,
+    ) -> Result<PartFrame> {
+        let topo = weld(topology, average, cap_fraction)?;
+        let n = topo.front.len();
+        let adj = neighbours(n, &topo.triangles);
+        let mut on_boundary = vec![false; n];
+        for &(a, b) in &topo.boundary {
+            on_boundary[a as usize] = true;
+            on_boundary[b as usize] = true;
+        }
+        let fronts = pieces
+            .iter()
+            .map(|p| {
+                let mut f = front_positions(&topo.source, &topo.caps, p);
+                untangle::untangle(&mut f, &topo.triangles, &adj, &on_boundary);
+                f
+            })
+            .collect();
+        Ok(PartFrame {
+            topo,
+            adj,
+            on_boundary,
+            fronts,
+        })
+    }
 }
