@@ -80,7 +80,14 @@ impl<'a> TriangleGrid<'a> {
             .map(|(l, h)| (*h - *l).max_element())
             .sum::<f32>()
             / triangles.len().max(1) as f32;
-        let cell = (2.0 * mean).max(1e-6);
+        // Twice the mean triangle, but never so fine that the grid has more than ~64 cells
+        // per triangle along its longest side: a back surface that collapsed to slivers
+        // under a few large triangles (a cube's, MorphStressTest) made 0.1 mm cells over
+        // 80 mm, each large triangle in ~10⁵ of them, and every nearest query walked
+        // thousands of empty cells (133 s to measure 8 pieces; results do not depend on the
+        // cell size, only the time).
+        let coarsest = (hi - lo).max_element() / (4.0 * (triangles.len().max(1) as f32).cbrt());
+        let cell = (2.0 * mean).max(coarsest).max(1e-6);
         let key = |p: Vec3| cell_of(p, lo, cell);
         let mut cells: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
         for (t, (a, b)) in boxes.iter().enumerate() {
@@ -239,8 +246,9 @@ mod tests {
 
     #[test]
     fn grid_distance_far_from_tiny_triangles_scans_the_occupied_cells() {
-        // Cells of 2·10⁻³ and a point 10⁶ cells away: ring by ring this would visit ~10¹⁸
-        // empty cells (the jobs test's tube hung here); it must answer at once, exactly.
+        // Triangles 10⁻³ across and a point 2,000 away, 10⁴ cells: ring by ring this would
+        // visit ~10¹² empty cells (the jobs test's tube hung here); it must answer at once,
+        // exactly.
         let p = vec![
             Vec3::ZERO,
             Vec3::new(1e-3, 0.0, 0.0),
@@ -254,5 +262,52 @@ mod tests {
         let q = Vec3::new(0.0, 0.0, 2000.0);
         assert!((grid.distance(q) - 2000.0).abs() < 1e-3);
         assert!(grid.distance_below(q, 1.0) >= 1.0);
+    }
+
+    /// The back of a cube's half (MorphStressTest, `--auto-parts 2`): a thousand slivers
+    /// where the back collapsed, under two triangles across the whole part. Cells of twice
+    /// the mean triangle put each large triangle in ~10⁴–10⁵ cells and every query walked
+    /// them (133 s to measure 8 pieces, 1.9 s with the coarser grid).
+    #[test]
+    fn collapsed_back_under_large_triangles_keeps_the_grid_coarse() {
+        let mut rng = anim::SplitMix64::new(11, 0);
+        let mut r = |s: f32| (rng.next_f32() - 0.5) * s;
+        let mut p: Vec<Vec3> = Vec::new();
+        for _ in 0..1000 {
+            let c = Vec3::new(r(80.0), r(80.0), r(2.0));
+            p.extend([
+                c,
+                c + Vec3::new(0.01, 0.0, 0.0),
+                c + Vec3::new(0.0, 0.01, 0.0),
+            ]);
+        }
+        p.extend([
+            Vec3::new(-40.0, -40.0, 0.0),
+            Vec3::new(40.0, -40.0, 0.0),
+            Vec3::new(-40.0, 40.0, 0.0),
+            Vec3::new(40.0, 40.0, 1.0),
+        ]);
+        let t: Vec<[u32; 3]> = (0..1000)
+            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+            .chain([[3000, 3001, 3002], [3001, 3003, 3002]])
+            .collect();
+        let grid = TriangleGrid::new(&p, &t);
+        let cells = grid.cells().count();
+        assert!(
+            cells < 20 * t.len(),
+            "{cells} cells for {} triangles",
+            t.len()
+        );
+        for _ in 0..50 {
+            let q = Vec3::new(r(90.0), r(90.0), r(10.0));
+            let brute = t
+                .iter()
+                .map(|&[a, b, c]| {
+                    let [a, b, c] = [a, b, c].map(|v| p[v as usize]);
+                    f64::from(closest_point_on_triangle(q, a, b, c).distance(q))
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!((grid.distance(q) - brute).abs() < 1e-9, "{q}");
+        }
     }
 }

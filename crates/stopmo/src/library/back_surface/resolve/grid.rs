@@ -13,10 +13,27 @@ pub(super) struct BoxGrid {
 }
 
 impl BoxGrid {
+    /// Bins the boxes of `tris` into cells of `cell` (or coarser: at most ~64 cells per
+    /// triangle along the longest side of all boxes, so that a few large wall triangles over
+    /// a collapsed back do not fill 10⁵ tiny cells each).
     pub(super) fn new(positions: &[Vec3], tris: &[[u32; 3]], cell: f32) -> BoxGrid {
+        let boxes: Vec<(Vec3, Vec3)> = tris
+            .iter()
+            .map(|tri| bounds(tri.map(|v| positions[v as usize])))
+            .collect();
+        let (lo, hi) = boxes.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(l, h), b| (l.min(b.0), h.max(b.1)),
+        );
+        let extent = (hi - lo).max_element();
+        let coarsest = if extent.is_finite() {
+            extent / (4.0 * (tris.len().max(1) as f32).cbrt())
+        } else {
+            0.0
+        };
+        let cell = cell.max(coarsest).max(1e-6);
         let mut cells: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
-        for (t, tri) in tris.iter().enumerate() {
-            let (lo, hi) = bounds(tri.map(|v| positions[v as usize]));
+        for (t, &(lo, hi)) in boxes.iter().enumerate() {
             let (a, b) = (key(lo, cell), key(hi, cell));
             for x in a[0]..=b[0] {
                 for y in a[1]..=b[1] {
@@ -33,6 +50,20 @@ impl BoxGrid {
     pub(super) fn near(&self, lo: Vec3, hi: Vec3) -> Vec<u32> {
         let (a, b) = (key(lo, self.cell), key(hi, self.cell));
         let mut out = Vec::new();
+        let span = (0..3)
+            .map(|k| (i64::from(b[k]) - i64::from(a[k]) + 1).max(0))
+            .product::<i64>();
+        if span > self.cells.len() as i64 {
+            // A box wider than the occupied grid: visit the occupied cells instead.
+            for (k, list) in &self.cells {
+                if (0..3).all(|i| a[i] <= k[i] && k[i] <= b[i]) {
+                    out.extend_from_slice(list);
+                }
+            }
+            out.sort_unstable();
+            out.dedup();
+            return out;
+        }
         for x in a[0]..=b[0] {
             for y in a[1]..=b[1] {
                 for z in a[2]..=b[2] {
@@ -58,4 +89,51 @@ pub(super) fn bounds(t: [Vec3; 3]) -> (Vec3, Vec3) {
 
 pub(super) fn boxes_overlap(a: (Vec3, Vec3), b: (Vec3, Vec3)) -> bool {
     !(a.0.cmpgt(b.1).any() || b.0.cmpgt(a.1).any())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Slivers under two triangles across the whole solid (the back of a cube's half,
+    /// MorphStressTest): the grid stays coarse and a box wider than it finds exactly the
+    /// triangles whose boxes a brute-force scan finds.
+    #[test]
+    fn wide_boxes_over_slivers_find_what_a_scan_finds() {
+        let mut rng = anim::SplitMix64::new(5, 0);
+        let mut r = |s: f32| (rng.next_f32() - 0.5) * s;
+        let mut p: Vec<Vec3> = Vec::new();
+        for _ in 0..500 {
+            let c = Vec3::new(r(80.0), r(80.0), r(2.0));
+            p.extend([
+                c,
+                c + Vec3::new(0.01, 0.0, 0.0),
+                c + Vec3::new(0.0, 0.01, 0.0),
+            ]);
+        }
+        p.extend([
+            Vec3::new(-40.0, -40.0, 0.0),
+            Vec3::new(40.0, -40.0, 0.0),
+            Vec3::new(-40.0, 40.0, 0.0),
+        ]);
+        let t: Vec<[u32; 3]> = (0..501).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+        let grid = BoxGrid::new(&p, &t, 0.2);
+        assert!(
+            grid.cells.len() < 20 * t.len(),
+            "{} cells",
+            grid.cells.len()
+        );
+        for size in [0.5, 5.0, 200.0] {
+            let (lo, hi) = (Vec3::new(r(60.0), r(60.0), -1.0), Vec3::splat(size));
+            let hi = lo + hi;
+            let found = grid.near(lo, hi);
+            // Everything whose box overlaps the query box is found (cells may add more).
+            for (i, tri) in t.iter().enumerate() {
+                if boxes_overlap(bounds(tri.map(|v| p[v as usize])), (lo, hi)) {
+                    assert!(found.binary_search(&(i as u32)).is_ok(), "{i} missing");
+                }
+            }
+            assert!(found.windows(2).all(|w| w[0] < w[1]));
+        }
+    }
 }
