@@ -187,6 +187,7 @@ pub(crate) fn print_pieces(
         .collect();
     let shell_opts = ShellOptions {
         wall_mm: s.thickness_mm,
+        model_height_mm: s.print_height_mm,
         ..ShellOptions::default()
     };
     let built = build_shells(&inputs, &shell_opts)?;

@@ -27,7 +27,7 @@
 use std::collections::HashMap;
 
 use super::error::{LibraryError, Result};
-use super::fabricate::check_solid;
+use super::fabricate::{check_solid, DEFAULT_PRINT_HEIGHT_MM};
 use anim::Mesh;
 use glam::Vec3;
 
@@ -44,8 +44,9 @@ mod untangle;
 pub use measure::ThinnestWall;
 pub use options::{
     DirectionField, ShellOptions, ShellStats, DEFAULT_BACK_SMOOTHING_ITERATIONS,
-    DEFAULT_CAP_FRACTION, DEFAULT_EDGE_RING_RADIUS_MM, DEFAULT_NORMAL_SMOOTHING_MM,
-    DEFAULT_REPAIR_ROUNDS, DEFAULT_RESOLVE_ROUNDS,
+    DEFAULT_CAP_FRACTION, DEFAULT_EDGE_RING_RADIUS_MM, DEFAULT_ENVELOPE_LATERAL,
+    DEFAULT_ENVELOPE_REACH, DEFAULT_NORMAL_SMOOTHING_MM, DEFAULT_REPAIR_ROUNDS,
+    DEFAULT_RESOLVE_ROUNDS,
 };
 pub use seams::{build_shells, ShellInput};
 
@@ -60,11 +61,6 @@ const REPAIR_STEPS: usize = 10;
 /// How far along a seam the neighbours of a shared back point that had to move deeper
 /// follow it, in walls.
 const SEAM_SPREAD_WALLS: f64 = 3.0;
-
-/// Radius of the column under a front vertex the back must stay behind, in walls.
-const ENVELOPE_LATERAL_WALLS: f64 = 2.0;
-/// How far behind a front vertex the column reaches, in walls.
-const ENVELOPE_REACH_WALLS: f64 = 3.0;
 
 /// The shared back surface of one part and how pieces are closed onto it.
 #[derive(Debug, Clone)]
@@ -174,6 +170,12 @@ impl PartShell {
                 opts.wall_mm
             )));
         }
+        if !(opts.model_height_mm.is_finite() && opts.model_height_mm > 0.0) {
+            return Err(LibraryError::InvalidParameter(format!(
+                "model height must be finite and > 0 mm, got {}",
+                opts.model_height_mm
+            )));
+        }
         if let DirectionField::EdgeRings { radius_mm: w }
         | DirectionField::Geodesic { sigma_mm: w } = opts.direction
         {
@@ -207,11 +209,12 @@ impl PartShell {
                 Ok(Self::along(&frame, disc(sigma_mm), pieces, opts, shared))
             }
             DirectionField::Best => {
+                let scale = opts.model_height_mm / DEFAULT_PRINT_HEIGHT_MM;
                 let (a, b) = rayon::join(
                     || {
                         Self::along(
                             &frame,
-                            rings(DEFAULT_EDGE_RING_RADIUS_MM),
+                            rings(DEFAULT_EDGE_RING_RADIUS_MM * scale),
                             pieces,
                             opts,
                             shared,
@@ -220,7 +223,7 @@ impl PartShell {
                     || {
                         Self::along(
                             &frame,
-                            disc(DEFAULT_NORMAL_SMOOTHING_MM),
+                            disc(DEFAULT_NORMAL_SMOOTHING_MM * scale),
                             pieces,
                             opts,
                             shared,
@@ -257,8 +260,8 @@ impl PartShell {
             fronts,
             &normals,
             wall,
-            (ENVELOPE_LATERAL_WALLS * opts.wall_mm) as f32,
-            (ENVELOPE_REACH_WALLS * opts.wall_mm) as f32,
+            (DEFAULT_ENVELOPE_LATERAL * opts.model_height_mm) as f32,
+            (DEFAULT_ENVELOPE_REACH * opts.model_height_mm) as f32,
         );
         let shared_at: HashMap<[u32; 3], Vec3> =
             shared.iter().map(|(a, b)| (position_key(*a), *b)).collect();

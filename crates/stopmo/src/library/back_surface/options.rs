@@ -2,15 +2,30 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::library::fabricate::DEFAULT_THICKNESS_MM;
+use crate::library::fabricate::{DEFAULT_PRINT_HEIGHT_MM, DEFAULT_THICKNESS_MM};
 
-/// Width (Gaussian σ, millimetres along the surface) of [`DirectionField::Geodesic`].
-/// Narrower or wider, the directions fold the back behind the nose on the ICT face (README
-/// seeds, `upper` part, crossing triangles left: 792 at 7 mm and 8 pieces, 160 at 14 mm and
-/// 20 pieces, 240 at 21 mm and 8 pieces; none at 17.5 mm for 8, 20 and 50 pieces).
+/// Width (Gaussian σ, millimetres along the surface) of [`DirectionField::Geodesic`] for a
+/// model printed [`DEFAULT_PRINT_HEIGHT_MM`] high ([`DirectionField::Best`] scales it with
+/// [`ShellOptions::model_height_mm`]). Narrower or wider, the directions fold the back behind
+/// the nose on the ICT face (README seeds, `upper` part, crossing triangles left: 792 at 7 mm
+/// and 8 pieces, 160 at 14 mm and 20 pieces, 240 at 21 mm and 8 pieces; none at 17.5 mm for
+/// 8, 20 and 50 pieces).
 pub const DEFAULT_NORMAL_SMOOTHING_MM: f64 = 17.5;
-/// Radius (millimetres, in mean edge lengths) of [`DirectionField::EdgeRings`].
+/// Radius (millimetres, in mean edge lengths) of [`DirectionField::EdgeRings`] for a model
+/// printed [`DEFAULT_PRINT_HEIGHT_MM`] high (scaled like [`DEFAULT_NORMAL_SMOOTHING_MM`]).
 pub const DEFAULT_EDGE_RING_RADIUS_MM: f64 = 14.0;
+
+/// Radius of the column under a front vertex the back must stay behind
+/// ([`ShellOptions::model_height_mm`] × this), and how far behind the vertex it reaches
+/// ([`DEFAULT_ENVELOPE_REACH`]). They follow the face's features (the nostrils behind the
+/// nose tip, the lips behind the mouth corners), so they scale with the print, not with the
+/// wall: set in walls (2 and 3 walls of 1.5 mm at 60 mm), a 1 mm wall left 0.56 mm under the
+/// nose and a 2.5 mm wall 816 crossing triangles, and prints of 100 and 150 mm left 0.87 and
+/// 0.00 mm walls at the nose tip (ICT face, README seeds, 8 pieces; all clean with these).
+pub const DEFAULT_ENVELOPE_LATERAL: f64 = 0.05;
+/// How far behind a front vertex its column reaches, × [`ShellOptions::model_height_mm`]
+/// (see [`DEFAULT_ENVELOPE_LATERAL`]).
+pub const DEFAULT_ENVELOPE_REACH: f64 = 0.075;
 
 /// How the inward direction field the back is offset along is smoothed.
 ///
@@ -35,8 +50,11 @@ pub enum DirectionField {
         /// Gaussian width in millimetres along the surface.
         sigma_mm: f64,
     },
-    /// Both fields at their default widths; each part keeps the back with fewer crossing
-    /// triangles (then one whose wall holds the minimum; a tie keeps the edge rings).
+    /// Both fields at their default widths scaled to the model's height
+    /// ([`ShellOptions::model_height_mm`] / [`DEFAULT_PRINT_HEIGHT_MM`]: at 25 mm the
+    /// unscaled widths left 572 crossing triangles on the README cut, none scaled); each part
+    /// keeps the back with fewer crossing triangles (then one whose wall holds the minimum; a
+    /// tie keeps the edge rings).
     Best,
 }
 
@@ -67,6 +85,9 @@ pub const DEFAULT_RESOLVE_ROUNDS: usize = 8;
 pub struct ShellOptions {
     /// Minimum wall between any piece's front and the back surface.
     pub wall_mm: f64,
+    /// Printed height of the whole model: the direction field ([`DirectionField::Best`]) and
+    /// the envelope's column scale with it.
+    pub model_height_mm: f64,
     /// How the inward direction field is smoothed.
     pub direction: DirectionField,
     /// Laplacian smoothing steps of the back surface.
@@ -87,6 +108,7 @@ impl Default for ShellOptions {
     fn default() -> Self {
         ShellOptions {
             wall_mm: DEFAULT_THICKNESS_MM,
+            model_height_mm: DEFAULT_PRINT_HEIGHT_MM,
             direction: DirectionField::Best,
             smoothing_iterations: DEFAULT_BACK_SMOOTHING_ITERATIONS,
             repair_rounds: DEFAULT_REPAIR_ROUNDS,
