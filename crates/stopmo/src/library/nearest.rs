@@ -63,6 +63,18 @@ pub struct TriangleGrid<'a> {
     cells: HashMap<[i32; 3], Vec<u32>>,
 }
 
+/// The finest cell a uniform grid of `triangles` triangles over the box `lo..hi` may use:
+/// about 64 cells per triangle along the box's longest side (and at least 10⁻⁶; a box that
+/// is not finite gives that floor).
+pub(crate) fn coarsest_cell(lo: Vec3, hi: Vec3, triangles: usize) -> f32 {
+    let cell = (hi - lo).max_element() / (4.0 * (triangles.max(1) as f32).cbrt());
+    if cell.is_finite() {
+        cell.max(1e-6)
+    } else {
+        1e-6
+    }
+}
+
 impl<'a> TriangleGrid<'a> {
     /// Bins the triangles (indices must be valid) into cells of about twice their mean size.
     pub fn new(positions: &'a [Vec3], triangles: &'a [[u32; 3]]) -> TriangleGrid<'a> {
@@ -86,8 +98,7 @@ impl<'a> TriangleGrid<'a> {
         // 80 mm, each large triangle in ~10⁵ of them, and every nearest query walked
         // thousands of empty cells (133 s to measure 8 pieces; results do not depend on the
         // cell size, only the time).
-        let coarsest = (hi - lo).max_element() / (4.0 * (triangles.len().max(1) as f32).cbrt());
-        let cell = (2.0 * mean).max(coarsest).max(1e-6);
+        let cell = (2.0 * mean).max(coarsest_cell(lo, hi, triangles.len()));
         let key = |p: Vec3| cell_of(p, lo, cell);
         let mut cells: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
         for (t, (a, b)) in boxes.iter().enumerate() {
@@ -212,9 +223,48 @@ impl<'a> TriangleGrid<'a> {
     }
 }
 
+/// `slivers` triangles 0.01 across scattered over 80 × 80 × 2, under two triangles across
+/// all of it: a back surface that collapsed under its walls (MorphStressTest's cube).
+#[cfg(test)]
+pub(crate) fn slivers_under_large_triangles(seed: u64, slivers: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let mut rng = anim::SplitMix64::new(seed, 0);
+    let mut r = |s: f32| (rng.next_f32() - 0.5) * s;
+    let mut p: Vec<Vec3> = Vec::new();
+    for _ in 0..slivers {
+        let c = Vec3::new(r(80.0), r(80.0), r(2.0));
+        p.extend([
+            c,
+            c + Vec3::new(0.01, 0.0, 0.0),
+            c + Vec3::new(0.0, 0.01, 0.0),
+        ]);
+    }
+    let n = 3 * slivers;
+    p.extend([
+        Vec3::new(-40.0, -40.0, 0.0),
+        Vec3::new(40.0, -40.0, 0.0),
+        Vec3::new(-40.0, 40.0, 0.0),
+        Vec3::new(40.0, 40.0, 1.0),
+    ]);
+    let t = (0..slivers)
+        .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+        .chain([[n, n + 1, n + 2], [n + 1, n + 3, n + 2]])
+        .collect();
+    (p, t)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Distance from `q` to the nearest triangle, by trying every one.
+    fn brute(p: &[Vec3], t: &[[u32; 3]], q: Vec3) -> f64 {
+        t.iter()
+            .map(|&[a, b, c]| {
+                let [a, b, c] = [a, b, c].map(|v| p[v as usize]);
+                f64::from(closest_point_on_triangle(q, a, b, c).distance(q))
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
 
     #[test]
     fn grid_distance_matches_brute_force_near_and_far() {
@@ -229,13 +279,7 @@ mod tests {
         for i in 0..200 {
             let scale = if i % 2 == 0 { 5.0 } else { 40.0 };
             let q = Vec3::new(r(scale), r(scale), r(scale));
-            let brute = t
-                .iter()
-                .map(|&[a, b, c]| {
-                    let [a, b, c] = [a, b, c].map(|v| p[v as usize]);
-                    f64::from(closest_point_on_triangle(q, a, b, c).distance(q))
-                })
-                .fold(f64::INFINITY, f64::min);
+            let brute = brute(&p, &t, q);
             assert!((grid.distance(q) - brute).abs() < 1e-9, "{q}");
             // Under a limit: the exact distance when nearer, else at least the limit.
             let below = grid.distance_below(q, brute * 0.5);
@@ -270,27 +314,7 @@ mod tests {
     /// them (133 s to measure 8 pieces, 1.9 s with the coarser grid).
     #[test]
     fn collapsed_back_under_large_triangles_keeps_the_grid_coarse() {
-        let mut rng = anim::SplitMix64::new(11, 0);
-        let mut r = |s: f32| (rng.next_f32() - 0.5) * s;
-        let mut p: Vec<Vec3> = Vec::new();
-        for _ in 0..1000 {
-            let c = Vec3::new(r(80.0), r(80.0), r(2.0));
-            p.extend([
-                c,
-                c + Vec3::new(0.01, 0.0, 0.0),
-                c + Vec3::new(0.0, 0.01, 0.0),
-            ]);
-        }
-        p.extend([
-            Vec3::new(-40.0, -40.0, 0.0),
-            Vec3::new(40.0, -40.0, 0.0),
-            Vec3::new(-40.0, 40.0, 0.0),
-            Vec3::new(40.0, 40.0, 1.0),
-        ]);
-        let t: Vec<[u32; 3]> = (0..1000)
-            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
-            .chain([[3000, 3001, 3002], [3001, 3003, 3002]])
-            .collect();
+        let (p, t) = slivers_under_large_triangles(11, 1000);
         let grid = TriangleGrid::new(&p, &t);
         let cells = grid.cells().count();
         assert!(
@@ -298,16 +322,10 @@ mod tests {
             "{cells} cells for {} triangles",
             t.len()
         );
+        let mut rng = anim::SplitMix64::new(12, 0);
         for _ in 0..50 {
-            let q = Vec3::new(r(90.0), r(90.0), r(10.0));
-            let brute = t
-                .iter()
-                .map(|&[a, b, c]| {
-                    let [a, b, c] = [a, b, c].map(|v| p[v as usize]);
-                    f64::from(closest_point_on_triangle(q, a, b, c).distance(q))
-                })
-                .fold(f64::INFINITY, f64::min);
-            assert!((grid.distance(q) - brute).abs() < 1e-9, "{q}");
+            let q = Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, 0.1) * 90.0;
+            assert!((grid.distance(q) - brute(&p, &t, q)).abs() < 1e-9, "{q}");
         }
     }
 }

@@ -6,6 +6,8 @@ use std::collections::HashMap;
 
 use glam::Vec3;
 
+use crate::library::nearest::coarsest_cell;
+
 /// A uniform grid of triangle boxes of one piece's solid, built once per round.
 pub(super) struct BoxGrid {
     cell: f32,
@@ -25,13 +27,7 @@ impl BoxGrid {
             (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
             |(l, h), b| (l.min(b.0), h.max(b.1)),
         );
-        let extent = (hi - lo).max_element();
-        let coarsest = if extent.is_finite() {
-            extent / (4.0 * (tris.len().max(1) as f32).cbrt())
-        } else {
-            0.0
-        };
-        let cell = cell.max(coarsest).max(1e-6);
+        let cell = cell.max(coarsest_cell(lo, hi, tris.len()));
         let mut cells: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
         for (t, &(lo, hi)) in boxes.iter().enumerate() {
             let (a, b) = (key(lo, cell), key(hi, cell));
@@ -100,23 +96,9 @@ mod tests {
     /// triangles whose boxes a brute-force scan finds.
     #[test]
     fn wide_boxes_over_slivers_find_what_a_scan_finds() {
-        let mut rng = anim::SplitMix64::new(5, 0);
+        let (p, t) = crate::library::nearest::slivers_under_large_triangles(5, 500);
+        let mut rng = anim::SplitMix64::new(6, 0);
         let mut r = |s: f32| (rng.next_f32() - 0.5) * s;
-        let mut p: Vec<Vec3> = Vec::new();
-        for _ in 0..500 {
-            let c = Vec3::new(r(80.0), r(80.0), r(2.0));
-            p.extend([
-                c,
-                c + Vec3::new(0.01, 0.0, 0.0),
-                c + Vec3::new(0.0, 0.01, 0.0),
-            ]);
-        }
-        p.extend([
-            Vec3::new(-40.0, -40.0, 0.0),
-            Vec3::new(40.0, -40.0, 0.0),
-            Vec3::new(-40.0, 40.0, 0.0),
-        ]);
-        let t: Vec<[u32; 3]> = (0..501).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
         let grid = BoxGrid::new(&p, &t, 0.2);
         assert!(
             grid.cells.len() < 20 * t.len(),
