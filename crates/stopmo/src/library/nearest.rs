@@ -64,9 +64,9 @@ pub struct TriangleGrid<'a> {
 }
 
 /// The finest cell a uniform grid of `triangles` triangles over the box `lo..hi` may use:
-/// about 64 cells per triangle along the box's longest side (and at least 10⁻⁶; a box that
-/// is not finite gives that floor).
-pub(crate) fn coarsest_cell(lo: Vec3, hi: Vec3, triangles: usize) -> f32 {
+/// 4 ∛`triangles` cells along the box's longest side, so at most ~64 cells per triangle in
+/// all (and at least 10⁻⁶; a box that is not finite gives that floor).
+pub(crate) fn finest_cell(lo: Vec3, hi: Vec3, triangles: usize) -> f32 {
     let cell = (hi - lo).max_element() / (4.0 * (triangles.max(1) as f32).cbrt());
     if cell.is_finite() {
         cell.max(1e-6)
@@ -93,12 +93,12 @@ impl<'a> TriangleGrid<'a> {
             .sum::<f32>()
             / triangles.len().max(1) as f32;
         // Twice the mean triangle, but never so fine that the grid has more than ~64 cells
-        // per triangle along its longest side: a back surface that collapsed to slivers
+        // per triangle (finest_cell): a back surface that collapsed to slivers
         // under a few large triangles (a cube's, MorphStressTest) made 0.1 mm cells over
         // 80 mm, each large triangle in ~10⁵ of them, and every nearest query walked
         // thousands of empty cells (133 s to measure 8 pieces; results do not depend on the
         // cell size, only the time).
-        let cell = (2.0 * mean).max(coarsest_cell(lo, hi, triangles.len()));
+        let cell = (2.0 * mean).max(finest_cell(lo, hi, triangles.len()));
         let key = |p: Vec3| cell_of(p, lo, cell);
         let mut cells: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
         for (t, (a, b)) in boxes.iter().enumerate() {

@@ -6,7 +6,7 @@ use std::collections::HashMap;
 
 use glam::Vec3;
 
-use crate::library::nearest::coarsest_cell;
+use crate::library::nearest::finest_cell;
 
 /// A uniform grid of triangle boxes of one piece's solid, built once per round.
 pub(super) struct BoxGrid {
@@ -15,9 +15,9 @@ pub(super) struct BoxGrid {
 }
 
 impl BoxGrid {
-    /// Bins the boxes of `tris` into cells of `cell` (or coarser: at most ~64 cells per
-    /// triangle along the longest side of all boxes, so that a few large wall triangles over
-    /// a collapsed back do not fill 10⁵ tiny cells each).
+    /// Bins the boxes of `tris` into cells of `cell`, or coarser ([`finest_cell`]: at most
+    /// ~64 cells per triangle in all), so that a few large wall triangles over a collapsed
+    /// back do not fill 10⁵ tiny cells each.
     pub(super) fn new(positions: &[Vec3], tris: &[[u32; 3]], cell: f32) -> BoxGrid {
         let boxes: Vec<(Vec3, Vec3)> = tris
             .iter()
@@ -27,7 +27,7 @@ impl BoxGrid {
             (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
             |(l, h), b| (l.min(b.0), h.max(b.1)),
         );
-        let cell = cell.max(coarsest_cell(lo, hi, tris.len()));
+        let cell = cell.max(finest_cell(lo, hi, tris.len()));
         let mut cells: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
         for (t, &(lo, hi)) in boxes.iter().enumerate() {
             let (a, b) = (key(lo, cell), key(hi, cell));
