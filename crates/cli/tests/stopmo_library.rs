@@ -311,6 +311,35 @@ fn bad_library_inputs_exit_2_with_one_line() {
     );
 }
 
+/// The issue's `--gamma 10000`: the graph cut's shrinking bias wins and the upper part
+/// collapses around its seed (14 of 18,480 triangles). That is an error with advice, and
+/// nothing is written.
+#[test]
+fn a_part_that_collapses_is_refused_with_advice() {
+    let dir = tempfile::tempdir().unwrap();
+    let face = face();
+    let out = dir.path().join("seg.glb");
+    assert_bad_input(
+        &[
+            "stopmo",
+            "segment",
+            s(&face),
+            "-o",
+            s(&out),
+            "--fps",
+            "1",
+            "--part",
+            "upper=point:0,10,13",
+            "--part",
+            "lower=point:0,-14,10",
+            "--gamma",
+            "10000",
+        ],
+        "part 'upper' collapsed to 14 of 18480 triangles (γ 10000): lower --gamma",
+    );
+    assert!(!out.exists(), "nothing is written for a collapsed cut");
+}
+
 /// Fig. 13: `stopmo run --plugs` fuses a pin into every upper piece and a socket tube into
 /// every lower piece; each STL is the piece's shell plus one closed plug shell.
 #[test]
