@@ -109,23 +109,20 @@ fn diagnose_crossings() {
                     format!("{}/{}@({:.1},{:.1},{:.1})", kind(i), kind(j), c.x, c.y, c.z)
                 })
                 .collect();
-            // STOPMO_DUMP=DIR: every solid as OBJ (a group per kind) and its crossing pairs.
+            // STOPMO_DUMP=DIR: every solid as OBJ, the triangle ranges of each kind and the
+            // crossing pairs.
             if let Ok(dir) = std::env::var("STOPMO_DUMP") {
-                let mut obj = String::new();
-                for v in &solid.positions {
-                    obj += &format!("v {} {} {}\n", v.x, v.y, v.z);
-                }
-                let mut last = "";
-                for (i, tri) in solid.triangles.iter().enumerate() {
-                    let k = kind(i as u32);
-                    if k != last {
-                        obj += &format!("g {k}\n");
-                        last = k;
-                    }
-                    obj += &format!("f {} {} {}\n", tri[0] + 1, tri[1] + 1, tri[2] + 1);
-                }
                 let base = format!("{dir}/{}_{k}", a.mesh.name);
-                std::fs::write(format!("{base}.obj"), obj).unwrap();
+                std::fs::write(format!("{base}.obj"), tkio::obj::write(&solid)).unwrap();
+                let mut ranges = String::new();
+                let mut start = 0u32;
+                for i in 1..=solid.triangles.len() as u32 {
+                    if i == solid.triangles.len() as u32 || kind(i) != kind(start) {
+                        ranges += &format!("{} {start} {i}\n", kind(start));
+                        start = i;
+                    }
+                }
+                std::fs::write(format!("{base}.kinds"), ranges).unwrap();
                 let list: String = pairs.iter().map(|(i, j)| format!("{i} {j}\n")).collect();
                 std::fs::write(format!("{base}.pairs"), list).unwrap();
             }

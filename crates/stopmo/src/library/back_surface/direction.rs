@@ -99,7 +99,7 @@ pub(super) fn smoothed_directions(
 /// vertex's and its neighbours' directions ([`super::DirectionField::EdgeRings`]).
 ///
 /// # Performance
-/// O(steps × edges), serial.
+/// O(steps × edges), each step parallel over vertices into a second buffer.
 pub(super) fn edge_ring_directions(
     front: &[Vec3],
     tris: &[[u32; 3]],
@@ -119,16 +119,16 @@ pub(super) fn edge_ring_directions(
     let steps = ((radius_mm / mean_edge).powi(2)).ceil() as usize;
     let steps = steps.min(4000);
     let mut normals = anim::vertex_normals(front, tris);
+    // Two buffers swapped per step (up to 4,000 steps): no allocation in the loop.
+    let mut next = vec![Vec3::ZERO; n];
     for _ in 0..steps {
-        let next: Vec<Vec3> = (0..n)
-            .map(|v| {
-                let s = adj[v]
-                    .iter()
-                    .fold(normals[v], |acc, &w| acc + normals[w as usize]);
-                s.try_normalize().unwrap_or(normals[v])
-            })
-            .collect();
-        normals = next;
+        next.par_iter_mut().enumerate().for_each(|(v, out)| {
+            let s = adj[v]
+                .iter()
+                .fold(normals[v], |acc, &w| acc + normals[w as usize]);
+            *out = s.try_normalize().unwrap_or(normals[v]);
+        });
+        std::mem::swap(&mut normals, &mut next);
     }
     normals
 }

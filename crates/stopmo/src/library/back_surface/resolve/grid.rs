@@ -56,15 +56,13 @@ impl BoxGrid {
                     out.extend_from_slice(list);
                 }
             }
-            out.sort_unstable();
-            out.dedup();
-            return out;
-        }
-        for x in a[0]..=b[0] {
-            for y in a[1]..=b[1] {
-                for z in a[2]..=b[2] {
-                    if let Some(list) = self.cells.get(&[x, y, z]) {
-                        out.extend_from_slice(list);
+        } else {
+            for x in a[0]..=b[0] {
+                for y in a[1]..=b[1] {
+                    for z in a[2]..=b[2] {
+                        if let Some(list) = self.cells.get(&[x, y, z]) {
+                            out.extend_from_slice(list);
+                        }
                     }
                 }
             }
