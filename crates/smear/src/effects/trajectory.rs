@@ -182,6 +182,34 @@ impl<'a> Trajectories<'a> {
         self.sample(self.causal.then_some(now), i, time)
     }
 
+    /// Plain trajectories: no past-only mode, arcs, ground or colliders (the common case,
+    /// which [`Self::catmull_rom`] evaluates without the general path's branches).
+    #[inline]
+    fn is_plain(&self) -> bool {
+        !self.causal && self.arcs.is_none() && self.ground.is_none() && self.colliders.is_empty()
+    }
+
+    /// [`Self::sample`] of plain trajectories ([`Self::is_plain`]): the same arithmetic,
+    /// small enough to inline into the per-vertex loops.
+    #[inline(always)]
+    fn catmull_rom(&self, i: usize, time: f32) -> Vec3 {
+        let last = self.frames.saturating_sub(1);
+        if last == 0 || time.is_nan() || time <= 0.0 {
+            return self.positions[i];
+        }
+        if time >= last as f32 {
+            return self.positions[last * self.points + i];
+        }
+        let k = (time as usize).min(last - 1);
+        let t = time - k as f32;
+        let n = self.points;
+        let p1 = self.positions[k * n + i];
+        let p2 = self.positions[(k + 1) * n + i];
+        let p0 = self.positions[k.saturating_sub(1) * n + i];
+        let p3 = self.positions[(k + 2).min(last) * n + i];
+        hermite(p1, p2, (p2 - p0) * 0.5, (p3 - p1) * 0.5, t)
+    }
+
     #[inline]
     fn sample(&self, now: Option<usize>, i: usize, time: f32) -> Vec3 {
         let last = self.frames.saturating_sub(1);
@@ -245,9 +273,19 @@ impl<'a> Trajectories<'a> {
     /// With a ground plane or colliders, a displacement that would end below the ground or
     /// inside a collider stops where the trajectory reaches it (bisection on β), and a point
     /// already there is lifted out ([`Trajectories::lifted`]).
-    #[inline]
+    #[inline(always)]
     pub fn displaced(&self, f: usize, i: usize, beta: f32) -> Vec3 {
         let beta = if beta.is_finite() { beta } else { 0.0 };
+        if self.is_plain() {
+            return self.catmull_rom(i, f as f32 + beta);
+        }
+        self.displaced_shaped(f, i, beta)
+    }
+
+    /// [`Self::displaced`] of shaped trajectories (past-only, arcs, ground, colliders): kept
+    /// out of line so that the plain path inlines into the per-vertex loops.
+    #[inline(never)]
+    fn displaced_shaped(&self, f: usize, i: usize, beta: f32) -> Vec3 {
         let q = self.seen_from(f, i, f as f32 + beta);
         if self.is_blocked(f, q) {
             self.stopped(f, i, beta)
@@ -324,6 +362,40 @@ mod tests {
         let one = [Vec3::ONE];
         assert_eq!(Trajectories::new(&one, 1, 1).unwrap().at(0, 0.7), Vec3::ONE);
         assert!(Trajectories::new(&one, 2, 1).is_err());
+    }
+
+    #[test]
+    fn the_plain_path_is_the_general_path_bit_for_bit() {
+        // `displaced` takes `catmull_rom` when nothing shapes the trajectories; elongated
+        // in-betweens must keep their bytes whichever path draws them.
+        let (frames, points) = (7, 3);
+        let p: Vec<Vec3> = (0..frames * points)
+            .map(|k| {
+                let t = k as f32;
+                Vec3::new((0.7 * t).sin(), t * t * 0.01, (1.3 * t).cos())
+            })
+            .collect();
+        let tr = Trajectories::new(&p, frames, points).unwrap();
+        assert!(tr.is_plain());
+        for step in -80..=110 {
+            let time = step as f32 * 0.073;
+            for i in 0..points {
+                let (plain, general) = (tr.catmull_rom(i, time), tr.sample(None, i, time));
+                assert_eq!(plain.to_array(), general.to_array(), "point {i} at {time}");
+            }
+        }
+        for time in [
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            0.0,
+            6.0,
+            5.999_999,
+        ] {
+            assert_eq!(tr.catmull_rom(1, time), tr.sample(None, 1, time), "{time}");
+        }
+        let shaped = tr.shaped(true, None, None);
+        assert!(!shaped.is_plain() && !tr.shaped(false, Some(0.0), None).is_plain());
     }
 
     #[test]
