@@ -271,3 +271,62 @@ fn face_run_equals_segment_then_library_and_searches_a_size() {
         run.report.errors_mm
     );
 }
+
+/// A part whose own animated surface presses through itself (as lips can at a mouth corner
+/// inside one part): the report counts it apart from the back's crossings and the warning
+/// says what to do.
+#[test]
+fn a_surface_that_presses_through_itself_is_reported_with_advice() {
+    let rest = segment_support::tube(16, 12);
+    let frames = 6;
+    // The middle rows' cross-section flattens, then inverts (z scaled 1 → −0.6): the front and
+    // back walls pass through each other between the inverted and the untouched rows.
+    let pos: Vec<Vec3> = (0..frames)
+        .flat_map(|f| {
+            let s = 1.0 - 1.6 * f as f32 / (frames - 1) as f32;
+            rest.positions.iter().map(move |&p| {
+                let band = (1.0 - (p.y / 0.5).abs()).clamp(0.0, 1.0);
+                let k = 1.0 + (s - 1.0) * band;
+                Vec3::new(p.x, p.y, p.z * k)
+            })
+        })
+        .collect();
+    let anim = MeshAnimation::new(rest, 30.0, pos).unwrap();
+    let lib = stopmo::library(
+        std::slice::from_ref(&anim),
+        &LibraryJobOptions {
+            pieces: PieceCount::Each(3),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let part = &lib.report.printing.parts[0];
+    assert!(
+        part.surface_self_intersecting_triangles > 0,
+        "{:?}",
+        lib.report.warnings
+    );
+    assert!(
+        lib.report
+            .warnings
+            .iter()
+            .any(|w| w.contains("the animated surface itself crosses")
+                && w.contains("a seam runs between the touching surfaces")),
+        "{:?}",
+        lib.report.warnings
+    );
+    // An untouched tube reports none.
+    let calm = segment_support::talking_tube(16, 12, 6);
+    let lib = stopmo::library(
+        std::slice::from_ref(&calm),
+        &LibraryJobOptions {
+            pieces: PieceCount::Each(3),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(
+        lib.report.printing.parts[0].surface_self_intersecting_triangles,
+        0
+    );
+}

@@ -73,6 +73,11 @@ pub struct PartPrintReport {
     /// Smallest largest-vertex-distance between two pieces of the part (mm; `null` for one
     /// piece).
     pub min_sibling_distance_mm: f64,
+    /// Triangles of the pieces' animated surfaces (the library pieces alone, before the back
+    /// is added) that cross that same surface, summed over the pieces: where the input's
+    /// lips or lids press into each other inside one part. No back can undo these; a seam
+    /// between the touching surfaces (one in each part) does.
+    pub surface_self_intersecting_triangles: usize,
 }
 
 /// The print-time estimate.
@@ -221,9 +226,12 @@ pub(crate) fn print_pieces(
             Vec::new()
         };
         let pixel = (s.print_height_mm * 0.02).clamp(0.3, 1.0);
-        let made: Vec<(Piece, usize)> = (0..pieces_mm.len())
+        // Per piece: the piece, its solid's crossing triangles, and where its animated
+        // surface alone crosses (count, a place).
+        type Made = (Piece, usize, Option<(usize, Vec3)>);
+        let made: Vec<Made> = (0..pieces_mm.len())
             .into_par_iter()
-            .map(|k| -> Result<(Piece, usize)> {
+            .map(|k| -> Result<Made> {
                 let surface = lib.piece_surface(p, k, &a.mesh).ok_or_else(|| {
                     Error::option_error("pieces", format!("no piece {k} of part {p}"))
                 })?;
@@ -244,6 +252,11 @@ pub(crate) fn print_pieces(
                 // coordinate beyond the exact test's range counts every triangle.
                 let crossing = self_intersecting_triangles(&solid.positions, &solid.triangles)
                     .map_or(solid.triangles.len(), |t| t.len());
+                let surface_crossing = if crossing > 0 {
+                    shell.surface_crossings(&pieces_mm[k])
+                } else {
+                    None
+                };
                 let solid = add_plugs(&solid, p, s.plugs, s.plug_segments);
                 let piece = Piece {
                     id: surface.name.clone(),
@@ -252,15 +265,20 @@ pub(crate) fn print_pieces(
                     surface,
                     solid,
                 };
-                Ok((piece, crossing))
+                Ok((piece, crossing, surface_crossing))
             })
             .collect::<Result<_>>()?;
         let crossing_pieces: Vec<String> = made
             .iter()
-            .filter(|(_, c)| *c > 0)
-            .map(|(piece, c)| format!("{} ({c})", piece.id))
+            .filter(|(_, c, _)| *c > 0)
+            .map(|(piece, c, _)| format!("{} ({c})", piece.id))
             .collect();
-        shell.stats.self_intersecting_triangles = made.iter().map(|(_, c)| c).sum();
+        shell.stats.self_intersecting_triangles = made.iter().map(|(_, c, _)| c).sum();
+        let surface: Vec<(&Piece, usize, Vec3)> = made
+            .iter()
+            .filter_map(|(piece, _, s)| s.map(|(n, at)| (piece, n, at)))
+            .collect();
+        let surface_triangles: usize = surface.iter().map(|(_, n, _)| n).sum();
         let refs: Vec<&[Vec3]> = pieces_mm.iter().map(Vec::as_slice).collect();
         let thinnest = shell.thinnest_wall(&refs);
         if let Some(t) = thinnest {
@@ -289,7 +307,19 @@ pub(crate) fn print_pieces(
                 crossing_pieces.join(", ")
             ));
         }
-        let made: Vec<Piece> = made.into_iter().map(|(piece, _)| piece).collect();
+        if let Some((first, _, at)) = surface.first() {
+            warnings.push(format!(
+                "part {}: in {} of these pieces the animated surface itself crosses ({} triangles, e.g. piece {} at ({:.1}, {:.1}, {:.1}) mm): the input's lips or lids press into each other inside the part, which no back surface can undo; cut the parts so that a seam runs between the touching surfaces (one side in each part)",
+                part.name,
+                surface.len(),
+                surface_triangles,
+                first.id,
+                at.x,
+                at.y,
+                at.z,
+            ));
+        }
+        let made: Vec<Piece> = made.into_iter().map(|(piece, _, _)| piece).collect();
         let (close, nearest) = below_resolution(&part.name, &pieces_mm, s.resolution_mm);
         let n = pieces_mm.len();
         if !close.is_empty() {
@@ -307,6 +337,7 @@ pub(crate) fn print_pieces(
             keys,
             below_resolution: close,
             min_sibling_distance_mm: nearest,
+            surface_self_intersecting_triangles: surface_triangles,
         });
         pieces_out.extend(made);
     }
