@@ -74,9 +74,9 @@ pub struct PartPrintReport {
     /// piece).
     pub min_sibling_distance_mm: f64,
     /// Triangles of the pieces' animated surfaces (the library pieces alone, before the back
-    /// is added) that cross that same surface, summed over the pieces: where the input's
-    /// lips or lids press into each other inside one part. No back can undo these; a seam
-    /// between the touching surfaces (one in each part) does.
+    /// is added) that cross that same surface, summed over the pieces whose solid crosses:
+    /// where the input's lips or lids press into each other inside one part. No back can
+    /// undo these; a seam between the touching surfaces (one in each part) does.
     pub surface_self_intersecting_triangles: usize,
 }
 
