@@ -292,14 +292,14 @@ fn a_surface_that_presses_through_itself_is_reported_with_advice() {
         })
         .collect();
     let anim = MeshAnimation::new(rest, 30.0, pos).unwrap();
-    let lib = stopmo::library(
-        std::slice::from_ref(&anim),
-        &LibraryJobOptions {
+    let three_pieces = |a: &MeshAnimation| {
+        let options = LibraryJobOptions {
             pieces: PieceCount::Each(3),
             ..Default::default()
-        },
-    )
-    .unwrap();
+        };
+        stopmo::library(std::slice::from_ref(a), &options).unwrap()
+    };
+    let lib = three_pieces(&anim);
     let part = &lib.report.printing.parts[0];
     assert!(
         part.surface_self_intersecting_triangles > 0,
@@ -316,15 +316,7 @@ fn a_surface_that_presses_through_itself_is_reported_with_advice() {
         lib.report.warnings
     );
     // An untouched tube reports none.
-    let calm = segment_support::talking_tube(16, 12, 6);
-    let lib = stopmo::library(
-        std::slice::from_ref(&calm),
-        &LibraryJobOptions {
-            pieces: PieceCount::Each(3),
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let lib = three_pieces(&segment_support::talking_tube(16, 12, 6));
     assert_eq!(
         lib.report.printing.parts[0].surface_self_intersecting_triangles,
         0

@@ -1,10 +1,11 @@
-//! What a shell is checked by: the minimum wall in front of the back surface and the
-//! triangles that cross in some piece's solid (the exact test).
+//! What a shell is checked by: the minimum wall in front of the back surface, the
+//! triangles that cross in some piece's solid (the exact test), and those that cross in the
+//! animated surface alone (the input's own).
 
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::PartShell;
+use super::{front_positions, PartShell};
 use crate::library::intersect::self_intersecting_triangles;
 use crate::library::nearest::TriangleGrid;
 
@@ -56,6 +57,27 @@ impl PartShell {
             }
         }
         best
+    }
+
+    /// Where the animated surface of `piece` (millimetres, input vertex order) crosses
+    /// itself over the welded front (without the caps), before any untangling: the triangles
+    /// that cross and the centre of the first, `None` when none does (or a coordinate is
+    /// beyond the exact test's range). These come with the input (lips or lids pressing
+    /// into each other inside the part), not from the back.
+    ///
+    /// # Performance
+    /// One exact self-intersection test of the front (see [`self_intersecting_triangles`]).
+    pub fn surface_crossings(&self, piece: &[Vec3]) -> Option<(usize, Vec3)> {
+        let f = front_positions(&self.source, &self.caps, piece);
+        let surface = &self.triangles[..self.triangles.len() - self.cap_triangle_count()];
+        let hits = self_intersecting_triangles(&f, surface)?;
+        let first = *hits.first()?;
+        let at = self.triangles[first as usize]
+            .iter()
+            .map(|&v| f[v as usize])
+            .sum::<Vec3>()
+            / 3.0;
+        Some((hits.len(), at))
     }
 
     /// Shell vertices (front or back copies folded onto shell ids) of the triangles that

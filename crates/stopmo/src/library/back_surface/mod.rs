@@ -523,28 +523,6 @@ impl PartShell {
         &self.source
     }
 
-    /// Where the animated surface of `piece` (millimetres, input vertex order) crosses
-    /// itself over the welded front (without the caps), before any untangling: the triangles
-    /// that cross and the centre of the first, `None` when none does (or a coordinate is
-    /// beyond the exact test's range). These come with the input (lips or lids pressing
-    /// into each other inside the part), not from the back.
-    ///
-    /// # Performance
-    /// One exact self-intersection test of the front (see
-    /// [`self_intersecting_triangles`](super::self_intersecting_triangles)).
-    pub fn surface_crossings(&self, piece: &[Vec3]) -> Option<(usize, Vec3)> {
-        let f = front_positions(&self.source, &self.caps, piece);
-        let surface = &self.triangles[..self.triangles.len() - self.cap_triangle_count()];
-        let hits = super::self_intersecting_triangles(&f, surface)?;
-        let first = *hits.first()?;
-        let at = self.triangles[first as usize]
-            .iter()
-            .map(|&v| f[v as usize])
-            .sum::<Vec3>()
-            / 3.0;
-        Some((hits.len(), at))
-    }
-
     /// Front of `piece` over the shell vertices (caps included), untangled where it
     /// crosses itself.
     fn front(&self, piece: &[Vec3]) -> Vec<Vec3> {

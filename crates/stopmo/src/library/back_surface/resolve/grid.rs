@@ -57,14 +57,11 @@ impl BoxGrid {
                 }
             }
         } else {
-            for x in a[0]..=b[0] {
-                for y in a[1]..=b[1] {
-                    for z in a[2]..=b[2] {
-                        if let Some(list) = self.cells.get(&[x, y, z]) {
-                            out.extend_from_slice(list);
-                        }
-                    }
-                }
+            let keys = (a[0]..=b[0]).flat_map(|x| {
+                (a[1]..=b[1]).flat_map(move |y| (a[2]..=b[2]).map(move |z| [x, y, z]))
+            });
+            for list in keys.filter_map(|k| self.cells.get(&k)) {
+                out.extend_from_slice(list);
             }
         }
         out.sort_unstable();
