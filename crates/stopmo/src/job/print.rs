@@ -75,8 +75,9 @@ pub struct PartPrintReport {
     pub min_sibling_distance_mm: f64,
     /// Triangles of the pieces' animated surfaces (the library pieces alone, before the back
     /// is added) that cross that same surface, summed over the pieces whose solid crosses:
-    /// where the input's lips or lids press into each other inside one part. No back can
-    /// undo these; a seam between the touching surfaces (one in each part) does.
+    /// where the input presses into itself inside one part (lips or lids on a face) or has
+    /// degenerate triangles. No back can undo these; a seam between the touching surfaces
+    /// (one in each part) or a mended input does.
     pub surface_self_intersecting_triangles: usize,
 }
 
@@ -309,7 +310,7 @@ pub(crate) fn print_pieces(
         }
         if let Some((first, _, at)) = surface.first() {
             warnings.push(format!(
-                "part {}: in {} of these pieces the animated surface itself crosses ({} triangles, e.g. piece {} at ({:.1}, {:.1}, {:.1}) mm): the input's lips or lids press into each other inside the part, which no back surface can undo; cut the parts so that a seam runs between the touching surfaces (one side in each part)",
+                "part {}: in {} of these pieces the animated surface itself crosses ({} triangles, e.g. piece {} at ({:.1}, {:.1}, {:.1}) mm): the input presses into itself inside the part (lips or lids on a face) or has degenerate triangles there, which no back surface can undo; cut the parts so that a seam runs between the touching surfaces (one side in each part), or mend the input there",
                 part.name,
                 surface.len(),
                 surface_triangles,

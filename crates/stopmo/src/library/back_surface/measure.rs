@@ -63,7 +63,7 @@ impl PartShell {
     /// itself over the welded front (without the caps), before any untangling: the triangles
     /// that cross and the centre of the first, `None` when none does (or a coordinate is
     /// beyond the exact test's range). These come with the input (lips or lids pressing
-    /// into each other inside the part), not from the back.
+    /// into each other inside the part, degenerate triangles), not from the back.
     ///
     /// # Performance
     /// One exact self-intersection test of the front (see [`self_intersecting_triangles`]).
