@@ -8,6 +8,9 @@
 //! `MADV_HUGEPAGE`, so the kernel backs them with 2 MiB pages where it can (systems with
 //! transparent huge pages in `madvise` or `always` mode); everything smaller goes to the
 //! system allocator. Without huge pages the mapping still works, with 4 KiB pages.
+//! [`configure_heap`], called first in `main`, does the same for glibc's heap, where every
+//! smaller block lives (one heap for all threads, grown once and advised; the benchmark
+//! tube's `smear offsets`: 1,810 → ~600 faults, ~2 ms of the whole process).
 //!
 //! glibc's `glibc.malloc.hugetlb=1` tunable does the same, but only through an environment
 //! variable read before `main`; this does it for every run of the binary. mimalloc (with or
@@ -22,7 +25,12 @@
 //! #[cfg(target_os = "linux")]
 //! #[global_allocator]
 //! static ALLOCATOR: toonkit_alloc::HugePageAlloc = toonkit_alloc::HugePageAlloc;
-//! # fn main() {}
+//!
+//! fn main() {
+//!     #[cfg(target_os = "linux")]
+//!     toonkit_alloc::configure_heap();
+//!     // … the program
+//! }
 //! ```
 
 #![cfg(target_os = "linux")]
@@ -31,6 +39,10 @@
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::ptr;
+
+mod heap;
+
+pub use heap::{configure_heap, HEAP_RESERVE};
 
 /// Size of a transparent huge page on x86-64 and aarch64 Linux (with 4 KiB base pages).
 const HUGE_PAGE: usize = 2 << 20;

@@ -7,5 +7,8 @@
 static ALLOCATOR: toonkit_alloc::HugePageAlloc = toonkit_alloc::HugePageAlloc;
 
 fn main() -> std::process::ExitCode {
+    // glibc's heap for a short job (one heap on huge pages, kept), before any work.
+    #[cfg(target_os = "linux")]
+    toonkit_alloc::configure_heap();
     toonkit_cli::main()
 }

@@ -1,0 +1,101 @@
+//! [`toonkit_alloc::configure_heap`] on the main thread of a fresh process (its own harness:
+//! the settings are process-wide, and the test harness's threads would already hold arenas
+//! of their own).
+
+// Reads the heap's end and allocates through libc directly: what the settings change.
+#![allow(unsafe_code)]
+
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+fn main() {
+    // The program's own heap before any setting: where a block of the heap may start.
+    // SAFETY: `sbrk(0)` only reads the current end of the heap.
+    let heap_start = unsafe { libc::sbrk(0) } as usize;
+    toonkit_alloc::configure_heap();
+    // SAFETY: as above.
+    let heap_end = unsafe { libc::sbrk(0) } as usize;
+    assert!(
+        heap_end >= heap_start + toonkit_alloc::HEAP_RESERVE,
+        "the heap grew by its reserve at once: {heap_start:#x}..{heap_end:#x}"
+    );
+    let block = 512 << 10;
+    // SAFETY: a plain allocation, freed below and never dereferenced.
+    let p = unsafe { libc::malloc(block) } as usize;
+    assert!(p != 0);
+    // SAFETY: `p` came from `malloc` above.
+    unsafe { libc::free(p as *mut libc::c_void) };
+    // SAFETY: as above.
+    let after_free = unsafe { libc::sbrk(0) } as usize;
+    assert_eq!(
+        after_free, heap_end,
+        "freed memory stays in the heap for the next block"
+    );
+
+    // A thread started now allocates from the same heap (no arena of its own).
+    // SAFETY: as above; the block is freed at once and only its address kept.
+    let q = std::thread::spawn(move || unsafe {
+        let q = libc::malloc(block);
+        libc::free(q);
+        q as usize
+    })
+    .join()
+    .expect("thread");
+    assert_eq!(
+        mapping_of(q).0.as_deref(),
+        Some("[heap]"),
+        "a thread's block"
+    );
+
+    // The block's mapping: the program's heap, advised for transparent huge pages where the
+    // kernel has them.
+    let (name, flags) = mapping_of(p);
+    assert_eq!(
+        name.as_deref(),
+        Some("[heap]"),
+        "a 512 KiB block comes from the heap, not a mapping of its own"
+    );
+    let flags = flags.expect("the heap's flags in /proc/self/smaps");
+    let thp =
+        std::fs::read_to_string("/sys/kernel/mm/transparent_hugepage/enabled").unwrap_or_default();
+    if thp.is_empty() || thp.contains("[never]") {
+        eprintln!("transparent huge pages are off here: advice not checked");
+        return;
+    }
+    assert!(
+        flags.split_whitespace().any(|f| f == "hg"),
+        "the heap is advised MADV_HUGEPAGE (VmFlags:{flags})"
+    );
+    println!(
+        "heap: {} MiB advised for huge pages",
+        (heap_end - heap_start) >> 20
+    );
+}
+
+/// Name and `VmFlags` of the mapping holding `address`, from `/proc/self/smaps`.
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+fn mapping_of(address: usize) -> (Option<String>, Option<String>) {
+    let smaps = std::fs::read_to_string("/proc/self/smaps").expect("/proc/self/smaps");
+    let (mut name, mut flags) = (None, None);
+    let mut inside = false;
+    for line in smaps.lines() {
+        let mut words = line.split_whitespace();
+        if let Some((a, b)) = words.next().and_then(|r| r.split_once('-')) {
+            if let (Ok(a), Ok(b)) = (usize::from_str_radix(a, 16), usize::from_str_radix(b, 16)) {
+                inside = (a..b).contains(&address);
+                if inside {
+                    name = Some(words.nth(4).unwrap_or("").to_string());
+                }
+                continue;
+            }
+        }
+        if inside {
+            if let Some(f) = line.strip_prefix("VmFlags:") {
+                flags = Some(f.to_string());
+                break;
+            }
+        }
+    }
+    (name, flags)
+}
+
+#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+fn main() {}
