@@ -4,7 +4,8 @@ use super::*;
 
 /// Diagnostics: which parts of the solids cross (run with `--ignored --nocapture`;
 /// `STOPMO_PIECES` sets the library size, default 8; `STOPMO_AUTO_PARTS=N` cuts N automatic
-/// parts, `STOPMO_SEEDS="x,y,z;x,y,z"` one part per point seed).
+/// parts, `STOPMO_SEEDS="x,y,z;x,y,z"` one part per point seed, `STOPMO_HEIGHT=MM` another
+/// print height).
 #[test]
 #[ignore]
 fn diagnose_crossings() {
@@ -44,9 +45,14 @@ fn diagnose_crossings() {
     };
     let refs: Vec<&MeshAnimation> = anims.iter().collect();
     let lib = library_of(&anims, pieces);
-    let mm = print_scale(&refs, HEIGHT_MM) as f32;
+    // STOPMO_HEIGHT=MM: another print height than the acceptance's.
+    let height: f64 = std::env::var("STOPMO_HEIGHT")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(HEIGHT_MM);
+    let mm = print_scale(&refs, height) as f32;
     let all_mm = in_mm(&lib, mm);
-    for (p, (shell, keys, _)) in shells(&anims, &all_mm, mm).into_iter().enumerate() {
+    for (p, (shell, keys, _)) in shells(&anims, &all_mm, mm, height).into_iter().enumerate() {
         let a = &anims[p];
         let pieces_mm = &all_mm[p];
         let avg: Vec<Vec3> = a.average_positions().iter().map(|x| *x * mm).collect();

@@ -153,13 +153,14 @@ fn shells(
     anims: &[MeshAnimation],
     pieces_mm: &[Vec<Vec<Vec3>>],
     mm: f32,
+    height_mm: f64,
 ) -> Vec<(PartShell, Vec<stopmo::library::Key>, usize)> {
     let averages = averages_mm(anims, mm);
-    let built = build_shells(
-        &shell_inputs(anims, &averages, pieces_mm),
-        &ShellOptions::default(),
-    )
-    .expect("shells");
+    let opts = ShellOptions {
+        model_height_mm: height_mm,
+        ..ShellOptions::default()
+    };
+    let built = build_shells(&shell_inputs(anims, &averages, pieces_mm), &opts).expect("shells");
     let boundaries: Vec<Vec<(Vec3, Vec3)>> = built
         .iter()
         .zip(&averages)
@@ -260,7 +261,10 @@ fn close_pieces_of(seg: &Segmentation, pieces: usize) -> Measured {
         min_key_spread: f64::INFINITY,
         ..Measured::default()
     };
-    for (p, (shell, keys, seams)) in shells(&anims, &pieces_mm, mm).into_iter().enumerate() {
+    for (p, (shell, keys, seams)) in shells(&anims, &pieces_mm, mm, HEIGHT_MM)
+        .into_iter()
+        .enumerate()
+    {
         let a = &anims[p];
         m.keys += keys.len();
         assert!(seams >= 1, "part {}: no seam found", a.mesh.name);
