@@ -90,6 +90,8 @@ pub struct PartShell {
     /// Shift of every piece's front at each shell vertex (mm, at most the printer
     /// resolution; zero but where a front folds over a wall).
     nudge: Vec<Vec3>,
+    /// Retraction per round where a piece's front crosses itself (mm, see `untangle`).
+    untangle_step_mm: f32,
     /// Measurements.
     pub stats: ShellStats,
 }
@@ -195,7 +197,13 @@ impl PartShell {
         if topology.triangles.is_empty() {
             return Err(bad("no triangle".into()));
         }
-        let frame = topology::PartFrame::new(topology, average, pieces, opts.cap_fraction)?;
+        let frame = topology::PartFrame::new(
+            topology,
+            average,
+            pieces,
+            opts.cap_fraction,
+            untangle::step_for_height(opts.model_height_mm),
+        )?;
         // Inward direction field (see `DirectionField`); the frame is shared by both fields.
         let (front, tris, adj) = (&frame.topo.front, &frame.topo.triangles, &frame.adj);
         let rings = |radius_mm| direction::edge_ring_directions(front, tris, adj, radius_mm);
@@ -356,6 +364,7 @@ impl PartShell {
             adjacency: adj.clone(),
             limits: limit.clone(),
             nudge: vec![Vec3::ZERO; n],
+            untangle_step_mm: untangle::step_for_height(opts.model_height_mm),
             stats: ShellStats::default(),
         };
         // Repair where the exact test still finds crossings. A crossing wall rung is set
@@ -527,7 +536,13 @@ impl PartShell {
     /// crosses itself.
     fn front(&self, piece: &[Vec3]) -> Vec<Vec3> {
         let mut f = front_positions(&self.source, &self.caps, piece);
-        untangle::untangle(&mut f, &self.triangles, &self.adjacency, &self.on_boundary);
+        untangle::untangle(
+            &mut f,
+            &self.triangles,
+            &self.adjacency,
+            &self.on_boundary,
+            self.untangle_step_mm,
+        );
         for (p, d) in f.iter_mut().zip(&self.nudge) {
             *p += *d;
         }

@@ -156,6 +156,7 @@ impl PartFrame {
         average: &[Vec3],
         pieces: &[&[Vec3]],
         cap_fraction: f64,
+        untangle_step_mm: f32,
     ) -> Result<PartFrame> {
         let topo = weld(topology, average, cap_fraction)?;
         let n = topo.front.len();
@@ -169,7 +170,13 @@ impl PartFrame {
             .iter()
             .map(|p| {
                 let mut f = front_positions(&topo.source, &topo.caps, p);
-                untangle::untangle(&mut f, &topo.triangles, &adj, &on_boundary);
+                untangle::untangle(
+                    &mut f,
+                    &topo.triangles,
+                    &adj,
+                    &on_boundary,
+                    untangle_step_mm,
+                );
                 f
             })
             .collect();

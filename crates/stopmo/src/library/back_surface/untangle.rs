@@ -12,13 +12,28 @@
 
 use glam::Vec3;
 
+use crate::library::fabricate::DEFAULT_PRINT_HEIGHT_MM;
 use crate::library::intersect::intersecting_pairs;
 
-/// Retraction per round (mm).
+/// Retraction per round (mm) at the default print height and above.
 const STEP_MM: f32 = 0.02;
-/// Rounds at most (`ROUNDS × STEP_MM` = 3 mm of retraction; the first round without a
-/// crossing ends it).
+/// Rounds at most (`ROUNDS × STEP_MM` = 3 mm of retraction at the default print height; the
+/// first round without a crossing ends it).
 const ROUNDS: usize = 150;
+
+/// Retraction per round for a print `model_height_mm` tall: [`STEP_MM`], smaller in
+/// proportion on a smaller print. A lip of a 25 mm face is 2.4 times thinner than at 60 mm:
+/// the 60 mm step pushed its crossing vertices through the lip's other side there, and
+/// the README cut's 20 pieces kept a crossing lower piece at 25 mm (40 triangles; none with
+/// the scaled step).
+pub(super) fn step_for_height(model_height_mm: f64) -> f32 {
+    let scale = (model_height_mm / DEFAULT_PRINT_HEIGHT_MM).min(1.0) as f32;
+    if scale.is_finite() && scale > 0.0 {
+        STEP_MM * scale
+    } else {
+        STEP_MM
+    }
+}
 /// Fraction of the way to the neighbours' centroid a crossing vertex moves per round.
 const RELAX: f32 = 0.5;
 /// Rings around the first crossings that the later rounds test.
@@ -27,12 +42,14 @@ const REGION_RINGS: usize = 8;
 /// Untangles `front` (positions of the triangles `tris`, `adj` their vertex adjacency) in
 /// place, never moving a `pinned` vertex (the part boundary: a seam's front must stay the
 /// same curve in every piece of every part that meets there, an open border where the input
-/// puts it); returns the vertices moved.
+/// puts it), retracting by `step_mm` per round (see [`step_for_height`]); returns the
+/// vertices moved.
 pub(super) fn untangle(
     front: &mut [Vec3],
     tris: &[[u32; 3]],
     adj: &[Vec<u32>],
     pinned: &[bool],
+    step_mm: f32,
 ) -> usize {
     let free = |v: usize| !pinned.get(v).copied().unwrap_or(false);
     let n = front.len();
@@ -109,7 +126,7 @@ pub(super) fn untangle(
         front.copy_from_slice(&relaxed);
         for v in 0..n {
             if ring[v] && free(v) {
-                let s = if mark[v] { STEP_MM } else { STEP_MM * 0.5 };
+                let s = if mark[v] { step_mm } else { step_mm * 0.5 };
                 front[v] -= normals[v] * s;
                 moved[v] = true;
             }
