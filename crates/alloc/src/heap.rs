@@ -7,7 +7,7 @@
 //! offsets` of the benchmark tube (issue #14) took ~1,300 faults of 4 KiB pages beyond the
 //! program's own ~370 — at 2–4 µs each in a virtual machine, more system time than the motion
 //! offsets take. [`configure_heap`] makes glibc keep such blocks in one heap, grown once by
-//! [`HEAP_RESERVE`] that is advised `MADV_HUGEPAGE`, and never hand it back: ~500 faults.
+//! [`HEAP_RESERVE`] that is advised `MADV_HUGEPAGE`, and never hand it back: ~600 faults.
 
 use std::ffi::c_int;
 

@@ -20,6 +20,10 @@ const STEP_MM: f32 = 0.02;
 /// Rounds at most (`ROUNDS × STEP_MM` = 3 mm of retraction at the default print height; the
 /// first round without a crossing ends it).
 const ROUNDS: usize = 150;
+/// Fraction of the way to the neighbours' centroid a crossing vertex moves per round.
+const RELAX: f32 = 0.5;
+/// Rings around the first crossings that the later rounds test.
+const REGION_RINGS: usize = 8;
 
 /// Retraction per round for a print `model_height_mm` tall: [`STEP_MM`], smaller in
 /// proportion on a smaller print. A lip of a 25 mm face is 2.4 times thinner than at 60 mm:
@@ -34,10 +38,6 @@ pub(super) fn step_for_height(model_height_mm: f64) -> f32 {
         STEP_MM
     }
 }
-/// Fraction of the way to the neighbours' centroid a crossing vertex moves per round.
-const RELAX: f32 = 0.5;
-/// Rings around the first crossings that the later rounds test.
-const REGION_RINGS: usize = 8;
 
 /// Untangles `front` (positions of the triangles `tris`, `adj` their vertex adjacency) in
 /// place, never moving a `pinned` vertex (the part boundary: a seam's front must stay the
@@ -138,4 +138,18 @@ pub(super) fn untangle(
         moved = m;
     }
     moved.iter().filter(|&&m| m).count()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_step_shrinks_with_a_smaller_print_only() {
+        assert_eq!(step_for_height(60.0), STEP_MM);
+        assert_eq!(step_for_height(150.0), STEP_MM);
+        assert!((step_for_height(30.0) - STEP_MM * 0.5).abs() < 1e-9);
+        assert_eq!(step_for_height(f64::NAN), STEP_MM);
+        assert_eq!(step_for_height(0.0), STEP_MM);
+    }
 }
