@@ -36,6 +36,7 @@ mod direction;
 mod envelope;
 mod measure;
 mod options;
+mod repair;
 mod resolve;
 mod seams;
 mod topology;
@@ -52,11 +53,6 @@ pub use seams::{build_shells, ShellInput};
 
 /// Largest sideways slide of a back boundary point per millimetre of wall depth.
 const RUNG_SLOPE: f32 = 0.3;
-
-/// Repair rounds without fewer crossings before the repair gives up.
-const REPAIR_PATIENCE: usize = 3;
-/// Relaxation steps per repair round.
-const REPAIR_STEPS: usize = 10;
 
 /// How far along a seam the neighbours of a shared back point that had to move deeper
 /// follow it, in walls.
@@ -257,6 +253,7 @@ impl PartShell {
             adj,
             on_boundary,
             fronts,
+            untangle_step_mm,
         } = frame;
         let (front, tris, boundary) = (&topo.front, &topo.triangles, &topo.boundary);
         let n = front.len();
@@ -364,127 +361,10 @@ impl PartShell {
             adjacency: adj.clone(),
             limits: limit.clone(),
             nudge: vec![Vec3::ZERO; n],
-            untangle_step_mm: untangle::step_for_height(opts.model_height_mm),
+            untangle_step_mm: *untangle_step_mm,
             stats: ShellStats::default(),
         };
-        // Repair where the exact test still finds crossings. A crossing wall rung is set
-        // straight along the direction field (the boundary smoothing slid its back end
-        // sideways, fanning the wall through the front at crooked boundaries), at the same
-        // depth so the envelope holds, and the back next to it follows its back end so the
-        // back does not fold over the moved wall. Then, around the crossings, the back relaxes
-        // *tangentially* (towards the neighbours' centroid, never shallower along the
-        // direction field), which unfolds it without thinning the wall; the boundary curve is
-        // smoothed along its loop. The state with the fewest crossings is kept; a round that
-        // brings the wall under the minimum is undone and its rungs are left alone after.
-        let mut rounds = 0;
-        // Fewest crossings: their count, the back, the crossing vertices, the wall.
-        type State = (usize, Vec<Vec3>, Vec<u32>, f64);
-        let mut best: Option<State> = None;
-        let mut stale = 0;
-        let mut frozen = vec![false; n];
-        let mut straightened: Vec<usize> = Vec::new();
-        let mut floor = f64::NEG_INFINITY;
-        loop {
-            let (mut bad_vertices, mut count) = shell.crossings(pieces);
-            let wall_now = shell.min_wall_of(pieces);
-            if best.is_none() {
-                floor = wall_now.min(opts.wall_mm);
-            }
-            if !straightened.is_empty() && wall_now < floor {
-                for &v in &straightened {
-                    frozen[v] = true;
-                }
-                if let Some(b) = &best {
-                    shell.back.clone_from(&b.1);
-                    bad_vertices.clone_from(&b.2);
-                    count = b.0;
-                }
-                stale += 1;
-            } else if best.as_ref().is_none_or(|b| count < b.0) {
-                best = Some((count, shell.back.clone(), bad_vertices.clone(), wall_now));
-                stale = 0;
-            } else {
-                stale += 1;
-            }
-            if count == 0 || rounds >= opts.repair_rounds || stale >= REPAIR_PATIENCE {
-                break;
-            }
-            rounds += 1;
-            let mut delta = vec![Vec3::ZERO; n];
-            straightened.clear();
-            for &v in &bad_vertices {
-                let v = v as usize;
-                if !on_boundary[v] || fixed[v].is_some() || frozen[v] {
-                    continue;
-                }
-                let d = normals[v];
-                let depth = -(shell.back[v] - front[v]).dot(d);
-                let straight = front[v] - d * depth;
-                delta[v] = straight - shell.back[v];
-                shell.back[v] = straight;
-                straightened.push(v);
-            }
-            let follow: Vec<Vec3> = (0..n)
-                .map(|u| {
-                    if on_boundary[u] || fixed[u].is_some() {
-                        return Vec3::ZERO;
-                    }
-                    let (s, c) = adj[u]
-                        .iter()
-                        .filter(|&&w| delta[w as usize] != Vec3::ZERO)
-                        .fold((Vec3::ZERO, 0usize), |(s, c), &w| {
-                            (s + delta[w as usize], c + 1)
-                        });
-                    if c == 0 {
-                        Vec3::ZERO
-                    } else {
-                        s / c as f32
-                    }
-                })
-                .collect();
-            for (b, f) in shell.back.iter_mut().zip(&follow) {
-                *b += *f;
-            }
-            enforce(&mut shell.back);
-            let mut mask = vec![false; n];
-            for &v in &bad_vertices {
-                mask[v as usize] = true;
-            }
-            for _ in 0..(1 + rounds.min(6)) {
-                let grown: Vec<bool> = (0..n)
-                    .map(|v| mask[v] || adj[v].iter().any(|&w| mask[w as usize]))
-                    .collect();
-                mask = grown;
-            }
-            for _ in 0..REPAIR_STEPS {
-                let back = &shell.back;
-                let next: Vec<Vec3> = (0..n)
-                    .map(|v| {
-                        if !mask[v] || fixed[v].is_some() {
-                            return back[v];
-                        }
-                        if on_boundary[v] {
-                            return along_loop(back, v).unwrap_or(back[v]);
-                        }
-                        if adj[v].is_empty() {
-                            return back[v];
-                        }
-                        let c = centroid(back, &adj[v]);
-                        let (d, nv) = (c - back[v], normals[v]);
-                        let along_n = d.dot(nv);
-                        back[v] + (d - nv * along_n + nv * along_n.min(0.0)) * 0.5
-                    })
-                    .collect();
-                shell.back = next;
-                enforce(&mut shell.back);
-            }
-        }
-        if let Some((count, back, _, wall)) = best {
-            shell.back = back;
-            shell.stats.self_intersecting_triangles = count;
-            shell.stats.min_wall_mm = wall;
-        }
-        shell.stats.repair_rounds = rounds;
+        shell.repair(front, &fixed, pieces, opts, &enforce, &along_loop);
         shell
     }
 

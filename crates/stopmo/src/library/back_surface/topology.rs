@@ -144,6 +144,8 @@ pub(super) struct PartFrame {
     pub on_boundary: Vec<bool>,
     /// Every piece's front over the shell vertices, untangled where it crosses itself.
     pub fronts: Vec<Vec<Vec3>>,
+    /// The retraction per round those fronts were untangled with (mm).
+    pub untangle_step_mm: f32,
 }
 
 impl PartFrame {
@@ -185,6 +187,7 @@ impl PartFrame {
             adj,
             on_boundary,
             fronts,
+            untangle_step_mm,
         })
     }
 }
