@@ -3,6 +3,7 @@
 
 use glam::Vec3;
 
+use super::topology::grow_mask;
 use super::{centroid, PartShell, ShellOptions};
 
 /// Repair rounds without fewer crossings before the repair gives up.
@@ -111,12 +112,7 @@ impl PartShell {
             for &v in &bad_vertices {
                 mask[v as usize] = true;
             }
-            for _ in 0..(1 + rounds.min(6)) {
-                let grown: Vec<bool> = (0..n)
-                    .map(|v| mask[v] || self.adjacency[v].iter().any(|&w| mask[w as usize]))
-                    .collect();
-                mask = grown;
-            }
+            let mask = grow_mask(mask, &self.adjacency, 1 + rounds.min(6));
             for _ in 0..REPAIR_STEPS {
                 let back = &self.back;
                 let next: Vec<Vec3> = (0..n)

@@ -8,6 +8,7 @@ use anim::Mesh;
 use glam::Vec3;
 
 use super::resolve::resolve_crossings;
+use super::topology::grow_mask;
 use super::{centroid, position_key, PartShell, ShellOptions};
 use crate::library::error::{LibraryError, Result};
 
@@ -214,12 +215,7 @@ impl PartShell {
         for &v in moved {
             mask[v as usize] = true;
         }
-        for _ in 0..rings {
-            let grown: Vec<bool> = (0..n)
-                .map(|v| mask[v] || self.adjacency[v].iter().any(|&w| mask[w as usize]))
-                .collect();
-            mask = grown;
-        }
+        let mask = grow_mask(mask, &self.adjacency, rings);
         for _ in 0..steps {
             let back = &self.back;
             let next: Vec<Vec3> = (0..n)

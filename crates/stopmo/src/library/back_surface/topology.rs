@@ -116,6 +116,17 @@ pub(super) fn weld(topology: &Mesh, average: &[Vec3], cap_fraction: f64) -> Resu
     })
 }
 
+/// `mask` grown by `rings` rings of the adjacency `adj` (a vertex joins when a neighbour is
+/// in).
+pub(super) fn grow_mask(mut mask: Vec<bool>, adj: &[Vec<u32>], rings: usize) -> Vec<bool> {
+    for _ in 0..rings {
+        mask = (0..mask.len())
+            .map(|v| mask[v] || adj[v].iter().any(|&w| mask[w as usize]))
+            .collect();
+    }
+    mask
+}
+
 /// Vertex adjacency (sorted, deduplicated) of a triangle list.
 pub(super) fn neighbours(n: usize, tris: &[[u32; 3]]) -> Vec<Vec<u32>> {
     let mut adj = vec![Vec::new(); n];

@@ -12,6 +12,7 @@
 
 use glam::Vec3;
 
+use super::topology::grow_mask;
 use crate::library::fabricate::DEFAULT_PRINT_HEIGHT_MM;
 use crate::library::intersect::intersecting_pairs;
 
@@ -69,11 +70,7 @@ pub(super) fn untangle(
             }
         }
     }
-    for _ in 0..REGION_RINGS {
-        region = (0..n)
-            .map(|v| region[v] || adj[v].iter().any(|&w| region[w as usize]))
-            .collect();
-    }
+    let region = grow_mask(region, adj, REGION_RINGS);
     let local: Vec<[u32; 3]> = tris
         .iter()
         .filter(|t| t.iter().any(|&v| region[v as usize]))
