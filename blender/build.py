@@ -1,6 +1,6 @@
 """Builds the Blender extension zip: `python blender/build.py [--wheel WHEEL] [-o DIR]`.
 
-Builds the toonkit cp311-abi3 wheel with pip (maturin, release) unless `--wheel` names one,
+Builds the toonkit cp311-abi3 wheel with pip (maturin, `wheel` profile) unless `--wheel` names one,
 then writes `dist/toonkit-<version>-<platform>.zip` with the extension's Python files, the
 manifest (its `wheels` and `platforms` set to that wheel) and the wheel under `wheels/`.
 Install it with Edit ▸ Preferences ▸ Get Extensions ▸ Install from Disk, or headless with
