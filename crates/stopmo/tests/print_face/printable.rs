@@ -34,13 +34,13 @@ fn eight_pieces_are_printable() {
 }
 
 #[test]
-#[ignore = "slow in a debug build (minutes): cargo test --release -p toonkit-stopmo --test print_face -- --include-ignored"]
+#[ignore = "minutes each (CI runs them in its print phase): cargo test --workspace --test print_face -- --include-ignored"]
 fn twenty_pieces_are_printable() {
     printable(20);
 }
 
 #[test]
-#[ignore = "slow in a debug build (minutes): cargo test --release -p toonkit-stopmo --test print_face -- --include-ignored"]
+#[ignore = "minutes each (CI runs them in its print phase): cargo test --workspace --test print_face -- --include-ignored"]
 fn fifty_pieces_are_printable() {
     printable(50);
 }
@@ -52,7 +52,7 @@ fn fifty_pieces_are_printable() {
 /// millimetres along the surface, 80 and 80. (The walls at the lip edges still cross: see
 /// the README's known limit.)
 #[test]
-#[ignore = "slow in a debug build (minutes): cargo test --release -p toonkit-stopmo --test print_face -- --include-ignored"]
+#[ignore = "minutes each (CI runs them in its print phase): cargo test --workspace --test print_face -- --include-ignored"]
 fn two_automatic_parts_keep_the_back_unfolded_behind_the_lips() {
     let parts = auto_parts(face(), 2).expect("auto parts");
     // The construction alone (no local search): what the direction field decides.
@@ -103,7 +103,7 @@ fn bare_shells(
 /// edge rings 0), the edge rings fold the back behind the lips with two automatic parts
 /// (the test above); `DirectionField::Best` keeps, per part, the back that crosses less.
 #[test]
-#[ignore = "slow in a debug build (minutes): cargo test --release -p toonkit-stopmo --test print_face -- --include-ignored"]
+#[ignore = "minutes each (CI runs them in its print phase): cargo test --workspace --test print_face -- --include-ignored"]
 fn a_seed_beside_the_face_prints_without_crossings() {
     let parts = vec![
         PartSpec::new("side", vec![Seed::Point(Vec3::new(30.0, 0.0, 0.0))]),
@@ -127,7 +127,7 @@ fn a_seed_beside_the_face_prints_without_crossings() {
 /// triangles at the nose tip, 100 mm a 0.87 mm wall, a 2.5 mm wall 816 crossing triangles and
 /// a 1 mm wall 0.56 mm under the nose.
 #[test]
-#[ignore = "slow in a debug build (minutes): cargo test --release -p toonkit-stopmo --test print_face -- --include-ignored"]
+#[ignore = "minutes each (CI runs them in its print phase): cargo test --workspace --test print_face -- --include-ignored"]
 fn other_print_heights_and_walls_print_clean() {
     let parts = part_animations(segmentation());
     for (height, wall) in [
@@ -168,7 +168,7 @@ fn other_print_heights_and_walls_print_clean() {
 /// nose at this size with a 1.5 mm wall in this test's 1 fps sampling (540 triangles, none
 /// from the 24 fps clip of `stopmo run`), and the lower wall is 1.44 mm at the cheek.
 #[test]
-#[ignore = "slow in a debug build (minutes): cargo test --release -p toonkit-stopmo --test print_face -- --include-ignored"]
+#[ignore = "minutes each (CI runs them in its print phase): cargo test --workspace --test print_face -- --include-ignored"]
 fn a_25_mm_print_untangles_the_lip_corners() {
     let parts = part_animations(segmentation());
     let opts = stopmo::LibraryJobOptions {
