@@ -15,7 +15,8 @@ rm -rf "$VENV" "$WHEELS"
 "$PY" -m venv "$VENV"
 PIP=("$VENV/bin/pip" --disable-pip-version-check --quiet)
 
-# The wheel, built as `pip install` builds it (maturin, the `wheel` profile: release without line tables, stripped).
+# The wheel, built as `pip install` builds it (maturin, the `wheel` profile: release without
+# line tables, stripped).
 "${PIP[@]}" wheel --no-deps --wheel-dir "$WHEELS" ./crates/python
 wheel=$(ls "$WHEELS"/toonkit-*.whl)
 name=$(basename "$wheel")
