@@ -19,13 +19,24 @@ const GRID: f64 = (1u64 << 24) as f64;
 
 type P = [i64; 3];
 
+/// Nearest grid point (ties away from zero, as `f64::round`). An `f32` times 2²⁴ is exact in
+/// `f64` with at most 24 significant bits, so adding ½ is exact wherever it could matter and
+/// the truncating cast rounds like `round` without its library call (the hot path of the
+/// searches that move points and test again).
 fn snap(p: Vec3) -> P {
-    [
-        (f64::from(p.x) * GRID).round() as i64,
-        (f64::from(p.y) * GRID).round() as i64,
-        (f64::from(p.z) * GRID).round() as i64,
-    ]
+    let r = |x: f32| {
+        let x = f64::from(x) * GRID;
+        (x + 0.5f64.copysign(x)) as i64
+    };
+    [r(p.x), r(p.y), r(p.z)]
 }
+
+/// Relative error bound of [`orient3d`]'s floating-point determinant over its permanent
+/// (Shewchuk's `o3derrboundA` ≈ 7.8·10⁻¹⁶, with a margin): beyond it the sign is certain.
+const ORIENT3D_FILTER: f64 = 4.0e-15;
+/// Relative error bound of [`orient2d`]'s floating-point determinant (Shewchuk's
+/// `ccwerrboundA` ≈ 3.3·10⁻¹⁶, with a margin).
+const ORIENT2D_FILTER: f64 = 2.0e-15;
 
 fn sub(a: P, b: P) -> [i128; 3] {
     [
@@ -37,7 +48,32 @@ fn sub(a: P, b: P) -> [i128; 3] {
 
 /// Sign of the volume of the tetrahedron `(a, b, c, d)` (positive when `d` is below the plane
 /// of the counter-clockwise triangle `a b c`, following Shewchuk's convention).
+///
+/// Differences of snapped points (≤ 2³⁷) are exact in `f64`; the determinant is evaluated
+/// there first and only falls back to `i128` when it is within rounding of zero, so the sign is
+/// always the exact one.
 fn orient3d(a: P, b: P, c: P, d: P) -> i32 {
+    let f = |p: P| [0, 1, 2].map(|k| (p[k] - d[k]) as f64);
+    let (u, v, w) = (f(a), f(b), f(c));
+    let (m0, m1) = (v[1] * w[2], v[2] * w[1]);
+    let (m2, m3) = (v[0] * w[2], v[2] * w[0]);
+    let (m4, m5) = (v[0] * w[1], v[1] * w[0]);
+    let det = u[0] * (m0 - m1) - u[1] * (m2 - m3) + u[2] * (m4 - m5);
+    let permanent = u[0].abs() * (m0.abs() + m1.abs())
+        + u[1].abs() * (m2.abs() + m3.abs())
+        + u[2].abs() * (m4.abs() + m5.abs());
+    let bound = ORIENT3D_FILTER * permanent;
+    if det > bound {
+        return 1;
+    }
+    if -det > bound {
+        return -1;
+    }
+    orient3d_exact(a, b, c, d)
+}
+
+/// [`orient3d`] in `i128` arithmetic.
+fn orient3d_exact(a: P, b: P, c: P, d: P) -> i32 {
     let (u, v, w) = (sub(a, d), sub(b, d), sub(c, d));
     let det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
         + u[2] * (v[0] * w[1] - v[1] * w[0]);
@@ -64,7 +100,18 @@ fn projection_axes(a: P, b: P, c: P) -> (usize, usize) {
 
 type Q = [i128; 2];
 
+/// Sign of the signed area of `a b c` (positive counter-clockwise); filtered in `f64` like
+/// [`orient3d`], exact in `i128`.
 fn orient2d(a: Q, b: Q, c: Q) -> i32 {
+    let l = (b[0] - a[0]) as f64 * (c[1] - a[1]) as f64;
+    let r = (b[1] - a[1]) as f64 * (c[0] - a[0]) as f64;
+    let (det, bound) = (l - r, ORIENT2D_FILTER * (l.abs() + r.abs()));
+    if det > bound {
+        return 1;
+    }
+    if -det > bound {
+        return -1;
+    }
     ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])).signum() as i32
 }
 
@@ -108,6 +155,12 @@ fn project(p: P, axes: (usize, usize)) -> Q {
 /// Closed segment `pq` meets closed triangle `t` (3D, exact).
 fn segment_meets_triangle(p: P, q: P, t: [P; 3]) -> bool {
     let (op, oq) = (orient3d(t[0], t[1], t[2], p), orient3d(t[0], t[1], t[2], q));
+    segment_meets_triangle_given(p, q, op, oq, t)
+}
+
+/// [`segment_meets_triangle`] with the sides `op`, `oq` of `p` and `q` to the plane of `t`
+/// (`orient3d(t[0], t[1], t[2], ·)`) already known.
+fn segment_meets_triangle_given(p: P, q: P, op: i32, oq: i32, t: [P; 3]) -> bool {
     if op * oq > 0 {
         return false;
     }
@@ -129,18 +182,50 @@ fn segment_meets_triangle(p: P, q: P, t: [P; 3]) -> bool {
 
 /// Closed triangles share a point (exact; no shared vertex assumed).
 fn triangles_meet(a: [P; 3], b: [P; 3]) -> bool {
-    let oa = a.map(|v| orient3d(b[0], b[1], b[2], v));
+    let oa = sides(b, a);
     if oa.iter().all(|&o| o > 0) || oa.iter().all(|&o| o < 0) {
         return false;
     }
-    let ob = b.map(|v| orient3d(a[0], a[1], a[2], v));
+    let ob = sides(a, b);
     if ob.iter().all(|&o| o > 0) || ob.iter().all(|&o| o < 0) {
         return false;
     }
     // The intersection (if any) is a segment whose ends lie on an edge of one triangle inside
     // the other (also in the coplanar case, or a vertex of one lies inside the other).
-    (0..3).any(|k| segment_meets_triangle(a[k], a[(k + 1) % 3], b))
-        || (0..3).any(|k| segment_meets_triangle(b[k], b[(k + 1) % 3], a))
+    (0..3).any(|k| segment_meets_triangle_given(a[k], a[(k + 1) % 3], oa[k], oa[(k + 1) % 3], b))
+        || (0..3)
+            .any(|k| segment_meets_triangle_given(b[k], b[(k + 1) % 3], ob[k], ob[(k + 1) % 3], a))
+}
+
+/// `orient3d(t[0], t[1], t[2], p)` for the three points `pts`, with the plane's normal
+/// computed once (the first test of every pair of triangles that share no vertex).
+///
+/// The filter's bound is [`ORIENT3D_FILTER`] times the permanent of this evaluation order
+/// (about 6 roundings of it at most); within it, the exact [`orient3d_exact`] decides.
+fn sides(t: [P; 3], pts: [P; 3]) -> [i32; 3] {
+    let e = |p: P| [0, 1, 2].map(|k| (p[k] - t[0][k]) as f64);
+    let (e1, e2) = (e(t[1]), e(t[2]));
+    let m = [
+        (e1[1] * e2[2], e1[2] * e2[1]),
+        (e1[2] * e2[0], e1[0] * e2[2]),
+        (e1[0] * e2[1], e1[1] * e2[0]),
+    ];
+    let normal = m.map(|(x, y)| x - y);
+    let weight = m.map(|(x, y)| x.abs() + y.abs());
+    pts.map(|p| {
+        let d = e(p);
+        // orient3d(t0, t1, t2, p) = −(p − t0)·((t1 − t0) × (t2 − t0)).
+        let det = -(d[0] * normal[0] + d[1] * normal[1] + d[2] * normal[2]);
+        let bound = ORIENT3D_FILTER
+            * (d[0].abs() * weight[0] + d[1].abs() * weight[1] + d[2].abs() * weight[2]);
+        if det > bound {
+            1
+        } else if -det > bound {
+            -1
+        } else {
+            orient3d_exact(t[0], t[1], t[2], p)
+        }
+    })
 }
 
 /// Triangles `a` and `b` share exactly the vertex at corner `ia` of `a` and `ib` of `b`: do they
@@ -148,12 +233,13 @@ fn triangles_meet(a: [P; 3], b: [P; 3]) -> bool {
 fn meet_beyond_vertex(a: [P; 3], ia: usize, b: [P; 3], ib: usize) -> bool {
     let (a1, a2) = (a[(ia + 1) % 3], a[(ia + 2) % 3]);
     let (b1, b2) = (b[(ib + 1) % 3], b[(ib + 2) % 3]);
-    let coplanar = orient3d(b[0], b[1], b[2], a1) == 0 && orient3d(b[0], b[1], b[2], a2) == 0;
-    if !coplanar {
+    let [o1, o2, _] = sides(b, [a1, a2, a2]);
+    if o1 != 0 || o2 != 0 {
         // Both meet the common line of their planes in segments starting at the shared vertex:
         // they overlap beyond it iff the shorter one's far end (on its opposite edge) lies in
         // the other triangle.
-        return segment_meets_triangle(a1, a2, b) || segment_meets_triangle(b1, b2, a);
+        return segment_meets_triangle_given(a1, a2, o1, o2, b)
+            || segment_meets_triangle(b1, b2, a);
     }
     let axes = projection_axes(b[0], b[1], b[2]);
     let (v, pa1, pa2, pb1, pb2) = (
@@ -232,10 +318,18 @@ pub(crate) fn degenerate(t: [Vec3; 3]) -> bool {
 
 /// [`pair_intersects`] on snapped corners.
 fn pair_meets(ti: [u32; 3], a: [P; 3], tj: [u32; 3], b: [P; 3]) -> bool {
-    let shared: Vec<(usize, usize)> = (0..3)
-        .flat_map(|x| (0..3).map(move |y| (x, y)))
-        .filter(|&(x, y)| ti[x] == tj[y])
-        .collect();
+    // Shared corners (at most three), without allocating: this runs for every tested pair.
+    let mut shared = [(0usize, 0usize); 3];
+    let mut count = 0;
+    for x in 0..3 {
+        for y in 0..3 {
+            if ti[x] == tj[y] && count < 3 {
+                shared[count] = (x, y);
+                count += 1;
+            }
+        }
+    }
+    let shared = &shared[..count];
     match shared.len() {
         0 => triangles_meet(a, b),
         1 => meet_beyond_vertex(a, shared[0].0, b, shared[0].1),
@@ -389,6 +483,67 @@ mod tests {
             Vec3::new(0.5, 1.0, 1.0),
         ];
         assert_eq!(count(&r, &[[0, 1, 2], [0, 3, 4]]), 2);
+    }
+
+    /// The `f64` filters never change a sign: random points, points nudged a grid step off a
+    /// plane or line (the cases the filter must hand to `i128`), at the largest coordinates the
+    /// test accepts; and snapping rounds like `f64::round`.
+    #[test]
+    fn filtered_predicates_give_the_exact_signs() {
+        let mut rng = anim::SplitMix64::new(19, 0);
+        let big = (f64::from(MAX_EXACT_COORDINATE) * GRID) as i64;
+        let mut coord = |scale: i64| (rng.next_f32() as f64 * 2.0 - 1.0) as f32 * scale as f32;
+        let mut exact_2d = 0;
+        for i in 0..20_000 {
+            let scale = [big, 1 << 20, 1000][i % 3];
+            let mut pt = || [0; 3].map(|_| coord(scale) as i64);
+            let (a, b, c) = (pt(), pt(), pt());
+            // d on the plane of a b c (exactly when the weights divide), then nudged.
+            let d = if i % 2 == 0 {
+                let d = [0, 1, 2].map(|k| (a[k] + b[k]) / 2 + (c[k] - a[k]) / 4);
+                [d[0] + (i as i64 % 3) - 1, d[1], d[2]]
+            } else {
+                pt()
+            };
+            let exact = orient3d_exact(a, b, c, d);
+            assert_eq!(orient3d(a, b, c, d), exact, "{a:?} {b:?} {c:?} {d:?}");
+            assert_eq!(
+                sides([a, b, c], [d, a, pt()])[0],
+                exact,
+                "{a:?} {b:?} {c:?} {d:?}"
+            );
+            let q = |p: P| [i128::from(p[0]), i128::from(p[1])];
+            // c on the line a b (when the halves are exact), nudged by -1, 0 or 1 step.
+            let (qa, qb) = (q(a), q(b));
+            let nudge = i128::from(i as i64 % 3 - 1);
+            let qc = if i % 2 == 0 {
+                [(qa[0] + qb[0]) / 2 + nudge, (qa[1] + qb[1]) / 2]
+            } else {
+                q(d)
+            };
+            let exact = ((qb[0] - qa[0]) * (qc[1] - qa[1]) - (qb[1] - qa[1]) * (qc[0] - qa[0]))
+                .signum() as i32;
+            exact_2d += usize::from(exact == 0);
+            assert_eq!(orient2d(qa, qb, qc), exact);
+        }
+        assert!(exact_2d > 0, "no collinear case was tried");
+        for x in [
+            0.5f32,
+            -0.5,
+            1.5,
+            -2.5,
+            1e-30,
+            -1e-30,
+            4095.9998,
+            0.1,
+            -0.3,
+            1.0 / 3.0,
+        ] {
+            let v = Vec3::splat(x / GRID as f32);
+            assert_eq!(snap(v)[0], (f64::from(v.x) * GRID).round() as i64, "{x}");
+            let w = Vec3::splat(x);
+            assert_eq!(snap(w)[0], (f64::from(w.x) * GRID).round() as i64, "{x}");
+        }
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! Nearest-distance queries against a triangle set: the closest point of a triangle and a
 //! uniform grid of triangles searched ring by ring (the minimum wall of printable pieces).
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap;
 
 use glam::Vec3;
 
@@ -45,8 +45,19 @@ pub fn closest_point_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
 
 /// Cell of `p` in a grid of cube size `cell` anchored at `lo`.
 fn cell_of(p: Vec3, lo: Vec3, cell: f32) -> [i32; 3] {
-    let q = ((p - lo) / cell).floor();
-    [q.x as i32, q.y as i32, q.z as i32]
+    ((p - lo) / cell).to_array().map(floor_i32)
+}
+
+/// `x.floor() as i32` (saturating, NaN → 0) without `floorf`'s library call: grid keys are
+/// taken for every tested pair and every visited cell.
+#[inline]
+pub(crate) fn floor_i32(x: f32) -> i32 {
+    let i = x as i32;
+    if (i as f32) > x {
+        i.saturating_sub(1)
+    } else {
+        i
+    }
 }
 
 /// A uniform grid of triangles for nearest-distance queries (and the exact intersection
@@ -60,7 +71,7 @@ pub struct TriangleGrid<'a> {
     dims: [i32; 3],
     /// Bounding box of every triangle.
     boxes: Vec<(Vec3, Vec3)>,
-    cells: HashMap<[i32; 3], Vec<u32>>,
+    cells: FxHashMap<[i32; 3], Vec<u32>>,
 }
 
 /// The finest cell a uniform grid of `triangles` triangles over the box `lo..hi` may use:
@@ -100,7 +111,7 @@ impl<'a> TriangleGrid<'a> {
         // cell size, only the time).
         let cell = (2.0 * mean).max(finest_cell(lo, hi, triangles.len()));
         let key = |p: Vec3| cell_of(p, lo, cell);
-        let mut cells: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
+        let mut cells: FxHashMap<[i32; 3], Vec<u32>> = FxHashMap::default();
         for (t, (a, b)) in boxes.iter().enumerate() {
             let (ka, kb) = (key(*a), key(*b));
             for x in ka[0]..=kb[0] {
@@ -160,8 +171,7 @@ impl<'a> TriangleGrid<'a> {
         if self.triangles.is_empty() {
             return f64::INFINITY;
         }
-        let q = ((p - self.lo) / self.cell).floor();
-        let c = [q.x as i32, q.y as i32, q.z as i32];
+        let c = self.key(p);
         let max_ring = (0..3)
             .map(|k| (c[k]).abs().max((self.dims[k] - c[k]).abs()))
             .max()
@@ -255,6 +265,39 @@ pub(crate) fn slivers_under_large_triangles(seed: u64, slivers: u32) -> (Vec<Vec
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn floor_i32_is_floor_then_cast() {
+        let xs = [
+            0.0f32,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            -1.0001,
+            2.9999,
+            -2.9999,
+            1e-30,
+            -1e-30,
+            16_777_217.0,
+            -16_777_217.0,
+            3e9,
+            -3e9,
+            2_147_483_520.0,
+            -2_147_483_648.0,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            f32::MAX,
+            f32::MIN,
+        ];
+        let mut rng = anim::SplitMix64::new(3, 0);
+        let random = (0..10_000).map(|_| (rng.next_f32() - 0.5) * 1e4);
+        for x in xs.into_iter().chain(random) {
+            assert_eq!(floor_i32(x), x.floor() as i32, "{x}");
+        }
+    }
 
     /// Distance from `q` to the nearest triangle, by trying every one.
     fn brute(p: &[Vec3], t: &[[u32; 3]], q: Vec3) -> f64 {

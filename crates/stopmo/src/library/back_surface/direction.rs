@@ -57,6 +57,19 @@ pub(super) fn smoothed_directions(
     }
     let radius = DISC_SIGMAS * sigma;
     let inv_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
+    // Edges in one array with their lengths (the same f32 values the search would compute
+    // per visit): every disc relaxes each edge inside it, n discs in all.
+    let mut start = Vec::with_capacity(n + 1);
+    let mut edges: Vec<(u32, f32)> = Vec::new();
+    start.push(0);
+    for (u, around) in adj.iter().enumerate().take(n) {
+        edges.extend(
+            around
+                .iter()
+                .map(|&w| (w, front[u].distance(front[w as usize]))),
+        );
+        start.push(edges.len());
+    }
     (0..n)
         .into_par_iter()
         .map_init(
@@ -72,9 +85,9 @@ pub(super) fn smoothed_directions(
                         continue;
                     }
                     sum += area_normals[u] * (-g * g * inv_two_sigma2).exp();
-                    for &w in &adj[u] {
+                    for &(w, length) in &edges[start[u]..start[u + 1]] {
                         let w = w as usize;
-                        let gw = g + front[u].distance(front[w]);
+                        let gw = g + length;
                         if gw <= radius && gw < dist[w] {
                             if dist[w] == f32::INFINITY {
                                 touched.push(w as u32);

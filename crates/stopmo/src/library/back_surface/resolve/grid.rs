@@ -2,16 +2,16 @@
 //! [`TriangleGrid`](crate::library::nearest::TriangleGrid), because the search moves the
 //! positions it was built from).
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap;
 
 use glam::Vec3;
 
-use crate::library::nearest::finest_cell;
+use crate::library::nearest::{finest_cell, floor_i32};
 
 /// A uniform grid of triangle boxes of one piece's solid, built once per round.
 pub(super) struct BoxGrid {
     cell: f32,
-    cells: HashMap<[i32; 3], Vec<u32>>,
+    cells: FxHashMap<[i32; 3], Vec<u32>>,
 }
 
 impl BoxGrid {
@@ -28,7 +28,7 @@ impl BoxGrid {
             |(l, h), b| (l.min(b.0), h.max(b.1)),
         );
         let cell = cell.max(finest_cell(lo, hi, tris.len()));
-        let mut cells: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
+        let mut cells: FxHashMap<[i32; 3], Vec<u32>> = FxHashMap::default();
         for (t, &(lo, hi)) in boxes.iter().enumerate() {
             let (a, b) = (key(lo, cell), key(hi, cell));
             for x in a[0]..=b[0] {
@@ -71,7 +71,7 @@ impl BoxGrid {
 }
 
 fn key(p: Vec3, cell: f32) -> [i32; 3] {
-    (p / cell).floor().to_array().map(|x| x as i32)
+    (p / cell).to_array().map(floor_i32)
 }
 
 pub(super) fn bounds(t: [Vec3; 3]) -> (Vec3, Vec3) {
