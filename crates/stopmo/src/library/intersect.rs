@@ -48,28 +48,59 @@ fn sub(a: P, b: P) -> [i128; 3] {
 
 /// Sign of the volume of the tetrahedron `(a, b, c, d)` (positive when `d` is below the plane
 /// of the counter-clockwise triangle `a b c`, following Shewchuk's convention).
-///
-/// Differences of snapped points (≤ 2³⁷) are exact in `f64`; the determinant is evaluated
-/// there first and only falls back to `i128` when it is within rounding of zero, so the sign is
-/// always the exact one.
 fn orient3d(a: P, b: P, c: P, d: P) -> i32 {
-    let f = |p: P| [0, 1, 2].map(|k| (p[k] - d[k]) as f64);
-    let (u, v, w) = (f(a), f(b), f(c));
-    let (m0, m1) = (v[1] * w[2], v[2] * w[1]);
-    let (m2, m3) = (v[0] * w[2], v[2] * w[0]);
-    let (m4, m5) = (v[0] * w[1], v[1] * w[0]);
-    let det = u[0] * (m0 - m1) - u[1] * (m2 - m3) + u[2] * (m4 - m5);
-    let permanent = u[0].abs() * (m0.abs() + m1.abs())
-        + u[1].abs() * (m2.abs() + m3.abs())
-        + u[2].abs() * (m4.abs() + m5.abs());
-    let bound = ORIENT3D_FILTER * permanent;
-    if det > bound {
-        return 1;
+    Plane::new([a, b, c]).side(d)
+}
+
+/// The plane of a triangle, for the side of any number of points ([`orient3d`] with the
+/// normal computed once: a pair of triangles tests up to six points against each plane).
+///
+/// Differences of snapped points (≤ 2³⁷) are exact in `f64`; a side is the sign of the `f64`
+/// determinant when it is beyond [`ORIENT3D_FILTER`] times its permanent (about 6 roundings
+/// of it at most), and of the `i128` one ([`orient3d_exact`]) within, so always the exact one.
+struct Plane {
+    corners: [P; 3],
+    /// `(t1 − t0) × (t2 − t0)`.
+    normal: [f64; 3],
+    /// The normal's components with the products' magnitudes added (the permanent's).
+    weight: [f64; 3],
+}
+
+impl Plane {
+    fn new(corners: [P; 3]) -> Plane {
+        let [e1, e2] = [corners[1], corners[2]].map(|p| Plane::from_origin(corners[0], p));
+        let m = [
+            (e1[1] * e2[2], e1[2] * e2[1]),
+            (e1[2] * e2[0], e1[0] * e2[2]),
+            (e1[0] * e2[1], e1[1] * e2[0]),
+        ];
+        Plane {
+            corners,
+            normal: m.map(|(x, y)| x - y),
+            weight: m.map(|(x, y)| x.abs() + y.abs()),
+        }
     }
-    if -det > bound {
-        return -1;
+
+    /// `p − o`, exact in `f64`.
+    fn from_origin(o: P, p: P) -> [f64; 3] {
+        [0, 1, 2].map(|k| (p[k] - o[k]) as f64)
     }
-    orient3d_exact(a, b, c, d)
+
+    /// `orient3d(t0, t1, t2, p) = −(p − t0)·((t1 − t0) × (t2 − t0))`.
+    fn side(&self, p: P) -> i32 {
+        let d = Plane::from_origin(self.corners[0], p);
+        let (n, w) = (self.normal, self.weight);
+        let det = -(d[0] * n[0] + d[1] * n[1] + d[2] * n[2]);
+        let bound = ORIENT3D_FILTER * (d[0].abs() * w[0] + d[1].abs() * w[1] + d[2].abs() * w[2]);
+        if det > bound {
+            1
+        } else if -det > bound {
+            -1
+        } else {
+            let [a, b, c] = self.corners;
+            orient3d_exact(a, b, c, p)
+        }
+    }
 }
 
 /// [`orient3d`] in `i128` arithmetic.
@@ -112,6 +143,11 @@ fn orient2d(a: Q, b: Q, c: Q) -> i32 {
     if -det > bound {
         return -1;
     }
+    orient2d_exact(a, b, c)
+}
+
+/// [`orient2d`] in `i128` arithmetic.
+fn orient2d_exact(a: Q, b: Q, c: Q) -> i32 {
     ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])).signum() as i32
 }
 
@@ -154,7 +190,8 @@ fn project(p: P, axes: (usize, usize)) -> Q {
 
 /// Closed segment `pq` meets closed triangle `t` (3D, exact).
 fn segment_meets_triangle(p: P, q: P, t: [P; 3]) -> bool {
-    let (op, oq) = (orient3d(t[0], t[1], t[2], p), orient3d(t[0], t[1], t[2], q));
+    let plane = Plane::new(t);
+    let (op, oq) = (plane.side(p), plane.side(q));
     segment_meets_triangle_given(p, q, op, oq, t)
 }
 
@@ -182,11 +219,13 @@ fn segment_meets_triangle_given(p: P, q: P, op: i32, oq: i32, t: [P; 3]) -> bool
 
 /// Closed triangles share a point (exact; no shared vertex assumed).
 fn triangles_meet(a: [P; 3], b: [P; 3]) -> bool {
-    let oa = sides(b, a);
+    let plane_b = Plane::new(b);
+    let oa = a.map(|v| plane_b.side(v));
     if oa.iter().all(|&o| o > 0) || oa.iter().all(|&o| o < 0) {
         return false;
     }
-    let ob = sides(a, b);
+    let plane_a = Plane::new(a);
+    let ob = b.map(|v| plane_a.side(v));
     if ob.iter().all(|&o| o > 0) || ob.iter().all(|&o| o < 0) {
         return false;
     }
@@ -197,43 +236,13 @@ fn triangles_meet(a: [P; 3], b: [P; 3]) -> bool {
             .any(|k| segment_meets_triangle_given(b[k], b[(k + 1) % 3], ob[k], ob[(k + 1) % 3], a))
 }
 
-/// `orient3d(t[0], t[1], t[2], p)` for the three points `pts`, with the plane's normal
-/// computed once (the first test of every pair of triangles that share no vertex).
-///
-/// The filter's bound is [`ORIENT3D_FILTER`] times the permanent of this evaluation order
-/// (about 6 roundings of it at most); within it, the exact [`orient3d_exact`] decides.
-fn sides(t: [P; 3], pts: [P; 3]) -> [i32; 3] {
-    let e = |p: P| [0, 1, 2].map(|k| (p[k] - t[0][k]) as f64);
-    let (e1, e2) = (e(t[1]), e(t[2]));
-    let m = [
-        (e1[1] * e2[2], e1[2] * e2[1]),
-        (e1[2] * e2[0], e1[0] * e2[2]),
-        (e1[0] * e2[1], e1[1] * e2[0]),
-    ];
-    let normal = m.map(|(x, y)| x - y);
-    let weight = m.map(|(x, y)| x.abs() + y.abs());
-    pts.map(|p| {
-        let d = e(p);
-        // orient3d(t0, t1, t2, p) = −(p − t0)·((t1 − t0) × (t2 − t0)).
-        let det = -(d[0] * normal[0] + d[1] * normal[1] + d[2] * normal[2]);
-        let bound = ORIENT3D_FILTER
-            * (d[0].abs() * weight[0] + d[1].abs() * weight[1] + d[2].abs() * weight[2]);
-        if det > bound {
-            1
-        } else if -det > bound {
-            -1
-        } else {
-            orient3d_exact(t[0], t[1], t[2], p)
-        }
-    })
-}
-
 /// Triangles `a` and `b` share exactly the vertex at corner `ia` of `a` and `ib` of `b`: do they
 /// meet anywhere else?
 fn meet_beyond_vertex(a: [P; 3], ia: usize, b: [P; 3], ib: usize) -> bool {
     let (a1, a2) = (a[(ia + 1) % 3], a[(ia + 2) % 3]);
     let (b1, b2) = (b[(ib + 1) % 3], b[(ib + 2) % 3]);
-    let [o1, o2, _] = sides(b, [a1, a2, a2]);
+    let plane = Plane::new(b);
+    let (o1, o2) = (plane.side(a1), plane.side(a2));
     if o1 != 0 || o2 != 0 {
         // Both meet the common line of their planes in segments starting at the shared vertex:
         // they overlap beyond it iff the shorter one's far end (on its opposite edge) lies in
@@ -507,11 +516,6 @@ mod tests {
             };
             let exact = orient3d_exact(a, b, c, d);
             assert_eq!(orient3d(a, b, c, d), exact, "{a:?} {b:?} {c:?} {d:?}");
-            assert_eq!(
-                sides([a, b, c], [d, a, pt()])[0],
-                exact,
-                "{a:?} {b:?} {c:?} {d:?}"
-            );
             let q = |p: P| [i128::from(p[0]), i128::from(p[1])];
             // c on the line a b (when the halves are exact), nudged by -1, 0 or 1 step.
             let (qa, qb) = (q(a), q(b));
@@ -521,8 +525,7 @@ mod tests {
             } else {
                 q(d)
             };
-            let exact = ((qb[0] - qa[0]) * (qc[1] - qa[1]) - (qb[1] - qa[1]) * (qc[0] - qa[0]))
-                .signum() as i32;
+            let exact = orient2d_exact(qa, qb, qc);
             exact_2d += usize::from(exact == 0);
             assert_eq!(orient2d(qa, qb, qc), exact);
         }
