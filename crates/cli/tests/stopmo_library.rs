@@ -81,8 +81,11 @@ fn piece_positions(path: &Path) -> Vec<anim::glam::Vec3> {
 fn max_error_picks_smallest_library_and_writes_curve_csv_and_png() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("lib");
-    let summary = library(&out, &["--max-error", "0.25"]);
+    let summary = library(&out, &["--max-error", "0.25", "--no-print"]);
     let pieces = summary["pieces"].as_u64().unwrap() as usize;
+    // `--no-print`: the pieces' surfaces, no solids.
+    assert!(out.join(format!("pieces/{PART}_00.obj")).is_file());
+    assert!(!out.join(format!("pieces/{PART}_00.stl")).exists());
     let csv = std::fs::read_to_string(out.join("error_curve.csv")).unwrap();
     let mut lines = csv.lines();
     assert_eq!(
@@ -179,8 +182,11 @@ fn saliency_lowers_the_error_where_it_is_high() {
     )
     .unwrap();
     let (plain, weighted) = (dir.path().join("plain"), dir.path().join("weighted"));
-    library(&plain, &["--pieces", "6"]);
-    library(&weighted, &["--pieces", "6", "--saliency", s(&npy)]);
+    library(&plain, &["--pieces", "6", "--no-print"]);
+    library(
+        &weighted,
+        &["--pieces", "6", "--no-print", "--saliency", s(&npy)],
+    );
     let (e0, e1) = (
         mean_error(&plain, &salient),
         mean_error(&weighted, &salient),
@@ -197,7 +203,7 @@ fn methods_rank_as_in_fig_19() {
     let mut errs = Vec::new();
     for m in ["stopshop", "kmeans", "uniform"] {
         let out = dir.path().join(m);
-        let r = library(&out, &["--pieces", "8", "--method", m]);
+        let r = library(&out, &["--pieces", "8", "--no-print", "--method", m]);
         assert_eq!(r["method"], m, "{r}");
         let e = &r["errors_mm"];
         errs.push((

@@ -40,13 +40,30 @@ def test_run_writes_the_cli_layout(face, tmp_path):
         p.name for p in (cli / "pieces").iterdir())
 
 
+def test_no_print_is_the_cli_without_solids(face, tmp_path):
+    """``print=False`` is ``--no-print``: the same library and files, no STL solids."""
+    cli = tmp_path / "cli"
+    run_cli("stopmo", "run", asset(FACE), "-o", cli, "--fps", "2",
+            "--part", "upper=point:0,10,13", "--part", "lower=point:0,-14,10",
+            "--pieces", "3", "--restarts", "1", "--no-print")
+    lib = toonkit.stopmo.run(face, parts=PARTS, pieces=3, restarts=1, print=False)
+    py = tmp_path / "py"
+    lib.save(py)
+    assert (py / "assembly.csv").read_text() == (cli / "assembly.csv").read_text()
+    pieces = sorted(p.name for p in (py / "pieces").iterdir())
+    assert pieces == sorted(p.name for p in (cli / "pieces").iterdir())
+    assert pieces == [f"{part}_{k:02}.obj" for part in ("lower", "upper") for k in range(3)]
+    assert lib.report["printing"] is None
+    assert json.loads((cli / "report.json").read_text())["printing"] is None
+
+
 def test_segment_then_library(face, tmp_path):
     seg = toonkit.stopmo.segment(face, parts=PARTS)
     assert seg.part_names == ["upper", "lower"]
     assert set(np.unique(seg.labels)) == {0, 1}
     assert seg.report["parts"] == ["upper", "lower"]
     seg.save(tmp_path / "parts.glb")
-    lib = toonkit.stopmo.library(seg, pieces=3, restarts=1)
+    lib = toonkit.stopmo.library(seg, pieces=3, restarts=1, print=False)
     assert [len([p for p in lib.pieces if p["part"] == i]) for i in range(2)] == [3, 3]
     assert len(lib.assembly) == face.frame_count
 
@@ -59,7 +76,7 @@ def test_bad_parts_raise(face):
 
 
 def test_budget_replaces_the_piece_count(face):
-    lib = toonkit.stopmo.run(face, parts=PARTS, budget=5, restarts=1)
+    lib = toonkit.stopmo.run(face, parts=PARTS, budget=5, restarts=1, print=False)
     assert len(lib.pieces) == 5
     with pytest.raises(ValueError, match="budget"):
         toonkit.stopmo.library(toonkit.stopmo.segment(face, parts=PARTS), budget=4,

@@ -265,6 +265,10 @@ pub struct LibraryOptionsArgs {
     /// No piece ID (`P-NN`) embossed on the back of every piece.
     #[arg(long)]
     pub no_ids: bool,
+    /// No printable solids: the pieces' surfaces (`pieces/*.obj`), labels, errors and
+    /// sheets only, in a fraction of the time — to judge a library size before printing it.
+    #[arg(long, conflicts_with = "plugs")]
+    pub no_print: bool,
     /// Also write the JSON report here (it is always written to DIR/report.json).
     #[arg(long)]
     pub report: Option<PathBuf>,
@@ -323,6 +327,7 @@ impl LibraryOptionsArgs {
             resolution_mm: self.resolution,
             keys: !self.no_keys,
             ids: !self.no_ids,
+            print: !self.no_print,
         })
     }
 

@@ -72,7 +72,7 @@ fn segment_then_library_on_a_tube_gives_the_spec_layout() {
     assert!(lib.labels().iter().all(|l| l.len() == 36));
     // Every piece is a closed solid in millimetres and a surface in model units.
     for p in &lib.pieces {
-        let check = stopmo::library::check_solid(&p.solid);
+        let check = stopmo::library::check_solid(p.solid.as_ref().expect("a solid"));
         assert!(check.is_closed_manifold(), "{}: {check:?}", p.id);
         assert_eq!(p.surface.vertex_count(), parts[p.part].vertex_count());
     }
@@ -150,6 +150,31 @@ fn segment_then_library_on_a_tube_gives_the_spec_layout() {
         }
         other => panic!("reconstruction.pc2 holds {other:?}"),
     }
+
+    // Without printing: the same library, labels and surfaces, no solids, backs, `.stl` or
+    // "printing" report.
+    let quick = stopmo::library(
+        &parts,
+        &LibraryJobOptions {
+            print: false,
+            ..opts.clone()
+        },
+    )
+    .unwrap();
+    assert_eq!(quick.labels(), lib.labels());
+    assert_eq!(quick.report.energy, lib.report.energy);
+    assert_eq!(quick.report.errors_mm, lib.report.errors_mm);
+    assert_eq!(quick.pieces.len(), 8);
+    for (q, p) in quick.pieces.iter().zip(&lib.pieces) {
+        assert_eq!((&q.id, &q.surface), (&p.id, &p.surface));
+        assert!(q.solid.is_none(), "{} has a solid", q.id);
+    }
+    assert!(quick.backs.is_empty() && quick.report.printing.is_none());
+    let files = quick.files().unwrap();
+    assert!(files.iter().all(|f| !f.path.ends_with(".stl")));
+    assert!(files.iter().any(|f| f.path == "pieces/lower_04.obj"));
+    let report: serde_json::Value = serde_json::from_str(&quick.report.to_json()).unwrap();
+    assert!(report["printing"].is_null(), "{}", report["printing"]);
 }
 
 #[test]
@@ -241,6 +266,8 @@ fn face_run_equals_segment_then_library_and_searches_a_size() {
                 restarts: 2,
                 ..Default::default()
             },
+            // Labels, energies and the size search are the subject, not the solids.
+            print: false,
             ..Default::default()
         },
     };
@@ -300,7 +327,7 @@ fn a_surface_that_presses_through_itself_is_reported_with_advice() {
         stopmo::library(std::slice::from_ref(a), &options).unwrap()
     };
     let lib = three_pieces(&anim);
-    let part = &lib.report.printing.parts[0];
+    let part = &lib.report.printing.as_ref().expect("printed").parts[0];
     assert!(
         part.surface_self_intersecting_triangles > 0,
         "{:?}",
@@ -318,7 +345,7 @@ fn a_surface_that_presses_through_itself_is_reported_with_advice() {
     // An untouched tube reports none.
     let lib = three_pieces(&segment_support::talking_tube(16, 12, 6));
     assert_eq!(
-        lib.report.printing.parts[0].surface_self_intersecting_triangles,
+        lib.report.printing.as_ref().expect("printed").parts[0].surface_self_intersecting_triangles,
         0
     );
 }

@@ -36,7 +36,8 @@ pub struct OutputFile<'a> {
 }
 
 impl LibraryResult {
-    /// Every file of the output layout: `pieces/<part>_<NN>.obj` and `.stl`,
+    /// Every file of the output layout: `pieces/<part>_<NN>.obj` and `.stl` (no `.stl` when
+    /// the job did not print),
     /// `pieces/<part>_back.obj` (the shared back surface, mm), `assembly.csv`,
     /// `assembly.md`, `catalogue.png`, `assembly_shotNN.png` (one per shot),
     /// `shooting_order.csv`, `report.json`, `reconstruction.glb`,
@@ -63,10 +64,9 @@ impl LibraryResult {
                 format!("pieces/{}.obj", p.id),
                 FileData::Mesh(&p.surface),
             ));
-            out.push(file(
-                format!("pieces/{}.stl", p.id),
-                FileData::Mesh(&p.solid),
-            ));
+            if let Some(solid) = &p.solid {
+                out.push(file(format!("pieces/{}.stl", p.id), FileData::Mesh(solid)));
+            }
         }
         for b in &self.backs {
             out.push(file(format!("pieces/{}.obj", b.name), FileData::Mesh(b)));

@@ -7,7 +7,7 @@ use anim::MeshAnimation;
 
 use super::error::{Error, Result};
 use super::options::{LibraryJobOptions, PieceCount, RunOptions};
-use super::print::{print_pieces, PrintSettings};
+use super::print::{print_pieces, surface_pieces, PrintSettings};
 use super::report::{InputErrors, LibraryReport, ReportInputs};
 use super::result::LibraryResult;
 use super::segment_job::segment;
@@ -315,20 +315,24 @@ pub(super) fn finish(
     };
     let segments = opts.plugs.map(|p| p.segments);
     let errors = input_errors(&lib, anims, inputs, &opts.cuts)?;
-    let printed = print_pieces(
-        &lib,
-        anims,
-        &PrintSettings {
-            thickness_mm: opts.thickness_mm,
-            print_height_mm: opts.print_height_mm,
-            resolution_mm: opts.resolution_mm,
-            keys: opts.keys,
-            ids: opts.ids,
-            plugs: &plugs,
-            plug_segments: segments.unwrap_or(crate::library::DEFAULT_PLUG_SEGMENTS),
-            backs: &opts.backs,
-        },
-    )?;
+    let printed = if opts.print {
+        print_pieces(
+            &lib,
+            anims,
+            &PrintSettings {
+                thickness_mm: opts.thickness_mm,
+                print_height_mm: opts.print_height_mm,
+                resolution_mm: opts.resolution_mm,
+                keys: opts.keys,
+                ids: opts.ids,
+                plugs: &plugs,
+                plug_segments: segments.unwrap_or(crate::library::DEFAULT_PLUG_SEGMENTS),
+                backs: &opts.backs,
+            },
+        )?
+    } else {
+        surface_pieces(&lib, anims, opts.resolution_mm)?
+    };
     let catalogue = catalogue_png(&lib, anims)?;
     let assembly = lib.assembly();
     let sheets = assembly_sheets(&lib, anims, &assembly, &opts.cuts)?;

@@ -78,7 +78,7 @@ pub struct LibraryJobOptions {
     /// (checked before segmenting, then carried through the cut to the parts).
     pub saliency: Option<Vec<f32>>,
     /// Frames that start a new, unrelated shot (no velocity term across them, StopShop
-    /// StopShop Eq. 12).
+    /// Eq. 12).
     pub cuts: Vec<usize>,
     /// Pre-made pieces per part name (model units, one position per vertex of the part):
     /// they are kept and new pieces are added up to the library size.
@@ -95,6 +95,11 @@ pub struct LibraryJobOptions {
     pub keys: bool,
     /// Piece ID (`P-NN`) embossed on the back of every piece.
     pub ids: bool,
+    /// Build the printable solids (`pieces/*.stl`, the back surfaces, keys, IDs and the
+    /// report's `"printing"`). Off, the job stops at the pieces' surfaces, the labels and the
+    /// errors — a quick look at a library size before printing it (on the face, the solids
+    /// are ~95 % of the job's time).
+    pub print: bool,
 }
 
 impl Default for LibraryJobOptions {
@@ -113,6 +118,7 @@ impl Default for LibraryJobOptions {
             resolution_mm: DEFAULT_RESOLUTION_MM,
             keys: true,
             ids: true,
+            print: true,
         }
     }
 }

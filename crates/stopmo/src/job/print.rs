@@ -50,8 +50,8 @@ pub(crate) struct PrintSettings<'a> {
 pub(crate) struct Printed {
     /// Every piece, part by part.
     pub(crate) pieces: Vec<Piece>,
-    /// `report.json` `"printing"`.
-    pub(crate) report: PrintReport,
+    /// `report.json` `"printing"` (none for surfaces alone).
+    pub(crate) report: Option<PrintReport>,
     /// Warnings (pieces below the printer resolution, walls thinner than asked, pieces whose
     /// solid crosses itself).
     pub(crate) warnings: Vec<String>,
@@ -129,8 +129,9 @@ pub struct Piece {
     pub index: usize,
     /// The piece's surface in model units, with the part's topology and UVs.
     pub surface: Mesh,
-    /// The printable solid in millimetres (with the part's plug shells, if any).
-    pub solid: Mesh,
+    /// The printable solid in millimetres (with the part's plug shells, if any); `None` when
+    /// the job was asked for surfaces alone ([`LibraryJobOptions::print`](crate::LibraryJobOptions::print)).
+    pub solid: Option<Mesh>,
 }
 
 /// A part's back surface with what it was built from (millimetres).
@@ -264,7 +265,7 @@ pub(crate) fn print_pieces(
                     part: p,
                     index: k,
                     surface,
-                    solid,
+                    solid: Some(solid),
                 };
                 Ok((piece, crossing, surface_crossing))
             })
@@ -322,16 +323,13 @@ pub(crate) fn print_pieces(
         }
         let made: Vec<Piece> = made.into_iter().map(|(piece, _, _)| piece).collect();
         let (close, nearest) = below_resolution(&part.name, &pieces_mm, s.resolution_mm);
-        let n = pieces_mm.len();
-        if !close.is_empty() {
-            warnings.push(format!(
-                "part {}: {} of {n} pieces differ from a sibling by less than the printer resolution ({} mm): {}; print larger (print height) or use fewer pieces",
-                part.name,
-                close.len(),
-                s.resolution_mm,
-                close.join(", ")
-            ));
-        }
+        warn_below_resolution(
+            &mut warnings,
+            &part.name,
+            &close,
+            pieces_mm.len(),
+            s.resolution_mm,
+        );
         parts_report.push(PartPrintReport {
             name: part.name.clone(),
             shell: shell.stats,
@@ -342,7 +340,7 @@ pub(crate) fn print_pieces(
         });
         pieces_out.extend(made);
     }
-    let solids: Vec<Mesh> = pieces_out.iter().map(|p| p.solid.clone()).collect();
+    let solids: Vec<Mesh> = pieces_out.iter().filter_map(|p| p.solid.clone()).collect();
     let report = PrintReport {
         material: material(&solids),
         print_time: print_time(&solids),
@@ -353,10 +351,74 @@ pub(crate) fn print_pieces(
     };
     Ok(Printed {
         pieces: pieces_out,
-        report,
+        report: Some(report),
         warnings,
         backs,
     })
+}
+
+/// The pieces' surfaces alone, without solids, backs or the `"printing"` report (a look at a
+/// library before printing it); still warns about pieces closer than the printer resolution,
+/// which says as much about the library size as about printing.
+pub(crate) fn surface_pieces(
+    lib: &Library,
+    anims: &[&MeshAnimation],
+    resolution_mm: f64,
+) -> Result<Printed> {
+    let mm = lib.mm_per_unit as f32;
+    let mut pieces = Vec::new();
+    let mut warnings = Vec::new();
+    for (p, (part, a)) in lib.parts.iter().zip(anims).enumerate() {
+        let pieces_mm: Vec<Vec<Vec3>> = part
+            .solution
+            .pieces
+            .iter()
+            .map(|q| q.iter().map(|x| *x * mm).collect())
+            .collect();
+        let (close, _) = below_resolution(&part.name, &pieces_mm, resolution_mm);
+        warn_below_resolution(
+            &mut warnings,
+            &part.name,
+            &close,
+            pieces_mm.len(),
+            resolution_mm,
+        );
+        for k in 0..pieces_mm.len() {
+            let surface = lib.piece_surface(p, k, &a.mesh).ok_or_else(|| {
+                Error::option_error("pieces", format!("no piece {k} of part {p}"))
+            })?;
+            pieces.push(Piece {
+                id: surface.name.clone(),
+                part: p,
+                index: k,
+                surface,
+                solid: None,
+            });
+        }
+    }
+    Ok(Printed {
+        pieces,
+        report: None,
+        warnings,
+        backs: Vec::new(),
+    })
+}
+
+/// The warning about pieces closer to a sibling than the printer resolution.
+fn warn_below_resolution(
+    warnings: &mut Vec<String>,
+    part: &str,
+    close: &[String],
+    n: usize,
+    resolution_mm: f64,
+) {
+    if !close.is_empty() {
+        warnings.push(format!(
+            "part {part}: {} of {n} pieces differ from a sibling by less than the printer resolution ({resolution_mm} mm): {}; print larger (print height) or use fewer pieces",
+            close.len(),
+            close.join(", ")
+        ));
+    }
 }
 
 /// Pieces closer to a sibling than `resolution_mm` (largest vertex distance), and the

@@ -100,8 +100,9 @@ pub struct LibraryReport {
     /// What homogenization alone changed (homogenized parts against the input), when the
     /// input is known.
     pub homogenization_errors_mm: Option<ErrorSummary>,
-    /// Back surfaces, keys, IDs, resolution check, material and print time.
-    pub printing: PrintReport,
+    /// Back surfaces, keys, IDs, resolution check, material and print time (`null` when the
+    /// job did not print: [`LibraryJobOptions::print`](crate::LibraryJobOptions::print)).
+    pub printing: Option<PrintReport>,
     /// Printing warnings (e.g. pieces below the printer resolution).
     pub warnings: Vec<String>,
     /// The assembly sheets with thumbnails (`assembly_shotNN.png`).
@@ -131,7 +132,7 @@ pub(crate) struct ReportInputs<'a> {
     pub(crate) thickness_mm: f64,
     pub(crate) restarts: usize,
     pub(crate) errors: InputErrors,
-    pub(crate) printing: PrintReport,
+    pub(crate) printing: Option<PrintReport>,
     pub(crate) warnings: Vec<String>,
     pub(crate) sheets: Vec<String>,
 }

@@ -144,7 +144,7 @@ fn other_print_heights_and_walls_print_clean() {
             ..Default::default()
         };
         let result = stopmo::library(&parts, &opts).expect("library");
-        for part in &result.report.printing.parts {
+        for part in &result.report.printing.as_ref().expect("printed").parts {
             let s = &part.shell;
             eprintln!("{height} mm, wall {wall} mm, {}: {s:?}", part.name);
             assert_eq!(
@@ -190,10 +190,10 @@ fn a_25_mm_print_untangles_the_lip_corners() {
         pressed > 0,
         "no piece surface crosses itself: the test tests nothing"
     );
-    for part in &result.report.printing.parts {
+    for part in &result.report.printing.as_ref().expect("printed").parts {
         eprintln!("25 mm, 20 pieces, {}: {:?}", part.name, part.shell);
     }
-    let lower = &result.report.printing.parts[1];
+    let lower = &result.report.printing.as_ref().expect("printed").parts[1];
     assert_eq!(lower.name, "lower");
     assert_eq!(
         lower.shell.self_intersecting_triangles, 0,
