@@ -46,6 +46,10 @@ class StopmoSettings(bpy.types.PropertyGroup):
     print_height_mm: FloatProperty(name="Print height (mm)", default=60.0, min=1.0)
     plugs: BoolProperty(name="Plugs", default=False,
                         description="Registration plugs between parts")
+    print_solids: BoolProperty(
+        name="Printable solids", default=True,
+        description="Build the STL solids; off, the pieces' surfaces, labels and errors only "
+                    "(a quick look at a library size, many times sooner)")
     directory: StringProperty(name="Directory", default="//stopmo", subtype="DIR_PATH")
     seeds: CollectionProperty(type=StopmoSeed, name="Seeds")
     seed_part: StringProperty(name="Part", default="upper",
@@ -100,7 +104,7 @@ def options(s):
     count = {"EACH": {"pieces": s.pieces}, "BUDGET": {"budget": s.budget},
              "MAX_ERROR": {"max_error_mm": s.max_error_mm}}[s.count]
     opts = {**count, "lambda": s.lam, "restarts": s.restarts, "seed": s.seed,
-            "print_height_mm": s.print_height_mm}
+            "print_height_mm": s.print_height_mm, "print": bool(s.print_solids)}
     if s.plugs:
         opts["plugs"] = {}
     return opts

@@ -96,7 +96,8 @@ class TOONKIT_PT_stopmo(bpy.types.Panel):
         lay.prop(s, "count", text="")
         lay.prop(s, {"EACH": "pieces", "BUDGET": "budget", "MAX_ERROR": "max_error_mm"}[s.count])
         col = lay.column(align=True)
-        for name in ("lam", "restarts", "seed", "print_height_mm", "plugs", "directory"):
+        for name in ("lam", "restarts", "seed", "print_height_mm", "print_solids", "plugs",
+                     "directory"):
             col.prop(s, name)
         lay.operator("toonkit.stopmo_run", icon="MOD_BUILD")
         img = bpy.data.images.get("toonkit error curve")

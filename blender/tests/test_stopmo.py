@@ -133,8 +133,9 @@ def test_stopmo_cursor_seeds():
     for g in list(obj.vertex_groups):
         obj.vertex_groups.remove(g)
     s = scene.toonkit_stopmo
-    # One restart: what is tested here is where the parts come from.
+    # One restart and no solids: what is tested here is where the parts come from.
     s.count, s.pieces, s.restarts, s.seed = "EACH", PIECES, 1, 1
+    s.print_solids = False
     for name, seed in SEEDS.items():
         scene.cursor.location = seed
         r = bpy.ops.toonkit.stopmo_add_seed(part=name)
@@ -154,6 +155,10 @@ def test_stopmo_cursor_seeds():
     glb = toonkit.load(os.path.join(REPO, "assets", "face", "ict-face-talk.glb"), fps=2)
     ref = toonkit.stopmo.run(glb, parts=GLTF_SEEDS, **stopmo.options(s))
     ours, theirs = same_as(folder, ref, os.path.join(OUT, "cli-seeds"))
+    written = os.listdir(os.path.join(folder, "pieces"))
+    check(written and not any(f.endswith(".stl") for f in written),
+          f"'Printable solids' off still wrote solids: {written}")
+    check(ours["printing"] is None, "a printing report without solids")
     print(f"  cursor seeds: energy {ours['energy']!r} (CLI seeds {theirs['energy']!r})")
     # One seed part only: one line, nothing made.
     bpy.ops.toonkit.stopmo_remove_seed()
