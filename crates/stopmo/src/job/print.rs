@@ -171,17 +171,7 @@ pub(crate) fn print_pieces(
         .iter()
         .map(|a| a.average_positions().iter().map(|x| *x * mm).collect())
         .collect();
-    let pieces_of: Vec<Vec<Vec<Vec3>>> = lib
-        .parts
-        .iter()
-        .map(|part| {
-            part.solution
-                .pieces
-                .iter()
-                .map(|q| q.iter().map(|x| *x * mm).collect())
-                .collect()
-        })
-        .collect();
+    let pieces_of = pieces_in_mm(lib);
     let inputs: Vec<ShellInput<'_>> = anims
         .iter()
         .enumerate()
@@ -365,16 +355,15 @@ pub(crate) fn surface_pieces(
     anims: &[&MeshAnimation],
     resolution_mm: f64,
 ) -> Result<Printed> {
-    let mm = lib.mm_per_unit as f32;
     let mut pieces = Vec::new();
     let mut warnings = Vec::new();
-    for (p, (part, a)) in lib.parts.iter().zip(anims).enumerate() {
-        let pieces_mm: Vec<Vec<Vec3>> = part
-            .solution
-            .pieces
-            .iter()
-            .map(|q| q.iter().map(|x| *x * mm).collect())
-            .collect();
+    for (p, ((part, a), pieces_mm)) in lib
+        .parts
+        .iter()
+        .zip(anims)
+        .zip(pieces_in_mm(lib))
+        .enumerate()
+    {
         let (close, _) = below_resolution(&part.name, &pieces_mm, resolution_mm);
         warn_below_resolution(
             &mut warnings,
@@ -402,6 +391,21 @@ pub(crate) fn surface_pieces(
         warnings,
         backs: Vec::new(),
     })
+}
+
+/// Every part's pieces in millimetres (the STL coordinates), part by part.
+fn pieces_in_mm(lib: &Library) -> Vec<Vec<Vec<Vec3>>> {
+    let mm = lib.mm_per_unit as f32;
+    lib.parts
+        .iter()
+        .map(|part| {
+            part.solution
+                .pieces
+                .iter()
+                .map(|q| q.iter().map(|x| *x * mm).collect())
+                .collect()
+        })
+        .collect()
 }
 
 /// The warning about pieces closer to a sibling than the printer resolution.
