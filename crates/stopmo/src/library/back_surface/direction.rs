@@ -6,7 +6,7 @@
 //! it (two automatic parts, 8 pieces, before the local search: 1,032 and 1,360 back/back
 //! crossing pairs; 96 and 64 averaged over σ = 14 mm along the surface).
 
-use std::cmp::Ordering;
+use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 use glam::Vec3;
@@ -17,22 +17,11 @@ use super::PartShell;
 /// Radius of the disc averaged over, in Gaussian widths (its edge weighs e⁻²).
 const DISC_SIGMAS: f32 = 2.0;
 
-/// A vertex reached at a geodesic distance (min-heap order).
-#[derive(PartialEq)]
-struct Reached(f32, u32);
-
-impl Eq for Reached {}
-
-impl PartialOrd for Reached {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-impl Ord for Reached {
-    fn cmp(&self, other: &Self) -> Ordering {
-        other.0.total_cmp(&self.0).then(other.1.cmp(&self.1))
-    }
+/// A vertex `u` reached at geodesic distance `g` as one min-heap key: `g`'s bits above `u`.
+/// Distances are never negative, and the bits of non-negative floats order as the floats
+/// do, so the keys pop in the order of `(g, u)` — one integer comparison per heap step.
+fn reached(g: f32, u: u32) -> Reverse<u64> {
+    Reverse((u64::from(g.to_bits()) << 32) | u64::from(u))
 }
 
 /// Unit outward direction at every vertex of `front` (triangles `tris`, vertex adjacency
@@ -78,9 +67,9 @@ pub(super) fn smoothed_directions(
                 let mut sum = Vec3::ZERO;
                 dist[v] = 0.0;
                 touched.push(v as u32);
-                heap.push(Reached(0.0, v as u32));
-                while let Some(Reached(g, u)) = heap.pop() {
-                    let u = u as usize;
+                heap.push(reached(0.0, v as u32));
+                while let Some(Reverse(key)) = heap.pop() {
+                    let (g, u) = (f32::from_bits((key >> 32) as u32), key as u32 as usize);
                     if g > dist[u] {
                         continue;
                     }
@@ -93,7 +82,7 @@ pub(super) fn smoothed_directions(
                                 touched.push(w as u32);
                             }
                             dist[w] = gw;
-                            heap.push(Reached(gw, w as u32));
+                            heap.push(reached(gw, w as u32));
                         }
                     }
                 }

@@ -25,6 +25,7 @@
 //! over the seam wall beside the nose wing in two pieces).
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
 use super::error::{LibraryError, Result};
 use super::fabricate::{check_solid, DEFAULT_PRINT_HEIGHT_MM};
@@ -88,6 +89,8 @@ pub struct PartShell {
     nudge: Vec<Vec3>,
     /// Retraction per round where a piece's front crosses itself (mm, see `untangle`).
     untangle_step_mm: f32,
+    /// The part's pieces' fronts, untangled once (shared with the other direction field's shell).
+    fronts: Arc<topology::Fronts>,
     /// Measurements.
     pub stats: ShellStats,
 }
@@ -262,7 +265,7 @@ impl PartShell {
         let wall = opts.wall_mm as f32;
         let limit = envelope::envelope_limits(
             front,
-            fronts,
+            &fronts.untangled,
             &normals,
             wall,
             (DEFAULT_ENVELOPE_LATERAL * opts.model_height_mm) as f32,
@@ -362,6 +365,7 @@ impl PartShell {
             limits: limit.clone(),
             nudge: vec![Vec3::ZERO; n],
             untangle_step_mm: *untangle_step_mm,
+            fronts: Arc::clone(fronts),
             stats: ShellStats::default(),
         };
         shell.repair(front, &fixed, pieces, opts, &enforce, &along_loop);
@@ -415,14 +419,23 @@ impl PartShell {
     /// Front of `piece` over the shell vertices (caps included), untangled where it
     /// crosses itself.
     fn front(&self, piece: &[Vec3]) -> Vec<Vec3> {
-        let mut f = front_positions(&self.source, &self.caps, piece);
-        untangle::untangle(
-            &mut f,
-            &self.triangles,
-            &self.adjacency,
-            &self.on_boundary,
-            self.untangle_step_mm,
-        );
+        let laid = front_positions(&self.source, &self.caps, piece);
+        // A piece of the part was untangled when the part was laid out; another one (a
+        // caller's) is untangled here.
+        let mut f = match self.fronts.find(&laid) {
+            Some(untangled) => untangled.to_vec(),
+            None => {
+                let mut f = laid;
+                untangle::untangle(
+                    &mut f,
+                    &self.triangles,
+                    &self.adjacency,
+                    &self.on_boundary,
+                    self.untangle_step_mm,
+                );
+                f
+            }
+        };
         for (p, d) in f.iter_mut().zip(&self.nudge) {
             *p += *d;
         }

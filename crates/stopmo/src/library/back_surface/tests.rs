@@ -47,3 +47,47 @@ fn wall_rungs_lean_no_more_than_the_rung_slope_at_sharp_boundary_corners() {
     assert_eq!(shell.stats.self_intersecting_triangles, 0);
     assert!(shell.stats.min_wall_mm >= ShellOptions::default().wall_mm * 0.99);
 }
+
+#[test]
+fn a_piece_of_the_part_is_untangled_once_and_another_on_demand() {
+    // The fronts are untangled when the part is laid out; `front` finds a piece's there
+    // and must give exactly what untangling it again would.
+    let (mesh, avg) = saddle();
+    // Two different pieces: the saddle and one row of it pushed 2.5 mm sideways and down
+    // (a lookup that returned the other piece's front would differ).
+    let folded: Vec<Vec3> = avg
+        .iter()
+        .map(|p| {
+            if p.y == 0.0 && p.x.abs() < 6.0 {
+                *p + Vec3::new(0.0, 2.5, -0.6)
+            } else {
+                *p
+            }
+        })
+        .collect();
+    let shell =
+        PartShell::new(&mesh, &avg, &[&avg, &folded], &ShellOptions::default()).expect("shell");
+    let untangled_again = |piece: &[Vec3]| {
+        let mut f = front_positions(&shell.source, &shell.caps, piece);
+        untangle::untangle(
+            &mut f,
+            &shell.triangles,
+            &shell.adjacency,
+            &shell.on_boundary,
+            shell.untangle_step_mm,
+        );
+        f.iter()
+            .zip(&shell.nudge)
+            .map(|(p, d)| *p + *d)
+            .collect::<Vec<_>>()
+    };
+    let laid = |piece: &[Vec3]| front_positions(&shell.source, &shell.caps, piece);
+    for piece in [&avg, &folded] {
+        assert!(shell.fronts.find(&laid(piece)).is_some(), "not cached");
+        assert_eq!(shell.front(piece), untangled_again(piece));
+    }
+    // A piece the part was not built with is untangled when it is asked for.
+    let other: Vec<Vec3> = folded.iter().map(|p| *p + Vec3::Z * 0.01).collect();
+    assert!(shell.fronts.find(&laid(&other)).is_none());
+    assert_eq!(shell.front(&other), untangled_again(&other));
+}
