@@ -1,11 +1,9 @@
 //! The whole smear job on a real character: `prepare` once, `stylize` many times. A second
-//! `stylize` with another style reuses the prepared offsets (no solve, and much faster than
-//! preparing), and the merged job gives the offsets of the per-object solve. A frame range
+//! `stylize` with another style reuses the prepared offsets (no solve; `benches/restyle.rs`
+//! measures the cost), and the merged job gives the offsets of the per-object solve. A frame range
 //! (`stylize_frames`, the studio's current frame first) gives those frames of the whole clip.
 
 mod common;
-
-use std::time::Instant;
 
 use anim::{sample, SampleOptions, SampledScene};
 use smear::{prepare, stylize, stylize_frames, OffsetOptions, PrepareOptions, Style};
@@ -46,20 +44,10 @@ fn second_stylize_reuses_prepared_offsets() {
         ..PrepareOptions::default()
     };
 
-    let t = Instant::now();
     let prepared = prepare(scene, &options).unwrap();
     let solves = smear::offset_solves();
     let a = stylize(&prepared, &first_style).unwrap();
-    let first = t.elapsed().as_secs_f64();
-    let t = Instant::now();
     let b = stylize(&prepared, &second_style).unwrap();
-    let second = t.elapsed().as_secs_f64();
-    println!(
-        "prepare {:.4} s (solve {:.4} s), first (prepare + stylize) {first:.4} s, second stylize {second:.4} s, {:.1}x",
-        prepared.report().seconds,
-        prepared.report().solve_seconds,
-        first / second
-    );
 
     // Structural: stylize never solved offsets, and says so.
     assert_eq!(
@@ -83,11 +71,7 @@ fn second_stylize_reuses_prepared_offsets() {
     // Half the strength, less stretch.
     assert!(max(&a) > 0.0);
     assert!(max(&b) < max(&a), "{} vs {}", max(&b), max(&a));
-    // Restyling costs a fraction of preparing (the offset solve dominates).
-    assert!(
-        second < first,
-        "second stylize {second:.4} s not faster than the first run {first:.4} s"
-    );
+    // What restyling costs against preparing is measured by `benches/restyle.rs`.
 }
 
 #[test]
