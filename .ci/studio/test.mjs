@@ -317,6 +317,14 @@ try {
       check('the library folder is exported', written.includes('stopmo_library/assembly.csv') && written.some((f) => f.endsWith('.stl')), `${written.length} files ${await stopmoError()}`);
       await page.waitForTimeout(300);
       await page.screenshot({ path: join(shots, 'stopmo-library.png') });
+      // Without printable solids: the same library, surfaces only, sooner.
+      await page.uncheck('#stopmo-print');
+      const tSurfaces = Date.now();
+      await page.click('#stopmo-chart circle[data-pieces="2"]');
+      await page.waitForFunction(() => (window.studio.panels.stopmo.built || {}).printed === false || !document.getElementById('error').hidden, null, { timeout: 300000 });
+      console.log(`stopmo build (2 pieces per part) without solids: ${((Date.now() - tSurfaces) / 1000).toFixed(1)} s`);
+      const surfaces = await page.locator('#stopmo-built').textContent();
+      check('unticking printable solids builds the library as surfaces only', surfaces.includes('surfaces only'), `${surfaces} ${await stopmoError()}`);
     }
   }
   check('no console errors', consoleErrors.length === 0, consoleErrors.join(' | '));

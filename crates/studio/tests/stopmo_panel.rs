@@ -213,4 +213,32 @@ async fn segment_curve_build_reconstruct_and_export_the_library_folder() {
     let csv = std::fs::read_to_string(dir.join("assembly.csv")).unwrap();
     assert!(csv.starts_with("frame,part1,part2\n"), "{csv:.80}");
     assert_eq!(csv.lines().count(), frames + 1);
+    assert_eq!(built["printed"], true);
+
+    // Without printing: the same library (pieces and assembly), surfaces but no solids.
+    let surfaces = c
+        .job("/api/stopmo/build", json!({"pieces": 2, "print": false}))
+        .await;
+    assert_eq!(surfaces["printed"], false);
+    assert_eq!(surfaces["frame_ids"], built["frame_ids"]);
+    assert_eq!(surfaces["errors_mm"], built["errors_mm"]);
+    let (status, _) = c
+        .call(
+            "POST",
+            "/api/stopmo/export",
+            Some(json!({"folder": "libs/surfaces"})),
+        )
+        .await;
+    assert_eq!(status, StatusCode::OK);
+    let pieces: Vec<String> = std::fs::read_dir(out.path().join("libs/surfaces/pieces"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(pieces.contains(&"part1_00.obj".to_string()), "{pieces:?}");
+    assert!(!pieces.iter().any(|f| f.ends_with(".stl")), "{pieces:?}");
+    let report: Value = serde_json::from_slice(
+        &std::fs::read(out.path().join("libs/surfaces/report.json")).unwrap(),
+    )
+    .unwrap();
+    assert!(report["printing"].is_null(), "{}", report["printing"]);
 }

@@ -218,11 +218,11 @@ export class StopmoPanel {
   /** Builds the library of a curve point, then shows its reconstruction beside the face. */
   build(pieces) {
     for (const c of document.querySelectorAll('#stopmo-chart circle')) c.classList.toggle('picked', Number(c.dataset.pieces) === pieces);
-    this.start('/api/stopmo/build', { pieces }, async (r) => {
+    this.start('/api/stopmo/build', { pieces, print: $('stopmo-print').checked }, async (r) => {
       const { header, buffers } = await getPack('/api/stopmo/reconstruction');
       this.setReconstruction(header, buffers);
       this.built = r;
-      $('stopmo-built').textContent = `library of ${r.pieces} pieces per part (${r.total_pieces} in all): mean error ${r.errors_mm.position_mean.toFixed(3)} mm, max ${r.errors_mm.position_max.toFixed(3)} mm` + (r.warnings.length ? '\n' + r.warnings.join('\n') : '');
+      $('stopmo-built').textContent = `library of ${r.pieces} pieces per part (${r.total_pieces} in all${r.printed ? '' : ', surfaces only'}): mean error ${r.errors_mm.position_mean.toFixed(3)} mm, max ${r.errors_mm.position_max.toFixed(3)} mm` + (r.warnings.length ? '\n' + r.warnings.join('\n') : '');
       $('stopmo-export').disabled = false;
     });
   }

@@ -42,6 +42,14 @@ pub(crate) struct CurveRequest {
 pub(crate) struct BuildRequest {
     /// Pieces per part: a point of the curve.
     pieces: usize,
+    /// Print the pieces as solids (default); `false` stops at their surfaces, labels and
+    /// errors, ~20× sooner on the face (`LibraryJobOptions::print`).
+    #[serde(default = "printed_by_default")]
+    print: bool,
+}
+
+fn printed_by_default() -> bool {
+    LibraryJobOptions::default().print
 }
 
 /// `POST /api/stopmo/export` body.
@@ -110,8 +118,9 @@ pub(crate) async fn curve(
     Ok(Json(json!({ "job": id })))
 }
 
-/// `POST /api/stopmo/build`: `{"job": id}`; the result is `{"pieces", "parts",
-/// "frame_ids" (per frame, the piece id of every part), "errors_mm", "total_pieces"}`.
+/// `POST /api/stopmo/build` (`{"pieces", "print"?}`): `{"job": id}`; the result is
+/// `{"pieces", "parts", "frame_ids" (per frame, the piece id of every part), "errors_mm",
+/// "total_pieces", "printed", "warnings"}`.
 pub(crate) async fn build(
     State(studio): State<Arc<Studio>>,
     request: Result<Bytes, BytesRejection>,
@@ -142,8 +151,12 @@ pub(crate) async fn build(
             .stage("pieces, assembly and reconstruction", 0.1)
             .map_err(cancelled)?;
         let solved = curve.library(r.pieces).ok_or("the curve lost its point")?;
-        let result = stopmo::library_of(&parts, &LibraryJobOptions::default(), solved)
-            .map_err(|e| format!("library: {e}"))?;
+        let options = LibraryJobOptions {
+            print: r.print,
+            ..LibraryJobOptions::default()
+        };
+        let result =
+            stopmo::library_of(&parts, &options, solved).map_err(|e| format!("library: {e}"))?;
         progress.stage("done", 1.0).map_err(cancelled)?;
         let answer = json!({
             "pieces": r.pieces,
@@ -151,6 +164,7 @@ pub(crate) async fn build(
             "parts": result.part_names,
             "frame_ids": result.frame_ids(),
             "errors_mm": result.library.errors_mm,
+            "printed": result.report.printing.is_some(),
             // Thin walls, crossing triangles, pieces below the printer resolution.
             "warnings": result.report.warnings,
             "segmentation": version,
