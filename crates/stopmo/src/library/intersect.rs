@@ -383,6 +383,34 @@ pub fn self_intersecting_triangles(positions: &[Vec3], tris: &[[u32; 3]]) -> Opt
 /// # Returns
 /// Sorted pairs; `None` as for [`self_intersecting_triangles`].
 pub fn intersecting_pairs(positions: &[Vec3], tris: &[[u32; 3]]) -> Option<Vec<(u32, u32)>> {
+    pairs_touching(positions, tris, None)
+}
+
+/// [`intersecting_pairs`] restricted to the pairs with at least one triangle marked in
+/// `varying` (and the degenerate triangles among the marked ones): with the pairs of the
+/// unmarked triangles among themselves, found once, it gives [`intersecting_pairs`] of
+/// meshes that share those triangles (a part's pieces on one back surface).
+///
+/// # Returns
+/// Sorted pairs; `None` as for [`intersecting_pairs`], or when `varying` does not have one
+/// flag per triangle.
+pub(crate) fn intersecting_pairs_touching(
+    positions: &[Vec3],
+    tris: &[[u32; 3]],
+    varying: &[bool],
+) -> Option<Vec<(u32, u32)>> {
+    if varying.len() != tris.len() {
+        return None;
+    }
+    pairs_touching(positions, tris, Some(varying))
+}
+
+/// The pairs of [`intersecting_pairs`]; with `varying`, only those touching a marked triangle.
+fn pairs_touching(
+    positions: &[Vec3],
+    tris: &[[u32; 3]],
+    varying: Option<&[bool]>,
+) -> Option<Vec<(u32, u32)>> {
     if positions
         .iter()
         .any(|p| !p.is_finite() || p.abs().max_element() > MAX_EXACT_COORDINATE)
@@ -395,6 +423,7 @@ pub fn intersecting_pairs(positions: &[Vec3], tris: &[[u32; 3]]) -> Option<Vec<(
     if tris.is_empty() {
         return Some(Vec::new());
     }
+    let marked = |t: u32| varying.is_none_or(|m| m[t as usize]);
     let snapped: Vec<P> = positions.iter().map(|&p| snap(p)).collect();
     // Cells of about twice the mean triangle size limit the exact tests to nearby pairs.
     let grid = TriangleGrid::new(positions, tris);
@@ -402,6 +431,7 @@ pub fn intersecting_pairs(positions: &[Vec3], tris: &[[u32; 3]]) -> Option<Vec<(
     let degenerate: Vec<u32> = tris
         .iter()
         .enumerate()
+        .filter(|&(t, _)| marked(t as u32))
         .filter(|(_, t)| {
             let [a, b, c] = t.map(|v| snapped[v as usize]);
             let (u, v) = (sub(b, a), sub(c, a));
@@ -415,7 +445,11 @@ pub fn intersecting_pairs(positions: &[Vec3], tris: &[[u32; 3]]) -> Option<Vec<(
         .flat_map_iter(|(cell_key, list)| {
             let mut out = Vec::new();
             for (x, &i) in list.iter().enumerate() {
+                let marked_i = marked(i);
                 for &j in &list[x + 1..] {
+                    if !marked_i && !marked(j) {
+                        continue;
+                    }
                     let (bi, bj) = (boxes[i as usize], boxes[j as usize]);
                     if bi.0.cmpgt(bj.1).any() || bj.0.cmpgt(bi.1).any() {
                         continue;
@@ -492,6 +526,50 @@ mod tests {
             Vec3::new(0.5, 1.0, 1.0),
         ];
         assert_eq!(count(&r, &[[0, 1, 2], [0, 3, 4]]), 2);
+    }
+
+    /// A crumpled random sheet (many crossing and touching pairs): the pairs touching the
+    /// marked triangles plus the pairs among the unmarked ones are exactly all the pairs.
+    #[test]
+    fn marked_and_unmarked_pairs_make_up_all_pairs() {
+        let mut rng = anim::SplitMix64::new(7, 0);
+        let k = 12;
+        let p: Vec<Vec3> = (0..k * k)
+            .map(|i| {
+                let (x, y) = ((i % k) as f32, (i / k) as f32);
+                Vec3::new(
+                    x + 1.5 * rng.next_f32(),
+                    y + 1.5 * rng.next_f32(),
+                    4.0 * rng.next_f32(),
+                )
+            })
+            .collect();
+        let mut t = Vec::new();
+        for r in 0..k - 1 {
+            for c in 0..k - 1 {
+                let v = (r * k + c) as u32;
+                t.push([v, v + 1, v + k as u32 + 1]);
+                t.push([v, v + k as u32 + 1, v + k as u32]);
+            }
+        }
+        t.push([3, 3, 40]); // degenerate
+        let all = intersecting_pairs(&p, &t).unwrap();
+        assert!(all.len() > 20, "{} pairs", all.len());
+        let varying: Vec<bool> = (0..t.len()).map(|i| i % 3 == 0 || i > 150).collect();
+        let unmarked: Vec<u32> = (0..t.len() as u32)
+            .filter(|&i| !varying[i as usize])
+            .collect();
+        let sub: Vec<[u32; 3]> = unmarked.iter().map(|&i| t[i as usize]).collect();
+        let mut parts: Vec<(u32, u32)> = intersecting_pairs(&p, &sub)
+            .unwrap()
+            .into_iter()
+            .map(|(i, j)| (unmarked[i as usize], unmarked[j as usize]))
+            .chain(intersecting_pairs_touching(&p, &t, &varying).unwrap())
+            .collect();
+        parts.sort_unstable();
+        parts.dedup();
+        assert_eq!(parts, all);
+        assert!(intersecting_pairs_touching(&p, &t, &varying[1..]).is_none());
     }
 
     /// The `f64` filters never change a sign: random points, points nudged a grid step off a

@@ -6,7 +6,9 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::{front_positions, PartShell};
-use crate::library::intersect::self_intersecting_triangles;
+use crate::library::intersect::{
+    intersecting_pairs, intersecting_pairs_touching, self_intersecting_triangles,
+};
 use crate::library::nearest::TriangleGrid;
 
 /// Where a shell's wall is thinnest ([`PartShell::thinnest_wall`]).
@@ -83,17 +85,63 @@ impl PartShell {
     /// Shell vertices (front or back copies folded onto shell ids) of the triangles that
     /// cross another triangle in some piece's solid, and how many triangles cross, summed
     /// over the pieces.
+    ///
+    /// # Performance
+    /// The pieces share the back, the walls and every front vertex they agree on (the seams):
+    /// the pairs among triangles that are the same in every solid are tested once, and each
+    /// piece's solid only tests the pairs touching a triangle of its own.
     pub(super) fn crossings(&self, pieces: &[&[Vec3]]) -> (Vec<u32>, usize) {
-        let n = self.back.len() as u32;
-        let per_piece: Vec<(Vec<u32>, usize)> = pieces
+        let n = self.back.len();
+        let tris = self.solid_topology();
+        let fronts: Vec<Vec<Vec3>> = pieces.par_iter().map(|p| self.front(p)).collect();
+        let Some(first) = fronts.first() else {
+            return (Vec::new(), 0);
+        };
+        // Solid vertices (fronts, then the back) at the same place in every piece.
+        let bits = |p: Vec3| p.to_array().map(f32::to_bits);
+        let same: Vec<bool> = (0..n)
+            .map(|v| fronts.iter().all(|f| bits(f[v]) == bits(first[v])))
+            .chain(std::iter::repeat_n(true, n))
+            .collect();
+        let varying: Vec<bool> = tris
+            .iter()
+            .map(|t| t.iter().any(|&v| !same[v as usize]))
+            .collect();
+        let shared_ids: Vec<u32> = (0..tris.len() as u32)
+            .filter(|&t| !varying[t as usize])
+            .collect();
+        let shared_tris: Vec<[u32; 3]> = shared_ids.iter().map(|&t| tris[t as usize]).collect();
+        // Vertices only varying triangles use are never read there.
+        let shared_positions: Vec<Vec3> = first
+            .iter()
+            .zip(&same)
+            .map(|(&p, &s)| if s { p } else { Vec3::ZERO })
+            .chain(self.back.iter().copied())
+            .collect();
+        let shared_pairs: Vec<(u32, u32)> = intersecting_pairs(&shared_positions, &shared_tris)
+            .unwrap_or_default()
+            .into_iter()
+            .map(|(i, j)| (shared_ids[i as usize], shared_ids[j as usize]))
+            .collect();
+        let per_piece: Vec<(Vec<u32>, usize)> = fronts
             .par_iter()
-            .map(|p| {
-                let solid = self.solid_unchecked(p, "");
-                let hits = self_intersecting_triangles(&solid.positions, &solid.triangles)
-                    .unwrap_or_default();
+            .map(|front| {
+                let mut positions = front.clone();
+                positions.extend_from_slice(&self.back);
+                let mut hits: Vec<u32> =
+                    match intersecting_pairs_touching(&positions, &tris, &varying) {
+                        Some(own) => own
+                            .into_iter()
+                            .chain(shared_pairs.iter().copied())
+                            .flat_map(|(i, j)| [i, j])
+                            .collect(),
+                        None => Vec::new(),
+                    };
+                hits.sort_unstable();
+                hits.dedup();
                 let vertices = hits
                     .iter()
-                    .flat_map(|&t| solid.triangles[t as usize].map(|v| v % n))
+                    .flat_map(|&t| tris[t as usize].map(|v| v % n as u32))
                     .collect();
                 (vertices, hits.len())
             })
