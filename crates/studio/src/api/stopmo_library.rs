@@ -43,7 +43,7 @@ pub(crate) struct BuildRequest {
     /// Pieces per part: a point of the curve.
     pieces: usize,
     /// Print the pieces as solids (default); `false` stops at their surfaces, labels and
-    /// errors, ~20× sooner on the face (`LibraryJobOptions::print`).
+    /// errors, ~10× sooner on the face (`LibraryJobOptions::print`).
     #[serde(default = "printed_by_default")]
     print: bool,
 }
