@@ -224,9 +224,7 @@ pub(crate) fn print_pieces(
         let made: Vec<Made> = (0..pieces_mm.len())
             .into_par_iter()
             .map(|k| -> Result<Made> {
-                let surface = lib.piece_surface(p, k, &a.mesh).ok_or_else(|| {
-                    Error::option_error("pieces", format!("no piece {k} of part {p}"))
-                })?;
+                let surface = piece_surface(lib, p, k, &a.mesh)?;
                 let id = if s.ids {
                     text_bitmap(&piece_label(p, k))?
                 } else {
@@ -330,9 +328,10 @@ pub(crate) fn print_pieces(
         });
         pieces_out.extend(made);
     }
-    let solids: Vec<Mesh> = pieces_out.iter().filter_map(|p| p.solid.clone()).collect();
+    // The solids are measured where they are (a piece's solid is ~30k triangles).
+    let solids: Vec<&Mesh> = pieces_out.iter().filter_map(|p| p.solid.as_ref()).collect();
     let report = PrintReport {
-        material: material(&solids),
+        material: material(solids.iter().copied()),
         print_time: print_time(&solids),
         resolution_mm: s.resolution_mm,
         keys: s.keys,
@@ -373,9 +372,7 @@ pub(crate) fn surface_pieces(
             resolution_mm,
         );
         for k in 0..pieces_mm.len() {
-            let surface = lib.piece_surface(p, k, &a.mesh).ok_or_else(|| {
-                Error::option_error("pieces", format!("no piece {k} of part {p}"))
-            })?;
+            let surface = piece_surface(lib, p, k, &a.mesh)?;
             pieces.push(Piece {
                 id: surface.name.clone(),
                 part: p,
@@ -391,6 +388,12 @@ pub(crate) fn surface_pieces(
         warnings,
         backs: Vec::new(),
     })
+}
+
+/// Piece `k` of part `p` as a surface ([`Library::piece_surface`]), or an error naming it.
+fn piece_surface(lib: &Library, p: usize, k: usize, topology: &Mesh) -> Result<Mesh> {
+    lib.piece_surface(p, k, topology)
+        .ok_or_else(|| Error::option_error("pieces", format!("no piece {k} of part {p}")))
 }
 
 /// Every part's pieces in millimetres (the STL coordinates), part by part.
@@ -450,7 +453,7 @@ fn below_resolution(name: &str, pieces_mm: &[Vec<Vec3>], resolution_mm: f64) -> 
 
 /// Resin print time: plates by footprint (pieces laid on their smallest extent, 50 % margin),
 /// layers by the tallest piece.
-fn print_time(solids: &[Mesh]) -> PrintTime {
+fn print_time(solids: &[&Mesh]) -> PrintTime {
     let tallest = solids
         .iter()
         .map(|s| {

@@ -286,8 +286,8 @@ pub struct MaterialEstimate {
 }
 
 /// Sums the volumes of solids given in millimetres.
-pub fn material(solids_mm: &[Mesh]) -> MaterialEstimate {
-    let v: f64 = solids_mm.iter().map(volume).sum();
+pub fn material<'a>(solids_mm: impl IntoIterator<Item = &'a Mesh>) -> MaterialEstimate {
+    let v: f64 = solids_mm.into_iter().map(volume).sum();
     MaterialEstimate {
         volume_mm3: v,
         grams_pla: v * PLA_DENSITY_G_PER_MM3,
