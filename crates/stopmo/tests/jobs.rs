@@ -300,8 +300,8 @@ fn face_run_equals_segment_then_library_and_searches_a_size() {
 }
 
 /// A part whose own animated surface presses through itself (as lips can at a mouth corner
-/// inside one part): the report counts it apart from the back's crossings and the warning
-/// says what to do.
+/// inside one part): the report counts it apart from the back's crossings, the warning
+/// says what to do, and the written solids are regularized.
 #[test]
 fn a_surface_that_presses_through_itself_is_reported_with_advice() {
     let rest = segment_support::tube(16, 12);
@@ -342,6 +342,34 @@ fn a_surface_that_presses_through_itself_is_reported_with_advice() {
         "{:?}",
         lib.report.warnings
     );
+    // What is written is regularized: the pieces that crossed are named, and none of the
+    // written solids crosses itself any more (closed, one shell).
+    assert!(part.built_self_intersecting_triangles > 0, "{part:?}");
+    assert!(!part.regularized_pieces.is_empty(), "{part:?}");
+    assert_eq!(part.shell.self_intersecting_triangles, 0, "{part:?}");
+    for piece in &lib.pieces {
+        let solid = piece.solid.as_ref().expect("solid");
+        let crossing =
+            stopmo::library::self_intersecting_triangles(&solid.positions, &solid.triangles)
+                .expect("coordinates in range");
+        assert!(
+            crossing.is_empty(),
+            "{}: {} crossing",
+            piece.id,
+            crossing.len()
+        );
+        assert!(
+            stopmo::library::check_solid(solid).is_closed_manifold(),
+            "{}",
+            piece.id
+        );
+        assert_eq!(stopmo::library::components(solid).len(), 1, "{}", piece.id);
+    }
+    assert!(lib
+        .report
+        .warnings
+        .iter()
+        .any(|w| w.contains("regularized to the material it encloses")));
     // An untouched tube reports none.
     let lib = three_pieces(&segment_support::talking_tube(16, 12, 6));
     assert_eq!(

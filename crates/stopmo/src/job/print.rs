@@ -12,9 +12,9 @@ use serde::Serialize;
 
 use super::error::{Error, Result};
 use crate::library::{
-    add_plugs, build_shells, material, piece_id, self_intersecting_triangles, Bitmap, Key,
-    KeyOptions, Library, MaterialEstimate, PartShell, Plug, ShellInput, ShellOptions, ShellStats,
-    DEFAULT_ID_RELIEF_MM,
+    add_plugs, build_shells, material, piece_id, regularize, self_intersecting_triangles, Bitmap,
+    Key, KeyOptions, Library, MaterialEstimate, PartShell, Plug, ShellInput, ShellOptions,
+    ShellStats, DEFAULT_ID_RELIEF_MM,
 };
 
 /// Resin layer height assumed by the print-time estimate (mm).
@@ -76,9 +76,20 @@ pub struct PartPrintReport {
     /// Triangles of the pieces' animated surfaces (the library pieces alone, before the back
     /// is added) that cross that same surface, summed over the pieces whose solid crosses:
     /// where the input presses into itself inside one part (lips or lids on a face) or has
-    /// degenerate triangles. No back can undo these; a seam between the touching surfaces
-    /// (one in each part) or a mended input does.
+    /// degenerate triangles. No back can undo these (the regularized solid merges the touching
+    /// surfaces); a seam between them (one in each part) or a mended input keeps them apart.
     pub surface_self_intersecting_triangles: usize,
+    /// Triangles of the solids as built (front, back, walls, keys, ID) that cross the same
+    /// solid, summed over the pieces; those pieces were regularized
+    /// ([`regularize`](crate::library::regularize)) and `shell.self_intersecting_triangles`
+    /// counts what is left in the written solids.
+    pub built_self_intersecting_triangles: usize,
+    /// Pieces whose solid crossed itself as built and was regularized: the printed shape
+    /// differs from the animated surface where it crossed.
+    pub regularized_pieces: Vec<String>,
+    /// Volume of what regularizing dropped (mm³): chips of material apart from a piece and
+    /// sealed cavities inside it (filled).
+    pub dropped_volume_mm3: f64,
 }
 
 /// The print-time estimate.
@@ -132,6 +143,20 @@ pub struct Piece {
     /// The printable solid in millimetres (with the part's plug shells, if any); `None` when
     /// the job was asked for surfaces alone ([`LibraryJobOptions::print`](crate::LibraryJobOptions::print)).
     pub solid: Option<Mesh>,
+}
+
+/// One piece as [`print_pieces`] made it.
+struct Made {
+    piece: Piece,
+    /// Crossing triangles of the solid as built.
+    built: usize,
+    /// Crossing triangles of the written solid (after regularizing, when it was).
+    crossing: usize,
+    /// Volume of the chips and cavities dropped when the solid was regularized (mm³); `None`
+    /// when it was not.
+    dropped: Option<f64>,
+    /// Where the piece's animated surface alone crosses: count and a place.
+    surface_crossing: Option<(usize, Vec3)>,
 }
 
 /// A part's back surface with what it was built from (millimetres).
@@ -218,9 +243,6 @@ pub(crate) fn print_pieces(
             Vec::new()
         };
         let pixel = (s.print_height_mm * 0.02).clamp(0.3, 1.0);
-        // Per piece: the piece, its solid's crossing triangles, and where its animated
-        // surface alone crosses (count, a place).
-        type Made = (Piece, usize, Option<(usize, Vec3)>);
         let made: Vec<Made> = (0..pieces_mm.len())
             .into_par_iter()
             .map(|k| -> Result<Made> {
@@ -240,12 +262,25 @@ pub(crate) fn print_pieces(
                 )?;
                 // Measured on what is written (keys and ID included), not assumed: a
                 // coordinate beyond the exact test's range counts every triangle.
-                let crossing = self_intersecting_triangles(&solid.positions, &solid.triangles)
-                    .map_or(solid.triangles.len(), |t| t.len());
-                let surface_crossing = if crossing > 0 {
+                let count = |m: &Mesh| {
+                    self_intersecting_triangles(&m.positions, &m.triangles)
+                        .map_or(m.triangles.len(), |t| t.len())
+                };
+                let built = count(&solid);
+                let surface_crossing = if built > 0 {
                     shell.surface_crossings(&pieces_mm[k])
                 } else {
                     None
+                };
+                // What the construction could not keep apart is regularized (measured
+                // again: the new vertices are rounded to f32); a solid the exact
+                // arrangement refuses stays as built, and its crossings are reported.
+                let (solid, crossing, dropped) = match (built > 0).then(|| regularize(&solid)) {
+                    Some(Ok(r)) => {
+                        let c = count(&r.mesh);
+                        (r.mesh, c, Some(r.dropped_volume))
+                    }
+                    _ => (solid, built, None),
                 };
                 let solid = add_plugs(&solid, p, s.plugs, s.plug_segments);
                 let piece = Piece {
@@ -255,18 +290,32 @@ pub(crate) fn print_pieces(
                     surface,
                     solid: Some(solid),
                 };
-                Ok((piece, crossing, surface_crossing))
+                Ok(Made {
+                    piece,
+                    built,
+                    crossing,
+                    dropped,
+                    surface_crossing,
+                })
             })
             .collect::<Result<_>>()?;
-        let crossing_pieces: Vec<String> = made
+        let listed = |f: &dyn Fn(&Made) -> usize| -> Vec<String> {
+            made.iter()
+                .filter(|m| f(m) > 0)
+                .map(|m| format!("{} ({})", m.piece.id, f(m)))
+                .collect()
+        };
+        let crossing_pieces = listed(&|m| m.crossing);
+        let regularized: Vec<&Made> = made.iter().filter(|m| m.dropped.is_some()).collect();
+        let built_crossing: usize = made.iter().map(|m| m.built).sum();
+        shell.stats.self_intersecting_triangles = made.iter().map(|m| m.crossing).sum();
+        let dropped_mm3 = regularized
             .iter()
-            .filter(|(_, c, _)| *c > 0)
-            .map(|(piece, c, _)| format!("{} ({c})", piece.id))
-            .collect();
-        shell.stats.self_intersecting_triangles = made.iter().map(|(_, c, _)| c).sum();
+            .filter_map(|m| m.dropped)
+            .fold(0.0, |a, b| a + b);
         let surface: Vec<(&Piece, usize, Vec3)> = made
             .iter()
-            .filter_map(|(piece, _, s)| s.map(|(n, at)| (piece, n, at)))
+            .filter_map(|m| m.surface_crossing.map(|(n, at)| (&m.piece, n, at)))
             .collect();
         let surface_triangles: usize = surface.iter().map(|(_, n, _)| n).sum();
         let refs: Vec<&[Vec3]> = pieces_mm.iter().map(Vec::as_slice).collect();
@@ -287,6 +336,21 @@ pub(crate) fn print_pieces(
                 s.thickness_mm
             ));
         }
+        if !regularized.is_empty() {
+            warnings.push(format!(
+                "part {}: {} of {} pieces crossed their own surface as built ({built_crossing} triangles: {}); each was regularized to the material it encloses, as a slicer reads it ({} crossing triangles left{}): the printed shape differs from the animated surface there, look at those places before printing",
+                part.name,
+                regularized.len(),
+                made.len(),
+                listed(&|m| m.built).join(", "),
+                shell.stats.self_intersecting_triangles,
+                if dropped_mm3 > 0.0 {
+                    format!("; {dropped_mm3:.3} mm³ of chips apart from the pieces or sealed cavities dropped")
+                } else {
+                    String::new()
+                }
+            ));
+        }
         if !crossing_pieces.is_empty() {
             warnings.push(format!(
                 "part {}: {} triangles of {} of {} pieces cross the solid's own surface (a slicer may misprint there): {}",
@@ -299,7 +363,7 @@ pub(crate) fn print_pieces(
         }
         if let Some((first, _, at)) = surface.first() {
             warnings.push(format!(
-                "part {}: in {} of these pieces the animated surface itself crosses ({} triangles, e.g. piece {} at ({:.1}, {:.1}, {:.1}) mm): the input presses into itself inside the part (lips or lids on a face) or has degenerate triangles there, which no back surface can undo; cut the parts so that a seam runs between the touching surfaces (one side in each part), or mend the input there",
+                "part {}: in {} of these pieces the animated surface itself crosses ({} triangles, e.g. piece {} at ({:.1}, {:.1}, {:.1}) mm): the input presses into itself inside the part (lips or lids on a face) or has degenerate triangles there, which no back surface can undo (the regularized solid prints them merged there); to keep them apart, cut the parts so that a seam runs between the touching surfaces (one side in each part), or mend the input there",
                 part.name,
                 surface.len(),
                 surface_triangles,
@@ -309,7 +373,9 @@ pub(crate) fn print_pieces(
                 at.z,
             ));
         }
-        let made: Vec<Piece> = made.into_iter().map(|(piece, _, _)| piece).collect();
+        let regularized_pieces: Vec<String> =
+            regularized.iter().map(|m| m.piece.id.clone()).collect();
+        let made: Vec<Piece> = made.into_iter().map(|m| m.piece).collect();
         let (close, nearest) = below_resolution(&part.name, &pieces_mm, s.resolution_mm);
         warn_below_resolution(
             &mut warnings,
@@ -325,6 +391,9 @@ pub(crate) fn print_pieces(
             below_resolution: close,
             min_sibling_distance_mm: nearest,
             surface_self_intersecting_triangles: surface_triangles,
+            built_self_intersecting_triangles: built_crossing,
+            regularized_pieces,
+            dropped_volume_mm3: dropped_mm3,
         });
         pieces_out.extend(made);
     }

@@ -56,6 +56,16 @@ pub enum LibraryError {
         /// What is wrong.
         reason: String,
     },
+    /// A solid could not be regularized (`regularize`): it is not
+    /// closed and orientable, has a non-finite coordinate or encloses no material. Build it
+    /// closed and outward oriented (every piece toonkit writes is).
+    #[error("solid '{mesh}' cannot be regularized: {reason}")]
+    Regularization {
+        /// Name of the mesh.
+        mesh: String,
+        /// What is wrong.
+        reason: String,
+    },
     /// A parameter is out of range (negative or non-finite λ, zero restarts, non-positive print
     /// height or thickness, …). The message names the parameter and its valid range.
     #[error("invalid parameter: {0}")]

@@ -55,9 +55,12 @@ mod nearest;
 mod piece_id;
 mod plugs;
 mod problem;
+mod regularize;
 mod size;
 mod solver;
 mod subspace;
+#[cfg(test)]
+mod test_shapes;
 mod update;
 mod viterbi;
 
@@ -93,6 +96,7 @@ pub use plugs::{
     DEFAULT_PLUG_LENGTH_MM, DEFAULT_PLUG_RADIUS_MM, DEFAULT_PLUG_SEGMENTS, DEFAULT_PLUG_WALL_MM,
 };
 pub use problem::{PartProblem, PartSetup};
+pub use regularize::{regularize, Regularized};
 pub use size::{allocate_budget, CurvePoint};
 pub use solver::{
     PartSolution, SolveOptions, DEFAULT_LAMBDA, DEFAULT_MAX_ITERATIONS, DEFAULT_RESTARTS,

@@ -49,8 +49,8 @@ fn fifty_pieces_are_printable() {
 /// boundaries of a part. Offset along directions diffused over edge rings (which smooth ~3×
 /// less on the fine lip mesh than on the chin), the back hooked behind the lips: 1,032 and
 /// 1,360 back/back crossing pairs over 8 pieces before the local search; averaged over
-/// millimetres along the surface, 80 and 80. (The walls at the lip edges still cross: see
-/// the README's known limit.)
+/// millimetres along the surface, 80 and 80. (The walls at the lip edges still cross as
+/// built; the written solids are regularized: see the last test.)
 #[test]
 #[ignore = "minutes each (CI runs them in its print phase): cargo test --workspace --test print_face -- --include-ignored"]
 fn two_automatic_parts_keep_the_back_unfolded_behind_the_lips() {
@@ -200,4 +200,86 @@ fn a_25_mm_print_untangles_the_lip_corners() {
         "{:?}",
         lower.shell
     );
+}
+
+/// Cuts the back surface was not tuned on: seeds on the forehead and the chin put the seam
+/// through both eyes, two automatic parts put it along the upper lip's rim. As built, their
+/// solids cross themselves where no single-point move helps (the front folds over the wall
+/// where the seam meets an eye opening; the lip rims' walls cross the curled lips; 118 + 254
+/// and 990 + 1,019 triangles over 8 pieces per part at 2 fps): every one of those is
+/// regularized, so every written solid is a closed, oriented single shell without a
+/// crossing triangle, and regularizing trims next to nothing (chips and cavities under 0.1 %
+/// of the material).
+#[test]
+#[ignore = "minutes each (CI runs them in its print phase): cargo test --workspace --test print_face -- --include-ignored"]
+fn cuts_through_the_eyes_and_along_the_lips_print_regularized() {
+    let through_eyes = vec![
+        PartSpec::new("upper", vec![Seed::Point(Vec3::new(0.0, 15.0, 8.0))]),
+        PartSpec::new("lower", vec![Seed::Point(Vec3::new(0.0, -8.0, 12.0))]),
+    ];
+    let along_lips = auto_parts(face(), 2).expect("auto parts");
+    for (cut, parts) in [
+        ("through the eyes", through_eyes),
+        ("two automatic parts", along_lips),
+    ] {
+        let seg = segment(face(), &parts, &SegmentOptions::default()).expect("segment");
+        let opts = stopmo::LibraryJobOptions {
+            pieces: stopmo::PieceCount::Each(8),
+            ..Default::default()
+        };
+        let result = stopmo::library(&part_animations(&seg), &opts).expect("library");
+        let printing = result.report.printing.as_ref().expect("printed");
+        let regularized: usize = printing
+            .parts
+            .iter()
+            .map(|p| p.regularized_pieces.len())
+            .sum();
+        eprintln!(
+            "{cut}: {:?}",
+            printing
+                .parts
+                .iter()
+                .map(|p| (
+                    p.built_self_intersecting_triangles,
+                    p.regularized_pieces.len()
+                ))
+                .collect::<Vec<_>>()
+        );
+        assert!(
+            regularized > 0,
+            "{cut}: nothing to regularize, the test tests nothing"
+        );
+        for part in &printing.parts {
+            assert_eq!(part.shell.self_intersecting_triangles, 0, "{cut}: {part:?}");
+            assert_eq!(
+                part.built_self_intersecting_triangles > 0,
+                !part.regularized_pieces.is_empty(),
+                "{cut}: {part:?}"
+            );
+        }
+        let dropped: f64 = printing.parts.iter().map(|p| p.dropped_volume_mm3).sum();
+        assert!(
+            dropped < 1e-3 * printing.material.volume_mm3,
+            "{cut}: {dropped} mm³ dropped of {}",
+            printing.material.volume_mm3
+        );
+        let bad: Vec<String> = result
+            .pieces
+            .par_iter()
+            .filter_map(|p| {
+                let s = p.solid.as_ref().expect("solid");
+                let crossing = self_intersecting_triangles(&s.positions, &s.triangles)
+                    .map_or(usize::MAX, |t| t.len());
+                let shells = components(s).len();
+                let closed = check_solid(s).is_closed_manifold();
+                (crossing > 0 || shells != 1 || !closed).then(|| {
+                    format!(
+                        "{}: {crossing} crossing, {shells} shells, closed {closed}",
+                        p.id
+                    )
+                })
+            })
+            .collect();
+        assert!(bad.is_empty(), "{cut}: {bad:?}");
+    }
 }

@@ -22,7 +22,9 @@
 //! over a wall shift by at most the printer resolution; a move is kept when the exact test
 //! of the triangles around it, in every piece, finds fewer crossings and the wall holds
 //! (8 pieces: 247 → 20; what is left: a spike of the cut at the lips and the front folding
-//! over the seam wall beside the nose wing in two pieces).
+//! over the seam wall beside the nose wing in two pieces). A written solid that still crosses
+//! itself is regularized ([`regularize`](super::regularize)): the construction keeps those
+//! places few and small, the exact arrangement removes them.
 
 use std::collections::HashMap;
 use std::sync::Arc;

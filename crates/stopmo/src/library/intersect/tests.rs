@@ -155,22 +155,6 @@ fn filtered_predicates_give_the_exact_signs() {
 
 #[test]
 fn closed_box_is_clean() {
-    let p: Vec<Vec3> = (0..8)
-        .map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32))
-        .collect();
-    let t = [
-        [0, 2, 1],
-        [1, 2, 3],
-        [4, 5, 6],
-        [5, 7, 6],
-        [0, 1, 4],
-        [1, 5, 4],
-        [2, 6, 3],
-        [3, 6, 7],
-        [0, 4, 2],
-        [2, 4, 6],
-        [1, 3, 5],
-        [3, 7, 5],
-    ];
+    let (p, t) = crate::library::test_shapes::cuboid(Vec3::ZERO, Vec3::ONE);
     assert_eq!(count(&p, &t), 0);
 }
