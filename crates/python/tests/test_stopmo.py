@@ -81,3 +81,18 @@ def test_budget_replaces_the_piece_count(face):
     with pytest.raises(ValueError, match="budget"):
         toonkit.stopmo.library(toonkit.stopmo.segment(face, parts=PARTS), budget=4,
                                max_error_mm=1.0)
+
+
+def test_solids_that_cross_as_built_are_regularized(face, tmp_path):
+    """A seam through both eyes folds the fronts over the walls where it meets the eye
+    openings: the module writes those solids regularized, as the CLI does, and says so."""
+    lib = toonkit.stopmo.run(face, parts={"upper": [(0, 15, 8)], "lower": [(0, -8, 12)]},
+                             pieces=3, restarts=1)
+    parts = lib.report["printing"]["parts"]
+    assert any(p["regularized_pieces"] for p in parts), parts
+    for p in parts:
+        assert p["shell"]["self_intersecting_triangles"] == 0, p
+        assert (p["built_self_intersecting_triangles"] > 0) == bool(p["regularized_pieces"])
+    assert any("regularized to the material it encloses" in w for w in lib.report["warnings"])
+    written = lib.save(tmp_path / "py")
+    assert any(name.endswith(".stl") for name in written)
