@@ -168,8 +168,14 @@ impl<'a> TriangleGrid<'a> {
     /// `limit` (as [`PartShell::min_wall`](super::PartShell::min_wall) does) keeps every query
     /// after the first to a few rings.
     pub fn distance_below(&self, p: Vec3, limit: f64) -> f64 {
+        self.nearest_below(p, limit).0
+    }
+
+    /// [`TriangleGrid::distance_below`] and the nearest triangle (`None` when none was
+    /// found below `limit`).
+    pub(crate) fn nearest_below(&self, p: Vec3, limit: f64) -> (f64, Option<u32>) {
         if self.triangles.is_empty() {
-            return f64::INFINITY;
+            return (f64::INFINITY, None);
         }
         let c = self.key(p);
         let max_ring = (0..3)
@@ -177,14 +183,17 @@ impl<'a> TriangleGrid<'a> {
             .max()
             .unwrap_or(0)
             + 1;
-        let mut best = f64::INFINITY;
-        let nearest_in = |list: &[u32], best: &mut f64| {
+        let mut best = (f64::INFINITY, None);
+        let nearest_in = |list: &[u32], best: &mut (f64, Option<u32>)| {
             for &t in list {
                 let [a, b, c] = self.triangles[t as usize].map(|v| self.positions[v as usize]);
-                *best = best.min(f64::from(closest_point_on_triangle(p, a, b, c).distance(p)));
+                let d = f64::from(closest_point_on_triangle(p, a, b, c).distance(p));
+                if d < best.0 {
+                    *best = (d, Some(t));
+                }
             }
         };
-        let visit = |x: i32, y: i32, z: i32, best: &mut f64| {
+        let visit = |x: i32, y: i32, z: i32, best: &mut (f64, Option<u32>)| {
             if let Some(list) = self.cells.get(&[x, y, z]) {
                 nearest_in(list, best);
             }
@@ -192,7 +201,7 @@ impl<'a> TriangleGrid<'a> {
         let mut visited = 0usize;
         for r in 0..=max_ring {
             // Cells of ring r lie at least (r − 1)·cell from p.
-            if f64::from((r - 1).max(0) as f32 * self.cell) >= best.min(limit) {
+            if f64::from((r - 1).max(0) as f32 * self.cell) >= best.0.min(limit) {
                 break;
             }
             // Far from every triangle (a back far behind a thin part, a point outside the
@@ -201,13 +210,13 @@ impl<'a> TriangleGrid<'a> {
                 (2 * r as usize + 1).pow(3) - (2 * r as usize).saturating_sub(1).pow(3);
             visited += ring_cells;
             if visited > self.cells.len() {
-                let reach = best.min(limit);
+                let reach = best.0.min(limit);
                 for (k, list) in &self.cells {
                     let lo = self.lo + Vec3::new(k[0] as f32, k[1] as f32, k[2] as f32) * self.cell;
                     let gap = (lo - p)
                         .max(p - lo - Vec3::splat(self.cell))
                         .max(Vec3::ZERO);
-                    if f64::from(gap.length()) < reach.min(best) {
+                    if f64::from(gap.length()) < reach.min(best.0) {
                         nearest_in(list, &mut best);
                     }
                 }

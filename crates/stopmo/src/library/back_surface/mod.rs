@@ -24,7 +24,8 @@
 //! (8 pieces: 247 → 20; what is left: a spike of the cut at the lips and the front folding
 //! over the seam wall beside the nose wing in two pieces). A written solid that still crosses
 //! itself is regularized ([`regularize`](super::regularize)): the construction keeps those
-//! places few and small, the exact arrangement removes them.
+//! places few and small, the exact arrangement removes them. Where a front point still comes
+//! closer to the back than the wall, the back is thickened there (`thicken.rs`).
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -42,6 +43,7 @@ mod options;
 mod repair;
 mod resolve;
 mod seams;
+mod thicken;
 mod topology;
 mod untangle;
 

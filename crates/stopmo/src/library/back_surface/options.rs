@@ -129,6 +129,9 @@ pub struct ShellStats {
     /// Front points shifted (by at most the printer resolution, 0.05 mm, in every piece)
     /// where the front folds over a wall.
     pub front_nudged_points: usize,
+    /// Back points pushed deeper at the end where some piece's front still came closer to
+    /// the back than the wall.
+    pub thickened_back_points: usize,
     /// Self-intersecting triangles over all pieces' solids, summed (0 when printable): after
     /// the repair for a bare shell; of the written solids (keys and IDs included) in a
     /// library job's report.

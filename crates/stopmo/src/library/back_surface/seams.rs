@@ -120,6 +120,16 @@ pub fn build_shells(inputs: &[ShellInput<'_>], opts: &ShellOptions) -> Result<Ve
             opts.resolve_rounds,
         );
     }
+    // Then the wall, wherever a front point came closer to the back than it (a printed
+    // back stays as printed; the measurements say where).
+    for (shell, input) in out.iter_mut().zip(inputs) {
+        if input.printed_back.is_none() && shell.stats.min_wall_mm < opts.wall_mm {
+            shell.stats.thickened_back_points = shell.thicken(&input.pieces, opts.wall_mm);
+            if shell.stats.thickened_back_points > 0 {
+                shell.measure(&input.pieces);
+            }
+        }
+    }
     Ok(out)
 }
 
