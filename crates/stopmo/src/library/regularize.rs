@@ -14,7 +14,7 @@
 //! front) is dropped, and so is a sealed cavity inside it (filled: resin trapped in a closed
 //! void spoils a print), so a piece stays one shell.
 
-use anim::Mesh;
+use anim::{Aabb, Mesh};
 use manifold_rust::linalg::Vec3 as MVec3;
 use manifold_rust::manifold::Manifold;
 use manifold_rust::types::{BooleanEngine, Error as ManifoldError, MeshGL, OpType};
@@ -22,6 +22,7 @@ use manifold_rust::types::{BooleanEngine, Error as ManifoldError, MeshGL, OpType
 use super::error::{LibraryError, Result};
 use super::fabricate::{check_solid, split_fans, volume};
 use super::plugs::components;
+use crate::segment::Weld;
 
 /// A regularized solid and what was cut off it.
 #[derive(Debug, Clone)]
@@ -177,14 +178,8 @@ fn separate_touching_fans(mesh: &mut Mesh) {
     for (v, p) in mesh.positions.iter().enumerate() {
         split[v] = v >= n || originals.contains(&p.to_array().map(f32::to_bits));
     }
-    let (lo, hi) = mesh.positions.iter().fold(
-        (
-            glam::Vec3::splat(f32::INFINITY),
-            glam::Vec3::splat(f32::NEG_INFINITY),
-        ),
-        |(lo, hi), &p| (lo.min(p), hi.max(p)),
-    );
-    let step = (hi - lo).length() * FAN_SEPARATION;
+    let bounds = Aabb::from_points(&mesh.positions);
+    let step = (bounds.max - bounds.min).length() * FAN_SEPARATION;
     let mut towards = vec![(glam::Vec3::ZERO, 0u32); mesh.positions.len()];
     for t in &mesh.triangles {
         for k in 0..3 {
@@ -205,33 +200,19 @@ fn separate_touching_fans(mesh: &mut Mesh) {
     }
 }
 
-/// Merges vertices with the same `f32` position and drops the triangles that collapse.
+/// Merges vertices with the same `f32` position (the segmentation's exact [`Weld`]) and drops
+/// the triangles that collapse.
 fn weld_rounded(mesh: &mut Mesh) {
-    let mut index: std::collections::HashMap<[u32; 3], u32> =
-        std::collections::HashMap::with_capacity(mesh.positions.len());
-    let mut positions = Vec::with_capacity(mesh.positions.len());
-    let remap: Vec<u32> = mesh
-        .positions
-        .iter()
-        .map(|p| {
-            *index
-                .entry(p.to_array().map(f32::to_bits))
-                .or_insert_with(|| {
-                    positions.push(*p);
-                    (positions.len() - 1) as u32
-                })
-        })
-        .collect();
-    if positions.len() == mesh.positions.len() {
+    let weld = Weld::new(&mesh.positions, 0.0);
+    if weld.len() == mesh.positions.len() {
         return;
     }
-    mesh.positions = positions;
-    mesh.triangles = mesh
-        .triangles
-        .iter()
-        .map(|t| t.map(|i| remap[i as usize]))
+    mesh.triangles = weld
+        .triangles(&mesh.triangles)
+        .into_iter()
         .filter(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0])
         .collect();
+    mesh.positions = weld.gather(&mesh.positions);
 }
 
 #[cfg(test)]

@@ -34,9 +34,10 @@ impl PartShell {
         let n = self.back.len();
         let mut moved = vec![false; n];
         let mut last = f32::INFINITY;
+        // Only the back moves: the pieces' fronts are laid out once.
+        let fronts: Vec<Vec<Vec3>> = pieces.par_iter().map(|p| self.front(p)).collect();
         for _ in 0..THICKEN_ROUNDS {
             let grid = TriangleGrid::new(&self.back, &self.triangles);
-            let fronts: Vec<Vec<Vec3>> = pieces.par_iter().map(|p| self.front(p)).collect();
             // Per back vertex, the deepest push any front point asks of it.
             let push = fronts
                 .par_iter()
