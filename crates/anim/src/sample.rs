@@ -356,7 +356,10 @@ fn sample_object(
         p = scene.nodes[q].parent;
     }
 
-    let mut positions = vec![Vec3::ZERO; poses.len() * nv];
+    // Zeroed by the allocator (fresh pages for a large cache, none touched here): the skinning
+    // workers write every frame and so fault its pages in on all cores, instead of this
+    // thread clearing the whole cache first.
+    let mut positions: Vec<Vec3> = bytemuck::allocation::zeroed_vec(poses.len() * nv);
     // Each frame is checked for non-finite positions while it is still in cache, instead of
     // a second pass over the whole buffer in `MeshAnimation::new`.
     let finite = positions

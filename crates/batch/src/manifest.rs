@@ -56,7 +56,8 @@ pub enum ToolOutput {
 #[cfg(feature = "clap")]
 impl ToolOutput {
     /// How the command `words` (subcommand names under `root`) takes its output file, read
-    /// from the parser itself: an argument with id `output`, positional or not.
+    /// from the parser itself: an argument with id `output`, positional or not. `root` must be
+    /// built ([`clap::Command::build`]) when its subcommands define their flags lazily.
     pub fn of(root: &clap::Command, words: &[&str]) -> ToolOutput {
         let mut command = root;
         for w in words {

@@ -15,6 +15,7 @@ use tkio::args as shared;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use tkio::args::Deferred;
 
 /// Stylization tools for 3D animation: smear frames, 3D-printed stop-motion, lines of action.
 #[derive(Debug, Parser)]
@@ -38,23 +39,23 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Describe a file: meshes, vertices, triangles, joints, morph targets, clips, bounds.
-    Info(commands::info::InfoArgs),
+    Info(Deferred<commands::info::InfoArgs>),
     /// Convert any readable animation into any writable one.
-    Convert(commands::convert::ConvertArgs),
+    Convert(Deferred<commands::convert::ConvertArgs>),
     /// Run the tools on the bundled sample and write the results.
-    Demo(commands::demo::DemoArgs),
+    Demo(Deferred<commands::demo::DemoArgs>),
     /// Dynamic lines of action: sketched keystrokes → animated line (Guay et al. 2015).
-    Loa(commands::loa::LoaArgs),
+    Loa(Deferred<commands::loa::LoaArgs>),
     /// Preview an animation as PNG (one frame, onion skins) or GIF, coloured by motion offsets.
-    Render(commands::render::RenderArgs),
+    Render(Deferred<commands::render::RenderArgs>),
     /// Smear frames: motion offsets (Basset et al. 2024).
-    Smear(Box<commands::smear::SmearArgs>),
+    Smear(Deferred<Box<commands::smear::SmearArgs>>),
     /// Replacement libraries for 3D-printed stop-motion (StopShop).
-    Stopmo(Box<commands::stopmo::StopmoArgs>),
+    Stopmo(Deferred<Box<commands::stopmo::StopmoArgs>>),
     /// A local web page to tune smears, sketch lines of action and segment faces (127.0.0.1).
-    Studio(commands::studio::StudioArgs),
+    Studio(Deferred<commands::studio::StudioArgs>),
     /// Many shots from a manifest: in parallel here, or as an Open Job Description farm job.
-    Batch(commands::batch::BatchArgs),
+    Batch(Deferred<commands::batch::BatchArgs>),
 }
 
 /// Runs `toonkit ARGS…` in this process, quietly (no summary, no spinner): the demo's steps
@@ -141,14 +142,14 @@ pub(crate) fn one_line(e: &anyhow::Error) -> String {
 /// it too).
 fn run(ctx: &commands::Context, command: Command) -> anyhow::Result<()> {
     match command {
-        Command::Info(a) => commands::info::run(ctx, a),
-        Command::Convert(a) => commands::convert::run(ctx, a),
-        Command::Demo(a) => commands::demo::run(ctx, a),
-        Command::Loa(a) => commands::loa::run(ctx, a),
-        Command::Render(a) => commands::render::run(ctx, a),
-        Command::Smear(a) => commands::smear::run(ctx, *a),
-        Command::Stopmo(a) => commands::stopmo::run(ctx, *a),
-        Command::Batch(a) => commands::batch::run(ctx, a),
-        Command::Studio(a) => commands::studio::run(ctx, a),
+        Command::Info(a) => commands::info::run(ctx, a.0),
+        Command::Convert(a) => commands::convert::run(ctx, a.0),
+        Command::Demo(a) => commands::demo::run(ctx, a.0),
+        Command::Loa(a) => commands::loa::run(ctx, a.0),
+        Command::Render(a) => commands::render::run(ctx, a.0),
+        Command::Smear(a) => commands::smear::run(ctx, *a.0),
+        Command::Stopmo(a) => commands::stopmo::run(ctx, *a.0),
+        Command::Batch(a) => commands::batch::run(ctx, a.0),
+        Command::Studio(a) => commands::studio::run(ctx, a.0),
     }
 }

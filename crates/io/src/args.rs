@@ -12,6 +12,10 @@ use clap::Args;
 
 use crate::{IoError, LoadOptions, Loaded};
 
+mod deferred;
+
+pub use deferred::Deferred;
+
 /// Why the shared flags cannot open an input, in the user's terms.
 #[derive(Debug, thiserror::Error)]
 pub enum ArgsError {

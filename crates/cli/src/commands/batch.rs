@@ -124,7 +124,13 @@ impl InProcess {
     fn new(json: bool) -> InProcess {
         let show = !json && std::io::stderr().is_terminal();
         InProcess {
-            parser: crate::Cli::command(),
+            // Built whole: subcommands define their flags only when used (`Deferred`), and
+            // the shots' outputs are looked up among them.
+            parser: {
+                let mut parser = crate::Cli::command();
+                parser.build();
+                parser
+            },
             multi: show.then(MultiProgress::new),
             bars: Mutex::default(),
         }

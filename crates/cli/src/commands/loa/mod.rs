@@ -9,6 +9,7 @@ use std::path::Path;
 use anyhow::{Context as _, Result};
 use clap::{Args, Subcommand};
 pub(crate) use loa::args::LineFlags;
+use tkio::args::Deferred;
 
 use super::Context;
 
@@ -23,16 +24,16 @@ pub(crate) struct LoaArgs {
 #[derive(Debug, Subcommand)]
 pub(crate) enum LoaCommand {
     /// Interpolate sketched keystrokes into a dynamic line of action (Guay et al. 2015, §3).
-    Line(line::LineArgs),
+    Line(Deferred<line::LineArgs>),
     /// Synthesize 3D character motion that follows the dynamic line (Guay et al. 2015, §4).
-    Animate(Box<animate::AnimateArgs>),
+    Animate(Deferred<Box<animate::AnimateArgs>>),
 }
 
 /// Runs `toonkit loa …`.
 pub(crate) fn run(ctx: &Context, args: LoaArgs) -> Result<()> {
     match args.command {
-        LoaCommand::Line(a) => line::run(ctx, a),
-        LoaCommand::Animate(a) => animate::run(ctx, *a),
+        LoaCommand::Line(a) => line::run(ctx, a.0),
+        LoaCommand::Animate(a) => animate::run(ctx, *a.0),
     }
 }
 

@@ -12,6 +12,7 @@ use anyhow::{bail, Result};
 use clap::{Args, Subcommand};
 pub(crate) use smear::args::{EffectArgs, OffsetArgs};
 use smear::{PrepareOptions, Prepared};
+use tkio::args::Deferred;
 
 use super::Context;
 use crate::input::{self, InputArgs};
@@ -30,23 +31,23 @@ pub(crate) struct SmearArgs {
 #[derive(Debug, Subcommand)]
 pub(crate) enum SmearCommand {
     /// Motion offsets per frame and vertex: leading parts > 0, trailing parts < 0 (§3).
-    Offsets(offsets::OffsetsArgs),
+    Offsets(Deferred<offsets::OffsetsArgs>),
     /// Elongated in-betweens: vertices slid along their trajectories by β = S_E(δ) (§4.1).
-    Elongate(effects::ElongateArgs),
+    Elongate(Deferred<effects::ElongateArgs>),
     /// Multiple in-betweens: displaced copies with per-vertex opacity (§4.2).
-    Multiples(effects::MultiplesArgs),
+    Multiples(Deferred<effects::MultiplesArgs>),
     /// Motion lines: tubes along seed trajectories, length τ = S_L(δ) (§4.3).
-    Lines(effects::LinesArgs),
+    Lines(Deferred<effects::LinesArgs>),
 }
 
 /// Runs `toonkit smear`.
 pub(crate) fn run(ctx: &Context, args: SmearArgs) -> Result<()> {
     match args.command {
         None => style::run(ctx, args.style),
-        Some(SmearCommand::Offsets(a)) => offsets::run(ctx, a),
-        Some(SmearCommand::Elongate(a)) => effects::elongate(ctx, a),
-        Some(SmearCommand::Multiples(a)) => effects::multiples(ctx, a),
-        Some(SmearCommand::Lines(a)) => effects::lines(ctx, a),
+        Some(SmearCommand::Offsets(a)) => offsets::run(ctx, a.0),
+        Some(SmearCommand::Elongate(a)) => effects::elongate(ctx, a.0),
+        Some(SmearCommand::Multiples(a)) => effects::multiples(ctx, a.0),
+        Some(SmearCommand::Lines(a)) => effects::lines(ctx, a.0),
     }
 }
 

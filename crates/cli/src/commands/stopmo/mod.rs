@@ -13,6 +13,7 @@ mod segment;
 use anyhow::Result;
 use clap::{Args, Subcommand};
 pub(crate) use stopmo::args::{LibraryOptionsArgs, SegmentOptionsArgs};
+use tkio::args::Deferred;
 
 use super::Context;
 
@@ -28,21 +29,21 @@ pub(crate) struct StopmoArgs {
 pub(crate) enum StopmoCommand {
     /// Cut the animation into parts along low-motion seams and make the seams identical in
     /// every frame (StopShop Sections 3.1–3.2).
-    Segment(segment::SegmentArgs),
+    Segment(Deferred<segment::SegmentArgs>),
     /// Build a replacement library of printable pieces per part, the assembly sheet and a
     /// shooting order (StopShop Sections 3.3–3.4, 5).
-    Library(library::LibraryArgs),
+    Library(Deferred<library::LibraryArgs>),
     /// Segment, then build the library of every part: `segment` and `library` in one go,
     /// writing DIR/segmentation.glb, DIR/segmentation.json and the library layout in DIR.
-    Run(run::RunArgs),
+    Run(Deferred<run::RunArgs>),
 }
 
 /// Runs `toonkit stopmo …`.
 pub(crate) fn run(ctx: &Context, args: StopmoArgs) -> Result<()> {
     match args.command {
-        StopmoCommand::Segment(a) => segment::segment(ctx, a),
-        StopmoCommand::Library(a) => library::library(ctx, a),
-        StopmoCommand::Run(a) => run::run(ctx, a),
+        StopmoCommand::Segment(a) => segment::segment(ctx, a.0),
+        StopmoCommand::Library(a) => library::library(ctx, a.0),
+        StopmoCommand::Run(a) => run::run(ctx, a.0),
     }
 }
 
