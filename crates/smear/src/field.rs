@@ -285,7 +285,9 @@ fn masked_maxima(raw: &[f32], in_root: &[f32], in_tip: &[f32]) -> [f32; 2] {
     [masked_max(raw, in_root), masked_max(raw, in_tip)]
 }
 
-/// max |raw| over the entries flagged 1 in `mask` (see [`masked_maxima`]).
+/// max |raw| over the entries flagged 1 in `mask` (see [`masked_maxima`]), compiled for
+/// baseline x86-64 and AVX2 like [`Ribbon::eval_batch`].
+#[multiversion::multiversion(targets("x86_64+avx2"))]
 fn masked_max(raw: &[f32], mask: &[f32]) -> f32 {
     const L: usize = 8;
     #[inline(always)]

@@ -278,6 +278,20 @@ impl Ribbon {
         u: &mut [f32],
         coll: &mut [f32],
     ) {
+        eval_columns(self, xs, ys, zs, raw, u, coll);
+    }
+
+    /// The body of [`Ribbon::eval_batch`] (see [`eval_columns`]).
+    #[inline(always)]
+    fn eval_columns(
+        &self,
+        xs: &[f32],
+        ys: &[f32],
+        zs: &[f32],
+        raw: &mut [f32],
+        u: &mut [f32],
+        coll: &mut [f32],
+    ) {
         let n = xs.len();
         let (ys, zs) = (&ys[..n], &zs[..n]);
         let (raw, u, coll) = (&mut raw[..n], &mut u[..n], &mut coll[..n]);
@@ -433,6 +447,22 @@ impl Ribbon {
             }
         }
     }
+}
+
+/// [`Ribbon::eval_batch`], compiled for baseline x86-64 and for AVX2 and picked at run time:
+/// with AVX2 the columns run 8 points per instruction instead of 4, with the same bits (Rust
+/// never fuses or reorders float operations, so only the register width differs).
+#[multiversion::multiversion(targets("x86_64+avx2"))]
+fn eval_columns(
+    rib: &Ribbon,
+    xs: &[f32],
+    ys: &[f32],
+    zs: &[f32],
+    raw: &mut [f32],
+    u: &mut [f32],
+    coll: &mut [f32],
+) {
+    rib.eval_columns(xs, ys, zs, raw, u, coll);
 }
 
 #[cfg(test)]
