@@ -35,9 +35,10 @@ pub fn write_f32(shape: &[usize], data: &[f32]) -> Result<Vec<u8>> {
 /// Values per block of [`write_f32_to`]: 64 KiB of bytes, converted in cache and written.
 const BLOCK: usize = 16 * 1024;
 
-/// Writes the float32 array of [`write_f32`] (the same bytes) to `w` block by block, without
-/// encoding the whole file in memory first: a result of megabytes goes to the file as it is
-/// converted, with no second copy of it (and no fresh pages for one).
+/// Writes the float32 array of [`write_f32`] (the same bytes) to `w` without encoding the whole
+/// file in memory first: on a little-endian machine the values themselves, elsewhere block by
+/// block as they are converted (no second copy of a result of megabytes, and no fresh pages
+/// for one).
 ///
 /// # Errors
 /// [`IoError::Unsupported`] when `data.len()` is not the product of `shape`; the first write
@@ -46,6 +47,11 @@ pub fn write_f32_to(w: &mut impl std::io::Write, shape: &[usize], data: &[f32]) 
     let header = header_f32(shape, data.len())?;
     let io = |e| IoError::io(std::path::Path::new(""), e);
     w.write_all(&header).map_err(io)?;
+    // On a little-endian machine the values in memory are the file's bytes: written as they
+    // are, in one call (no conversion pass, no copy).
+    if cfg!(target_endian = "little") {
+        return w.write_all(bytemuck::cast_slice(data)).map_err(io);
+    }
     let mut block = vec![0u8; 4 * BLOCK.min(data.len())];
     for chunk in data.chunks(BLOCK) {
         // Fixed-size stores into a sized block: a plain copy on little-endian machines.

@@ -62,8 +62,8 @@ impl Field {
     /// The SMEAR Eqs. 3–9 field of a skinned group, and the (unsmoothed) offsets of its vertices.
     ///
     /// # Arguments
-    /// * `raw` — the buffer the offsets are written to (resized to `frames × vertices`;
-    ///   its pages may be mapped beforehand, see `touched_zeros`).
+    /// * `raw` — the buffer the offsets are written to (resized to `frames × vertices`; best
+    ///   fresh from the allocator, so that each worker maps the pages of the frames it writes).
     /// * `bones` — bones of the whole skeleton, frame-major `frames × joints`.
     ///
     /// # Returns
@@ -137,9 +137,7 @@ impl Field {
                         }
                     }
                     // Zero-length bones were skipped: renormalize over the remaining weights.
-                    for ((d, &a), &w) in dst.iter_mut().zip(&sc.acc).zip(&sc.wsum) {
-                        *d = if w > 0.0 { a / w } else { 0.0 };
-                    }
+                    weighted_means(dst, &sc.acc, &sc.wsum);
                 },
             );
         (
@@ -217,13 +215,14 @@ impl Scratch {
         if !self.runs {
             return;
         }
-        let fill = |col: &mut Vec<f32>, axis: fn(&Vec3) -> f32| {
-            col.clear();
-            col.extend(pos.iter().map(axis));
-        };
-        fill(&mut self.px, |p| p.x);
-        fill(&mut self.py, |p| p.y);
-        fill(&mut self.pz, |p| p.z);
+        // Sized once per worker (every frame has as many vertices), then filled in one pass.
+        for col in [&mut self.px, &mut self.py, &mut self.pz] {
+            col.resize(pos.len(), 0.0);
+        }
+        let cols = self.px.iter_mut().zip(&mut self.py).zip(&mut self.pz);
+        for (((x, y), z), p) in cols.zip(pos) {
+            (*x, *y, *z) = (p.x, p.y, p.z);
+        }
     }
 
     /// Evaluates one bone's ribbon over its neighbourhood (batched, SMEAR Eqs. 3–6), accumulates
@@ -258,17 +257,14 @@ impl Scratch {
                 o += len;
             }
         }
-        let (raw, u, coll) = (&self.raw[..n], &self.u[..n], &self.coll[..n]);
+        let (raw, u, coll) = (&mut self.raw[..n], &self.u[..n], &self.coll[..n]);
         let [mr, mt] = masked_maxima(raw, hood.in_root, hood.in_tip);
+        // Every entry normalized at once (vectorized), then the skinned ones gathered.
+        normalize_columns(raw, u, coll, mr, mt, collinear);
         for (&i, &w) in hood.skinned_at.iter().zip(hood.skinned_weight) {
             let i = i as usize;
             let v = hood.vertex[i] as usize;
-            let s = RibbonSample {
-                u: u[i],
-                raw: raw[i],
-                coll: coll[i],
-            };
-            self.acc[v] += w * normalized(s, mr, mt, collinear);
+            self.acc[v] += w * raw[i];
             self.wsum[v] += w;
         }
         [mr, mt]
@@ -325,6 +321,38 @@ fn normalized(s: RibbonSample, max_root: f32, max_tip: f32, collinear: bool) -> 
         coll * s.raw / m
     } else {
         0.0
+    }
+}
+
+/// [`normalized`] over a neighbourhood's columns, in place: `raw[i]` becomes entry i's
+/// w_coll·δ̃ / M (SMEAR Eqs. 8–9), or 0 where M vanishes. Written as selects so that the
+/// compiler vectorizes it; compiled for baseline x86-64 and AVX2 like [`Ribbon::eval_batch`]
+/// (the same operations in the same order as [`normalized`]: the same bits).
+#[multiversion::multiversion(targets("x86_64+avx2"))]
+fn normalize_columns(
+    raw: &mut [f32],
+    u: &[f32],
+    coll: &[f32],
+    max_root: f32,
+    max_tip: f32,
+    collinear: bool,
+) {
+    let n = raw.len();
+    let (u, coll) = (&u[..n], &coll[..n]);
+    for i in 0..n {
+        let m = (1.0 - u[i]) * max_root + u[i] * max_tip;
+        let c = if collinear { coll[i] } else { 1.0 };
+        let q = c * raw[i] / m;
+        raw[i] = if m > 0.0 { q } else { 0.0 };
+    }
+}
+
+/// SMEAR Eq. 7's weighted mean per vertex, `acc / wsum` (0 without weight), vectorized like
+/// [`normalize_columns`].
+#[multiversion::multiversion(targets("x86_64+avx2"))]
+fn weighted_means(dst: &mut [f32], acc: &[f32], wsum: &[f32]) {
+    for ((d, &a), &w) in dst.iter_mut().zip(acc).zip(wsum) {
+        *d = if w > 0.0 { a / w } else { 0.0 };
     }
 }
 

@@ -133,6 +133,11 @@ impl Rig {
             row_start: vec![0],
             ..Rig::default()
         };
+        let nv: usize = parts.iter().map(|s| s.weights.vertex_count()).sum();
+        rig.row_start.reserve(nv);
+        // Two influences per vertex is typical of a skinned mesh: most rows fit without growing.
+        rig.row_joint.reserve(2 * nv);
+        rig.row_weight.reserve(2 * nv);
         let mut row: Vec<(u32, f32)> = Vec::with_capacity(8);
         for skin in parts {
             for v in 0..skin.weights.vertex_count() {
@@ -186,62 +191,79 @@ impl Rig {
                 l
             })
             .collect();
-        let mut hoods: Vec<Vec<(u32, f32, u8)>> = vec![Vec::new(); n];
-        let mut local: Vec<(usize, u8)> = Vec::with_capacity(32);
-        for v in 0..rig.vertex_count() {
+        // Two passes over the vertices, no list per bone: each vertex's neighbourhoods with
+        // its flags and weight (its own short row), counted per bone; then every bone's
+        // entries written in place, vertices ascending.
+        let mut entry_start: Vec<u32> = Vec::with_capacity(nv + 1);
+        entry_start.push(0);
+        let mut entries: Vec<(u32, u8, f32)> = Vec::with_capacity(3 * nv);
+        let mut count = vec![0u32; n];
+        for v in 0..nv {
             let (js, ws) = rig.influences(v);
-            let local: &[(usize, u8)] = if let [m] = js {
-                &marks[*m as usize]
-            } else {
-                local.clear();
-                for &m in js {
-                    for &(k, flag) in &marks[m as usize] {
-                        match local.iter_mut().find(|e| e.0 == k) {
-                            Some(e) => e.1 |= flag,
-                            None => local.push((k, flag)),
+            let row = entries.len();
+            for &m in js {
+                for &(k, flag) in &marks[m as usize] {
+                    let k = k as u32;
+                    match entries[row..].iter_mut().find(|e| e.0 == k) {
+                        Some(e) => e.1 |= flag,
+                        None => {
+                            let w = js.iter().zip(ws).find(|(j, _)| **j == k);
+                            entries.push((k, flag, w.map_or(0.0, |(_, w)| *w)));
+                            count[k as usize] += 1;
                         }
                     }
                 }
-                &local
-            };
-            for &(k, flags) in local {
-                let weight = js
-                    .iter()
-                    .zip(ws)
-                    .find(|(j, _)| **j as usize == k)
-                    .map_or(0.0, |(_, w)| *w);
-                hoods[k].push((v as u32, weight, flags));
+            }
+            entry_start.push(entries.len() as u32);
+        }
+        let total = entries.len();
+        rig.hood_start = Vec::with_capacity(n + 1);
+        rig.hood_start.push(0);
+        for &c in &count {
+            let last = *rig.hood_start.last().expect("starts at 0");
+            rig.hood_start.push(last + c);
+        }
+        let mut fill: Vec<u32> = rig.hood_start[..n].to_vec();
+        rig.hood_vertex = vec![0; total];
+        rig.hood_flags = vec![0; total];
+        let mut weight = vec![0.0f32; total];
+        for v in 0..nv {
+            let (a, b) = (entry_start[v] as usize, entry_start[v + 1] as usize);
+            for &(k, flags, w) in &entries[a..b] {
+                let at = fill[k as usize] as usize;
+                fill[k as usize] += 1;
+                rig.hood_vertex[at] = v as u32;
+                rig.hood_flags[at] = flags;
+                weight[at] = w;
             }
         }
-        rig.hood_start.push(0);
+        let mask = |f: u8| move |&flags: &u8| if flags & f != 0 { 1.0 } else { 0.0 };
+        rig.hood_in_root = rig.hood_flags.iter().map(mask(IN_ROOT)).collect();
+        rig.hood_in_tip = rig.hood_flags.iter().map(mask(IN_TIP)).collect();
         rig.skinned_start.push(0);
         rig.run_start.push(0);
         let mut runs: Vec<(u32, u32)> = Vec::new();
-        for h in hoods {
+        for k in 0..n {
+            let (a, b) = (rig.hood_start[k] as usize, rig.hood_start[k + 1] as usize);
+            let hood = &rig.hood_vertex[a..b];
             runs.clear();
-            for &(v, _, _) in &h {
+            for &v in hood {
                 match runs.last_mut() {
                     Some((first, len)) if *first + *len == v => *len += 1,
                     _ => runs.push((v, 1)),
                 }
             }
-            if h.len() >= MIN_MEAN_RUN * runs.len() {
+            if hood.len() >= MIN_MEAN_RUN * runs.len() {
                 rig.runs.extend_from_slice(&runs);
             }
             rig.run_start.push(rig.runs.len() as u32);
-            rig.max_hood = rig.max_hood.max(h.len());
-            for (i, &(v, w, flags)) in h.iter().enumerate() {
+            rig.max_hood = rig.max_hood.max(hood.len());
+            for (i, &w) in weight[a..b].iter().enumerate() {
                 if w > 0.0 {
                     rig.skinned_at.push(i as u32);
                     rig.skinned_weight.push(w);
                 }
-                rig.hood_vertex.push(v);
-                rig.hood_flags.push(flags);
-                let mask = |f: u8| if flags & f != 0 { 1.0 } else { 0.0 };
-                rig.hood_in_root.push(mask(IN_ROOT));
-                rig.hood_in_tip.push(mask(IN_TIP));
             }
-            rig.hood_start.push(rig.hood_vertex.len() as u32);
             rig.skinned_start.push(rig.skinned_at.len() as u32);
         }
         Ok(rig)

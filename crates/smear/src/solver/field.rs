@@ -12,8 +12,8 @@ use crate::velocity::CameraSpace;
 use crate::{MotionOffsets, OffsetOptions, Result, SmearError};
 
 use super::groups::{
-    check_scene, group_keys, merged_positions, merged_triangles, tolerances, touched_zeros, Group,
-    GroupPositions, Slot,
+    check_scene, group_keys, merged_positions, merged_triangles, tolerances, Group, GroupPositions,
+    Slot,
 };
 use super::{count_solve, resolve_camera, OffsetMode};
 
@@ -61,14 +61,12 @@ impl SolvedField {
                     .iter()
                     .filter_map(|&i| scene.objects[i].skin.as_ref())
                     .collect();
-                // The rig is built on one core while the other maps the output's fresh pages
-                // (the kernel clears them on first touch): both serial costs at once.
-                let (rig, raw) = rayon::join(
-                    || Rig::new(&scene.skeleton, &pruned, &skins),
-                    || touched_zeros(frames * vertices),
-                );
+                let rig = Rig::new(&scene.skeleton, &pruned, &skins)?;
+                // Zeroed by the allocator, untouched: each frame's pages are mapped by the
+                // worker that writes the frame, on every core at once.
+                let raw = vec![0.0f32; frames * vertices];
                 Field::ribbons(
-                    rig?,
+                    rig,
                     raw,
                     positions,
                     frames,

@@ -109,17 +109,6 @@ pub(super) fn merged_triangles(parts: &[&MeshAnimation]) -> Vec<[u32; 3]> {
     out
 }
 
-/// `len` zeros whose pages are already mapped: one store per 4 KiB page (the value hidden
-/// from the optimizer, which would drop stores of zero into zeroed memory) makes the kernel
-/// map and clear each page here, on the calling thread.
-pub(super) fn touched_zeros(len: usize) -> Vec<f32> {
-    let mut v = vec![0.0f32; len];
-    for x in v.iter_mut().step_by(1024) {
-        *x = std::hint::black_box(0.0);
-    }
-    v
-}
-
 /// Checks that the scene's buffers agree (bones per frame, frames per object, skin slots).
 pub(super) fn check_scene(scene: &SampledScene) -> Result<()> {
     let frames = scene.frame_count;
