@@ -15,7 +15,7 @@ use anim::{
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 
-use crate::gltf::values::{vec2s, vec3s};
+use crate::gltf::values::{packed, vec2s, vec3s};
 use crate::{read_file, IoError, Result};
 
 const FORMAT: &str = "glTF";
@@ -324,11 +324,22 @@ fn primitive_geometry(
                 Dimensions::Scalar,
                 "indices",
             )?;
-            reader
-                .read_indices()
-                .ok_or_else(|| outside("index"))?
-                .into_u32()
-                .collect()
+            match acc.data_type() {
+                DataType::U16 => {
+                    packed::<u16>(&acc, buffers).map(|v| v.into_iter().map(u32::from).collect())
+                }
+                DataType::U32 => packed::<u32>(&acc, buffers),
+                _ => None,
+            }
+            .map_or_else(
+                || {
+                    reader
+                        .read_indices()
+                        .map(|i| i.into_u32().collect())
+                        .ok_or_else(|| outside("index"))
+                },
+                Ok,
+            )?
         }
         None => (0..n as u32).collect(),
     };
@@ -399,16 +410,30 @@ fn primitive_influences(
             Dimensions::Vec4,
             "WEIGHTS",
         )?;
-        let j: Vec<[u16; 4]> = reader
-            .read_joints(set)
-            .ok_or_else(|| outside("JOINTS"))?
-            .into_u16()
-            .collect();
-        let w: Vec<[f32; 4]> = reader
-            .read_weights(set)
-            .ok_or_else(|| outside("WEIGHTS"))?
-            .into_f32()
-            .collect();
+        let packed_joints = match ja.data_type() {
+            DataType::U16 => packed::<[u16; 4]>(&ja, buffers),
+            _ => None,
+        };
+        let j: Vec<[u16; 4]> = match packed_joints {
+            Some(j) => j,
+            None => reader
+                .read_joints(set)
+                .ok_or_else(|| outside("JOINTS"))?
+                .into_u16()
+                .collect(),
+        };
+        let packed_weights = match wa.data_type() {
+            DataType::F32 => packed::<[f32; 4]>(&wa, buffers),
+            _ => None,
+        };
+        let w: Vec<[f32; 4]> = match packed_weights {
+            Some(w) => w,
+            None => reader
+                .read_weights(set)
+                .ok_or_else(|| outside("WEIGHTS"))?
+                .into_f32()
+                .collect(),
+        };
         sets.push((j, w));
         set += 1;
     }

@@ -59,6 +59,31 @@ fn outside(acc: &gltf::Accessor, what: &str) -> IoError {
     )
 }
 
+/// The elements of an accessor whose data lie tightly packed in its buffer view (no gap
+/// between elements, not sparse), decoded straight from the bytes: the items `gltf`'s
+/// iterator yields, without its per-item bookkeeping (most of the cost of reading a mesh).
+/// `None` for any other layout, or data outside the buffer: the caller then reads through the
+/// iterator, which handles every case and reports the errors.
+pub(crate) fn packed<T: Item>(acc: &gltf::Accessor, buffers: &[&[u8]]) -> Option<Vec<T>> {
+    let size = std::mem::size_of::<T>();
+    if acc.sparse().is_some() || acc.size() != size {
+        return None;
+    }
+    let view = acc.view()?;
+    if view.stride().is_some_and(|s| s != size) {
+        return None;
+    }
+    let len = acc.count().checked_mul(size)?;
+    if acc.offset().checked_add(len)? > view.length() {
+        return None;
+    }
+    let start = view.offset().checked_add(acc.offset())?;
+    let bytes = buffers
+        .get(view.buffer().index())?
+        .get(start..start.checked_add(len)?)?;
+    Some(bytes.chunks_exact(size).map(T::from_slice).collect())
+}
+
 macro_rules! reader {
     ($name:ident, $n:literal) => {
         fn $name<T: Component>(
@@ -70,6 +95,12 @@ macro_rules! reader {
             [T; $n]: Item,
         {
             let norm = acc.normalized();
+            if let Some(items) = packed::<[T; $n]>(acc, buffers) {
+                return Ok(items
+                    .into_iter()
+                    .map(|v| v.map(|c| c.to_f32(norm)))
+                    .collect());
+            }
             let iter = Iter::<[T; $n]>::new(acc.clone(), |b: gltf::Buffer| {
                 buffers.get(b.index()).copied()
             })
@@ -120,3 +151,52 @@ macro_rules! dispatch {
 }
 dispatch!(vec2s, read2, 2, Dimensions::Vec2);
 dispatch!(vec3s, read3, 3, Dimensions::Vec3);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn iterated<T: Item>(acc: &gltf::Accessor, buffers: &[&[u8]]) -> Vec<T> {
+        Iter::<T>::new(acc.clone(), |b: gltf::Buffer| {
+            buffers.get(b.index()).copied()
+        })
+        .expect("in its buffer")
+        .collect()
+    }
+
+    /// Every tightly packed accessor of a real character reads the same through [`packed`]
+    /// as through `gltf`'s iterator (positions, normals, joints, weights, indices, times).
+    #[test]
+    fn packed_accessors_read_as_iterated() {
+        let path = testdata::asset("characters/RobotExpressive.glb");
+        let (doc, buffers, _) = gltf::import(path).unwrap();
+        let buffers: Vec<&[u8]> = buffers.iter().map(|b| &b[..]).collect();
+        let mut checked = 0;
+        for acc in doc.accessors() {
+            let same = match (acc.data_type(), acc.dimensions()) {
+                (DataType::F32, Dimensions::Vec3) => packed::<[f32; 3]>(&acc, &buffers)
+                    .map(|p| p == iterated::<[f32; 3]>(&acc, &buffers)),
+                (DataType::F32, Dimensions::Vec4) => packed::<[f32; 4]>(&acc, &buffers)
+                    .map(|p| p == iterated::<[f32; 4]>(&acc, &buffers)),
+                (DataType::F32, Dimensions::Scalar) => {
+                    packed::<f32>(&acc, &buffers).map(|p| p == iterated::<f32>(&acc, &buffers))
+                }
+                (DataType::U16, Dimensions::Scalar) => {
+                    packed::<u16>(&acc, &buffers).map(|p| p == iterated::<u16>(&acc, &buffers))
+                }
+                (DataType::U8, Dimensions::Vec4) => packed::<[u8; 4]>(&acc, &buffers)
+                    .map(|p| p == iterated::<[u8; 4]>(&acc, &buffers)),
+                _ => None,
+            };
+            if let Some(same) = same {
+                assert!(same, "accessor {}", acc.index());
+                checked += 1;
+            }
+        }
+        assert!(checked > 50, "only {checked} packed accessors");
+        // A layout it does not read (a component size that does not match) is left to the
+        // iterator.
+        let acc = doc.accessors().next().unwrap();
+        assert!(packed::<u8>(&acc, &buffers).is_none());
+    }
+}

@@ -50,18 +50,25 @@ impl SolvedField {
             let merged = merged_positions(&parts, frames);
             let positions: &[Vec3] = merged.as_deref().unwrap_or_else(|| parts[0].positions());
             let vertices: usize = parts.iter().map(|a| a.vertex_count()).sum();
-            let tol = tolerances(positions, frames, vertices, space.as_ref(), options.causal);
             let mode = match key {
                 None => OffsetMode::Simple,
                 Some(_) if options.whole_body => OffsetMode::WholeBody,
                 Some(_) => OffsetMode::Articulated,
             };
-            let (field, raw) = if mode == OffsetMode::Articulated {
-                let skins: Vec<&Skin> = members
-                    .iter()
-                    .filter_map(|&i| scene.objects[i].skin.as_ref())
-                    .collect();
-                let rig = Rig::new(&scene.skeleton, &pruned, &skins)?;
+            let skins: Vec<&Skin> = members
+                .iter()
+                .filter_map(|&i| scene.objects[i].skin.as_ref())
+                .collect();
+            // A character's rig is built on one core while the other measures the tolerances.
+            let (tol, rig) = rayon::join(
+                || tolerances(positions, frames, vertices, space.as_ref(), options.causal),
+                || {
+                    (mode == OffsetMode::Articulated)
+                        .then(|| Rig::new(&scene.skeleton, &pruned, &skins))
+                        .transpose()
+                },
+            );
+            let (field, raw) = if let Some(rig) = rig? {
                 // Zeroed by the allocator, untouched: each frame's pages are mapped by the
                 // worker that writes the frame, on every core at once.
                 let raw = vec![0.0f32; frames * vertices];
