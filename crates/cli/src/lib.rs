@@ -15,7 +15,6 @@ use tkio::args as shared;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use tkio::args::Deferred;
 
 /// Stylization tools for 3D animation: smear frames, 3D-printed stop-motion, lines of action.
 #[derive(Debug, Parser)]
@@ -39,23 +38,23 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Describe a file: meshes, vertices, triangles, joints, morph targets, clips, bounds.
-    Info(Deferred<commands::info::InfoArgs>),
+    Info(shared::Deferred<commands::info::InfoArgs>),
     /// Convert any readable animation into any writable one.
-    Convert(Deferred<commands::convert::ConvertArgs>),
+    Convert(shared::Deferred<commands::convert::ConvertArgs>),
     /// Run the tools on the bundled sample and write the results.
-    Demo(Deferred<commands::demo::DemoArgs>),
+    Demo(shared::Deferred<commands::demo::DemoArgs>),
     /// Dynamic lines of action: sketched keystrokes → animated line (Guay et al. 2015).
-    Loa(Deferred<commands::loa::LoaArgs>),
+    Loa(shared::Deferred<commands::loa::LoaArgs>),
     /// Preview an animation as PNG (one frame, onion skins) or GIF, coloured by motion offsets.
-    Render(Deferred<commands::render::RenderArgs>),
+    Render(shared::Deferred<commands::render::RenderArgs>),
     /// Smear frames: motion offsets (Basset et al. 2024).
-    Smear(Deferred<Box<commands::smear::SmearArgs>>),
+    Smear(shared::Deferred<Box<commands::smear::SmearArgs>>),
     /// Replacement libraries for 3D-printed stop-motion (StopShop).
-    Stopmo(Deferred<Box<commands::stopmo::StopmoArgs>>),
+    Stopmo(shared::Deferred<Box<commands::stopmo::StopmoArgs>>),
     /// A local web page to tune smears, sketch lines of action and segment faces (127.0.0.1).
-    Studio(Deferred<commands::studio::StudioArgs>),
+    Studio(shared::Deferred<commands::studio::StudioArgs>),
     /// Many shots from a manifest: in parallel here, or as an Open Job Description farm job.
-    Batch(Deferred<commands::batch::BatchArgs>),
+    Batch(shared::Deferred<commands::batch::BatchArgs>),
 }
 
 /// Runs `toonkit ARGS…` in this process, quietly (no summary, no spinner): the demo's steps

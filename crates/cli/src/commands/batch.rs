@@ -124,13 +124,7 @@ impl InProcess {
     fn new(json: bool) -> InProcess {
         let show = !json && std::io::stderr().is_terminal();
         InProcess {
-            // Built whole: subcommands define their flags only when used (`Deferred`), and
-            // the shots' outputs are looked up among them.
-            parser: {
-                let mut parser = crate::Cli::command();
-                parser.build();
-                parser
-            },
+            parser: crate::Cli::command(),
             multi: show.then(MultiProgress::new),
             bars: Mutex::default(),
         }

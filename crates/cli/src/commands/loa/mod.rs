@@ -9,7 +9,6 @@ use std::path::Path;
 use anyhow::{Context as _, Result};
 use clap::{Args, Subcommand};
 pub(crate) use loa::args::LineFlags;
-use tkio::args::Deferred;
 
 use super::Context;
 
@@ -24,9 +23,9 @@ pub(crate) struct LoaArgs {
 #[derive(Debug, Subcommand)]
 pub(crate) enum LoaCommand {
     /// Interpolate sketched keystrokes into a dynamic line of action (Guay et al. 2015, §3).
-    Line(Deferred<line::LineArgs>),
+    Line(tkio::args::Deferred<line::LineArgs>),
     /// Synthesize 3D character motion that follows the dynamic line (Guay et al. 2015, §4).
-    Animate(Deferred<Box<animate::AnimateArgs>>),
+    Animate(tkio::args::Deferred<Box<animate::AnimateArgs>>),
 }
 
 /// Runs `toonkit loa …`.

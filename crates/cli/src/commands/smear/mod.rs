@@ -12,10 +12,9 @@ use anyhow::{bail, Result};
 use clap::{Args, Subcommand};
 pub(crate) use smear::args::{EffectArgs, OffsetArgs};
 use smear::{PrepareOptions, Prepared};
-use tkio::args::Deferred;
 
 use super::Context;
-use crate::input::{self, InputArgs};
+use crate::input::{self, Deferred, InputArgs};
 
 /// Arguments of `toonkit smear`: a subcommand, or `IN --style STYLE.toml -o OUT.glb`.
 #[derive(Debug, Args)]

@@ -13,7 +13,6 @@ mod segment;
 use anyhow::Result;
 use clap::{Args, Subcommand};
 pub(crate) use stopmo::args::{LibraryOptionsArgs, SegmentOptionsArgs};
-use tkio::args::Deferred;
 
 use super::Context;
 
@@ -29,13 +28,13 @@ pub(crate) struct StopmoArgs {
 pub(crate) enum StopmoCommand {
     /// Cut the animation into parts along low-motion seams and make the seams identical in
     /// every frame (StopShop Sections 3.1–3.2).
-    Segment(Deferred<segment::SegmentArgs>),
+    Segment(tkio::args::Deferred<segment::SegmentArgs>),
     /// Build a replacement library of printable pieces per part, the assembly sheet and a
     /// shooting order (StopShop Sections 3.3–3.4, 5).
-    Library(Deferred<library::LibraryArgs>),
+    Library(tkio::args::Deferred<library::LibraryArgs>),
     /// Segment, then build the library of every part: `segment` and `library` in one go,
     /// writing DIR/segmentation.glb, DIR/segmentation.json and the library layout in DIR.
-    Run(Deferred<run::RunArgs>),
+    Run(tkio::args::Deferred<run::RunArgs>),
 }
 
 /// Runs `toonkit stopmo …`.
