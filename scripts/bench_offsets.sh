@@ -4,6 +4,9 @@
 # to .glb). Target (issue 14): ≤ 12.8 ms, 100× the authors' Blender add-on (1.28 s).
 #
 # usage: scripts/bench_offsets.sh [RUNS]      (needs hyperfine: apt-get install hyperfine)
+#
+# The VM's speed drifts over minutes: to compare two builds, time them run after run with
+# scripts/bench_offsets_interleaved.py TUBE.glb RUNS BUILD_A BUILD_B.
 set -euo pipefail
 
 runs=${1:-50}
