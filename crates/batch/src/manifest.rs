@@ -56,13 +56,10 @@ pub enum ToolOutput {
 #[cfg(feature = "clap")]
 impl ToolOutput {
     /// How the command `words` (subcommand names under `root`) takes its output file, read
-    /// from the parser itself: an argument with id `output`, positional or not. A parser whose
-    /// subcommands define their flags only when used (`tkio::args::Deferred`) is read from a
-    /// built copy.
+    /// from the parser itself: an argument with id `output`, positional or not. `root` must be
+    /// built ([`clap::Command::build`]) when its subcommands define their flags lazily.
     pub fn of(root: &clap::Command, words: &[&str]) -> ToolOutput {
-        let mut built = root.clone();
-        built.build();
-        let mut command = &built;
+        let mut command = root;
         for w in words {
             match command.find_subcommand(w) {
                 Some(c) => command = c,

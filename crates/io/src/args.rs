@@ -14,7 +14,7 @@ use crate::{IoError, LoadOptions, Loaded};
 
 mod deferred;
 
-pub use deferred::Deferred;
+pub use deferred::{built, Deferred};
 
 /// Why the shared flags cannot open an input, in the user's terms.
 #[derive(Debug, thiserror::Error)]

@@ -325,9 +325,9 @@ fn normalized(s: RibbonSample, max_root: f32, max_tip: f32, collinear: bool) -> 
 }
 
 /// [`normalized`] over a neighbourhood's columns, in place: `raw[i]` becomes entry i's
-/// w_coll·δ̃ / M (SMEAR Eqs. 8–9), or 0 where M vanishes. Written as selects so that the
-/// compiler vectorizes it; compiled for baseline x86-64 and AVX2 like [`Ribbon::eval_batch`]
-/// (the same operations in the same order as [`normalized`]: the same bits).
+/// w_coll·δ̃ / M (SMEAR Eqs. 8–9), or 0 where M vanishes. The compiler turns the branch into
+/// selects and vectorizes the loop; compiled for baseline x86-64 and AVX2 like
+/// [`Ribbon::eval_batch`].
 #[multiversion::multiversion(targets("x86_64+avx2"))]
 fn normalize_columns(
     raw: &mut [f32],
@@ -337,13 +337,9 @@ fn normalize_columns(
     max_tip: f32,
     collinear: bool,
 ) {
-    let n = raw.len();
-    let (u, coll) = (&u[..n], &coll[..n]);
-    for i in 0..n {
-        let m = (1.0 - u[i]) * max_root + u[i] * max_tip;
-        let c = if collinear { coll[i] } else { 1.0 };
-        let q = c * raw[i] / m;
-        raw[i] = if m > 0.0 { q } else { 0.0 };
+    for ((r, &u), &coll) in raw.iter_mut().zip(u).zip(coll) {
+        let s = RibbonSample { u, raw: *r, coll };
+        *r = normalized(s, max_root, max_tip, collinear);
     }
 }
 

@@ -267,8 +267,8 @@ impl Ribbon {
     /// If an input or output column is shorter than `xs`.
     ///
     /// # Performance
-    /// Branch-free columns the compiler vectorizes (4 points per instruction with SSE2); the
-    /// beyond-the-ends cases are selected, not branched to.
+    /// Branch-free columns the compiler vectorizes (4 points per instruction with SSE2, 8 with
+    /// AVX2, see [`eval_columns`]); the beyond-the-ends cases are selected, not branched to.
     pub(crate) fn eval_batch(
         &self,
         xs: &[f32],
@@ -279,44 +279,6 @@ impl Ribbon {
         coll: &mut [f32],
     ) {
         eval_columns(self, xs, ys, zs, raw, u, coll);
-    }
-
-    /// The body of [`Ribbon::eval_batch`] (see [`eval_columns`]).
-    #[inline(always)]
-    fn eval_columns(
-        &self,
-        xs: &[f32],
-        ys: &[f32],
-        zs: &[f32],
-        raw: &mut [f32],
-        u: &mut [f32],
-        coll: &mut [f32],
-    ) {
-        let n = xs.len();
-        let (ys, zs) = (&ys[..n], &zs[..n]);
-        let (raw, u, coll) = (&mut raw[..n], &mut u[..n], &mut coll[..n]);
-        match self.interp {
-            Interp::Slerp => self.batch(xs, ys, zs, raw, u, coll, |u| {
-                let (s, c) = sin_cos_0_pi(u * self.omega);
-                (c, s, 1.0)
-            }),
-            Interp::Lerp => self.batch(xs, ys, zs, raw, u, coll, |u| {
-                let (a, b) = (1.0 - u, u);
-                (
-                    a,
-                    b,
-                    a * a * self.pp + 2.0 * a * b * self.pq + b * b * self.qq,
-                )
-            }),
-            Interp::Still => {
-                for i in 0..n {
-                    let x = Vec3::new(xs[i], ys[i], zs[i]);
-                    u[i] = smoothstep(self.project(x).2);
-                }
-                raw.fill(0.0);
-                coll.fill(0.0);
-            }
-        }
     }
 
     /// The loops of [`Ribbon::eval_batch`] for v(u) = a·P + b·Q, `dir(u) = (a, b, |v|²)`: first
@@ -462,7 +424,27 @@ fn eval_columns(
     u: &mut [f32],
     coll: &mut [f32],
 ) {
-    rib.eval_columns(xs, ys, zs, raw, u, coll);
+    let n = xs.len();
+    let (ys, zs) = (&ys[..n], &zs[..n]);
+    let (raw, u, coll) = (&mut raw[..n], &mut u[..n], &mut coll[..n]);
+    match rib.interp {
+        Interp::Slerp => rib.batch(xs, ys, zs, raw, u, coll, |u| {
+            let (s, c) = sin_cos_0_pi(u * rib.omega);
+            (c, s, 1.0)
+        }),
+        Interp::Lerp => rib.batch(xs, ys, zs, raw, u, coll, |u| {
+            let (a, b) = (1.0 - u, u);
+            (a, b, a * a * rib.pp + 2.0 * a * b * rib.pq + b * b * rib.qq)
+        }),
+        Interp::Still => {
+            for i in 0..n {
+                let x = Vec3::new(xs[i], ys[i], zs[i]);
+                u[i] = smoothstep(rib.project(x).2);
+            }
+            raw.fill(0.0);
+            coll.fill(0.0);
+        }
+    }
 }
 
 #[cfg(test)]

@@ -43,6 +43,14 @@ use clap::{ArgMatches, Args, Command, FromArgMatches};
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct Deferred<T>(pub T);
 
+/// `command` with every deferred subcommand's flags defined ([`Command::build`]), for code
+/// that reads the parser rather than parsing with it (e.g. looking up a subcommand's
+/// arguments).
+pub fn built(mut command: Command) -> Command {
+    command.build();
+    command
+}
+
 impl<T> Deferred<T> {
     /// The arguments.
     pub fn into_inner(self) -> T {

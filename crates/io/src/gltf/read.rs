@@ -324,22 +324,11 @@ fn primitive_geometry(
                 Dimensions::Scalar,
                 "indices",
             )?;
-            match acc.data_type() {
-                DataType::U16 => {
-                    packed::<u16>(&acc, buffers).map(|v| v.into_iter().map(u32::from).collect())
-                }
-                DataType::U32 => packed::<u32>(&acc, buffers),
-                _ => None,
-            }
-            .map_or_else(
-                || {
-                    reader
-                        .read_indices()
-                        .map(|i| i.into_u32().collect())
-                        .ok_or_else(|| outside("index"))
-                },
-                Ok,
-            )?
+            packed::<u16>(&acc, buffers, DataType::U16)
+                .map(|v| v.into_iter().map(u32::from).collect())
+                .or_else(|| packed::<u32>(&acc, buffers, DataType::U32))
+                .or_else(|| reader.read_indices().map(|i| i.into_u32().collect()))
+                .ok_or_else(|| outside("index"))?
         }
         None => (0..n as u32).collect(),
     };
@@ -410,30 +399,12 @@ fn primitive_influences(
             Dimensions::Vec4,
             "WEIGHTS",
         )?;
-        let packed_joints = match ja.data_type() {
-            DataType::U16 => packed::<[u16; 4]>(&ja, buffers),
-            _ => None,
-        };
-        let j: Vec<[u16; 4]> = match packed_joints {
-            Some(j) => j,
-            None => reader
-                .read_joints(set)
-                .ok_or_else(|| outside("JOINTS"))?
-                .into_u16()
-                .collect(),
-        };
-        let packed_weights = match wa.data_type() {
-            DataType::F32 => packed::<[f32; 4]>(&wa, buffers),
-            _ => None,
-        };
-        let w: Vec<[f32; 4]> = match packed_weights {
-            Some(w) => w,
-            None => reader
-                .read_weights(set)
-                .ok_or_else(|| outside("WEIGHTS"))?
-                .into_f32()
-                .collect(),
-        };
+        let j: Vec<[u16; 4]> = packed(&ja, buffers, DataType::U16)
+            .or_else(|| reader.read_joints(set).map(|j| j.into_u16().collect()))
+            .ok_or_else(|| outside("JOINTS"))?;
+        let w: Vec<[f32; 4]> = packed(&wa, buffers, DataType::F32)
+            .or_else(|| reader.read_weights(set).map(|w| w.into_f32().collect()))
+            .ok_or_else(|| outside("WEIGHTS"))?;
         sets.push((j, w));
         set += 1;
     }

@@ -59,14 +59,18 @@ fn outside(acc: &gltf::Accessor, what: &str) -> IoError {
     )
 }
 
-/// The elements of an accessor whose data lie tightly packed in its buffer view (no gap
-/// between elements, not sparse), decoded straight from the bytes: the items `gltf`'s
+/// The elements of an accessor of `kind` components whose data lie tightly packed in its
+/// buffer view (no gap between elements, not sparse), decoded straight from the bytes: the items `gltf`'s
 /// iterator yields, without its per-item bookkeeping (most of the cost of reading a mesh).
-/// `None` for any other layout, or data outside the buffer: the caller then reads through the
-/// iterator, which handles every case and reports the errors.
-pub(crate) fn packed<T: Item>(acc: &gltf::Accessor, buffers: &[&[u8]]) -> Option<Vec<T>> {
+/// `None` for another component type, any other layout, or data outside the buffer: the
+/// caller then reads through the iterator, which handles every case and reports the errors.
+pub(crate) fn packed<T: Item>(
+    acc: &gltf::Accessor,
+    buffers: &[&[u8]],
+    kind: DataType,
+) -> Option<Vec<T>> {
     let size = std::mem::size_of::<T>();
-    if acc.sparse().is_some() || acc.size() != size {
+    if acc.data_type() != kind || acc.sparse().is_some() || acc.size() != size {
         return None;
     }
     let view = acc.view()?;
@@ -95,7 +99,7 @@ macro_rules! reader {
             [T; $n]: Item,
         {
             let norm = acc.normalized();
-            if let Some(items) = packed::<[T; $n]>(acc, buffers) {
+            if let Some(items) = packed::<[T; $n]>(acc, buffers, acc.data_type()) {
                 return Ok(items
                     .into_iter()
                     .map(|v| v.map(|c| c.to_f32(norm)))
@@ -174,17 +178,19 @@ mod tests {
         let mut checked = 0;
         for acc in doc.accessors() {
             let same = match (acc.data_type(), acc.dimensions()) {
-                (DataType::F32, Dimensions::Vec3) => packed::<[f32; 3]>(&acc, &buffers)
-                    .map(|p| p == iterated::<[f32; 3]>(&acc, &buffers)),
-                (DataType::F32, Dimensions::Vec4) => packed::<[f32; 4]>(&acc, &buffers)
-                    .map(|p| p == iterated::<[f32; 4]>(&acc, &buffers)),
-                (DataType::F32, Dimensions::Scalar) => {
-                    packed::<f32>(&acc, &buffers).map(|p| p == iterated::<f32>(&acc, &buffers))
+                (DataType::F32, Dimensions::Vec3) => {
+                    packed::<[f32; 3]>(&acc, &buffers, DataType::F32)
+                        .map(|p| p == iterated::<[f32; 3]>(&acc, &buffers))
                 }
-                (DataType::U16, Dimensions::Scalar) => {
-                    packed::<u16>(&acc, &buffers).map(|p| p == iterated::<u16>(&acc, &buffers))
+                (DataType::F32, Dimensions::Vec4) => {
+                    packed::<[f32; 4]>(&acc, &buffers, DataType::F32)
+                        .map(|p| p == iterated::<[f32; 4]>(&acc, &buffers))
                 }
-                (DataType::U8, Dimensions::Vec4) => packed::<[u8; 4]>(&acc, &buffers)
+                (DataType::F32, Dimensions::Scalar) => packed::<f32>(&acc, &buffers, DataType::F32)
+                    .map(|p| p == iterated::<f32>(&acc, &buffers)),
+                (DataType::U16, Dimensions::Scalar) => packed::<u16>(&acc, &buffers, DataType::U16)
+                    .map(|p| p == iterated::<u16>(&acc, &buffers)),
+                (DataType::U8, Dimensions::Vec4) => packed::<[u8; 4]>(&acc, &buffers, DataType::U8)
                     .map(|p| p == iterated::<[u8; 4]>(&acc, &buffers)),
                 _ => None,
             };
@@ -197,6 +203,7 @@ mod tests {
         // A layout it does not read (a component size that does not match) is left to the
         // iterator.
         let acc = doc.accessors().next().unwrap();
-        assert!(packed::<u8>(&acc, &buffers).is_none());
+        assert!(packed::<u8>(&acc, &buffers, acc.data_type()).is_none());
+        assert!(packed::<[f32; 3]>(&acc, &buffers, DataType::U32).is_none());
     }
 }
