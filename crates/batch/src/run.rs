@@ -88,6 +88,22 @@ impl BatchReport {
     pub fn count(&self, status: &str) -> usize {
         self.shots.iter().filter(|r| r.status == status).count()
     }
+
+    /// The batch in words: the counts and wall time, then one line per failed shot.
+    pub fn summary(&self, seconds: f64) -> String {
+        let mut text = format!(
+            "{} shots: {} done, {} skipped, {} failed in {seconds:.1} s",
+            self.shots.len(),
+            self.count("done"),
+            self.count("skipped"),
+            self.count("failed"),
+        );
+        for r in self.shots.iter().filter(|r| r.status == "failed") {
+            let error = r.error.as_deref().unwrap_or("");
+            text.push_str(&format!("\n  {}: {error}", r.name));
+        }
+        text
+    }
 }
 
 /// The error of a batch in which some shots failed (the others were made).

@@ -83,24 +83,8 @@ pub(crate) fn run(ctx: &Context, args: BatchArgs) -> Result<()> {
         "shots": report.shots,
         "seconds": start.elapsed().as_secs_f64(),
     });
-    ctx.report(&summary, || {
-        let mut text = format!(
-            "{} shots: {} done, {} skipped, {} failed in {:.1} s",
-            report.shots.len(),
-            report.count("done"),
-            report.count("skipped"),
-            failed,
-            start.elapsed().as_secs_f64()
-        );
-        for r in report.shots.iter().filter(|r| r.status == "failed") {
-            text.push_str(&format!(
-                "\n  {}: {}",
-                r.name,
-                r.error.as_deref().unwrap_or("")
-            ));
-        }
-        text
-    });
+    let seconds = start.elapsed().as_secs_f64();
+    ctx.report(&summary, || report.summary(seconds));
     if failed > 0 {
         return Err(ShotsFailed {
             failed,
