@@ -17,6 +17,11 @@
 //! without its large-OS-page option) was measured against it on the benchmark tube (issue
 //! #14): as fast for `smear offsets`, slower for `convert` (more system time), so this stays.
 //!
+//! Large buffers are first carved from a [`RESERVE`] mapped at start-up, which [`populate`]
+//! faults in on an idle thread (with the heap's first megabytes) while the job starts: the
+//! kernel's zeroing of those pages moves off the critical path (issue #14: ~1 ms of the
+//! tube's 13).
+//!
 //! Its own crate, apart from the CLI and the libraries: only the binary installs it (the
 //! libraries and the Python module keep their host's allocator), and it is the one place of
 //! the workspace that needs `unsafe`.
@@ -41,8 +46,10 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::ptr;
 
 mod heap;
+mod reserve;
 
 pub use heap::{configure_heap, HEAP_RESERVE};
+pub use reserve::{populate, HEAP_POPULATE, RESERVE};
 
 /// Size of a transparent huge page on x86-64 and aarch64 Linux (with 4 KiB base pages).
 const HUGE_PAGE: usize = 2 << 20;
@@ -67,9 +74,14 @@ fn mapping_len(size: usize) -> usize {
     size.div_ceil(HUGE_PAGE) * HUGE_PAGE
 }
 
-/// Maps `size` bytes (zeroed, as every fresh anonymous mapping) at a 2 MiB boundary, or null.
+/// `size` bytes (zeroed: a fresh anonymous mapping, or reserve never handed out before) at a
+/// 2 MiB boundary, or null.
 fn map(size: usize) -> *mut u8 {
     let len = mapping_len(size);
+    let p = reserve::take(len);
+    if !p.is_null() {
+        return p;
+    }
     let Some(reserve) = len.checked_add(HUGE_PAGE) else {
         return ptr::null_mut();
     };

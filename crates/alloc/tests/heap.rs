@@ -68,6 +68,62 @@ fn main() {
         "heap: {} MiB advised for huge pages",
         (heap_end - heap_start) >> 20
     );
+    reserve(p, heap_start);
+}
+
+/// The heap's next blocks lie past its first huge-page boundary; large buffers are carved
+/// from the reserve one after the other, zeroed; [`toonkit_alloc::populate`] makes a buffer
+/// that nobody touched resident; a spent reserve falls back to mappings of their own.
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+fn reserve(heap_block: usize, heap_start: usize) {
+    use std::alloc::{GlobalAlloc, Layout};
+    const HUGE: usize = 2 << 20;
+    assert!(
+        heap_block >= heap_start.next_multiple_of(HUGE),
+        "a heap block past the first 2 MiB boundary: {heap_block:#x} (heap from {heap_start:#x})"
+    );
+    let a = toonkit_alloc::HugePageAlloc;
+    let layout = Layout::from_size_align(3 * HUGE + 5, 64).expect("layout");
+    // SAFETY: valid non-zero layouts; reads and writes stay inside each block, and every
+    // block is released with its own layout.
+    unsafe {
+        let first = a.alloc_zeroed(layout);
+        let second = a.alloc_zeroed(layout);
+        assert!(!first.is_null() && !second.is_null());
+        assert_eq!(
+            second as usize,
+            first as usize + 4 * HUGE,
+            "consecutive buffers of the reserve"
+        );
+        assert_eq!(mapping_of(first as usize).0.as_deref(), Some(""));
+        toonkit_alloc::populate();
+        let pages = layout.size().div_ceil(4096);
+        let mut resident = vec![0u8; pages];
+        let rc = libc::mincore(first.cast(), layout.size(), resident.as_mut_ptr());
+        assert_eq!(rc, 0, "mincore");
+        assert!(
+            resident.iter().all(|r| r & 1 == 1),
+            "populate made the untouched buffer resident"
+        );
+        assert!((0..layout.size())
+            .step_by(4096)
+            .all(|i| *second.add(i) == 0));
+        *first = 1;
+        *second.add(layout.size() - 1) = 2;
+        // More than the reserve has left: a mapping of its own, aligned and zeroed too.
+        let big = Layout::from_size_align(toonkit_alloc::RESERVE, 64).expect("layout");
+        let third = a.alloc_zeroed(big);
+        assert!(!third.is_null() && (third as usize).is_multiple_of(HUGE));
+        assert!(
+            !(first as usize..first as usize + toonkit_alloc::RESERVE).contains(&(third as usize))
+        );
+        assert!((0..big.size()).step_by(4096).all(|i| *third.add(i) == 0));
+        assert_eq!((*first, *second.add(layout.size() - 1)), (1, 2));
+        for (p, l) in [(first, layout), (second, layout), (third, big)] {
+            a.dealloc(p, l);
+        }
+    }
+    println!("reserve: buffers carved in order and populated ahead of use");
 }
 
 /// Name and `VmFlags` of the mapping holding `address`, from `/proc/self/smaps`.

@@ -62,18 +62,8 @@ enum Command {
 /// an error of that command, not a crash of the caller.
 pub(crate) fn run_args(args: &[String]) -> anyhow::Result<()> {
     let argv = std::iter::once("toonkit").chain(args.iter().map(String::as_str));
-    let cli = Cli::try_parse_from(argv).map_err(|e| {
-        let text = e.to_string();
-        let first = text.lines().next().unwrap_or("invalid arguments");
-        anyhow::anyhow!("{}", first.trim_start_matches("error: "))
-    })?;
-    let ctx = commands::Context {
-        json: true,
-        quiet: true,
-        save: tkio::SaveOptions {
-            quantize: !cli.no_quantize,
-        },
-    };
+    let cli = Cli::try_parse_from(argv).map_err(|e| anyhow::anyhow!("{}", usage_error(&e)))?;
+    let ctx = cli.context(true);
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(&ctx, cli.command)))
         .unwrap_or_else(|_| {
             Err(anyhow::anyhow!(
@@ -88,22 +78,25 @@ pub fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) if e.use_stderr() => {
-            // Usage errors in one line too (clap adds usage and a --help hint below).
-            let text = e.to_string();
-            let first = text.lines().next().unwrap_or("invalid arguments");
-            let first = first.strip_prefix("error: ").unwrap_or(first);
-            eprintln!("toonkit: error: {first} (see --help)");
+            eprintln!("toonkit: error: {} (see --help)", usage_error(&e));
             return ExitCode::from(2);
         }
         Err(e) => e.exit(), // --help, --version
     };
-    let ctx = commands::Context {
-        json: cli.json,
-        quiet: false,
-        save: tkio::SaveOptions {
-            quantize: !cli.no_quantize,
-        },
-    };
+    // The main thread joins rayon's pool as its first worker, so the job's parallel loops
+    // start without handing work to another thread and waking it, and the second worker
+    // faults memory in while the input is read. Not for the studio: its jobs come from the
+    // server's threads.
+    if !matches!(cli.command, Command::Studio(_)) {
+        let _ = rayon::ThreadPoolBuilder::new()
+            .use_current_thread()
+            .build_global();
+        #[cfg(target_os = "linux")]
+        if rayon::current_num_threads() > 1 {
+            rayon::spawn(toonkit_alloc::populate);
+        }
+    }
+    let ctx = cli.context(false);
     match run(&ctx, cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) if e.is::<commands::batch::ShotsFailed>() => {
@@ -135,6 +128,24 @@ pub(crate) fn one_line(e: &anyhow::Error) -> String {
         }
     }
     msg.replace('\n', " ")
+}
+
+impl Cli {
+    /// The options every command sees (`quiet`: in-process runs, which report as JSON).
+    fn context(&self, quiet: bool) -> commands::Context {
+        let save = tkio::SaveOptions {
+            quantize: !self.no_quantize,
+        };
+        let json = self.json || quiet;
+        commands::Context { json, quiet, save }
+    }
+}
+
+/// The first line of a usage error, without clap's "error: " (its usage and hint follow).
+fn usage_error(e: &clap::Error) -> String {
+    let text = e.to_string();
+    let first = text.lines().next().unwrap_or("invalid arguments");
+    first.trim_start_matches("error: ").to_string()
 }
 
 /// Runs one parsed command (the binary's dispatcher; `toonkit batch` runs its shots through
