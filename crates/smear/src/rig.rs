@@ -1,6 +1,9 @@
 //! Skin weights over kept bones and the joint neighbourhoods of SMEAR Eq. 9, after pruning.
 
+use std::ops::Range;
+
 use anim::{Skeleton, Skin};
+use rayon::prelude::*;
 
 use crate::{Result, SmearError};
 
@@ -59,6 +62,129 @@ pub(crate) struct Hood<'a> {
     /// `(first vertex, length)` of the runs of consecutive vertices covering `vertex` in
     /// order, or empty when the neighbourhood is too fragmented (then gather `vertex`).
     pub(crate) runs: &'a [(u32, u32)],
+}
+
+/// Vertices per parallel job of [`Rig::new`].
+const RIG_BLOCK: usize = 4096;
+
+/// Rows and neighbourhood entries of a block of consecutive vertices (see [`Rig::new`]).
+struct Block {
+    /// End of each vertex's row in `row_joint` / `row_weight`.
+    row_end: Vec<u32>,
+    row_joint: Vec<u32>,
+    row_weight: Vec<f32>,
+    /// End of each vertex's entries in `entries`.
+    entry_end: Vec<u32>,
+    /// `(bone, membership flags, skin weight on the bone)` of each neighbourhood a vertex is in.
+    entries: Vec<(u32, u8, f32)>,
+    /// Entries per bone.
+    count: Vec<u32>,
+}
+
+impl Block {
+    /// The rows of the vertices in `range` (indices over the concatenated `parts`): their
+    /// influences merged onto kept joints and normalized; then the neighbourhoods each vertex
+    /// belongs to (`marks`, per joint), with merged flags and the vertex's weight on the bone.
+    fn new(
+        skeleton: &Skeleton,
+        pruned: &Pruned,
+        parts: &[&Skin],
+        marks: &[Vec<(usize, u8)>],
+        range: Range<usize>,
+    ) -> Result<Block> {
+        let len = range.len();
+        let mut block = Block {
+            row_end: Vec::with_capacity(len),
+            // Two influences per vertex is typical of a skinned mesh: most rows fit.
+            row_joint: Vec::with_capacity(2 * len),
+            row_weight: Vec::with_capacity(2 * len),
+            entry_end: Vec::with_capacity(len),
+            entries: Vec::with_capacity(3 * len),
+            count: vec![0; marks.len()],
+        };
+        let mut row: Vec<(u32, f32)> = Vec::with_capacity(8);
+        let mut base = 0;
+        for skin in parts {
+            let count = skin.weights.vertex_count();
+            for v in range.start.max(base)..range.end.min(base + count) {
+                row.clear();
+                let (slots, w) = skin.weights.influences(v - base);
+                for (&s, &x) in slots.iter().zip(w) {
+                    let j = skin.joints[s as usize];
+                    let Some(k) = pruned.drive[j] else {
+                        return Err(SmearError::PruneWithoutAncestor {
+                            name: skeleton.joints[j].name.clone(),
+                        });
+                    };
+                    match row.iter_mut().find(|e| e.0 == k as u32) {
+                        Some(e) => e.1 += x,
+                        None => row.push((k as u32, x)),
+                    }
+                }
+                let sum: f32 = row.iter().map(|e| e.1).sum();
+                for &(k, x) in &row {
+                    block.row_joint.push(k);
+                    block.row_weight.push(x / sum);
+                }
+                block.row_end.push(block.row_joint.len() as u32);
+            }
+            base += count;
+        }
+        let mut a = 0;
+        for &end in &block.row_end {
+            let (js, ws) = (
+                &block.row_joint[a..end as usize],
+                &block.row_weight[a..end as usize],
+            );
+            a = end as usize;
+            let row = block.entries.len();
+            for &m in js {
+                for &(k, flag) in &marks[m as usize] {
+                    let k = k as u32;
+                    match block.entries[row..].iter_mut().find(|e| e.0 == k) {
+                        Some(e) => e.1 |= flag,
+                        None => {
+                            let w = js.iter().zip(ws).find(|(j, _)| **j == k);
+                            block.entries.push((k, flag, w.map_or(0.0, |(_, w)| *w)));
+                            block.count[k as usize] += 1;
+                        }
+                    }
+                }
+            }
+            block.entry_end.push(block.entries.len() as u32);
+        }
+        Ok(block)
+    }
+}
+
+/// Per joint m, the neighbourhoods a vertex on m belongs to, with merged flags (SPEC.md):
+/// V_k,t ∋ vertices on k or its children; V_k,r ∋ vertices on k, its parent or the parent's
+/// other children (for a root: on any root bone).
+fn neighbourhood_marks(n: usize, pruned: &Pruned) -> Vec<Vec<(usize, u8)>> {
+    (0..n)
+        .map(|m| {
+            let mut l: Vec<(usize, u8)> = Vec::new();
+            let mut mark = |k: usize, flag: u8| match l.iter_mut().find(|e| e.0 == k) {
+                Some(e) => e.1 |= flag,
+                None => l.push((k, flag)),
+            };
+            mark(m, IN_ROOT | IN_TIP);
+            if let Some(p) = pruned.parent[m] {
+                mark(p, IN_TIP);
+                for &s in &pruned.children[p] {
+                    mark(s, IN_ROOT);
+                }
+            } else {
+                for &r in &pruned.roots {
+                    mark(r, IN_ROOT);
+                }
+            }
+            for &c in &pruned.children[m] {
+                mark(c, IN_ROOT);
+            }
+            l
+        })
+        .collect()
 }
 
 /// Joint hierarchy after pruning (paper Fig. 8d).
@@ -127,96 +253,43 @@ impl Rig {
     /// # Errors
     /// [`SmearError::PruneWithoutAncestor`] when a vertex is weighted on a pruned joint that has
     /// no kept ancestor.
+    ///
+    /// # Performance
+    /// Each vertex's row and neighbourhood entries are built in blocks of [`RIG_BLOCK`]
+    /// vertices in parallel (the rig is built on the critical path, between the sampling and
+    /// the ribbons), then concatenated and written bone by bone in one pass.
     pub(crate) fn new(skeleton: &Skeleton, pruned: &Pruned, parts: &[&Skin]) -> Result<Rig> {
         let n = skeleton.len();
-        let mut rig = Rig {
-            row_start: vec![0],
-            ..Rig::default()
-        };
         let nv: usize = parts.iter().map(|s| s.weights.vertex_count()).sum();
-        rig.row_start.reserve(nv);
-        // Two influences per vertex is typical of a skinned mesh: most rows fit without growing.
-        rig.row_joint.reserve(2 * nv);
-        rig.row_weight.reserve(2 * nv);
-        let mut row: Vec<(u32, f32)> = Vec::with_capacity(8);
-        for skin in parts {
-            for v in 0..skin.weights.vertex_count() {
-                row.clear();
-                let (slots, w) = skin.weights.influences(v);
-                for (&s, &x) in slots.iter().zip(w) {
-                    let j = skin.joints[s as usize];
-                    let Some(k) = pruned.drive[j] else {
-                        return Err(SmearError::PruneWithoutAncestor {
-                            name: skeleton.joints[j].name.clone(),
-                        });
-                    };
-                    match row.iter_mut().find(|e| e.0 == k as u32) {
-                        Some(e) => e.1 += x,
-                        None => row.push((k as u32, x)),
-                    }
-                }
-                let sum: f32 = row.iter().map(|e| e.1).sum();
-                for &(k, x) in &row {
-                    rig.row_joint.push(k);
-                    rig.row_weight.push(x / sum);
-                }
-                rig.row_start.push(rig.row_joint.len() as u32);
-            }
-        }
-
-        // Neighbourhoods (SPEC.md): V_k,t ∋ vertices on k or its children; V_k,r ∋ vertices on
-        // k, its parent or the parent's other children (for a root: on any root bone).
-        // Per joint m, the neighbourhoods a vertex on m belongs to (merged flags), once.
-        let marks: Vec<Vec<(usize, u8)>> = (0..n)
-            .map(|m| {
-                let mut l: Vec<(usize, u8)> = Vec::new();
-                let mut mark = |k: usize, flag: u8| match l.iter_mut().find(|e| e.0 == k) {
-                    Some(e) => e.1 |= flag,
-                    None => l.push((k, flag)),
-                };
-                mark(m, IN_ROOT | IN_TIP);
-                if let Some(p) = pruned.parent[m] {
-                    mark(p, IN_TIP);
-                    for &s in &pruned.children[p] {
-                        mark(s, IN_ROOT);
-                    }
-                } else {
-                    for &r in &pruned.roots {
-                        mark(r, IN_ROOT);
-                    }
-                }
-                for &c in &pruned.children[m] {
-                    mark(c, IN_ROOT);
-                }
-                l
+        let marks = neighbourhood_marks(n, pruned);
+        let blocks: Vec<Result<Block>> = (0..nv.div_ceil(RIG_BLOCK))
+            .into_par_iter()
+            .map(|b| {
+                let range = b * RIG_BLOCK..((b + 1) * RIG_BLOCK).min(nv);
+                Block::new(skeleton, pruned, parts, &marks, range)
             })
             .collect();
-        // Two passes over the vertices, no list per bone: each vertex's neighbourhoods with
-        // its flags and weight (its own short row), counted per bone; then every bone's
-        // entries written in place, vertices ascending.
-        let mut entry_start: Vec<u32> = Vec::with_capacity(nv + 1);
-        entry_start.push(0);
-        let mut entries: Vec<(u32, u8, f32)> = Vec::with_capacity(3 * nv);
+        // The first vertex's error, whichever block failed first in time.
+        let blocks = blocks.into_iter().collect::<Result<Vec<Block>>>()?;
+        let mut rig = Rig {
+            row_start: Vec::with_capacity(nv + 1),
+            ..Rig::default()
+        };
+        rig.row_start.push(0);
+        let rows: usize = blocks.iter().map(|b| b.row_joint.len()).sum();
+        rig.row_joint.reserve(rows);
+        rig.row_weight.reserve(rows);
         let mut count = vec![0u32; n];
-        for v in 0..nv {
-            let (js, ws) = rig.influences(v);
-            let row = entries.len();
-            for &m in js {
-                for &(k, flag) in &marks[m as usize] {
-                    let k = k as u32;
-                    match entries[row..].iter_mut().find(|e| e.0 == k) {
-                        Some(e) => e.1 |= flag,
-                        None => {
-                            let w = js.iter().zip(ws).find(|(j, _)| **j == k);
-                            entries.push((k, flag, w.map_or(0.0, |(_, w)| *w)));
-                            count[k as usize] += 1;
-                        }
-                    }
-                }
+        for b in &blocks {
+            let base = rig.row_joint.len() as u32;
+            rig.row_start.extend(b.row_end.iter().map(|e| base + e));
+            rig.row_joint.extend_from_slice(&b.row_joint);
+            rig.row_weight.extend_from_slice(&b.row_weight);
+            for (c, &x) in count.iter_mut().zip(&b.count) {
+                *c += x;
             }
-            entry_start.push(entries.len() as u32);
         }
-        let total = entries.len();
+        let total: usize = count.iter().map(|&c| c as usize).sum();
         rig.hood_start = Vec::with_capacity(n + 1);
         rig.hood_start.push(0);
         for &c in &count {
@@ -227,14 +300,18 @@ impl Rig {
         rig.hood_vertex = vec![0; total];
         rig.hood_flags = vec![0; total];
         let mut weight = vec![0.0f32; total];
-        for v in 0..nv {
-            let (a, b) = (entry_start[v] as usize, entry_start[v + 1] as usize);
-            for &(k, flags, w) in &entries[a..b] {
-                let at = fill[k as usize] as usize;
-                fill[k as usize] += 1;
-                rig.hood_vertex[at] = v as u32;
-                rig.hood_flags[at] = flags;
-                weight[at] = w;
+        for (b, block) in blocks.iter().enumerate() {
+            let mut a = 0;
+            for (i, &end) in block.entry_end.iter().enumerate() {
+                let v = (b * RIG_BLOCK + i) as u32;
+                for &(k, flags, w) in &block.entries[a..end as usize] {
+                    let at = fill[k as usize] as usize;
+                    fill[k as usize] += 1;
+                    rig.hood_vertex[at] = v;
+                    rig.hood_flags[at] = flags;
+                    weight[at] = w;
+                }
+                a = end as usize;
             }
         }
         let mask = |f: u8| move |&flags: &u8| if flags & f != 0 { 1.0 } else { 0.0 };
@@ -378,5 +455,101 @@ mod tests {
             Rig::new(&s, &root_pruned, &[&skin]),
             Err(SmearError::PruneWithoutAncestor { .. })
         ));
+    }
+
+    /// Two skins of several blocks each: every row, neighbourhood, flag and skinned weight is
+    /// what a vertex-by-vertex reading of SPEC.md's neighbourhoods gives, vertices ascending,
+    /// and a failing vertex is reported as before.
+    #[test]
+    fn blocks_join_like_one_pass_over_the_vertices() {
+        let s = chain(&["hips", "spine", "chest", "neck"]);
+        let p = Pruned::new(&s, &["neck".into()]).unwrap();
+        let skin = |n: usize, shift: usize| Skin {
+            joints: vec![0, 1, 2, 3],
+            inverse_bind: vec![Mat4::IDENTITY; 4],
+            weights: VertexWeights::from_influences((0..n).map(|v| {
+                let j = ((v + shift) / 700 % 4) as u32;
+                let w = (v % 5) as f32 * 0.2;
+                if w == 0.0 {
+                    vec![(j, 1.0)]
+                } else {
+                    vec![(j, 1.0 - w), ((j + 1) % 4, w)]
+                }
+            })),
+        };
+        let (a, b) = (skin(RIG_BLOCK + 1234, 0), skin(2 * RIG_BLOCK + 17, 300));
+        let rig = Rig::new(&s, &p, &[&a, &b]).unwrap();
+        let n = a.weights.vertex_count() + b.weights.vertex_count();
+        assert_eq!(rig.vertex_count(), n);
+        // Vertex by vertex: kept joints (neck → chest) with merged, normalized weights.
+        let rows: Vec<Vec<(u32, f32)>> = [
+            (&a, a.weights.vertex_count()),
+            (&b, b.weights.vertex_count()),
+        ]
+        .iter()
+        .flat_map(|(sk, len)| {
+            (0..*len).map(|v| {
+                let mut row: Vec<(u32, f32)> = Vec::new();
+                let (slots, w) = sk.weights.influences(v);
+                for (&j, &x) in slots.iter().zip(w) {
+                    let k = p.drive[j as usize].unwrap() as u32;
+                    match row.iter_mut().find(|e| e.0 == k) {
+                        Some(e) => e.1 += x,
+                        None => row.push((k, x)),
+                    }
+                }
+                let sum: f32 = row.iter().map(|e| e.1).sum();
+                row.iter().map(|&(k, x)| (k, x / sum)).collect()
+            })
+        })
+        .collect();
+        for (v, row) in rows.iter().enumerate() {
+            let (js, ws) = rig.influences(v);
+            assert_eq!(
+                js,
+                row.iter().map(|e| e.0).collect::<Vec<_>>(),
+                "vertex {v}"
+            );
+            assert_eq!(
+                ws,
+                row.iter().map(|e| e.1).collect::<Vec<_>>(),
+                "vertex {v}"
+            );
+        }
+        let marks = neighbourhood_marks(s.len(), &p);
+        for k in 0..s.len() {
+            let hood = rig.hood(k);
+            let mut want = (Vec::new(), Vec::new(), Vec::new());
+            for (v, row) in rows.iter().enumerate() {
+                let flags = row
+                    .iter()
+                    .flat_map(|&(m, _)| &marks[m as usize])
+                    .filter(|e| e.0 == k)
+                    .fold(0u8, |f, e| f | e.1);
+                if flags != 0 {
+                    if let Some(&(_, w)) = row.iter().find(|e| e.0 == k as u32) {
+                        want.2.push((want.0.len() as u32, w));
+                    }
+                    want.0.push(v as u32);
+                    want.1.push(flags);
+                }
+            }
+            assert_eq!(hood.vertex, want.0, "bone {k}");
+            assert_eq!(hood.flags, want.1, "bone {k}");
+            let skinned: Vec<(u32, f32)> = hood
+                .skinned_at
+                .iter()
+                .copied()
+                .zip(hood.skinned_weight.iter().copied())
+                .collect();
+            assert_eq!(skinned, want.2, "bone {k}");
+        }
+        assert!(rig.hood(0).vertex.len() > RIG_BLOCK, "a bone spans blocks");
+        // The root pruned: its vertices, in every block, have no kept joint to follow.
+        let bad = Pruned::new(&s, &["hips".into()]).unwrap();
+        match Rig::new(&s, &bad, &[&a, &b]) {
+            Err(SmearError::PruneWithoutAncestor { name }) => assert_eq!(name, "hips"),
+            other => panic!("expected PruneWithoutAncestor, got {other:?}"),
+        }
     }
 }
