@@ -117,9 +117,34 @@ fn map(size: usize) -> *mut u8 {
     start as *mut u8
 }
 
-// SAFETY: small layouts are forwarded to `System` unchanged; large ones get a fresh mapping of
-// at least `size` bytes aligned to 2 MiB (≥ their alignment) that only `dealloc` unmaps, with
-// the same layout, hence the same length.
+/// Gives back a block of [`map`]: its pages are freed. A piece of the reserve keeps its address
+/// range (inaccessible), so that no later mapping lands where [`populate`] may still reach.
+///
+/// # Safety
+/// `ptr` and `len` are a block of [`map`] that nothing uses any more.
+unsafe fn release(ptr: *mut u8, len: usize) {
+    let ptr = ptr as *mut libc::c_void;
+    // SAFETY: the range is the caller's block, whole huge pages, used by nothing else.
+    unsafe {
+        if reserve::owns(ptr as usize)
+            && libc::mmap(
+                ptr,
+                len,
+                libc::PROT_NONE,
+                libc::MAP_PRIVATE | libc::MAP_ANONYMOUS | libc::MAP_FIXED | libc::MAP_NORESERVE,
+                -1,
+                0,
+            ) != libc::MAP_FAILED
+        {
+            return;
+        }
+        libc::munmap(ptr, len);
+    }
+}
+
+// SAFETY: small layouts are forwarded to `System` unchanged; large ones get a fresh mapping or
+// a never-used piece of the reserve, of at least `size` bytes aligned to 2 MiB (≥ their
+// alignment), that only `dealloc` releases, with the same layout, hence the same length.
 unsafe impl GlobalAlloc for HugePageAlloc {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         if mapped(layout.size(), layout.align()) {
@@ -132,7 +157,7 @@ unsafe impl GlobalAlloc for HugePageAlloc {
 
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
         if mapped(layout.size(), layout.align()) {
-            // Fresh anonymous mappings are zero: no page is touched here.
+            // Fresh mappings and never-used reserve are zero: no page is touched here.
             map(layout.size())
         } else {
             // SAFETY: as `alloc`.
@@ -142,10 +167,9 @@ unsafe impl GlobalAlloc for HugePageAlloc {
 
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
         if mapped(layout.size(), layout.align()) {
-            // SAFETY: `ptr` came from `map` with this size (the caller's contract).
-            unsafe {
-                libc::munmap(ptr as *mut libc::c_void, mapping_len(layout.size()));
-            }
+            // SAFETY: `ptr` came from `map` with this size (the caller's contract): a piece
+            // of the reserve or a mapping of its own, either way no other block's memory.
+            unsafe { release(ptr, mapping_len(layout.size())) }
         } else {
             // SAFETY: `ptr` came from `System` with this layout.
             unsafe { System.dealloc(ptr, layout) }

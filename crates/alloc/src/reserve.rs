@@ -61,13 +61,20 @@ pub(crate) fn take(len: usize) -> *mut u8 {
     }
 }
 
+/// Whether `address` lies in the reserve.
+pub(crate) fn owns(address: usize) -> bool {
+    let base = BASE.load(Ordering::Acquire);
+    base != 0 && (base..base + RESERVE).contains(&address)
+}
+
 /// Faults in the first [`HEAP_POPULATE`] bytes of the heap, then the whole reserve, a huge
 /// page at a time; does nothing before [`configure_heap`](crate::configure_heap).
 ///
 /// Run it on a thread that would otherwise wait while the job starts (the `toonkit` binary
 /// hands it to its second worker): the pages are zeroed there instead of on the thread that
-/// first writes them. Buffers already released are skipped (the kernel refuses an unmapped
-/// range); pages already in place are left as they are.
+/// first writes them. Buffers already released are skipped (their range stays reserved,
+/// inaccessible, and the kernel refuses it); pages already in place are left as they are.
+/// Before Linux 5.14 (no `MADV_POPULATE_WRITE`) it changes nothing.
 ///
 /// Does nothing where transparent huge pages are off: faulting in megabytes 4 KiB at a time
 /// would keep that thread from the job's first parallel loops, for pages the job may never

@@ -257,7 +257,8 @@ impl Rig {
     /// # Performance
     /// Each vertex's row and neighbourhood entries are built in blocks of [`RIG_BLOCK`]
     /// vertices in parallel (the rig is built on the critical path, between the sampling and
-    /// the ribbons), then concatenated and written bone by bone in one pass.
+    /// the ribbons), then concatenated, and every entry written into its bone's neighbourhood
+    /// in one pass over the vertices.
     pub(crate) fn new(skeleton: &Skeleton, pruned: &Pruned, parts: &[&Skin]) -> Result<Rig> {
         let n = skeleton.len();
         let nv: usize = parts.iter().map(|s| s.weights.vertex_count()).sum();
@@ -269,7 +270,7 @@ impl Rig {
                 Block::new(skeleton, pruned, parts, &marks, range)
             })
             .collect();
-        // The first vertex's error, whichever block failed first in time.
+        // The first failing vertex's error (blocks in order), as a serial pass reports it.
         let blocks = blocks.into_iter().collect::<Result<Vec<Block>>>()?;
         let mut rig = Rig {
             row_start: Vec::with_capacity(nv + 1),
@@ -459,7 +460,7 @@ mod tests {
 
     /// Two skins of several blocks each: every row, neighbourhood, flag and skinned weight is
     /// what a vertex-by-vertex reading of SPEC.md's neighbourhoods gives, vertices ascending,
-    /// and a failing vertex is reported as before.
+    /// and the first failing vertex is reported, whichever block fails first.
     #[test]
     fn blocks_join_like_one_pass_over_the_vertices() {
         let s = chain(&["hips", "spine", "chest", "neck"]);
@@ -545,10 +546,22 @@ mod tests {
             assert_eq!(skinned, want.2, "bone {k}");
         }
         assert!(rig.hood(0).vertex.len() > RIG_BLOCK, "a bone spans blocks");
-        // The root pruned: its vertices, in every block, have no kept joint to follow.
-        let bad = Pruned::new(&s, &["hips".into()]).unwrap();
-        match Rig::new(&s, &bad, &[&a, &b]) {
-            Err(SmearError::PruneWithoutAncestor { name }) => assert_eq!(name, "hips"),
+        // Two roots pruned: the first failing vertex (block 1, on "prop") is reported, not a
+        // later block's (block 2, on "hips").
+        let mut two = chain(&["hips", "spine", "prop"]);
+        two.joints[2].parent = None;
+        let bad = Pruned::new(&two, &["hips".into(), "prop".into()]).unwrap();
+        let c = Skin {
+            joints: vec![0, 1, 2],
+            inverse_bind: vec![Mat4::IDENTITY; 3],
+            weights: VertexWeights::from_influences((0..3 * RIG_BLOCK).map(|v| match v {
+                v if v == RIG_BLOCK + 5 => vec![(2, 1.0)],
+                v if v == 2 * RIG_BLOCK + 9 => vec![(0, 1.0)],
+                _ => vec![(1, 1.0)],
+            })),
+        };
+        match Rig::new(&two, &bad, &[&c]) {
+            Err(SmearError::PruneWithoutAncestor { name }) => assert_eq!(name, "prop"),
             other => panic!("expected PruneWithoutAncestor, got {other:?}"),
         }
     }

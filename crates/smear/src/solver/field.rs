@@ -59,7 +59,7 @@ impl SolvedField {
                 .iter()
                 .filter_map(|&i| scene.objects[i].skin.as_ref())
                 .collect();
-            // A character's rig is built on one core while the other measures the tolerances.
+            // The tolerances are measured beside the rig (whose blocks are parallel too).
             let (tol, rig) = rayon::join(
                 || tolerances(positions, frames, vertices, space.as_ref(), options.causal),
                 || {
