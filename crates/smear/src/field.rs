@@ -5,7 +5,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use crate::plane::{plane_frames, PlaneFrame};
-use crate::ribbon::{Ribbon, RibbonSample};
+use crate::ribbon::{eval_batch, Ribbon, RibbonSample};
 use crate::rig::{Hood, Rig};
 use crate::velocity::{track_velocity, CameraSpace};
 
@@ -62,8 +62,6 @@ impl Field {
     /// The SMEAR Eqs. 3–9 field of a skinned group, and the (unsmoothed) offsets of its vertices.
     ///
     /// # Arguments
-    /// * `raw` — the buffer the offsets are written to (resized to `frames × vertices`; best
-    ///   fresh from the allocator, so that each worker maps the pages of the frames it writes).
     /// * `bones` — bones of the whole skeleton, frame-major `frames × joints`.
     ///
     /// # Returns
@@ -74,14 +72,14 @@ impl Field {
     /// neighbourhood V_k,r ∪ V_k,t (precomputed once per rig, struct-of-arrays) is read
     /// run by run from the frame's position columns (or gathered into per-worker columns
     /// when fragmented, see [`Hood::runs`]) and evaluated once by the vectorized
-    /// [`Ribbon::eval_batch`]:
-    /// the maxima of SMEAR Eq. 9 come out of that pass, then only the bone's skinned entries are
-    /// normalized and accumulated into SMEAR Eq. 7's sum in a per-worker buffer, and each output
-    /// frame is written once (no read of fresh zeroed pages). No allocation per frame or
-    /// vertex.
+    /// [`eval_batch`]:
+    /// the maxima of SMEAR Eq. 9 come out of that pass, then every entry is normalized
+    /// (vectorized) and the bone's skinned ones are accumulated into SMEAR Eq. 7's sum in a
+    /// per-worker buffer, and each output frame is written once into a buffer fresh from the
+    /// allocator (each worker maps the pages of the frames it writes; no read of zeroed pages).
+    /// No allocation per frame or vertex.
     pub(crate) fn ribbons(
         rig: Rig,
-        mut raw: Vec<f32>,
         positions: &[Vec3],
         frames: usize,
         bones: &[Bone],
@@ -91,10 +89,8 @@ impl Field {
     ) -> (Field, Vec<f32>) {
         let joints = rig.joint_count();
         let vertices = rig.vertex_count();
-        if raw.len() != frames * vertices {
-            raw.clear();
-            raw.resize(frames * vertices, 0.0);
-        }
+        // Zeroed by the allocator, untouched until the workers write their frames.
+        let mut raw = vec![0.0f32; frames * vertices];
         let mut ribbons = vec![None; frames * joints];
         let mut maxima = vec![[0.0f32; 2]; frames * joints];
         if joints == 0 || vertices == 0 {
@@ -239,14 +235,15 @@ impl Scratch {
                 let p = pos[v as usize];
                 (xs[i], ys[i], zs[i]) = (p.x, p.y, p.z);
             }
-            rib.eval_batch(xs, ys, zs, raw, u, coll);
+            eval_batch(rib, xs, ys, zs, raw, u, coll);
         } else {
             // Straight from the frame's columns (filled by `start_frame`), run by run.
             let mut o = 0;
             for &(v, len) in hood.runs {
                 let (v, len) = (v as usize, len as usize);
                 let (a, b) = (v, v + len);
-                rib.eval_batch(
+                eval_batch(
+                    rib,
                     &self.px[a..b],
                     &self.py[a..b],
                     &self.pz[a..b],
@@ -282,7 +279,7 @@ fn masked_maxima(raw: &[f32], in_root: &[f32], in_tip: &[f32]) -> [f32; 2] {
 }
 
 /// max |raw| over the entries flagged 1 in `mask` (see [`masked_maxima`]), compiled for
-/// baseline x86-64 and AVX2 like [`Ribbon::eval_batch`].
+/// baseline x86-64 and AVX2 like [`eval_batch`].
 #[multiversion::multiversion(targets("x86_64+avx2"))]
 fn masked_max(raw: &[f32], mask: &[f32]) -> f32 {
     const L: usize = 8;
@@ -327,7 +324,7 @@ fn normalized(s: RibbonSample, max_root: f32, max_tip: f32, collinear: bool) -> 
 /// [`normalized`] over a neighbourhood's columns, in place: `raw[i]` becomes entry i's
 /// w_coll·δ̃ / M (SMEAR Eqs. 8–9), or 0 where M vanishes. The compiler turns the branch into
 /// selects and vectorizes the loop; compiled for baseline x86-64 and AVX2 like
-/// [`Ribbon::eval_batch`].
+/// [`eval_batch`].
 #[multiversion::multiversion(targets("x86_64+avx2"))]
 fn normalize_columns(
     raw: &mut [f32],

@@ -4,7 +4,7 @@ use glam::Vec3;
 
 use crate::options::DEFAULT_LERP_ANGLE;
 
-/// Points per block of [`Ribbon::eval_batch`] (two SSE registers; 4 costs more overhead).
+/// Points per block of [`eval_batch`] (two SSE registers; 4 costs more overhead).
 const BATCH_LANES: usize = 8;
 
 /// The block of [`BATCH_LANES`] entries of `c` starting at `s`.
@@ -186,7 +186,7 @@ impl Ribbon {
     ///
     /// # Performance
     /// About 40 flops, a polynomial `sin_cos` for slerped bones, one square root and two
-    /// divisions. Hot loops call [`Ribbon::eval_batch`] instead.
+    /// divisions. Hot loops call [`eval_batch`] instead.
     #[inline]
     pub(crate) fn eval(&self, x: Vec3) -> RibbonSample {
         match self.interp {
@@ -259,29 +259,7 @@ impl Ribbon {
         }
     }
 
-    /// [`Ribbon::eval`] at many points, bit for bit: point i is `(xs[i], ys[i], zs[i])`, its
-    /// sample goes to `raw[i]`, `u[i]`, `coll[i]` (only the first `xs.len()` entries of the
-    /// outputs are written).
-    ///
-    /// # Panics
-    /// If an input or output column is shorter than `xs`.
-    ///
-    /// # Performance
-    /// Branch-free columns the compiler vectorizes (4 points per instruction with SSE2, 8 with
-    /// AVX2, see [`eval_columns`]); the beyond-the-ends cases are selected, not branched to.
-    pub(crate) fn eval_batch(
-        &self,
-        xs: &[f32],
-        ys: &[f32],
-        zs: &[f32],
-        raw: &mut [f32],
-        u: &mut [f32],
-        coll: &mut [f32],
-    ) {
-        eval_columns(self, xs, ys, zs, raw, u, coll);
-    }
-
-    /// The loops of [`Ribbon::eval_batch`] for v(u) = a·P + b·Q, `dir(u) = (a, b, |v|²)`: first
+    /// The loops of [`eval_batch`] for v(u) = a·P + b·Q, `dir(u) = (a, b, |v|²)`: first
     /// every point as beyond the bone's ends (SMEAR Eq. 6's dot product with the end normals;
     /// most of the neighbours of a bone), in one loop over whole columns; then each block of
     /// [`BATCH_LANES`] points holding a point within the span (spatially coherent in vertex
@@ -411,11 +389,20 @@ impl Ribbon {
     }
 }
 
-/// [`Ribbon::eval_batch`], compiled for baseline x86-64 and for AVX2 and picked at run time:
-/// with AVX2 the columns run 8 points per instruction instead of 4, with the same bits (Rust
-/// never fuses or reorders float operations, so only the register width differs).
+/// [`Ribbon::eval`] of `rib` at many points, bit for bit: point i is `(xs[i], ys[i], zs[i])`,
+/// its sample goes to `raw[i]`, `u[i]`, `coll[i]` (only the first `xs.len()` entries of the
+/// outputs are written).
+///
+/// # Panics
+/// If an input or output column is shorter than `xs`.
+///
+/// # Performance
+/// Branch-free columns the compiler vectorizes; the beyond-the-ends cases are selected, not
+/// branched to. Compiled for baseline x86-64 and for AVX2 and picked at run time: with AVX2
+/// the columns run 8 points per instruction instead of 4, with the same bits (Rust never fuses
+/// or reorders float operations, so only the register width differs).
 #[multiversion::multiversion(targets("x86_64+avx2"))]
-fn eval_columns(
+pub(crate) fn eval_batch(
     rib: &Ribbon,
     xs: &[f32],
     ys: &[f32],
@@ -535,7 +522,7 @@ mod tests {
             let rib = Ribbon::new(root, tip, vr, vt, 1e-9, 1e-9).unwrap();
             let n = pts.len();
             let (mut raw, mut u, mut coll) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-            rib.eval_batch(&xs, &ys, &zs, &mut raw, &mut u, &mut coll);
+            eval_batch(&rib, &xs, &ys, &zs, &mut raw, &mut u, &mut coll);
             for (i, p) in pts.iter().enumerate() {
                 let s = rib.eval(*p);
                 let same =

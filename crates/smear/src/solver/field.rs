@@ -55,26 +55,14 @@ impl SolvedField {
                 Some(_) if options.whole_body => OffsetMode::WholeBody,
                 Some(_) => OffsetMode::Articulated,
             };
-            let skins: Vec<&Skin> = members
-                .iter()
-                .filter_map(|&i| scene.objects[i].skin.as_ref())
-                .collect();
-            // The tolerances are measured beside the rig (whose blocks are parallel too).
-            let (tol, rig) = rayon::join(
-                || tolerances(positions, frames, vertices, space.as_ref(), options.causal),
-                || {
-                    (mode == OffsetMode::Articulated)
-                        .then(|| Rig::new(&scene.skeleton, &pruned, &skins))
-                        .transpose()
-                },
-            );
-            let (field, raw) = if let Some(rig) = rig? {
-                // Zeroed by the allocator, untouched: each frame's pages are mapped by the
-                // worker that writes the frame, on every core at once.
-                let raw = vec![0.0f32; frames * vertices];
+            let tol = tolerances(positions, frames, vertices, space.as_ref(), options.causal);
+            let (field, raw) = if mode == OffsetMode::Articulated {
+                let skins: Vec<&Skin> = members
+                    .iter()
+                    .filter_map(|&i| scene.objects[i].skin.as_ref())
+                    .collect();
                 Field::ribbons(
-                    rig,
-                    raw,
+                    Rig::new(&scene.skeleton, &pruned, &skins)?,
                     positions,
                     frames,
                     &scene.bones,
