@@ -184,3 +184,51 @@ pub(crate) fn style(data: &[u8]) {
         }
     }
 }
+
+/// glTF buffer URIs: the confinement rule of a `.gltf` (a URI resolves only inside the
+/// file's folder). Any text gives Ok or Err; an accepted URI is a relative path of plain
+/// names (no root, no `..`, no scheme or drive), so joined to the folder it stays inside.
+pub(crate) fn gltf_uri(data: &[u8]) {
+    use std::path::Component;
+    let Ok(uri) = std::str::from_utf8(data) else {
+        return;
+    };
+    if let Ok(rel) = tkio::gltf::confined_uri(uri) {
+        assert!(!uri.contains(':'), "a scheme or drive passed: {uri:?}");
+        assert!(
+            rel.components()
+                .all(|c| matches!(c, Component::Normal(_) | Component::CurDir)),
+            "{uri:?} leaves the folder as {rel:?}"
+        );
+        assert!(rel.is_relative(), "{uri:?}");
+    }
+}
+
+/// Option sizes: eight little-endian u64 values read as `--smooth`, a motion-line count,
+/// samples, sides, frames, an image's width and height, and keystrokes. The budget checks
+/// never panic (products saturate), and a size they accept is within its limit.
+pub(crate) fn sizes(data: &[u8]) {
+    use anim::budget::{self, product};
+    let mut v = [0u64; 8];
+    for (k, chunk) in data.chunks(8).take(8).enumerate() {
+        let mut b = [0u8; 8];
+        b[..chunk.len()].copy_from_slice(chunk);
+        v[k] = u64::from_le_bytes(b);
+    }
+    let [smooth, count, samples, sides, frames, width, height, keys] = v;
+    let options = smear::OffsetOptions {
+        smooth: smooth.min(usize::MAX as u64) as usize,
+        ..Default::default()
+    };
+    if options.check_budget().is_ok() {
+        assert!(smooth <= budget::DEFAULT_MAX_SMOOTH);
+    }
+    let lines = product(&[count, samples, sides, frames]);
+    match anim::check_budget("lines", lines, budget::DEFAULT_MAX_LINE_VERTICES, "") {
+        Ok(()) => assert!(lines <= budget::DEFAULT_MAX_LINE_VERTICES),
+        Err(e) => assert!(e.to_string().contains("over the limit")),
+    }
+    let pixels = product(&[width, height, frames]);
+    let _ = anim::check_budget("pixels", pixels, budget::DEFAULT_MAX_PIXELS, "");
+    let _ = anim::check_budget("keystrokes", keys, budget::DEFAULT_MAX_KEYSTROKES, "");
+}

@@ -20,6 +20,7 @@
 
 #![warn(missing_docs, unreachable_pub)]
 
+pub mod budget;
 mod camera;
 mod clip;
 mod error;
@@ -34,6 +35,7 @@ mod skeleton;
 mod skin;
 mod transform;
 
+pub use budget::{check_budget, OverBudget};
 pub use camera::{Camera, Projection};
 pub use clip::{frame_count, Channel, Clip, Interpolation, Property, MAX_FRAMES};
 pub use error::{AnimError, Result};

@@ -8,8 +8,8 @@ use crate::{
     SkeletalAnimation, Skeleton, Skin, Transform, DEFAULT_FPS,
 };
 
-/// Upper bound on sampled positions (frames × vertices), about 12 GB of `Vec3`.
-pub(crate) const MAX_SAMPLED_VALUES: usize = 1_000_000_000;
+/// Upper bound on sampled positions (frames × vertices): the job's point budget.
+pub(crate) const MAX_SAMPLED_VALUES: usize = crate::budget::DEFAULT_MAX_POINTS as usize;
 
 /// What to sample.
 #[derive(Debug, Clone, PartialEq)]
@@ -205,8 +205,11 @@ fn sample_with(
     );
     if frames > crate::MAX_FRAMES || cache_values > MAX_SAMPLED_VALUES {
         return Err(AnimError::Invalid(format!(
-            "sampling {:.1} s at {fps} fps needs {frames} frames: too many (lower --fps or pick a shorter clip)",
-            clip.map(|c| c.duration()).unwrap_or(0.0)
+            "sampling {:.1} s at {fps} fps needs {frames} frames: frames × vertices = {} is over \
+             the limit of {} (lower --fps or pick a shorter clip)",
+            clip.map(|c| c.duration()).unwrap_or(0.0),
+            crate::human_number(cache_values as f64),
+            crate::human_number(MAX_SAMPLED_VALUES as f64),
         )));
     }
     let order = scene.topological_order();

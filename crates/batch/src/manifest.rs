@@ -133,6 +133,14 @@ impl Manifest {
             if s.outputs.is_empty() {
                 return Err(bad(format!("shot '{}' lists no outputs", s.name)));
             }
+            if let Some(o) = s.outputs.iter().find(|o| !inside_output_folder(o)) {
+                return Err(bad(format!(
+                    "shot '{}': output {} must stay inside the output folder: name it relative to \
+                     OUT, without .. or a leading /",
+                    s.name,
+                    o.display()
+                )));
+            }
             if s.tool.split_whitespace().next() == Some("batch") {
                 return Err(bad(format!("shot '{}' cannot run a batch", s.name)));
             }
@@ -195,6 +203,17 @@ impl Shot {
         }
         Ok(argv)
     }
+}
+
+/// Whether `output` names a file inside the output folder: relative, plain names only.
+fn inside_output_folder(output: &Path) -> bool {
+    output.file_name().is_some()
+        && output.components().all(|c| {
+            matches!(
+                c,
+                std::path::Component::Normal(_) | std::path::Component::CurDir
+            )
+        })
 }
 
 fn scalar(v: &toml::Value) -> String {

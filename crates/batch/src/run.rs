@@ -171,13 +171,56 @@ pub fn run_shots<R: Runner>(
         shots
             .par_iter()
             .map(|shot| {
-                let report = run_shot(shot, base, out, options.force, runner);
+                let report = match output_over_an_input(shot, shots, base, out) {
+                    Some(error) => ShotReport {
+                        name: shot.name.clone(),
+                        status: "failed",
+                        outputs: shot.outputs.iter().map(|o| out.join(o)).collect(),
+                        seconds: 0.0,
+                        error: Some(error),
+                    },
+                    None => run_shot(shot, base, out, options.force, runner),
+                };
                 runner.finished(&report);
                 report
             })
             .collect()
     });
     Ok(BatchReport { jobs, shots })
+}
+
+/// Why `shot` may not run: one of its outputs is the input or style file of a shot of the
+/// batch (its own, or another's that it would break), compared as files (device and inode,
+/// so links and other spellings count) and, for outputs not written yet, by path.
+fn output_over_an_input(shot: &Shot, all: &[&Shot], base: &Path, out: &Path) -> Option<String> {
+    let lexical = |p: &Path| -> Option<PathBuf> {
+        let dir = p.parent().filter(|d| !d.as_os_str().is_empty());
+        let dir = std::fs::canonicalize(dir.unwrap_or(Path::new("."))).ok()?;
+        Some(dir.join(p.file_name()?))
+    };
+    for o in &shot.outputs {
+        let output = out.join(o);
+        for other in all {
+            for file in std::iter::once(&other.input).chain(other.style.as_ref()) {
+                let input = base.join(file);
+                let same = tkio::same_file(&output, &input)
+                    || matches!((lexical(&output), lexical(&input)), (Some(a), Some(b)) if a == b);
+                if same {
+                    let whose = if other.name == shot.name {
+                        "its own input".to_string()
+                    } else {
+                        format!("the input of shot '{}'", other.name)
+                    };
+                    return Some(format!(
+                        "output {} is {whose} ({}): refusing to write over it; name another output",
+                        output.display(),
+                        input.display()
+                    ));
+                }
+            }
+        }
+    }
+    None
 }
 
 /// Makes one shot (or skips it when its stamp matches).
@@ -193,9 +236,11 @@ fn run_shot<R: Runner>(
     let tool = |words: &[&str]| runner.tool_output(words);
     let result = (|| -> Result<&'static str, ShotFailure<R::Error>> {
         let hash = Stamp::hash(shot, base, &tool).map_err(ShotFailure::Hash)?;
-        if !force && Stamp::is_done(shot, out, &hash) {
+        if !force && Stamp::is_done(shot, out, &hash, base) {
             return Ok("skipped");
         }
+        // Every file the shot reads is recorded for its stamp, and none may be written over.
+        let reads = tkio::ReadScope::open();
         for (k, o) in outputs.iter().enumerate() {
             tkio::remove_stale_temps(o);
             runner.writing(shot, k, outputs.len(), o);
@@ -209,7 +254,9 @@ fn run_shot<R: Runner>(
                     error,
                 })?;
         }
-        Stamp::write_done(shot, out, &hash).map_err(ShotFailure::Batch)?;
+        let read = reads.files();
+        drop(reads);
+        Stamp::write_done(shot, out, &hash, base, &read).map_err(ShotFailure::Batch)?;
         Ok("done")
     })();
     let (status, error) = match result {

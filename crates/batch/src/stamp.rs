@@ -2,6 +2,11 @@
 //! recorded in `OUT/.toonkit-batch/<shot>.json` is done. The stamp is written (atomically)
 //! only after all of the shot's outputs, so a re-run after a crash or a kill redoes only what
 //! is missing.
+//!
+//! Inputs are every file the shot read, not only those the manifest names: the external
+//! buffers of a `.gltf`, the implicit rest `.obj` of a point cache, option files such as
+//! `collider = "floor.obj"`, style files (recorded by [`tkio::ReadScope`] while the shot ran).
+//! Outputs are hashed too, so an output edited or replaced since is made again.
 
 use std::path::{Path, PathBuf};
 
@@ -19,8 +24,18 @@ pub struct Stamp {
     pub shot: String,
     /// [`Stamp::hash`] of the shot when it was made.
     pub hash: String,
-    /// `(output, size in bytes)` of every declared output.
-    pub outputs: Vec<(PathBuf, u64)>,
+    /// `(output, size in bytes, content hash)` of every declared output.
+    pub outputs: Vec<(PathBuf, u64, String)>,
+    /// `(file, content hash)` of every file the shot read (relative to the manifest's folder
+    /// when inside it).
+    #[serde(default)]
+    pub inputs: Vec<(PathBuf, String)>,
+}
+
+/// The content hash of a file (XXH3-128, hex), or `None` when it cannot be read.
+fn file_hash(path: &Path) -> Option<String> {
+    let bytes = std::fs::read(path).ok()?;
+    Some(format!("{:032x}", twox_hash::XxHash3_128::oneshot(&bytes)))
 }
 
 impl Stamp {
@@ -57,17 +72,33 @@ impl Stamp {
         out.join(STAMP_DIR).join(format!("{}.json", shot.name))
     }
 
-    /// The stamp of the shot's outputs as they are on disk, if they all exist.
-    pub fn current(shot: &Shot, out: &Path, hash: &str) -> Option<Stamp> {
+    /// The stamp of the shot's outputs as they are on disk, if they all exist, with the
+    /// files `read` (paths relative to `base` or absolute) as they are now (`None` when one
+    /// is gone).
+    pub fn current(
+        shot: &Shot,
+        out: &Path,
+        hash: &str,
+        base: &Path,
+        read: &[PathBuf],
+    ) -> Option<Stamp> {
         let outputs = shot
             .outputs
             .iter()
-            .map(|o| Some((o.clone(), std::fs::metadata(out.join(o)).ok()?.len())))
+            .map(|o| {
+                let p = out.join(o);
+                Some((o.clone(), std::fs::metadata(&p).ok()?.len(), file_hash(&p)?))
+            })
+            .collect::<Option<Vec<_>>>()?;
+        let inputs = read
+            .iter()
+            .map(|r| Some((r.clone(), file_hash(&base.join(r))?)))
             .collect::<Option<Vec<_>>>()?;
         Some(Stamp {
             shot: shot.name.clone(),
             hash: hash.to_string(),
             outputs,
+            inputs,
         })
     }
 
@@ -77,10 +108,14 @@ impl Stamp {
         serde_json::from_slice(&bytes).ok()
     }
 
-    /// Whether the shot is done: its recorded stamp matches its outputs on disk and `hash`.
-    pub fn is_done(shot: &Shot, out: &Path, hash: &str) -> bool {
-        let recorded = Stamp::recorded(shot, out);
-        recorded.is_some() && recorded == Stamp::current(shot, out, hash)
+    /// Whether the shot is done: its recorded stamp matches its outputs on disk, the files
+    /// it read and `hash`.
+    pub fn is_done(shot: &Shot, out: &Path, hash: &str, base: &Path) -> bool {
+        let Some(recorded) = Stamp::recorded(shot, out) else {
+            return false;
+        };
+        let read: Vec<PathBuf> = recorded.inputs.iter().map(|(p, _)| p.clone()).collect();
+        Some(recorded) == Stamp::current(shot, out, hash, base, &read)
     }
 
     /// Records the shot as done (after all its outputs are written).
@@ -88,11 +123,25 @@ impl Stamp {
     /// # Errors
     /// [`BatchError::Invalid`] when a declared output was not written; [`BatchError::Write`]
     /// when the stamp cannot be written.
-    pub fn write_done(shot: &Shot, out: &Path, hash: &str) -> Result<(), BatchError> {
-        let stamp = Stamp::current(shot, out, hash).ok_or_else(|| {
+    /// `read` is every file the shot read (made relative to `base` here when inside it).
+    pub fn write_done(
+        shot: &Shot,
+        out: &Path,
+        hash: &str,
+        base: &Path,
+        read: &[PathBuf],
+    ) -> Result<(), BatchError> {
+        let read: Vec<PathBuf> = read
+            .iter()
+            .map(|r| {
+                r.strip_prefix(base)
+                    .map_or_else(|_| r.clone(), Path::to_path_buf)
+            })
+            .collect();
+        let stamp = Stamp::current(shot, out, hash, base, &read).ok_or_else(|| {
             BatchError::invalid(
                 Path::new(&format!("shot '{}'", shot.name)),
-                "a declared output was not written",
+                "a declared output was not written (or an input vanished while it ran)",
             )
         })?;
         let text = serde_json::to_string_pretty(&stamp).unwrap_or_default();

@@ -149,8 +149,15 @@ fn usage_error(e: &clap::Error) -> String {
 }
 
 /// Runs one parsed command (the binary's dispatcher; `toonkit batch` runs its shots through
-/// it too).
+/// it too). Each command (each batch shot, each demo step) is one job: no file it writes may
+/// replace a file it reads ([`tkio::ReadScope`]). A batch is not one job itself (its shots
+/// are), and the studio holds its scene for as long as it serves it.
 fn run(ctx: &commands::Context, command: Command) -> anyhow::Result<()> {
+    let _job = (!matches!(
+        command,
+        Command::Batch(_) | Command::Studio(_) | Command::Demo(_)
+    ))
+    .then(tkio::ReadScope::open);
     match command {
         Command::Info(a) => commands::info::run(ctx, a.0),
         Command::Convert(a) => commands::convert::run(ctx, a.0),

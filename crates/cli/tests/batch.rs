@@ -302,3 +302,137 @@ fn openjd_template_has_one_step_per_tool_and_one_task_per_shot() {
 fn out_exists(dir: &Path) -> bool {
     dir.join("out").exists()
 }
+
+/// `toonkit batch --json` on `m` into `out`: (exit code, shot name → status).
+fn run_statuses(m: &Path, out: &Path) -> (Option<i32>, Vec<(String, String)>, String) {
+    let o = toonkit(&["--json", "batch", s(m), "-o", s(out)]);
+    let text = String::from_utf8_lossy(&o.stdout).into_owned();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap_or_default();
+    let status = v["shots"]
+        .as_array()
+        .map(|a| {
+            a.iter()
+                .map(|r| {
+                    let f = |k: &str| r[k].as_str().unwrap_or_default().to_string();
+                    (f("name"), f("status"))
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    (o.status.code(), status, text)
+}
+
+/// Outputs are confined to the output folder: `../../x.glb` and `/abs/x.glb` are refused
+/// before anything runs, naming the shot, the output and the fix.
+#[test]
+fn outputs_outside_the_output_folder_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = data("characters/RobotExpressive.glb");
+    let escape = dir.path().join("escaped.pc2");
+    for bad in ["../../x.pc2", s(&escape)] {
+        let m = manifest(dir.path(), &[shot("a", "convert", &robot, "Punch", &[bad])]);
+        common::assert_bad_input(
+            &["batch", s(&m), "-o", s(&dir.path().join("out"))],
+            "must stay inside the output folder",
+        );
+    }
+    assert!(!escape.exists() && !dir.path().join("out").exists());
+}
+
+/// A shot whose output is its own input (or another shot's input) fails before it writes:
+/// the input keeps every byte and the other shots are made.
+#[test]
+fn a_shot_writing_over_an_input_fails_and_the_input_is_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("walk.glb");
+    std::fs::copy(data("characters/CesiumMan.glb"), &input).unwrap();
+    let before = std::fs::read(&input).unwrap();
+    let shots = vec![
+        shot("own", "convert", &input, "0", &["walk.glb"]),
+        shot("fine", "convert", &input, "0", &["walk.abc"]),
+    ];
+    let m = manifest(dir.path(), &shots);
+    let (code, status, text) = run_statuses(&m, dir.path());
+    assert_eq!(code, Some(1), "one shot failed: {text}");
+    assert_eq!(
+        status,
+        [
+            ("own".into(), "failed".into()),
+            ("fine".into(), "done".into())
+        ],
+        "{text}"
+    );
+    assert!(text.contains("is its own input"), "{text}");
+    assert_eq!(std::fs::read(&input).unwrap(), before);
+}
+
+/// The stamp covers every file a shot read, not only the manifest's input: an edited
+/// external `.bin` of a `.gltf`, an edited option file (`collider = "floor.obj"`) or a
+/// deleted implicit rest `.obj` make the shot run again; an edited output is made again too.
+#[test]
+fn stamps_hash_every_file_a_shot_reads_and_writes() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = dir.path().join("walk.pc2");
+    common::ok(&["convert", s(&data("characters/CesiumMan.glb")), s(&cache)]);
+    let floor = dir.path().join("floor.obj");
+    std::fs::write(
+        &floor,
+        "v -9 0 -9\nv 9 0 -9\nv 9 0 9\nv -9 0 9\nf 1 2 3 4\n",
+    )
+    .unwrap();
+    let mut collide = shot("collide", "smear elongate", &cache, "0", &["c.glb"]);
+    collide = collide.replace(
+        "clip = \"0\"",
+        &format!("options = {{ collider = \"{}\" }}", s(&floor)),
+    );
+    let mut plain = shot("plain", "convert", &cache, "0", &["p.abc"]);
+    plain = plain.replace("clip = \"0\"\n", "");
+    // A .gltf whose one triangle lies in tri.bin beside it.
+    let gltf = dir.path().join("tri.gltf");
+    std::fs::write(
+        &gltf,
+        r#"{"asset":{"version":"2.0"},"buffers":[{"uri":"tri.bin","byteLength":36}],
+        "bufferViews":[{"buffer":0,"byteLength":36}],
+        "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3",
+        "min":[0,0,0],"max":[1,1,0]}],
+        "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],
+        "nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],"scene":0}"#,
+    )
+    .unwrap();
+    let bin = |y: f32| -> Vec<u8> {
+        [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, y, 0.0]
+            .iter()
+            .flat_map(|c| c.to_le_bytes())
+            .collect()
+    };
+    std::fs::write(dir.path().join("tri.bin"), bin(1.0)).unwrap();
+    let mut tri = shot("tri", "convert", &gltf, "0", &["tri.obj"]);
+    tri = tri.replace("clip = \"0\"\n", "");
+    let m = manifest(dir.path(), &[collide, plain, tri]);
+    let out = dir.path().join("out");
+    let statuses = |want: [&str; 3]| {
+        let (_, status, text) = run_statuses(&m, &out);
+        let got: Vec<&str> = status.iter().map(|(_, s)| s.as_str()).collect();
+        assert_eq!(got, want, "{text}");
+    };
+    statuses(["done", "done", "done"]);
+    statuses(["skipped", "skipped", "skipped"]);
+    // The option file changes: only the shot that read it runs again.
+    std::fs::write(
+        &floor,
+        "v -9 -1 -9\nv 9 -1 -9\nv 9 -1 9\nv -9 -1 9\nf 1 2 3 4\n",
+    )
+    .unwrap();
+    statuses(["done", "skipped", "skipped"]);
+    // The external buffer of the .gltf changes: its shot runs again, with the new bytes.
+    std::fs::write(dir.path().join("tri.bin"), bin(2.0)).unwrap();
+    statuses(["skipped", "skipped", "done"]);
+    let obj = std::fs::read_to_string(out.join("tri.obj")).unwrap();
+    assert!(obj.contains("v 0 2 0"), "{obj}");
+    // An output edited by hand is made again.
+    std::fs::write(out.join("p.abc"), b"edited").unwrap();
+    statuses(["skipped", "done", "skipped"]);
+    // The implicit rest mesh of the cache is gone: both its shots run again (and fail).
+    std::fs::remove_file(dir.path().join("walk.obj")).unwrap();
+    statuses(["failed", "failed", "skipped"]);
+}

@@ -11,16 +11,18 @@ use std::path::Path;
 type Target = fn(&[u8]);
 
 /// Each fuzz target by name.
-const TARGETS: [(&str, Target); 11] = [
+const TARGETS: [(&str, Target); 13] = [
     ("abc", targets::abc),
     ("bvh", targets::bvh),
     ("expr", targets::expr),
     ("gltf", targets::gltf),
+    ("gltf_uri", targets::gltf_uri),
     ("keystrokes", targets::keystrokes),
     ("mdd", targets::mdd),
     ("npy", targets::npy),
     ("obj", targets::obj),
     ("pc2", targets::pc2),
+    ("sizes", targets::sizes),
     ("stl", targets::stl),
     ("style", targets::style),
 ];
@@ -51,7 +53,7 @@ fn seeds_and_crashers_replay_without_panic() {
         crashers += files(&root.join("regressions").join(name)).len();
     }
     assert!(
-        seeds >= 11 && crashers >= 5,
+        seeds >= 13 && crashers >= 5,
         "{seeds} seeds, {crashers} crashers"
     );
 }

@@ -165,3 +165,85 @@ fn messages_of_the_issue_are_one_readable_line() {
     );
     assert_bad_input(&["convert", s(&cesium()), s(&out), "--fps", "0"], "--fps");
 }
+
+/// Copies `asset` into `dir` and returns the copy and its bytes.
+fn copy_in(dir: &Path, asset: &str, name: &str) -> (std::path::PathBuf, Vec<u8>) {
+    let p = dir.join(name);
+    std::fs::copy(data(asset), &p).unwrap();
+    let bytes = std::fs::read(&p).unwrap();
+    (p, bytes)
+}
+
+/// `toonkit convert fox.glb fox.glb` replaced a three-clip character with a flipbook: now
+/// refused naming both paths and the fix, the input byte for byte as it was.
+#[test]
+fn converting_a_file_onto_itself_is_refused_and_keeps_every_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    let (fox, before) = copy_in(dir.path(), "characters/CesiumMan.glb", "fox.glb");
+    assert_bad_input(
+        &["convert", s(&fox), s(&fox)],
+        "refusing to write over it; name another output file",
+    );
+    let err = String::from_utf8_lossy(&toonkit(&["convert", s(&fox), s(&fox)]).stderr).into_owned();
+    assert_eq!(err.matches("fox.glb").count(), 2, "both paths named: {err}");
+    assert_eq!(std::fs::read(&fox).unwrap(), before);
+    assert_eq!(file_names(dir.path()), vec!["fox.glb"], "no temporary left");
+}
+
+/// A symlink to the output, and another spelling of the output's path, are the same file.
+#[cfg(unix)]
+#[test]
+fn a_symlink_or_an_alias_of_the_input_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let o2 = dir.path().join("o2");
+    std::fs::create_dir(&o2).unwrap();
+    let (fox, before) = copy_in(&o2, "characters/CesiumMan.glb", "fox.glb");
+    let link = dir.path().join("link.glb");
+    std::os::unix::fs::symlink(&fox, &link).unwrap();
+    assert_bad_input(
+        &["smear", "elongate", s(&link), "-o", s(&fox)],
+        "is the input",
+    );
+    // `./fox.glb` from inside o2 against `../o2/fox.glb`.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_toonkit"))
+        .current_dir(&o2)
+        .args(["convert", "./fox.glb", "../o2/fox.glb"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("../o2/fox.glb: is the input ./fox.glb"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(&fox).unwrap(), before);
+}
+
+/// `convert spot.obj spot.pc2` wrote the rest mesh over `spot.obj` (its uv and normal lines
+/// gone): the implicit rest `.obj` of a cache is an output too, and nothing is written.
+#[test]
+fn a_point_cache_whose_rest_obj_is_the_input_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let (spot, before) = copy_in(dir.path(), "meshes/spot.obj", "spot.obj");
+    assert_bad_input(
+        &["convert", s(&spot), s(&dir.path().join("spot.pc2"))],
+        "spot.obj: is the input",
+    );
+    assert_eq!(std::fs::read(&spot).unwrap(), before);
+    assert_eq!(file_names(dir.path()), vec!["spot.obj"], "the .pc2 neither");
+}
+
+/// A point cache read with its implicit rest `.obj`, written back as a `.mdd` beside it,
+/// would replace that rest mesh: refused too (the load recorded it).
+#[test]
+fn the_implicit_rest_obj_of_an_input_cache_is_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = dir.path().join("walk.pc2");
+    ok(&["convert", s(&cesium()), s(&cache)]);
+    let rest = std::fs::read(dir.path().join("walk.obj")).unwrap();
+    assert_bad_input(
+        &["convert", s(&cache), s(&dir.path().join("walk.mdd"))],
+        "walk.obj: is the input",
+    );
+    assert_eq!(std::fs::read(dir.path().join("walk.obj")).unwrap(), rest);
+}

@@ -45,7 +45,7 @@ pub struct InputArgs {
     #[arg(long)]
     pub clip: Option<String>,
     /// Frames per second to sample at (default: 24).
-    #[arg(long, value_name = "FPS")]
+    #[arg(long, value_name = "FPS", allow_negative_numbers = true)]
     pub fps: Option<f32>,
     /// Only this mesh object (by name; repeat or comma-separate for several).
     #[arg(long, value_delimiter = ',')]

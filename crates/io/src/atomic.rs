@@ -18,6 +18,7 @@
 use std::fs;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::{IoError, Result};
 
@@ -59,6 +60,10 @@ pub fn write_atomic_with(
 /// unwritable folder fails here) are they renamed over their targets. A failure removes the
 /// temporary files and leaves every previous file as it was.
 pub fn write_atomic_all(files: &[(PathBuf, Vec<u8>)]) -> Result<()> {
+    // Every target is checked before any is staged: all or nothing.
+    for (path, _) in files {
+        crate::inputs::check_not_input(path)?;
+    }
     let mut temps = Vec::with_capacity(files.len());
     for (path, bytes) in files {
         match stage(path, bytes) {
@@ -92,6 +97,7 @@ fn stage(path: &Path, bytes: &[u8]) -> Result<PathBuf> {
 
 /// [`stage`] with the contents written by `write`.
 fn stage_with(path: &Path, write: impl FnOnce(&mut fs::File) -> Result<()>) -> Result<PathBuf> {
+    crate::inputs::check_not_input(path)?;
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         fs::create_dir_all(dir).map_err(|e| IoError::io(dir, e))?;
     }
@@ -171,7 +177,7 @@ pub fn remove_stale_temps(path: &Path) -> usize {
         dir
     };
     let prefix = format!(".{}.", name.to_string_lossy());
-    let mine = temp_path(path);
+    let mine = format!("{prefix}{}.", std::process::id());
     let Ok(entries) = fs::read_dir(dir) else {
         return 0;
     };
@@ -179,23 +185,43 @@ pub fn remove_stale_temps(path: &Path) -> usize {
         .flatten()
         .filter(|e| {
             let n = e.file_name().to_string_lossy().into_owned();
-            n.starts_with(&prefix) && n.ends_with(".tmp") && e.path() != mine
+            n.starts_with(&prefix) && n.ends_with(".tmp") && !n.starts_with(&mine)
         })
         .filter(|e| fs::remove_file(e.path()).is_ok())
         .count()
 }
 
+/// Writes started by this process: each gets its own temporary name, so writes of one target
+/// from several threads at once (concurrent studio exports) never share a temporary file.
+static WRITES: AtomicU64 = AtomicU64::new(0);
+
+/// `.NAME.PID.N.tmp` beside `path`: the process id lets [`remove_stale_temps`] keep the
+/// running process's files, `N` makes every write's name unique.
 fn temp_path(path: &Path) -> PathBuf {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
+    let n = WRITES.fetch_add(1, Ordering::Relaxed);
+    path.with_file_name(format!(".{name}.{}.{n}.tmp", std::process::id()))
 }
 
-/// Reads a whole file, with the path in the error.
+/// Reads a whole file, with the path in the error, and records it as read by the open job
+/// (see [`ReadScope`](crate::ReadScope): no write of the job may replace it). Only regular
+/// files are read: a device or a pipe named as input (`/dev/zero`) could never end.
 pub fn read_file(path: &Path) -> Result<Vec<u8>> {
-    fs::read(path).map_err(|e| IoError::io(path, e))
+    let meta = fs::metadata(path).map_err(|e| IoError::io(path, e))?;
+    if !meta.is_file() {
+        return Err(IoError::unsupported(if meta.is_dir() {
+            "is a directory: name a file"
+        } else {
+            "is not a regular file (a device or a pipe): name a file"
+        })
+        .at(path));
+    }
+    let bytes = fs::read(path).map_err(|e| IoError::io(path, e))?;
+    crate::inputs::note_read(path);
+    Ok(bytes)
 }
 
 #[cfg(test)]
@@ -297,6 +323,59 @@ mod tests {
         assert!(!durable());
         assert_eq!(fs::read(&p).unwrap(), b"durable");
         assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    /// Sixteen threads writing one name at once all succeed (each write has its own
+    /// temporary file) and the target holds one of their files whole.
+    #[test]
+    fn concurrent_writes_of_one_name_all_succeed() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("export.glb");
+        let contents: Vec<Vec<u8>> = (0..16u8).map(|k| vec![k; 64 * 1024]).collect();
+        std::thread::scope(|s| {
+            let handles: Vec<_> = contents
+                .iter()
+                .map(|c| s.spawn(|| write_atomic(&p, c)))
+                .collect();
+            for h in handles {
+                h.join().unwrap().unwrap();
+            }
+        });
+        let got = fs::read(&p).unwrap();
+        assert!(contents.contains(&got), "a whole file of one writer");
+        assert_eq!(
+            fs::read_dir(dir.path()).unwrap().count(),
+            1,
+            "no temporary left"
+        );
+    }
+
+    /// A write over a file the open job read is refused before anything is written, naming
+    /// both paths; the input keeps every byte.
+    #[test]
+    fn writing_over_an_input_is_refused_and_the_input_is_kept() {
+        let dir = tempfile::tempdir().unwrap();
+        let input = dir.path().join("spot.obj");
+        fs::write(&input, b"v 0 0 0\n").unwrap();
+        let scope = crate::ReadScope::open();
+        read_file(&input).unwrap();
+        let other = dir.path().join("spot.pc2");
+        let e = write_atomic_all(&[
+            (other.clone(), b"cache".to_vec()),
+            (input.clone(), b"rest".to_vec()),
+        ])
+        .unwrap_err();
+        assert!(matches!(e, IoError::WouldOverwriteInput { .. }), "{e}");
+        assert!(e.to_string().contains("name another output file"), "{e}");
+        assert_eq!(fs::read(&input).unwrap(), b"v 0 0 0\n");
+        assert!(!other.exists(), "all or nothing");
+        drop(scope);
+    }
+
+    #[test]
+    fn a_device_is_not_read_as_an_input() {
+        let e = read_file(Path::new("/dev/zero")).unwrap_err().to_string();
+        assert!(e.contains("not a regular file"), "{e}");
     }
 
     #[test]

@@ -280,7 +280,14 @@ pub fn read(bytes: &[u8]) -> Result<Scene> {
     tk.expect("Frame")?;
     let dt_text = tk.keyed("Time:")?;
     let frame_time = match dt_text.parse::<f64>() {
-        Ok(v) if v.is_finite() && v > 0.0 => v,
+        Ok(v) if v.is_finite() && v >= MIN_FRAME_TIME => v,
+        Ok(v) if v.is_finite() && v > 0.0 => {
+            return Err(tk.err(format!(
+                "frame time {dt_text} s is below {MIN_FRAME_TIME} s (10,000 frames per second): \
+                 its frames would collapse into one when sampled; write the capture's real \
+                 frame time (e.g. 0.0083333 for 120 fps)"
+            )))
+        }
         _ => return Err(tk.err(format!("frame time '{dt_text}' must be a positive number"))),
     };
     let per_frame: usize = joints.iter().map(|j| j.channels.len()).sum();
@@ -315,6 +322,10 @@ pub fn read(bytes: &[u8]) -> Result<Scene> {
     }
     build_scene(&joints, frames, frame_time, &values)
 }
+
+/// The shortest `Frame Time` read (seconds): faster than any motion-capture system records,
+/// and far enough above f32's resolution that every frame keeps its own key time.
+pub const MIN_FRAME_TIME: f64 = 1e-4;
 
 fn read_vec3(tk: &mut Tokens<'_>) -> Result<DVec3> {
     Ok(DVec3::new(

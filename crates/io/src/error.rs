@@ -82,6 +82,26 @@ pub enum IoError {
         /// The last frame (0-based).
         last: usize,
     },
+    /// The output is a file the job reads (the same file by device and inode: a symlink or
+    /// another spelling of the path counts; a point cache's rest `.obj` too). Name another
+    /// output file.
+    #[error("{path}: is the input {} of this job (the same file): refusing to write over it; name another output file", .input.display())]
+    WouldOverwriteInput {
+        /// The output.
+        path: FilePath,
+        /// The input it is.
+        input: PathBuf,
+    },
+    /// A size derived from the file or an option is over its budget
+    /// ([`anim::budget`]): allocating it could exhaust memory. Lower the option the message
+    /// names, or split the input.
+    #[error("{path}: {source}")]
+    OverBudget {
+        /// File.
+        path: FilePath,
+        /// What is over which limit.
+        source: anim::OverBudget,
+    },
     /// The file parsed but its content is inconsistent (e.g. NaN positions, bad indices).
     #[error("{path}: {source}")]
     Anim {
@@ -139,6 +159,8 @@ impl IoError {
             | IoError::Encode { path, .. }
             | IoError::FramesDoNotFit { path, .. }
             | IoError::NoSuchFrame { path, .. }
+            | IoError::WouldOverwriteInput { path, .. }
+            | IoError::OverBudget { path, .. }
             | IoError::Anim { path, .. } => path,
         };
         if slot.0.as_os_str().is_empty() {
@@ -177,6 +199,15 @@ pub fn describe_io(e: &std::io::Error) -> String {
                 Some(f) => f.to_lowercase().chain(c).collect(),
                 None => "input/output error".into(),
             }
+        }
+    }
+}
+
+impl From<anim::OverBudget> for IoError {
+    fn from(source: anim::OverBudget) -> IoError {
+        IoError::OverBudget {
+            path: FilePath::default(),
+            source,
         }
     }
 }

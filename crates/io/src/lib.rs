@@ -14,6 +14,7 @@
 
 mod atomic;
 mod error;
+mod inputs;
 mod save;
 
 pub mod abc;
@@ -35,6 +36,7 @@ pub use atomic::{
     read_file, remove_stale_temps, write_atomic, write_atomic_all, write_atomic_with, SYNC_ENV,
 };
 pub use error::{describe_io, FilePath, IoError, Result};
+pub use inputs::{check_not_input, note_read, same_file, ReadScope};
 pub use save::{save, save_with, Layout, Output, SaveOptions};
 
 mod detect;

@@ -36,11 +36,55 @@ use crate::{IoError, Result};
 
 const FORMAT: &str = "OBJ";
 
+/// The statements of OBJ geometry files (Wavefront's specification, Appendix B1).
+const OBJ_KEYWORDS: &[&str] = &[
+    "v",
+    "vt",
+    "vn",
+    "vp",
+    "f",
+    "l",
+    "p",
+    "o",
+    "g",
+    "s",
+    "mg",
+    "usemtl",
+    "mtllib",
+    "cstype",
+    "deg",
+    "bmat",
+    "step",
+    "curv",
+    "curv2",
+    "surf",
+    "parm",
+    "trim",
+    "hole",
+    "scrv",
+    "sp",
+    "end",
+    "con",
+    "bevel",
+    "c_interp",
+    "d_interp",
+    "lod",
+    "shadow_obj",
+    "trace_obj",
+    "ctech",
+    "stech",
+    "call",
+    "csh",
+    "maplib",
+    "usemap",
+];
+
 /// Parses an OBJ file.
 ///
 /// # Errors
 /// [`IoError::Malformed`] naming the line of a non-number, a missing coordinate, a NaN or
-/// infinite value, an index of 0 or out of range, or more than `u32::MAX` vertices.
+/// infinite value, an index of 0 or out of range, a face of fewer than 3 vertices, more
+/// than `u32::MAX` vertices, or bytes with no OBJ statement at all.
 pub fn read(bytes: &[u8]) -> Result<Mesh> {
     let text = String::from_utf8_lossy(bytes);
     let mut positions: Vec<Vec3> = Vec::new();
@@ -52,6 +96,9 @@ pub fn read(bytes: &[u8]) -> Result<Mesh> {
     let mut faces: Vec<(usize, usize)> = Vec::new(); // (first corner, line)
     let mut object_name: Option<String> = None;
     let mut group_name: Option<String> = None;
+    // Lines with an OBJ keyword and lines with none: bytes that are not OBJ at all (random
+    // or binary data named .obj) are refused instead of read as an empty mesh.
+    let (mut known, mut unknown) = (0usize, 0usize);
 
     for (ln, raw) in text.split('\n').enumerate() {
         let line_no = ln + 1;
@@ -121,16 +168,27 @@ pub fn read(bytes: &[u8]) -> Result<Mesh> {
                     }
                     corners.push(c);
                 }
-                if corners.len() - start < 3 {
-                    corners.truncate(start);
-                } else {
-                    faces.push((start, line_no));
+                let found = corners.len() - start;
+                if found < 3 {
+                    return Err(bad(format!(
+                        "a face needs at least 3 vertices, this one has {found} \
+                         (an edge is written as an 'l' line; remove the face or re-export)"
+                    )));
                 }
+                faces.push((start, line_no));
             }
             "o" if object_name.is_none() => object_name = Some(rest_of(line)),
             "g" if group_name.is_none() => group_name = Some(rest_of(line)),
-            _ => {}
+            key if OBJ_KEYWORDS.contains(&key) => {}
+            _ => unknown += 1,
         }
+        known += usize::from(OBJ_KEYWORDS.contains(&key));
+    }
+    if positions.is_empty() && known == 0 && unknown > 0 {
+        return Err(IoError::malformed(
+            FORMAT,
+            "no line starts with an OBJ keyword (v, vt, vn, f, o, g, …): not an OBJ file",
+        ));
     }
     if positions.len() > u32::MAX as usize {
         return Err(IoError::unsupported("OBJ has more than 2^32 vertices"));

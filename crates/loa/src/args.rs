@@ -53,7 +53,7 @@ pub struct LineFlags {
     #[arg(long, value_enum, default_value_t = ModeArg::Physics)]
     pub mode: ModeArg,
     /// Frames per second (default: the keystrokes', else 24).
-    #[arg(long, value_name = "FPS")]
+    #[arg(long, value_name = "FPS", allow_negative_numbers = true)]
     pub fps: Option<f32>,
     /// Integration sub-steps per frame.
     #[arg(long, default_value_t = crate::DEFAULT_SUBSTEPS)]

@@ -104,4 +104,8 @@ pub enum LoaError {
     /// A wobble is not written `FRAME:S:DX,DY` (e.g. `20:1:0,-800`), with `S` in `[0, 1]`.
     #[error("wobble '{0}': expected FRAME:S:DX,DY with S in [0, 1] (e.g. 20:1:0,-800)")]
     Wobble(String),
+    /// The keystrokes ask for more than a budget allows ([`anim::budget`]): fewer keystrokes,
+    /// a flatter SVG, a shorter span.
+    #[error(transparent)]
+    OverBudget(#[from] anim::OverBudget),
 }

@@ -85,6 +85,12 @@ impl Keystrokes {
         if keys.is_empty() {
             return Err(LoaError::NoKeystrokes);
         }
+        anim::check_budget(
+            "keystrokes",
+            keys.len() as u64,
+            anim::budget::DEFAULT_MAX_KEYSTROKES,
+            "split the shot into several lines",
+        )?;
         if let Some(f) = fps {
             check_positive("fps", f)?;
         }

@@ -34,7 +34,39 @@ impl Keystrokes {
     }
 }
 
+/// The deepest element nesting of an XML text, counted on its tags before it is parsed
+/// (comments, processing instructions and CDATA are skipped; a `<` inside an attribute
+/// value can only over-count, which is safe).
+fn nesting_depth(text: &str) -> u64 {
+    let bytes = text.as_bytes();
+    let (mut depth, mut deepest) = (0u64, 0u64);
+    let mut i = 0;
+    while let Some(k) = bytes[i..].iter().position(|&b| b == b'<') {
+        i += k + 1;
+        let rest = &bytes[i..];
+        let end = rest.iter().position(|&b| b == b'>').unwrap_or(rest.len());
+        match rest.first() {
+            Some(b'/') => depth = depth.saturating_sub(1),
+            Some(b'!' | b'?') => {}
+            Some(_) if end > 0 && rest[end - 1] == b'/' => {}
+            Some(_) => {
+                depth += 1;
+                deepest = deepest.max(depth);
+            }
+            None => {}
+        }
+        i += end;
+    }
+    deepest
+}
+
 fn parse_keystrokes(text: &str) -> Result<Keystrokes, LoaError> {
+    anim::check_budget(
+        "SVG element nesting",
+        nesting_depth(text),
+        anim::budget::DEFAULT_MAX_NESTING,
+        "flatten the groups (<g>) of the keystroke file",
+    )?;
     let doc = roxmltree::Document::parse(text).map_err(|e| LoaError::Xml(e.to_string()))?;
     let root = doc.root_element();
     let fps = attr_f64(root, "data-fps").map_err(|m| LoaError::Xml(format!("<svg>: {m}")))?;

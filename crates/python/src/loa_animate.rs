@@ -29,6 +29,8 @@ pub(crate) struct Motion {
     scene: Arc<anim::Scene>,
     joint_names: Vec<String>,
     source: String,
+    /// The character file read (when given by path): no save of the motion may replace it.
+    _inputs: Option<tkio::ReadScope>,
 }
 
 #[pymethods]
@@ -164,6 +166,7 @@ pub(crate) fn animate(
     let pose: InitialPose = pose.parse().map_err(|e| bad("pose", pose, e))?;
     let line = line.get();
     let fps = line.line.animation.fps;
+    let mut inputs = None;
     let (scene, source) = match character {
         CharacterArg::Scene(s) => {
             let s = s.get();
@@ -181,7 +184,11 @@ pub(crate) fn animate(
                 ..Default::default()
             };
             let source = path.display().to_string();
-            match py.detach(|| tkio::load(&path, &load)).map_err(io_error)? {
+            let read = tkio::ReadScope::open();
+            let loaded = py.detach(|| tkio::load(&path, &load)).map_err(io_error)?;
+            read.freeze();
+            inputs = Some(read);
+            match loaded {
                 tkio::Loaded::Scene(scene) => (Arc::from(scene), source),
                 _ => {
                     return Err(value_error(format!(
@@ -205,5 +212,6 @@ pub(crate) fn animate(
         joint_names: motion.1,
         scene,
         source,
+        _inputs: inputs,
     })
 }

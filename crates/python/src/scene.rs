@@ -35,6 +35,8 @@ pub(crate) struct Scene {
     pub(crate) file_scene: Option<Arc<anim::Scene>>,
     positions: Py<PyArrayDyn<f32>>,
     triangles: Py<PyArrayDyn<i32>>,
+    /// The files the load read: while the scene lives, no save may replace them.
+    _inputs: Option<tkio::ReadScope>,
 }
 
 impl Scene {
@@ -44,6 +46,7 @@ impl Scene {
         sampled: SampledScene,
         source: String,
         file_scene: Option<Arc<anim::Scene>>,
+        inputs: Option<tkio::ReadScope>,
     ) -> PyResult<Scene> {
         let (frames, vertices) = (sampled.frame_count, sampled.vertex_count());
         let mut positions = Vec::with_capacity(frames * vertices * 3);
@@ -67,6 +70,7 @@ impl Scene {
             sampled: Arc::new(sampled),
             source,
             file_scene,
+            _inputs: inputs,
         })
     }
 
@@ -169,8 +173,16 @@ pub(crate) fn load(
         ClipArg::Name(n) => n,
     });
     let p = path.clone();
-    let (sampled, file_scene) = py.detach(move || load_sampled(&p, clip.as_deref(), fps))?;
-    Scene::new(py, sampled, path.display().to_string(), file_scene)
+    let inputs = tkio::ReadScope::open();
+    let (sampled, file_scene) = py.detach(|| load_sampled(&p, clip.as_deref(), fps))?;
+    inputs.freeze();
+    Scene::new(
+        py,
+        sampled,
+        path.display().to_string(),
+        file_scene,
+        Some(inputs),
+    )
 }
 
 #[pymethods]
@@ -228,7 +240,7 @@ impl Scene {
             .transpose()?;
         let sampled =
             crate::from_arrays::sampled(&positions, &triangles, fps, skin, objects, attributes)?;
-        Scene::new(py, sampled, "<arrays>".to_string(), None)
+        Scene::new(py, sampled, "<arrays>".to_string(), None, None)
     }
 
     /// float32 ``(frames, vertices, 3)``: world-space positions, objects merged in order.

@@ -85,6 +85,10 @@ pub enum RenderError {
     /// GIF encoding failed (an internal limit of the format, e.g. a side over 65535 pixels).
     #[error("gif: {0}")]
     Gif(String),
+    /// The pictures asked for are over the pixel budget ([`anim::budget::DEFAULT_MAX_PIXELS`]):
+    /// ask for a smaller `--size` or fewer frames.
+    #[error(transparent)]
+    OverBudget(#[from] anim::OverBudget),
 }
 
 /// Result alias of this crate.

@@ -35,6 +35,7 @@ pub fn flipbook_gif(book: &Flipbook, width: u32, height: u32) -> Result<Vec<u8>>
         ViewDirection::ThreeQuarter,
         width as f32 / height as f32,
     );
+    renderer.check_frames(book.frames)?;
     let images: Vec<Image> = (0..book.frames)
         .into_par_iter()
         .map(|f| {

@@ -32,6 +32,19 @@ pub(crate) fn check_size(width: u32, height: u32) -> Result<()> {
     Ok(())
 }
 
+/// Checks that `frames` pictures of `width × height` (kept together until a GIF or a sheet is
+/// encoded) fit the pixel budget, before any is drawn.
+pub(crate) fn check_pixels(width: u32, height: u32, frames: usize) -> Result<()> {
+    let asked = anim::budget::product(&[width as u64, height as u64, frames as u64]);
+    anim::check_budget(
+        "width × height × frames",
+        asked,
+        anim::budget::DEFAULT_MAX_PIXELS,
+        &format!("{frames} frames of {width}x{height}: ask for a smaller --size or fewer frames"),
+    )?;
+    Ok(())
+}
+
 impl Image {
     /// An image filled with one colour.
     ///

@@ -77,6 +77,7 @@ pub fn line_preview(
         .map(|s| fit.polyline(s, faint, 3.0))
         .collect();
     if gif {
+        renderer.check_frames(chains.len())?;
         let frames: Result<Vec<_>> = chains
             .iter()
             .map(|c| {

@@ -173,6 +173,7 @@ pub fn preview_scene(scene: &SampledScene, options: &PreviewOptions) -> Result<V
             encode_png(&draw(options.frame)?)
         }
         OutputFormat::Gif => {
+            renderer.check_frames(frames)?;
             let images: Vec<Image> = (0..frames)
                 .into_par_iter()
                 .map(draw)
@@ -181,6 +182,7 @@ pub fn preview_scene(scene: &SampledScene, options: &PreviewOptions) -> Result<V
         }
         OutputFormat::Sheet { every, columns } => {
             let picked: Vec<usize> = (0..frames).step_by(every.max(1)).collect();
+            renderer.check_frames(picked.len())?;
             let images: Vec<Image> = picked.par_iter().map(|&f| draw(f)).collect::<Result<_>>()?;
             let sheet = crate::contact_sheet(
                 &images,

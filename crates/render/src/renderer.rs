@@ -99,8 +99,24 @@ impl Renderer {
             .unwrap_or(DEFAULT_LIGHT.normalize());
         check_size(options.width, options.height)?;
         let s = options.supersample;
-        check_size(options.width * s, options.height * s)?;
+        if check_size(options.width * s, options.height * s).is_err() {
+            // The size asked for, and the largest side the supersampling leaves room for.
+            return Err(crate::RenderError::InvalidSize {
+                width: options.width,
+                height: options.height,
+                max: crate::MAX_IMAGE_SIZE / s,
+            });
+        }
         Ok(Renderer { options })
+    }
+
+    /// Checks that `frames` pictures of this renderer's size fit the pixel budget
+    /// ([`anim::budget::DEFAULT_MAX_PIXELS`]) before they are drawn.
+    ///
+    /// # Errors
+    /// [`crate::RenderError::OverBudget`].
+    pub fn check_frames(&self, frames: usize) -> Result<()> {
+        crate::image::check_pixels(self.options.width, self.options.height, frames)
     }
 
     /// The options in force.

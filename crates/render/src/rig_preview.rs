@@ -158,6 +158,7 @@ pub fn rig_preview(preview: &RigPreview<'_>, view: RigView<'_>, gif: bool) -> Re
             .collect(),
     };
     let which: Vec<usize> = if gif { (0..frames).collect() } else { vec![0] };
+    renderer.check_frames(which.len())?;
     let images = which
         .par_iter()
         .map(|&f| {

@@ -107,6 +107,9 @@ pub enum SmearError {
     /// A style's function or parameter is invalid (see [`StyleError`] for how to fix it).
     #[error(transparent)]
     Style(#[from] StyleError),
+    /// An option asks for more than its budget ([`anim::budget`]): lower it.
+    #[error(transparent)]
+    OverBudget(#[from] anim::OverBudget),
 }
 
 /// Result alias of the smear crate.

@@ -72,3 +72,24 @@ impl Default for OffsetOptions {
         }
     }
 }
+
+impl OffsetOptions {
+    /// Checks the sizes the options ask for against their budgets before anything is
+    /// allocated: the smoothing window's weights ([`anim::budget::DEFAULT_MAX_SMOOTH`]).
+    ///
+    /// # Errors
+    /// [`anim::OverBudget`] naming `--smooth`.
+    pub fn check_budget(&self) -> Result<(), anim::OverBudget> {
+        check_smooth(self.smooth)
+    }
+}
+
+/// `--smooth N` against [`anim::budget::DEFAULT_MAX_SMOOTH`].
+pub(crate) fn check_smooth(smooth: usize) -> Result<(), anim::OverBudget> {
+    anim::check_budget(
+        "--smooth",
+        smooth as u64,
+        anim::budget::DEFAULT_MAX_SMOOTH,
+        "a window wider than the clip only repeats its end frames (N = 2 is the paper's)",
+    )
+}

@@ -118,6 +118,7 @@ impl Stream {
                 name: "elongate",
                 reason: e.to_string(),
             })?;
+        crate::options::check_smooth(options.smooth)?;
         if options.history < 2 {
             return Err(SmearError::InvalidParameter {
                 name: "history",

@@ -70,6 +70,34 @@ impl ApiError {
         }
     }
 
+    /// 413: a size the request asks for is over the studio's budget (the server stays up).
+    pub fn too_large(message: impl Into<String>) -> ApiError {
+        ApiError {
+            status: StatusCode::PAYLOAD_TOO_LARGE,
+            message: message.into(),
+        }
+    }
+
+    /// A job's refusal: 413 when the request asked for more than a budget allows
+    /// (`over_budget`, [`anim::budget`]), else 400.
+    pub fn refused(message: impl Into<String>, over_budget: bool) -> ApiError {
+        if over_budget {
+            ApiError::too_large(message)
+        } else {
+            ApiError::bad(message)
+        }
+    }
+
+    /// A file error of a job: 409 for an export that would replace a file the studio read,
+    /// 413 for a size over budget, 500 otherwise (the disk, a bug).
+    pub fn from_io(e: &tkio::IoError) -> ApiError {
+        match e {
+            tkio::IoError::WouldOverwriteInput { .. } => ApiError::conflict(e.to_string()),
+            tkio::IoError::OverBudget { .. } => ApiError::too_large(e.to_string()),
+            _ => ApiError::internal(e.to_string()),
+        }
+    }
+
     /// 500: the job failed.
     pub fn internal(message: impl Into<String>) -> ApiError {
         ApiError {

@@ -21,6 +21,9 @@ pub struct OpenedFile {
     pub path: PathBuf,
     /// What was read.
     pub loaded: Loaded,
+    /// The files the load read (the file, its external buffers or rest mesh): no export may
+    /// replace them while the studio serves them.
+    inputs: tkio::ReadScope,
 }
 
 impl OpenedFile {
@@ -31,11 +34,19 @@ impl OpenedFile {
             rest: None,
             ..LoadOptions::default()
         };
+        let inputs = tkio::ReadScope::open();
         let loaded = tkio::load(path, &options).map_err(|e| StudioError::Open(e.to_string()))?;
+        inputs.freeze();
         Ok(OpenedFile {
             path: path.to_path_buf(),
             loaded,
+            inputs,
         })
+    }
+
+    /// The files the load read, each once.
+    pub fn inputs(&self) -> Vec<PathBuf> {
+        self.inputs.files()
     }
 
     /// The file name shown in the page.

@@ -29,7 +29,7 @@ pub(crate) struct DemoArgs {
     #[arg(long)]
     pub(crate) clip: Option<String>,
     /// Frames per second (default: 24).
-    #[arg(long, value_name = "FPS")]
+    #[arg(long, value_name = "FPS", allow_negative_numbers = true)]
     pub(crate) fps: Option<f32>,
 }
 

@@ -20,6 +20,7 @@ pub(crate) mod values;
 pub(crate) mod write;
 
 pub use flipbook::{write_animation, write_animations, write_animations_with, AnimationLayout};
+pub use prepare::confined_uri;
 pub use quantize::{GlbOptions, MAX_ERROR};
 pub use read::{read, read_bytes};
 pub use write::{write_glb, write_glb_with};

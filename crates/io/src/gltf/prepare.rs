@@ -191,8 +191,8 @@ fn strip(root: &mut Map<String, Value>, notes: &mut Vec<String>) {
     }
 }
 
-/// Reads buffer `i`'s bytes: the GLB chunk, a `data:` URI, or a file beside the document.
-/// A meshopt fallback buffer (no URI, no data) is empty.
+/// Reads buffer `i`'s bytes: the GLB chunk, a `data:` URI, or a file inside the document's
+/// folder ([`external_buffer`]). A meshopt fallback buffer (no URI, no data) is empty.
 fn load_buffer<'a>(
     i: usize,
     buffer: &Value,
@@ -200,30 +200,15 @@ fn load_buffer<'a>(
     base: Option<&Path>,
 ) -> Result<Cow<'a, [u8]>> {
     if let Some(uri) = buffer.get("uri").and_then(Value::as_str) {
-        // gltf 1.4 unwraps this decoding of a relative URI (a panic on "%FF").
-        if !uri.contains(':') && urlencoding::decode(uri).is_err() {
-            return Err(bad(format!(
-                "buffer {i}: its uri is not percent-encoded UTF-8: {:.80}",
-                uri.escape_default().to_string()
-            )));
+        if !uri.starts_with("data:") {
+            let byte_length = buffer
+                .get("byteLength")
+                .and_then(Value::as_u64)
+                .unwrap_or(0);
+            return external_buffer(i, uri, byte_length, base).map(Cow::Owned);
         }
-        let data =
-            gltf::buffer::Data::from_source(gltf::buffer::Source::Uri(uri), base).map_err(|e| {
-                match e {
-                    // The common case of a .gltf copied without its .bin: name the file it needs.
-                    gltf::Error::Io(io) if io.kind() == std::io::ErrorKind::NotFound => {
-                        bad(format!(
-                    "buffer {i}: {uri} is missing beside the file: copy it next to the .gltf, \
-                     or export a .glb"
-                ))
-                    }
-                    gltf::Error::Io(io) if !uri.starts_with("data:") => bad(format!(
-                        "buffer {i}: cannot read {uri}: {}",
-                        crate::error::describe_io(&io)
-                    )),
-                    e => bad(format!("buffer {i}: {e}")),
-                }
-            })?;
+        let data = gltf::buffer::Data::from_source(gltf::buffer::Source::Uri(uri), base)
+            .map_err(|e| bad(format!("buffer {i}: {e}")))?;
         return Ok(Cow::Owned(data.0));
     }
     let fallback = buffer
@@ -241,6 +226,95 @@ fn load_buffer<'a>(
             "buffer {i} has no uri and is not the GLB binary chunk"
         ))),
     }
+}
+
+/// The relative path an external URI names inside the document's folder, or why it may not
+/// be read: toonkit reads only the files named and what they reference inside their own
+/// folder (no absolute path, no `..`, no scheme such as `file:`).
+///
+/// # Errors
+/// The one-line reason an external URI is refused (the caller adds the buffer and file).
+pub fn confined_uri(uri: &str) -> std::result::Result<std::path::PathBuf, String> {
+    let shown = format!("{:.80}", uri.escape_default().to_string());
+    if uri.contains(':') {
+        return Err(format!(
+            "{shown} is not a file beside the .gltf (a URI with a scheme or a drive is not read): \
+             keep the file in the .gltf's folder and name it relatively, or export a .glb"
+        ));
+    }
+    let decoded = urlencoding::decode(uri)
+        .map_err(|_| format!("its uri is not percent-encoded UTF-8: {shown}"))?;
+    let rel = Path::new(decoded.as_ref());
+    let inside = !decoded.is_empty()
+        && !decoded.starts_with('\\')
+        && rel.components().all(|c| {
+            matches!(
+                c,
+                std::path::Component::Normal(_) | std::path::Component::CurDir
+            )
+        });
+    if !inside {
+        return Err(format!(
+            "{shown} lies outside the .gltf's folder (absolute, or through ..): toonkit reads only \
+             files inside it; copy the file next to the .gltf, or export a .glb"
+        ));
+    }
+    Ok(rel.to_path_buf())
+}
+
+/// Reads the external buffer `uri` of `byte_length` bytes from inside `base`: a regular file
+/// there (a symlink leading out of the folder, or a device such as `/dev/zero`, is refused),
+/// at least `byte_length` long (checked before reading, so a huge file is never read past
+/// what the document declares); its first `byte_length` bytes are read.
+fn external_buffer(i: usize, uri: &str, byte_length: u64, base: Option<&Path>) -> Result<Vec<u8>> {
+    let rel = confined_uri(uri).map_err(|m| bad(format!("buffer {i}: {m}")))?;
+    let base = base.ok_or_else(|| {
+        bad(format!(
+            "buffer {i}: {uri} is an external file, and glTF bytes without a folder have none: \
+             export a .glb"
+        ))
+    })?;
+    let path = base.join(&rel);
+    let missing = || {
+        bad(format!(
+            "buffer {i}: {uri} is missing beside the file: copy it next to the .gltf, or export a .glb"
+        ))
+    };
+    let real = std::fs::canonicalize(&path).map_err(|_| missing())?;
+    let folder = std::fs::canonicalize(base).map_err(|e| IoError::io(base, e))?;
+    if !real.starts_with(&folder) {
+        return Err(bad(format!(
+            "buffer {i}: {uri} leads outside the .gltf's folder (a symlink to {}): copy the \
+             file next to the .gltf, or export a .glb",
+            real.display()
+        )));
+    }
+    let meta = std::fs::metadata(&real).map_err(|e| IoError::io(&path, e))?;
+    if !meta.is_file() {
+        return Err(bad(format!(
+            "buffer {i}: {uri} is not a regular file (a device, pipe or folder): name a data file"
+        )));
+    }
+    if meta.len() < byte_length {
+        return Err(bad(format!(
+            "buffer {i}: {uri} holds {} bytes but the document declares byteLength {byte_length} \
+             (a truncated or wrong file)",
+            meta.len()
+        )));
+    }
+    let mut bytes = Vec::new();
+    let file = std::fs::File::open(&real).map_err(|e| IoError::io(&path, e))?;
+    use std::io::Read;
+    file.take(byte_length)
+        .read_to_end(&mut bytes)
+        .map_err(|e| {
+            bad(format!(
+                "buffer {i}: cannot read {uri}: {}",
+                crate::describe_io(&e)
+            ))
+        })?;
+    crate::note_read(&path);
+    Ok(bytes)
 }
 
 /// Accessors without a buffer view or sparse values are zeros (glTF 2.0 §3.6.2.1; exporters

@@ -100,4 +100,8 @@ pub enum AnimateError {
         /// What would be accepted.
         expected: &'static str,
     },
+    /// The space-time solve would be over its budget ([`anim::budget`]): fewer keystrokes or
+    /// fewer bones in the bone sets.
+    #[error(transparent)]
+    OverBudget(#[from] anim::OverBudget),
 }

@@ -112,6 +112,18 @@ fn mark_ancestors(rig: &Rig, p: ChainPoint, dof: &mut [bool]) {
     }
 }
 
+/// The space-time solve's unknowns (nodes × columns, LoA §4) against
+/// [`anim::budget::DEFAULT_MAX_SOLVER_UNKNOWNS`]: its dense normal equations hold their square.
+fn check_unknowns(nodes: usize, columns: usize) -> Result<(), AnimateError> {
+    anim::check_budget(
+        "space-time unknowns (nodes × degrees of freedom)",
+        anim::budget::product(&[nodes as u64, columns as u64]),
+        anim::budget::DEFAULT_MAX_SOLVER_UNKNOWNS,
+        "use fewer keystrokes or smaller bone sets",
+    )?;
+    Ok(())
+}
+
 pub(crate) fn run(
     character: &Character,
     line: &Animation,
@@ -226,6 +238,7 @@ pub(crate) fn run(
         ref_length,
         height,
     };
+    check_unknowns(reduction.nodes(), planar_stage(&dof).cols.len())?;
     let staging = !options.hold_pelvis && held != dof;
     let tolerance = if staging {
         STAGING_TOLERANCE
@@ -307,6 +320,11 @@ pub(crate) fn run(
             regularization: weights.spatial_regularization,
             ..*weights
         };
+        let axes = [DVec3::X, DVec3::Y, DVec3::Z];
+        check_unknowns(
+            reduction.nodes(),
+            Columns::new(rig, &dof, &axes, &axes).len(),
+        )?;
         let solve = |targets: &[FrameTargets], poses: &mut Poses| {
             Stage {
                 rig,

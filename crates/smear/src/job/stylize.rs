@@ -10,7 +10,9 @@ use serde::Serialize;
 
 use super::frames::{animation_at, check_range, elongate_range, lines_range, multiples_range};
 use super::prepare::Prepared;
-use crate::{CompiledEffects, EffectInputs, LineStyle, Result, SmearError, Style, Stylize};
+use crate::{
+    CompiledEffects, CompiledLines, EffectInputs, LineStyle, Result, SmearError, Style, Stylize,
+};
 
 /// One copy of the multiple in-betweens in a [`StylizeReport`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -248,6 +250,11 @@ pub fn stylize(prepared: &Prepared, style: &Style) -> Result<Stylized> {
 /// # Performance
 /// Costs the frames asked for: the per-frame effect functions, no whole-clip pass (the
 /// motion-line seeds' offsets still cost seeds × clip frames).
+///
+/// # Errors
+/// [`SmearError::OverBudget`] when the motion lines asked for (count, samples, sides, frames)
+/// exceed [`anim::budget::DEFAULT_MAX_LINE_VERTICES`] or their seeds' trajectories
+/// [`anim::budget::DEFAULT_MAX_POINTS`]; the errors of the effects.
 pub fn stylize_frames(
     prepared: &Prepared,
     style: &Style,
@@ -395,6 +402,7 @@ pub fn stylize_frames(
 
         let t = Instant::now();
         if let Some(l) = &fx.lines {
+            check_line_budget(l, prepared.report().frames, frames.len())?;
             let tris = &anim.mesh.triangles;
             let mut points = crate::sample_surface(anim.frame(0), tris, l.count, l.seed);
             if merged {
@@ -441,4 +449,29 @@ pub fn stylize_frames(
         report,
         first_frame: frames.start,
     })
+}
+
+/// Motion lines (SMEAR Eq. 13) are checked against their budgets before their seeds are
+/// sampled: each seed's trajectory spans the clip, and each drawn line holds samples × sides
+/// vertices per frame.
+fn check_line_budget(l: &CompiledLines, clip_frames: usize, frames: usize) -> Result<()> {
+    use anim::budget::{product, DEFAULT_MAX_LINE_VERTICES, DEFAULT_MAX_POINTS};
+    let (count, samples, sides) = (
+        l.count as u64,
+        l.options.samples as u64,
+        l.options.sides as u64,
+    );
+    anim::check_budget(
+        "lines count × clip frames",
+        product(&[count, clip_frames as u64]),
+        DEFAULT_MAX_POINTS,
+        "lower the motion-line --count",
+    )?;
+    anim::check_budget(
+        "lines count × samples × sides × frames",
+        product(&[count, samples, sides, frames as u64]),
+        DEFAULT_MAX_LINE_VERTICES,
+        "lower the motion-line --count, --samples or --sides",
+    )?;
+    Ok(())
 }

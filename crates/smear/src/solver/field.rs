@@ -33,6 +33,7 @@ impl SolvedField {
     /// Solves the offsets of every object of `scene` (see [`OffsetSolver::new`]).
     pub(crate) fn new(scene: &SampledScene, options: &OffsetOptions) -> Result<SolvedField> {
         count_solve();
+        options.check_budget()?;
         check_scene(scene)?;
         let frames = scene.frame_count;
         let pruned = Pruned::new(&scene.skeleton, &options.prune)?;
@@ -110,6 +111,7 @@ impl SolvedField {
         cameras: &[Camera],
     ) -> Result<SolvedField> {
         count_solve();
+        options.check_budget()?;
         if let Some(name) = options.prune.first() {
             return Err(SmearError::UnknownJoint {
                 name: name.clone(),

@@ -101,6 +101,18 @@ impl Expression {
         seed: u64,
         params: BTreeMap<String, Param>,
     ) -> Result<Self, StyleError> {
+        if let Err(over) = anim::check_budget(
+            "expression length (bytes)",
+            text.len() as u64,
+            anim::budget::DEFAULT_MAX_EXPRESSION_LEN,
+            "write a shorter expression, or name its constants under params",
+        ) {
+            let head: String = text.chars().take(40).collect();
+            return Err(StyleError::Expression {
+                expr: format!("{head}…"),
+                problem: over.to_string(),
+            });
+        }
         let problem = |p: String| StyleError::Expression {
             expr: text.to_string(),
             problem: p,
@@ -143,6 +155,20 @@ impl Expression {
                 "uses {} variables, at most {MAX_EXPRESSION_VARIABLES} are supported",
                 slots.len()
             )));
+        }
+        if slots.is_empty() {
+            // A constant: NaN or infinity here would be NaN or infinity at every vertex of
+            // every frame (silently drawn as 0): say so now.
+            match flat.eval(&[]) {
+                Ok(x) if !x.is_finite() => {
+                    return Err(problem(format!(
+                        "is {} at every frame and vertex (a division by zero, or log/sqrt of \
+                         a negative number): write a finite value",
+                        if x.is_nan() { "NaN" } else { "infinite" }
+                    )))
+                }
+                _ => {}
+            }
         }
         let uses_noise = slots.contains(&Slot::Input(3));
         Ok(Expression {

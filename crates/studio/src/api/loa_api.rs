@@ -148,12 +148,17 @@ pub(crate) async fn animate(
         let start = Instant::now();
         let fps = r.fps.unwrap_or(loa::DEFAULT_FPS);
         let keys_json = keystrokes_json(&r, fps);
-        let keys = loa::Keystrokes::from_json_str(&keys_json.to_string())
-            .map_err(|e| ApiError::bad(format!("keystrokes: {e}")))?;
+        let keys = loa::Keystrokes::from_json_str(&keys_json.to_string()).map_err(|e| {
+            let over = matches!(e, loa::LoaError::OverBudget(_));
+            ApiError::refused(format!("keystrokes: {e}"), over)
+        })?;
         let mut options = loa::LineOptions::default();
         options.physics.fps = fps;
         options.wobbles = r.wobbles.clone();
-        let line = loa::line(&keys, &options).map_err(|e| ApiError::bad(format!("line: {e}")))?;
+        let line = loa::line(&keys, &options).map_err(|e| {
+            let over = matches!(e, loa::LoaError::OverBudget(_));
+            ApiError::refused(format!("line: {e}"), over)
+        })?;
         let line_seconds = start.elapsed().as_secs_f64();
 
         let (c, label) = character(&studio, r.file, fps)?;
@@ -178,8 +183,10 @@ pub(crate) async fn animate(
             }),
             ..Default::default()
         };
-        let motion = loa::animate(&c, &line, &animate_options)
-            .map_err(|e| ApiError::bad(format!("{label}: {e}")))?;
+        let motion = loa::animate(&c, &line, &animate_options).map_err(|e| {
+            let over = matches!(e, loa::animate::AnimateError::OverBudget(_));
+            ApiError::refused(format!("{label}: {e}"), over)
+        })?;
         let scene = studio
             .file(r.file)?
             .scene()
@@ -337,7 +344,7 @@ pub(crate) async fn export(
         let text = |t: &str| {
             tkio::save(&path, &tkio::Output::Text(t))
                 .map(|_| ())
-                .map_err(|e| io(e.to_string()))
+                .map_err(|e| ApiError::from_io(&e))
         };
         match (ext.as_str(), r.what.as_deref()) {
             ("json", Some("keystrokes")) => text(&s.keys_json)?,
@@ -345,7 +352,8 @@ pub(crate) async fn export(
             ("svg", _) => text(&loa::to_svg_string(&s.line.animation, Some(&s.keys)))?,
             ("glb", _) => {
                 let bytes = tkio::gltf::write_glb(&s.scene).map_err(|e| io(e.to_string()))?;
-                tkio::save(&path, &tkio::Output::Bytes(&bytes)).map_err(|e| io(e.to_string()))?;
+                tkio::save(&path, &tkio::Output::Bytes(&bytes))
+                    .map_err(|e| ApiError::from_io(&e))?;
             }
             ("bvh", _) => {
                 let scene = studio

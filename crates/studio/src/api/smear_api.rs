@@ -149,8 +149,10 @@ fn stylized(studio: &Studio, r: &StyleRequest, all: bool) -> ApiResult<(Style, s
         Some([start, end]) if !all => start..end,
         _ => 0..p.report().frames,
     };
-    let s = smear::stylize_frames(&p, &style, frames)
-        .map_err(|e| ApiError::bad(format!("{label}: {e}")))?;
+    let s = smear::stylize_frames(&p, &style, frames).map_err(|e| {
+        let over = matches!(e, smear::SmearError::OverBudget(_));
+        ApiError::refused(format!("{label}: {e}"), over)
+    })?;
     Ok((style, s))
 }
 
@@ -274,7 +276,7 @@ pub(crate) async fn export(
         .ok_or_else(|| ApiError::bad("export: give \"name\" (a file name in the output folder)"))?;
     let path = output_path(&studio.out_dir, &name)?;
     blocking(move || {
-        let io = |e: tkio::IoError| ApiError::internal(e.to_string());
+        let io = |e: tkio::IoError| ApiError::from_io(&e);
         if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) {
             let p = studio.prepared(r.file, &r.clip)?;
             let style = read_style(&r, &p.options().offsets)?;

@@ -38,7 +38,14 @@ pub(crate) fn run(ctx: &Context, args: LoaArgs) -> Result<()> {
 
 /// Reads keystrokes (JSON or SVG).
 fn read_keystrokes(path: &Path) -> Result<loa::Keystrokes> {
-    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    // Through tkio: a keystroke file is an input the job's outputs may not replace.
+    let bytes = tkio::read_file(path)?;
+    let text = String::from_utf8(bytes).map_err(|_| {
+        anyhow::anyhow!(
+            "{}: keystrokes are UTF-8 text (JSON or SVG)",
+            path.display()
+        )
+    })?;
     loa::Keystrokes::parse(&text).with_context(|| path.display().to_string())
 }
 
