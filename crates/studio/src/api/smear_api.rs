@@ -18,7 +18,7 @@ use super::scene::ClipQuery;
 use super::{blocking, body};
 use crate::error::{ApiError, ApiResult};
 use crate::files::output_path;
-use crate::pack::Pack;
+use crate::pack::{coordinates, Pack};
 use crate::state::Studio;
 
 /// The example styles of `examples/smear/` (SMEAR Figs. 11, 12, 15, 16).
@@ -177,13 +177,9 @@ pub(crate) async fn stylize(
             .filter_map(|o| s.animation(o.body))
             .collect();
         let bodies = &bodies;
-        pack.f32(
+        pack.f32_slices(
             "body",
-            (0..frames).flat_map(move |f| {
-                bodies
-                    .iter()
-                    .flat_map(move |a| a.frame(f).iter().flat_map(|p| p.to_array()))
-            }),
+            (0..frames).flat_map(move |f| bodies.iter().map(move |a| coordinates(a.frame(f)))),
         );
         let mut copies = Vec::new();
         let mut lines = Vec::new();
@@ -193,9 +189,9 @@ pub(crate) async fn stylize(
                     s.flipbook.parts.get(i)
                 {
                     let n = copies.len();
-                    pack.f32(
+                    pack.f32_slices(
                         &format!("copy{n}.positions"),
-                        animation.positions().iter().flat_map(|p| p.to_array()),
+                        [coordinates(animation.positions())],
                     );
                     pack.u32(
                         &format!("copy{n}.triangles"),
@@ -223,11 +219,9 @@ pub(crate) async fn stylize(
                         .iter()
                         .flat_map(|m| [m.positions.len() as u32, m.triangles.len() as u32]),
                 );
-                pack.f32(
+                pack.f32_slices(
                     &format!("lines{n}.positions"),
-                    meshes
-                        .iter()
-                        .flat_map(|m| m.positions.iter().flat_map(|p| p.to_array())),
+                    meshes.iter().map(|m| coordinates(&m.positions)),
                 );
                 pack.u32(
                     &format!("lines{n}.triangles"),
