@@ -24,6 +24,31 @@ function splitLines(buffers, i) {
   return out;
 }
 
+/**
+ * The body of a whole-clip answer sent as changes (`body.changed` bits per frame and vertex,
+ * `body.positions` of the moved vertices; crates/studio/src/api/changes.rs) rebuilt over the
+ * input clip: the core's exact numbers from fewer bytes.
+ */
+export function expandChanges(buffers, input, first, frames) {
+  const n = input.vertices, words = Math.ceil(n / 32);
+  const body = input.positions.slice(first * n * 3, (first + frames) * n * 3);
+  const bits = buffers['body.changed'], moved = buffers['body.positions'];
+  let k = 0;
+  for (let f = 0; f < frames; f++) {
+    for (let w = 0; w < words; w++) {
+      let word = bits[f * words + w];
+      while (word) {
+        const b = 31 - Math.clz32(word & -word);
+        word &= word - 1;
+        const o = (f * n + w * 32 + b) * 3;
+        body[o] = moved[k]; body[o + 1] = moved[k + 1]; body[o + 2] = moved[k + 2];
+        k += 3;
+      }
+    }
+  }
+  return body;
+}
+
 /** A row of the "all parameters" block: label, field, and ◇/✕ for a keyable number. */
 function paramRow(d) {
   const row = document.createElement('label');
@@ -240,7 +265,7 @@ export class SmearPanel {
     // The whole clip is asked for now, not after the current frame is drawn: the server
     // answers the small request meanwhile, and the clip arrives one round trip sooner.
     const ctl = new AbortController();
-    const rest = getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...body }, ctl.signal);
+    const rest = getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...body, changes: true }, ctl.signal);
     rest.catch(() => {});
     this.restCtl = ctl;
     this.fresh = null;
@@ -321,6 +346,7 @@ export class SmearPanel {
     const s = this.studio;
     const total = header.clip_frames, k = header.first_frame, nf = header.frames;
     const n3 = this.anim.vertices * 3;
+    if (buffers['body.changed']) buffers.body = expandChanges(buffers, this.anim, k, nf);
     if (nf === total) this.body = buffers.body;
     else {
       if (!this.body || this.body.length !== total * n3) this.body = new Float32Array(this.anim.positions);

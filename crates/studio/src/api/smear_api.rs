@@ -14,10 +14,11 @@ use serde::Deserialize;
 use serde_json::{json, Value};
 use smear::{OffsetOptions, Style, WeightSource};
 
+use super::changes::pack_changes;
 use super::scene::ClipQuery;
 use super::{blocking, body};
 use crate::error::{ApiError, ApiResult};
-use crate::files::output_path;
+use crate::files::{merged, output_path};
 use crate::pack::{coordinates, Pack};
 use crate::state::Studio;
 
@@ -115,6 +116,10 @@ pub(crate) struct StyleRequest {
     /// then read ω), as the weight-group picker sends it.
     #[serde(default)]
     weights: Option<Value>,
+    /// The body as what changed from the input clip ([`super::changes`]): `body.changed`
+    /// and `body.positions` instead of `body` (the page's whole-clip request).
+    #[serde(default)]
+    changes: bool,
 }
 
 fn read_style(r: &StyleRequest, prepared: &OffsetOptions) -> ApiResult<Style> {
@@ -159,7 +164,8 @@ fn stylized(studio: &Studio, r: &StyleRequest, all: bool) -> ApiResult<(Style, s
 /// elongated in-betweens merged in object order), per copy `copyN.positions`,
 /// `copyN.alpha` (frames × copy vertices), `copyN.triangles`; per line set
 /// `linesN.counts` (u32 per frame: vertices, triangles), `linesN.positions`,
-/// `linesN.triangles`, `linesN.alpha`.
+/// `linesN.triangles`, `linesN.alpha`. With `"changes": true` the body comes as
+/// `body.changed` and `body.positions` instead ([`super::changes`]).
 pub(crate) async fn stylize(
     State(studio): State<Arc<Studio>>,
     request: Result<Bytes, BytesRejection>,
@@ -177,10 +183,29 @@ pub(crate) async fn stylize(
             .filter_map(|o| s.animation(o.body))
             .collect();
         let bodies = &bodies;
-        pack.f32_slices(
-            "body",
-            (0..frames).flat_map(move |f| bodies.iter().map(move |a| coordinates(a.frame(f)))),
-        );
+        let vertices: usize = bodies.iter().map(|a| a.vertex_count()).sum();
+        let input = if r.changes {
+            let sampled = studio.sampled(r.file, &r.clip)?;
+            Some(merged(&studio.file(r.file)?.label(), &sampled)?)
+        } else {
+            None
+        };
+        match &input {
+            Some(m) if m.vertex_count() == vertices => pack_changes(
+                &mut pack,
+                frames,
+                vertices,
+                |f| bodies.iter().map(|a| a.frame(f)).collect(),
+                |f| m.frame(s.first_frame + f),
+            ),
+            _ => {
+                pack.f32_slices(
+                    "body",
+                    (0..frames)
+                        .flat_map(move |f| bodies.iter().map(move |a| coordinates(a.frame(f)))),
+                );
+            }
+        }
         let mut copies = Vec::new();
         let mut lines = Vec::new();
         for o in &s.objects {
