@@ -41,7 +41,6 @@ step "apt chromium assimp-utils" apt_tools
 step "bpy 4.2.0 venv" venv target/caches-venv "bpy==4.2.0" "numpy<2" "openjd-cli" "usd-core==26.11"
 step "bpy 5.0.1 venv" venv target/blender-venv-5.0 "bpy==5.0.1" "numpy<2"
 step "pymeshlab venv" venv target/meshlab-venv pymeshlab
-step "npm studio" npm ci --prefix crates/studio/web --no-audit --no-fund --loglevel=error
 step "npm studio tests" npm ci --prefix .ci/studio --no-audit --no-fund --loglevel=error
 mkdir -p target/io-npm && cp .ci/io/package.json .ci/io/package-lock.json target/io-npm/
 step "npm io" npm ci --prefix target/io-npm --no-audit --no-fund --loglevel=error

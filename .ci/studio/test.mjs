@@ -2,7 +2,7 @@
 // against a running `toonkit studio` (URL in argv[2]); screenshots into argv[3].
 // Prints the latency figures and a closing "N passed, N failed" line; exit 1 on any failure.
 import { chromium } from 'playwright-core';
-import { mkdirSync } from 'node:fs';
+import { mkdirSync, readFileSync } from 'node:fs';
 import { join } from 'node:path';
 
 const url = process.argv[2];
@@ -39,11 +39,20 @@ try {
     ctx.drawImage(src, 0, 0);
     return Array.from(ctx.getImageData(0, 0, c.width, c.height).data);
   });
+  // The server is the binary alone in an empty folder (.ci/studio.sh): three.js came from it.
   const before = await pixels();
   const bg = [before[0], before[1], before[2]];
-  let lit = 0;
-  for (let i = 0; i < before.length; i += 4) if (Math.abs(before[i] - bg[0]) + Math.abs(before[i + 1] - bg[1]) + Math.abs(before[i + 2] - bg[2]) > 30) lit++;
-  check('canvas is not blank', lit > 2000, `${lit} pixels differ from the background`);
+  const width = await page.evaluate(() => document.getElementById('gl').width);
+  let lit = 0, x0 = Infinity, x1 = -1, y0 = Infinity, y1 = -1;
+  for (let i = 0; i < before.length; i += 4) {
+    if (Math.abs(before[i] - bg[0]) + Math.abs(before[i + 1] - bg[1]) + Math.abs(before[i + 2] - bg[2]) <= 30) continue;
+    lit++;
+    const x = (i / 4) % width, y = Math.floor(i / 4 / width);
+    x0 = Math.min(x0, x); x1 = Math.max(x1, x); y0 = Math.min(y0, y); y1 = Math.max(y1, y);
+  }
+  const height = before.length / 4 / width;
+  const centred = x0 < width / 2 && x1 > width / 2 && y0 < height / 2 && y1 > height / 2;
+  check('the viewport shows the character (three.js embedded in the binary)', lit > 2000 && centred, `${lit} pixels differ from the background, in x ${x0}–${x1}, y ${y0}–${y1} of ${width}×${height}`);
 
   // β max slider: pixels change; latency slider → geometry drawn.
   const setSlider = (v) => page.evaluate((v) => {
@@ -83,6 +92,9 @@ try {
   // load 9 (debug server); the targets are 4.5× and 2.7× those, so the medians are asserted.
   check('slider → current frame drawn: median ≤ 100 ms', smearMs <= 100, `${smearMs.toFixed(1)} ms`);
   console.log(`latency smear slider → all 81 frames drawn (background load): median ${median(latAll.map((l) => l.ms)).toFixed(1)} ms, server median ${median(latAll.map((l) => l.server_ms)).toFixed(1)} ms, ${(median(latAll.map((l) => l.bytes)) / 1048576).toFixed(1)} MiB`);
+  // The panel's report of the whole clip in sight (docs/studio.png).
+  await page.evaluate(() => document.getElementById('smear-report').scrollIntoView());
+  await page.screenshot({ path: join(shots, 'smear-report.png') });
   await page.evaluate(() => { const c = document.getElementById('show-offsets'); c.checked = true; c.dispatchEvent(new Event('change')); });
   await page.waitForTimeout(1500);
   await page.screenshot({ path: join(shots, 'smear-offsets.png') });
@@ -328,6 +340,12 @@ try {
     }
   }
   check('no console errors', consoleErrors.length === 0, consoleErrors.join(' | '));
+  // The server's peak resident memory (the robot, the face, one library built).
+  if (process.env.STUDIO_PID) {
+    const status = readFileSync(`/proc/${process.env.STUDIO_PID}/status`, 'utf8');
+    const kib = Number((status.match(/VmHWM:\s+(\d+)/) || [])[1]);
+    console.log(`server peak RSS (VmHWM): ${(kib / 1024).toFixed(0)} MiB; target 400 MB`);
+  }
   console.log(`screenshots in ${shots}`);
 } catch (e) {
   failed++;

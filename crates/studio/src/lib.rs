@@ -1,6 +1,6 @@
 //! toonkit studio: a local web page over the three tools' whole-job calls.
 //!
-//! `toonkit studio FILE... [--port 8765] [--no-open]` serves one page (three.js from npm for the
+//! `toonkit studio FILE... [--port 8765] [--no-open]` serves one page (three.js vendored and embedded for the
 //! viewport) and a small API on `127.0.0.1`:
 //!
 //! * smear — [`smear::prepare`] once per opened file and clip (offsets solved once), then

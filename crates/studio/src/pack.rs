@@ -35,6 +35,26 @@ impl Pack {
         self.entry(name, "f32", offset, count)
     }
 
+    /// Adds a float32 buffer from contiguous slices (frame-major geometry): copied as bytes,
+    /// not value by value.
+    pub fn f32_slices<'a>(
+        &mut self,
+        name: &str,
+        slices: impl IntoIterator<Item = &'a [f32]>,
+    ) -> &mut Pack {
+        let offset = self.data.len();
+        let mut count = 0usize;
+        for s in slices {
+            if cfg!(target_endian = "little") {
+                self.data.extend_from_slice(bytemuck::cast_slice(s));
+            } else {
+                self.data.extend(s.iter().flat_map(|v| v.to_le_bytes()));
+            }
+            count += s.len();
+        }
+        self.entry(name, "f32", offset, count)
+    }
+
     /// Adds a uint32 buffer.
     pub fn u32(&mut self, name: &str, values: impl IntoIterator<Item = u32>) -> &mut Pack {
         let offset = self.data.len();
@@ -85,6 +105,11 @@ impl Pack {
     }
 }
 
+/// Points as their x, y, z coordinates, without copying.
+pub fn coordinates(points: &[anim::glam::Vec3]) -> &[f32] {
+    bytemuck::cast_slice(points)
+}
+
 /// Reads a pack back: the header and the named float32 buffer (for tests and tools).
 pub fn read_f32(bytes: &[u8], name: &str) -> Option<(Value, Vec<f32>)> {
     let (header, data) = split(bytes)?;
@@ -117,9 +142,11 @@ mod tests {
     fn a_pack_reads_back() {
         let mut p = Pack::new();
         p.u32("tri", [0, 1, 2]).f32("pos", [1.5, -2.0]);
+        p.f32_slices("frames", [&[0.25f32, 3.0][..], &[-7.5][..]]);
         let bytes = p.finish(json!({"frames": 3}));
         let (header, pos) = read_f32(&bytes, "pos").unwrap();
         assert_eq!(pos, vec![1.5, -2.0]);
+        assert_eq!(read_f32(&bytes, "frames").unwrap().1, vec![0.25, 3.0, -7.5]);
         assert_eq!(header["frames"], 3);
         assert_eq!(header["buffers"][1]["offset"], 12);
         let len = u32::from_le_bytes(bytes[..4].try_into().unwrap()) as usize;

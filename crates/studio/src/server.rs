@@ -31,9 +31,6 @@ pub struct ServeOptions {
     pub open: bool,
     /// The only folder the studio writes into.
     pub out_dir: PathBuf,
-    /// Where the page's npm packages are (default: `crates/studio/web/node_modules` of the
-    /// checkout the binary was built from; `TOONKIT_STUDIO_NODE_MODULES` overrides).
-    pub node_modules: Option<PathBuf>,
 }
 
 impl Default for ServeOptions {
@@ -43,7 +40,6 @@ impl Default for ServeOptions {
             port: DEFAULT_PORT,
             open: false,
             out_dir: PathBuf::from("studio-out"),
-            node_modules: None,
         }
     }
 }
@@ -78,19 +74,7 @@ pub fn serve(options: &ServeOptions) -> Result<(), StudioError> {
         .map(|p| OpenedFile::open(p))
         .collect::<Result<Vec<_>, _>>()?;
     let out_dir = output_folder(&options.out_dir)?;
-    let node_modules = options
-        .node_modules
-        .clone()
-        .or_else(|| std::env::var_os("TOONKIT_STUDIO_NODE_MODULES").map(PathBuf::from))
-        .unwrap_or_else(web::default_node_modules);
-    if !web::three_installed(&node_modules) {
-        eprintln!(
-            "warning: three.js is not installed in {}: run `{}` in the toonkit checkout (the page will say so too)",
-            node_modules.display(),
-            web::INSTALL_HINT
-        );
-    }
-    let studio = Arc::new(Studio::new(files, out_dir, node_modules));
+    let studio = Arc::new(Studio::new(files, out_dir));
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .enable_all()
         .build()?;

@@ -58,8 +58,6 @@ pub struct Studio {
     pub files: Vec<OpenedFile>,
     /// The canonical output folder (the only place it writes).
     pub out_dir: PathBuf,
-    /// Where the page's npm packages are installed (`web/node_modules`).
-    pub node_modules: PathBuf,
     sampled: Mutex<HashMap<ClipKey, Arc<SampledScene>>>,
     prepared: Mutex<HashMap<ClipKey, Arc<smear::Prepared>>>,
     preparing: Mutex<()>,
@@ -73,11 +71,10 @@ pub struct Studio {
 
 impl Studio {
     /// A studio over opened files.
-    pub fn new(files: Vec<OpenedFile>, out_dir: PathBuf, node_modules: PathBuf) -> Studio {
+    pub fn new(files: Vec<OpenedFile>, out_dir: PathBuf) -> Studio {
         Studio {
             files,
             out_dir,
-            node_modules,
             sampled: Mutex::default(),
             prepared: Mutex::default(),
             preparing: Mutex::default(),

@@ -1,16 +1,12 @@
-//! The page: our HTML/JS/CSS embedded at build time, three.js served from the npm install
-//! in `crates/studio/web/node_modules` (`npm ci --prefix crates/studio/web`). When three.js
-//! is missing the page still loads and says how to install it.
+//! The page: our HTML/JS/CSS and the three.js modules it imports (vendored in
+//! `web/vendor/three`), all embedded at build time, so the binary serves the page from any
+//! folder with no npm install or network.
 
-use std::path::{Component, Path};
-use std::sync::Arc;
-
-use axum::extract::{Path as UrlPath, State};
-use axum::http::{header, StatusCode};
+use axum::extract::Path as UrlPath;
+use axum::http::header;
 use axum::response::{IntoResponse, Response};
 
 use crate::error::ApiError;
-use crate::state::Studio;
 
 /// Our page files: (URL name, content type, text).
 pub const PAGE: &[(&str, &str, &str)] = &[
@@ -36,22 +32,31 @@ pub const PAGE: &[(&str, &str, &str)] = &[
     ),
     ("loa.js", JS, include_str!("../web/loa.js")),
     ("stopmo.js", JS, include_str!("../web/stopmo.js")),
+    ("report.js", JS, include_str!("../web/report.js")),
 ];
 
 const JS: &str = "text/javascript; charset=utf-8";
 
-/// The command that installs the page's npm packages.
-pub const INSTALL_HINT: &str = "npm ci --prefix crates/studio/web";
+/// The vendored three.js version (`web/vendor/three/README.md`).
+pub const THREE_VERSION: &str = "0.187.0";
 
-/// The npm install folder of a source checkout.
-pub fn default_node_modules() -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("web/node_modules")
-}
-
-/// Whether three.js is installed under `node_modules`.
-pub fn three_installed(node_modules: &Path) -> bool {
-    node_modules.join("three/build/three.module.js").is_file()
-}
+/// The three.js modules the page imports (`web/vendor/three`, npm's `three` package at
+/// [`THREE_VERSION`]), embedded so the binary alone serves the page: (path under
+/// `/vendor/three/`, text).
+pub const THREE: &[(&str, &str)] = &[
+    (
+        "build/three.module.js",
+        include_str!("../web/vendor/three/build/three.module.js"),
+    ),
+    (
+        "build/three.core.js",
+        include_str!("../web/vendor/three/build/three.core.js"),
+    ),
+    (
+        "examples/jsm/controls/OrbitControls.js",
+        include_str!("../web/vendor/three/examples/jsm/controls/OrbitControls.js"),
+    ),
+];
 
 /// `GET /`: the page.
 pub async fn index() -> Response {
@@ -65,39 +70,27 @@ pub async fn page(UrlPath(name): UrlPath<String>) -> Response {
 
 fn file(name: &str) -> Response {
     match PAGE.iter().find(|(n, _, _)| *n == name) {
-        Some((_, kind, text)) => (
-            [
-                (header::CONTENT_TYPE, *kind),
-                (header::CACHE_CONTROL, "no-cache"),
-            ],
-            *text,
-        )
-            .into_response(),
+        Some((_, kind, text)) => text_response(kind, "no-cache", text),
         None => ApiError::not_found(format!("/{name}: no such page file")).into_response(),
     }
 }
 
-/// `GET /vendor/three/<path>`: a `.js` file of the installed `three` package (`build/` and
-/// `examples/jsm/` only).
-pub async fn three(State(studio): State<Arc<Studio>>, UrlPath(path): UrlPath<String>) -> Response {
-    let rel = Path::new(&path);
-    let plain = rel.components().all(|c| matches!(c, Component::Normal(_)));
-    let allowed = (path.starts_with("build/") || path.starts_with("examples/jsm/"))
-        && path.ends_with(".js")
-        && plain;
-    if !allowed {
-        return ApiError::forbidden(format!("/vendor/three/{path}: not served")).into_response();
+/// `GET /vendor/three/<path>`: one of the embedded three.js modules ([`THREE`]); they never
+/// change within a build, so the browser may keep them for a day.
+pub async fn three(UrlPath(path): UrlPath<String>) -> Response {
+    match THREE.iter().find(|(n, _)| *n == path) {
+        Some((_, text)) => text_response(JS, "max-age=86400", text),
+        None => ApiError::not_found(format!(
+            "/vendor/three/{path}: not one of the page's three.js {THREE_VERSION} modules"
+        ))
+        .into_response(),
     }
-    let file = studio.node_modules.join("three").join(rel);
-    match std::fs::read(&file) {
-        Ok(bytes) => ([(header::CONTENT_TYPE, JS)], bytes).into_response(),
-        Err(_) => (
-            StatusCode::NOT_FOUND,
-            [(header::CONTENT_TYPE, JS)],
-            format!(
-                "throw new Error('three.js is not installed: run `{INSTALL_HINT}` in the toonkit checkout, then restart the studio');"
-            ),
-        )
-            .into_response(),
-    }
+}
+
+fn text_response(kind: &'static str, cache: &'static str, text: &'static str) -> Response {
+    (
+        [(header::CONTENT_TYPE, kind), (header::CACHE_CONTROL, cache)],
+        text,
+    )
+        .into_response()
 }

@@ -415,3 +415,71 @@ async fn two_seeds_give_two_parts_on_a_worker_thread() {
     let (status, _) = send(&app, post("/api/jobs/999/cancel", json!({}))).await;
     assert_eq!(status, StatusCode::NOT_FOUND);
 }
+
+/// The u32 buffer `name` of a pack.
+fn read_u32(bytes: &[u8], name: &str) -> Vec<u32> {
+    let (header, data) = pack::split(bytes).unwrap();
+    let entry = header["buffers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|b| b["name"] == name && b["type"] == "u32")
+        .unwrap_or_else(|| panic!("no u32 buffer {name}"));
+    let offset = entry["offset"].as_u64().unwrap() as usize;
+    let count = entry["count"].as_u64().unwrap() as usize;
+    data[offset..offset + count * 4]
+        .chunks_exact(4)
+        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect()
+}
+
+#[tokio::test]
+async fn the_whole_clip_sent_as_changes_rebuilds_the_cores_body_exactly() {
+    let dir = tempfile::tempdir().unwrap();
+    let app = app(dir.path());
+    let (_, input) = pack::read_f32(
+        &send_ok(&app, get("/api/scene?clip=Dance")).await,
+        "positions",
+    )
+    .unwrap();
+    let style =
+        json!({"elongate": {"function": {"stages": [{"op": "speed"}, {"op": "scale", "by": 8}]}}});
+    for range in [None, Some([30, 34])] {
+        let mut request = json!({"clip": "Dance", "style": style});
+        if let Some(r) = range {
+            request["frames"] = json!(r);
+        }
+        let dense = send_ok(&app, post("/api/smear/stylize", request.clone())).await;
+        let (header, body) = pack::read_f32(&dense, "body").unwrap();
+        request["changes"] = json!(true);
+        let sent = send_ok(&app, post("/api/smear/stylize", request)).await;
+        assert!(pack::read_f32(&sent, "body").is_none());
+        let mask = read_u32(&sent, "body.changed");
+        let (_, moved) = pack::read_f32(&sent, "body.positions").unwrap();
+        let frames = header["frames"].as_u64().unwrap() as usize;
+        let first = header["first_frame"].as_u64().unwrap() as usize;
+        let n = body.len() / frames / 3;
+        let words = n.div_ceil(32);
+        // The page's rebuild: the input clip, moved vertices replaced in vertex order.
+        let mut rebuilt = input[first * n * 3..(first + frames) * n * 3].to_vec();
+        let mut k = 0;
+        for f in 0..frames {
+            for v in 0..n {
+                if mask[f * words + v / 32] >> (v % 32) & 1 == 1 {
+                    let o = (f * n + v) * 3;
+                    rebuilt[o..o + 3].copy_from_slice(&moved[k..k + 3]);
+                    k += 3;
+                }
+            }
+        }
+        assert_eq!(k, moved.len(), "{range:?}: every moved vertex is placed");
+        assert!(rebuilt == body, "{range:?}: the rebuilt body differs");
+        assert!(
+            moved.len() * 2 < body.len(),
+            "{range:?}: the speed style moves {} of {} coordinates",
+            moved.len(),
+            body.len()
+        );
+        assert!(sent.len() < dense.len());
+    }
+}

@@ -32,9 +32,6 @@ studio.status = status;
 
 async function main() {
   studio.info = await getJSON('/api/info');
-  if (!studio.info.three_installed) {
-    showError(`three.js is not installed: run \`${studio.info.install_hint}\` in the toonkit checkout, then restart the studio.`);
-  }
   const view = new Viewport($('gl'));
   studio.view = view;
   const fileSel = $('file');
@@ -63,7 +60,7 @@ async function main() {
     const t0 = performance.now();
     const { header, buffers } = await getPack(`/api/scene?file=${file}&clip=${encodeURIComponent(clip)}`);
     status(`${header.name}: ${header.frames} frames, ${header.vertices} vertices (${Math.round(performance.now() - t0)} ms)`);
-    return { triangles: buffers.triangles, positions: buffers.positions, frames: header.frames, vertices: header.vertices, fps: header.fps, name: header.name };
+    return { triangles: buffers.triangles, positions: buffers.positions, frames: header.frames, vertices: header.vertices, fps: header.fps, name: header.name, height: header.bbox[1][1] - header.bbox[0][1] };
   };
 
   const clipSel = $('clip');

@@ -2,6 +2,7 @@
 // (LoA Section 3); the server returns the dynamic line and the character motion that
 // follows it (LoA Section 4). Shift-drag on the line wobbles it.
 import { getJSON, getPack, postJSON } from './api.js';
+import { loaSummary } from './report.js';
 
 const $ = (id) => document.getElementById(id);
 const TIMELINE = 48;
@@ -175,14 +176,15 @@ export class LoaPanel {
       this.result = r;
       s.showError('');
       const h = r.header;
+      // The whole motion is asked for at once (the server keeps it since this answer).
+      this.loadRest(r, t0);
       s.view.setAnimation({ triangles: r.buffers.triangles, positions: r.buffers.positions, frames: h.motion.positions_frames, vertices: h.motion.vertices }, { frame: false });
       s.setTimeline(Math.max(TIMELINE, h.line.first_frame + h.line.frames + 12), 24);
       this.onFrame(s.frame);
       await s.view.rendered();
       const ms = performance.now() - t0;
       s.stats.loa.push({ ms, server_ms: h.seconds.total * 1000, bytes: r.bytes });
-      this.loadRest(r, t0);
-      $('loa-report').textContent = `line + character in ${ms.toFixed(0)} ms (line ${(h.seconds.line * 1000).toFixed(0)} ms, motion ${(h.seconds.animate * 1000).toFixed(0)} ms)\n` + JSON.stringify(h.report, null, 1) + (h.warnings.length ? '\n' + h.warnings.join('\n') : '');
+      $('loa-report').textContent = `line + character in ${ms.toFixed(0)} ms (line ${(h.seconds.line * 1000).toFixed(0)} ms, motion ${(h.seconds.animate * 1000).toFixed(0)} ms)\n` + loaSummary(h);
     } catch (e) {
       s.showError(e.message);
     } finally {

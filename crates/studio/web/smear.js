@@ -6,6 +6,7 @@
 import { getJSON, getPack, postJSON } from './api.js';
 import { KEYABLE, keyable, isCurve, paramAt, setKey, deleteKey, drawKeys, styleParams } from './smear_keys.js';
 import { WeightPicker } from './smear_weights.js';
+import { smearSummary } from './report.js';
 
 const $ = (id) => document.getElementById(id);
 const EMPTY_LINES = { positions: new Float32Array(0), triangles: new Uint32Array(0) };
@@ -21,6 +22,31 @@ function splitLines(buffers, i) {
     v += nv; t += nt;
   }
   return out;
+}
+
+/**
+ * The body of a whole-clip answer sent as changes (`body.changed` bits per frame and vertex,
+ * `body.positions` of the moved vertices; crates/studio/src/api/changes.rs) rebuilt over the
+ * input clip: the core's exact numbers from fewer bytes.
+ */
+export function expandChanges(buffers, input, first, frames) {
+  const n = input.vertices, words = Math.ceil(n / 32);
+  const body = input.positions.slice(first * n * 3, (first + frames) * n * 3);
+  const bits = buffers['body.changed'], moved = buffers['body.positions'];
+  let k = 0;
+  for (let f = 0; f < frames; f++) {
+    for (let w = 0; w < words; w++) {
+      let word = bits[f * words + w];
+      while (word) {
+        const b = 31 - Math.clz32(word & -word);
+        word &= word - 1;
+        const o = (f * n + w * 32 + b) * 3;
+        body[o] = moved[k]; body[o + 1] = moved[k + 1]; body[o + 2] = moved[k + 2];
+        k += 3;
+      }
+    }
+  }
+  return body;
 }
 
 /** A row of the "all parameters" block: label, field, and ◇/✕ for a keyable number. */
@@ -219,9 +245,10 @@ export class SmearPanel {
   }
 
   /**
-   * Restyles: the current frame first (a one-frame answer, drawn at once), then every frame
-   * in the background (cancelled by the next change); frames scrubbed to meanwhile are asked
-   * for one by one. While a first-frame request is in flight only the newest change waits.
+   * Restyles: the current frame (a one-frame answer, drawn at once) and every frame (asked
+   * for at the same time, drawn when it arrives, cancelled by the next change); frames
+   * scrubbed to meanwhile are asked for one by one. While a first-frame request is in flight
+   * only the newest change waits.
    */
   async request(body, t0) {
     this.gen = (this.gen || 0) + 1;
@@ -235,6 +262,13 @@ export class SmearPanel {
     this.inflight = true;
     const s = this.studio;
     const f = s.frame;
+    // The whole clip is asked for now, not after the current frame is drawn: the server
+    // answers the small request meanwhile, and the clip arrives one round trip sooner.
+    const ctl = new AbortController();
+    const rest = getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...body, changes: true }, ctl.signal);
+    rest.catch(() => {});
+    this.restCtl = ctl;
+    this.fresh = null;
     try {
       const r = await getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...body, frames: [f, f + 1] });
       const fetched = performance.now();
@@ -255,10 +289,11 @@ export class SmearPanel {
         await s.view.rendered();
         const ms = performance.now() - t0;
         s.stats.smear.push({ ms, server_ms: r.header.seconds * 1000, bytes: r.bytes, fetch_ms: fetched - t0, apply_ms: applied - fetched, draw_ms: performance.now() - applied, render_ms: s.view.renderMs });
-        $('smear-report').textContent = `frame ${f} restyled in ${ms.toFixed(0)} ms (server ${(r.header.seconds * 1000).toFixed(0)} ms, ${(r.bytes / 1024).toFixed(0)} KiB; offset solves so far: ${r.header.report.offset_solves})`;
-        this.loadRest(gen, t0);
+        $('smear-report').textContent = `frame ${f} restyled in ${ms.toFixed(0)} ms (server ${(r.header.seconds * 1000).toFixed(0)} ms, ${(r.bytes / 1024).toFixed(0)} KiB)`;
+        this.loadRest(gen, t0, rest, ctl);
       }
     } catch (e) {
+      ctl.abort();
       $('style-error').textContent = e.message;
       s.showError(e.message);
     } finally {
@@ -267,19 +302,17 @@ export class SmearPanel {
     }
   }
 
-  /** Every frame of the current style, in the background; a newer change aborts it. */
-  async loadRest(gen, t0) {
+  /** Every frame of the current style (the `rest` answer of `ctl`); a newer change aborts it. */
+  async loadRest(gen, t0, rest, ctl) {
     const s = this.studio;
-    const ctl = new AbortController();
-    this.restCtl = ctl;
     try {
-      const r = await getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...this.lastBody }, ctl.signal);
+      const r = await rest;
       if (gen !== this.gen) return;
       this.restCtl = null;
       this.apply(r);
       await s.view.rendered();
       s.stats.smearAll.push({ ms: performance.now() - t0, server_ms: r.header.seconds * 1000, bytes: r.bytes });
-      $('smear-report').textContent += `\nall ${r.header.frames} frames in ${(performance.now() - t0).toFixed(0)} ms (server ${(r.header.seconds * 1000).toFixed(0)} ms, ${(r.bytes / 1048576).toFixed(1)} MiB)\n` + JSON.stringify(r.header.report.objects.map((o) => ({ name: o.name, elongation_max: o.elongation_max, multiples: o.multiples, lines_max: o.lines_max })), null, 1);
+      $('smear-report').textContent += `\nall ${r.header.frames} frames in ${(performance.now() - t0).toFixed(0)} ms (server ${(r.header.seconds * 1000).toFixed(0)} ms, ${(r.bytes / 1048576).toFixed(1)} MiB)\n` + smearSummary(r.header.report, r.header.frames, this.anim.height);
     } catch (e) {
       if (e.name !== 'AbortError' && gen === this.gen) s.showError(e.message);
     } finally {
@@ -300,7 +333,7 @@ export class SmearPanel {
     } finally {
       this.frameInflight = false;
       const w = this.frameWant; this.frameWant = null;
-      if (w !== null && w !== undefined && this.restCtl && !this.fresh.has(w)) this.loadFrame(w);
+      if (w !== null && w !== undefined && this.restCtl && this.fresh && !this.fresh.has(w)) this.loadFrame(w);
     }
   }
 
@@ -313,6 +346,7 @@ export class SmearPanel {
     const s = this.studio;
     const total = header.clip_frames, k = header.first_frame, nf = header.frames;
     const n3 = this.anim.vertices * 3;
+    if (buffers['body.changed']) buffers.body = expandChanges(buffers, this.anim, k, nf);
     if (nf === total) this.body = buffers.body;
     else {
       if (!this.body || this.body.length !== total * n3) this.body = new Float32Array(this.anim.positions);

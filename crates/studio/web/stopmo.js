@@ -5,6 +5,7 @@
 // id of every part at the current frame; the library folder is exported.
 import * as THREE from 'three';
 import { getJSON, getPack, postJSON } from './api.js';
+import { segmentSummary } from './report.js';
 
 const $ = (id) => document.getElementById(id);
 const COLORS = [[0.95, 0.55, 0.3], [0.35, 0.6, 0.95], [0.45, 0.85, 0.45], [0.9, 0.8, 0.3], [0.8, 0.45, 0.85], [0.4, 0.85, 0.85]];
@@ -111,7 +112,7 @@ export class StopmoPanel {
       this.colour(this.labels);
       this.setSeams(r);
       $('stopmo-curve').disabled = false;
-      $('stopmo-report').textContent += '\n' + JSON.stringify(r.summary, null, 1);
+      $('stopmo-report').textContent += '\n' + segmentSummary(r.summary, this.anim && this.anim.height);
     });
   }
 

@@ -31,7 +31,6 @@ pub(crate) fn run(_ctx: &Context, args: StudioArgs) -> Result<()> {
         port: args.port,
         open: !args.no_open,
         out_dir: args.out,
-        node_modules: None,
     };
     studio::serve(&options)?;
     Ok(())

@@ -23,7 +23,7 @@ use serde_json::{json, Value};
 use super::{blocking, body};
 use crate::error::{ApiError, ApiResult};
 use crate::files::{merged, output_path};
-use crate::pack::Pack;
+use crate::pack::{coordinates, Pack};
 use crate::state::{lock, LoaSession, Studio};
 
 /// A file index (query string).
@@ -217,7 +217,7 @@ pub(crate) async fn animate(
                 .flat_map(|f| f.chain.joints().into_iter().flat_map(|p| [p.x as f32, p.y as f32])),
         );
         pack.u32("triangles", m.mesh.triangles.iter().flatten().copied());
-        let positions: Vec<f32> = m.positions().iter().flat_map(|p| p.to_array()).collect();
+        let positions = coordinates(m.positions()).to_vec();
         let (motion_frames, n) = (m.frame_count(), m.vertex_count() * 3);
         let shown = match r.frame {
             Some(f) => {
@@ -226,10 +226,7 @@ pub(crate) async fn animate(
             }
             None => 0..motion_frames,
         };
-        pack.f32(
-            "positions",
-            positions[shown.start * n..shown.end * n].iter().copied(),
-        );
+        pack.f32_slices("positions", [&positions[shown.start * n..shown.end * n]]);
         let mut session = lock(&studio.loa);
         let version = session.as_ref().map_or(1, |s| s.version + 1);
         let rep = &motion.report;
@@ -292,7 +289,7 @@ pub(crate) async fn motion(
             )));
         }
         let mut pack = Pack::new();
-        pack.f32("positions", s.positions.iter().copied());
+        pack.f32_slices("positions", [&s.positions[..]]);
         Ok(pack.response(json!({ "version": s.version })))
     })
     .await

@@ -2,11 +2,11 @@
 //!
 //! | route | what |
 //! |---|---|
-//! | `GET /api/info` | opened files, clips, output folder, whether three.js is installed |
+//! | `GET /api/info` | opened files, clips, output folder |
 //! | `GET /api/scene?file=&clip=` | the clip's merged mesh: triangles + positions per frame |
 //! | `GET /api/smear/presets` | the example styles (SMEAR Figs. 11–16) |
 //! | `GET /api/smear/offsets?file=&clip=` | motion offsets per frame and vertex (prepared once) |
-//! | `POST /api/smear/stylize` | a style → elongated body, multiples, lines (all frames or a range) |
+//! | `POST /api/smear/stylize` | a style → elongated body (or what changed), multiples, lines (all frames or a range) |
 //! | `POST /api/smear/export` | writes the result (glb/usda/usdc/abc) or the style (toml) |
 //! | `GET /api/smear/weight-sources?file=&clip=` | the file's weight groups / attributes (picker) |
 //! | `GET /api/smear/weights?file=&clip=&source=` | ω per vertex of one weight source (overlay) |
@@ -22,6 +22,7 @@
 //! | `POST /api/stopmo/export` | writes the library folder (the `stopmo run` layout) |
 //! | `GET /api/jobs/{id}`, `POST /api/jobs/{id}/cancel` | progress, result, cancel |
 
+mod changes;
 mod loa_api;
 mod scene;
 mod smear_api;

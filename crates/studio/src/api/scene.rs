@@ -10,9 +10,8 @@ use serde_json::{json, Value};
 
 use crate::error::ApiResult;
 use crate::files::merged;
-use crate::pack::Pack;
+use crate::pack::{coordinates, Pack};
 use crate::state::Studio;
-use crate::web;
 
 /// A file index and clip name (query string).
 #[derive(Debug, Deserialize)]
@@ -43,8 +42,6 @@ pub(crate) async fn info(State(studio): State<Arc<Studio>>) -> Json<Value> {
     Json(json!({
         "files": files,
         "out_dir": studio.out_dir.display().to_string(),
-        "three_installed": web::three_installed(&studio.node_modules),
-        "install_hint": web::INSTALL_HINT,
     }))
 }
 
@@ -69,7 +66,7 @@ pub(crate) async fn scene(
 pub(crate) fn animation_pack(m: &anim::MeshAnimation, mut header: Value) -> Response {
     let mut pack = Pack::new();
     pack.u32("triangles", m.mesh.triangles.iter().flatten().copied());
-    pack.f32("positions", m.positions().iter().flat_map(|p| p.to_array()));
+    pack.f32_slices("positions", [coordinates(m.positions())]);
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     for p in m.positions() {
         for k in 0..3 {

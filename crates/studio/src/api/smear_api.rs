@@ -14,11 +14,12 @@ use serde::Deserialize;
 use serde_json::{json, Value};
 use smear::{OffsetOptions, Style, WeightSource};
 
+use super::changes::pack_changes;
 use super::scene::ClipQuery;
 use super::{blocking, body};
 use crate::error::{ApiError, ApiResult};
-use crate::files::output_path;
-use crate::pack::Pack;
+use crate::files::{merged, output_path};
+use crate::pack::{coordinates, Pack};
 use crate::state::Studio;
 
 /// The example styles of `examples/smear/` (SMEAR Figs. 11, 12, 15, 16).
@@ -115,6 +116,10 @@ pub(crate) struct StyleRequest {
     /// then read ω), as the weight-group picker sends it.
     #[serde(default)]
     weights: Option<Value>,
+    /// The body as what changed from the input clip ([`super::changes`]): `body.changed`
+    /// and `body.positions` instead of `body` (the page's whole-clip request).
+    #[serde(default)]
+    changes: bool,
 }
 
 fn read_style(r: &StyleRequest, prepared: &OffsetOptions) -> ApiResult<Style> {
@@ -161,7 +166,8 @@ fn stylized(studio: &Studio, r: &StyleRequest, all: bool) -> ApiResult<(Style, s
 /// elongated in-betweens merged in object order), per copy `copyN.positions`,
 /// `copyN.alpha` (frames × copy vertices), `copyN.triangles`; per line set
 /// `linesN.counts` (u32 per frame: vertices, triangles), `linesN.positions`,
-/// `linesN.triangles`, `linesN.alpha`.
+/// `linesN.triangles`, `linesN.alpha`. With `"changes": true` the body comes as
+/// `body.changed` and `body.positions` instead ([`super::changes`]).
 pub(crate) async fn stylize(
     State(studio): State<Arc<Studio>>,
     request: Result<Bytes, BytesRejection>,
@@ -179,14 +185,29 @@ pub(crate) async fn stylize(
             .filter_map(|o| s.animation(o.body))
             .collect();
         let bodies = &bodies;
-        pack.f32(
-            "body",
-            (0..frames).flat_map(move |f| {
-                bodies
-                    .iter()
-                    .flat_map(move |a| a.frame(f).iter().flat_map(|p| p.to_array()))
-            }),
-        );
+        let vertices: usize = bodies.iter().map(|a| a.vertex_count()).sum();
+        let input = if r.changes {
+            let sampled = studio.sampled(r.file, &r.clip)?;
+            Some(merged(&studio.file(r.file)?.label(), &sampled)?)
+        } else {
+            None
+        };
+        match &input {
+            Some(m) if m.vertex_count() == vertices => pack_changes(
+                &mut pack,
+                frames,
+                vertices,
+                |f| bodies.iter().map(|a| a.frame(f)).collect(),
+                |f| m.frame(s.first_frame + f),
+            ),
+            _ => {
+                pack.f32_slices(
+                    "body",
+                    (0..frames)
+                        .flat_map(move |f| bodies.iter().map(move |a| coordinates(a.frame(f)))),
+                );
+            }
+        }
         let mut copies = Vec::new();
         let mut lines = Vec::new();
         for o in &s.objects {
@@ -195,9 +216,9 @@ pub(crate) async fn stylize(
                     s.flipbook.parts.get(i)
                 {
                     let n = copies.len();
-                    pack.f32(
+                    pack.f32_slices(
                         &format!("copy{n}.positions"),
-                        animation.positions().iter().flat_map(|p| p.to_array()),
+                        [coordinates(animation.positions())],
                     );
                     pack.u32(
                         &format!("copy{n}.triangles"),
@@ -225,11 +246,9 @@ pub(crate) async fn stylize(
                         .iter()
                         .flat_map(|m| [m.positions.len() as u32, m.triangles.len() as u32]),
                 );
-                pack.f32(
+                pack.f32_slices(
                     &format!("lines{n}.positions"),
-                    meshes
-                        .iter()
-                        .flat_map(|m| m.positions.iter().flat_map(|p| p.to_array())),
+                    meshes.iter().map(|m| coordinates(&m.positions)),
                 );
                 pack.u32(
                     &format!("lines{n}.triangles"),

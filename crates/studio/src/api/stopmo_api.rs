@@ -89,16 +89,18 @@ pub(crate) async fn segment(
         let s = stopmo::segment(&anim, &options).map_err(|e| format!("{label}: {e}"))?;
         progress.stage("done", 1.0).map_err(cancelled)?;
         let (seam_vertices, seam_weights) = seam_lines(&s);
-        let version = job_studio.store_segmentation(&s);
-        Ok(json!({
+        let mut answer = json!({
             "summary": s.summary(),
             "triangle_part": s.segmentation.input_triangle_part,
             "parts": s.segmentation.part_names,
             "seam_vertices": seam_vertices,
             "seam_weights": seam_weights,
-            "segmentation": version,
             "seconds": s.seconds,
-        }))
+        });
+        // The parts move into the session (the curve's input), not copied beside `s`.
+        let version = job_studio.store_segmentation(s.parts.into_iter().map(|p| p.animation));
+        answer["segmentation"] = json!(version);
+        Ok(answer)
     });
     Ok(Json(json!({ "job": id })))
 }
@@ -125,12 +127,12 @@ fn seam_lines(s: &stopmo::Segmented) -> (Vec<u32>, Vec<f32>) {
 
 impl Studio {
     /// Keeps a finished segmentation's parts for the curve; returns its version.
-    fn store_segmentation(&self, s: &stopmo::Segmented) -> u64 {
+    fn store_segmentation(&self, parts: impl Iterator<Item = anim::MeshAnimation>) -> u64 {
         let mut session = lock(&self.stopmo);
         let version = session.as_ref().map_or(1, |old| old.version + 1);
         *session = Some(StopmoSession {
             version,
-            parts: std::sync::Arc::new(s.parts.iter().map(|p| p.animation.clone()).collect()),
+            parts: std::sync::Arc::new(parts.collect()),
             curve: None,
             built: None,
         });

@@ -22,11 +22,7 @@ pub(crate) fn studio_with(files: &[&str], out: &Path) -> Arc<Studio> {
         .iter()
         .map(|f| OpenedFile::open(&testdata::asset(f)).unwrap())
         .collect();
-    Arc::new(Studio::new(
-        opened,
-        output_folder(out).unwrap(),
-        studio::web::default_node_modules(),
-    ))
+    Arc::new(Studio::new(opened, output_folder(out).unwrap()))
 }
 
 pub(crate) fn app(out: &Path) -> Router {
