@@ -36,7 +36,7 @@ fn scaled_robot(dir: &Path, scale: f32) -> PathBuf {
     assert!(doc["nodes"][root].get("scale").is_none());
     doc["nodes"][root]["scale"] = serde_json::json!([scale, scale, scale]);
     let mut text = serde_json::to_vec(&doc).unwrap();
-    while text.len() % 4 != 0 {
+    while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
     let rest = &bytes[20 + len..];
@@ -72,8 +72,11 @@ fn smear(input: &Path, style: &Path, fps: &str, out: &Path, extra: &[&str]) -> s
     json(&args)
 }
 
-/// Per object: (vertices, mean elongation, mean line length), lengths over the report's size.
-fn relative(v: &serde_json::Value) -> Vec<(f64, f64, f64)> {
+/// One object's (vertices, mean elongation, mean line length), lengths over the size.
+type Relative = (f64, f64, f64);
+
+/// Per object: [`Relative`].
+fn relative(v: &serde_json::Value) -> Vec<Relative> {
     let size = v["size"].as_f64().unwrap();
     assert!(size > 0.0, "{v}");
     v["objects"]
@@ -91,7 +94,7 @@ fn relative(v: &serde_json::Value) -> Vec<(f64, f64, f64)> {
 }
 
 /// Vertex-weighted mean elongation and the mean line length over objects with lines.
-fn summary(objects: &[(f64, f64, f64)]) -> (f64, f64) {
+fn summary(objects: &[Relative]) -> (f64, f64) {
     let n: f64 = objects.iter().map(|o| o.0).sum();
     let e = objects.iter().map(|o| o.0 * o.1).sum::<f64>() / n;
     let with_lines: Vec<f64> = objects.iter().map(|o| o.2).filter(|l| *l > 0.0).collect();
@@ -112,7 +115,7 @@ fn every_example_style_looks_the_same_in_centimetres_and_metres() {
         .collect();
     for style in examples() {
         let name = style.file_name().unwrap().to_string_lossy().into_owned();
-        let runs: Vec<(f64, Vec<(f64, f64, f64)>)> = robots
+        let runs: Vec<(f64, Vec<Relative>)> = robots
             .iter()
             .map(|(_, robot)| {
                 let v = smear(robot, &style, "8", &dir.path().join("o.glb"), &[]);
