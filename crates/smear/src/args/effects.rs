@@ -323,6 +323,15 @@ impl Lines {
         let thickness = match (&self.thickness_expr, &self.thickness) {
             (Some(e), _) => Some(FunctionSpec::expr(e, &[])),
             (None, Some(t)) => Some(FunctionSpec::stages(vec![Stage::Set { value: t.clone() }])),
+            // In scene units the body's default radius as given before units existed (bit
+            // for bit); in size units the style's default, the same fraction of the body.
+            (None, None) if effect.units.speed_units == Some(crate::SpeedUnits::Scene) => {
+                Some(FunctionSpec::stages(vec![Stage::Set {
+                    value: Param::Constant(
+                        crate::DEFAULT_LINE_THICKNESS * prepared.animation(0).bbox().diagonal(),
+                    ),
+                }]))
+            }
             (None, None) => None,
         };
         let flag = match self.thickness_expr {
