@@ -53,9 +53,11 @@ class SmearSettings(bpy.types.PropertyGroup):
     elongate: BoolProperty(name="Elongate", default=True, update=_restyle)
     preset: EnumProperty(name="Preset", items=PRESETS, default="SPEED", update=_restyle)
     beta_max: FloatProperty(name="β max", default=3.0, min=0.0, soft_max=30.0, update=_restyle,
-                            description="Largest elongation, in frames along the trajectory")
+                            description="Largest elongation, in frames along the trajectory "
+                                        "(Speed, Noise: per character size per second)")
     kappa: FloatProperty(name="κ", default=18.0, min=0.01, soft_max=100.0, update=_restyle,
-                         description="Noise frequency (Voronoi F1 scale)")
+                         description="Noise frequency: Voronoi F1 cells per character size "
+                                     "(bounding-box diagonal)")
     sign: EnumProperty(name="Offsets", items=SIGNS, default="BOTH", update=_restyle)
     warp: BoolProperty(name="Warp", default=False, update=_restyle,
                        description="Hise's curve on the offsets (SMEAR Fig. 12)")
@@ -84,7 +86,8 @@ class SmearSettings(bpy.types.PropertyGroup):
                                update=_restyle, description="τ max in frames (SMEAR Eq. 13)")
     line_thickness: FloatProperty(name="Thickness", default=0.0, min=0.0, soft_max=0.1,
                                   update=_restyle, precision=4,
-                                  description="Tube radius in scene units; 0 = 0.2 % of the size")
+                                  description="Tube radius in character sizes (bounding-box "
+                                              "diagonals); 0 = 0.2 % of the size")
     line_gap: FloatProperty(name="Gap", default=0.0, min=0.0, soft_max=2.0, update=_restyle,
                             description="Gap to the surface, in frames along the trajectory")
     seed: IntProperty(name="Seed", default=7, min=0, update=_restyle)

@@ -449,6 +449,9 @@ fn camera_relative_speed_drives_speed_presets() {
             "speed",
             "--beta-max",
             "2",
+            // The paper's per-frame scene units: the expected β below is in them.
+            "--speed-units",
+            "scene",
         ];
         a.extend_from_slice(extra);
         json(&a)
@@ -479,6 +482,8 @@ fn camera_relative_speed_drives_speed_presets() {
             s(&glb),
             "--min-speed",
             "0.75",
+            "--speed-units",
+            "scene",
             "--count",
             "50",
         ];

@@ -55,6 +55,15 @@ pub enum SmearError {
         /// Comma-separated object names.
         available: String,
     },
+    /// A style's `size_reference` (or `--size-reference`) names an object the scene does not
+    /// have. Use one of the listed object names (case-sensitive), or give a length.
+    #[error("no object named '{name}' to measure the size by; objects are: {available}")]
+    UnknownSizeReference {
+        /// The name that was asked for.
+        name: String,
+        /// Comma-separated object names.
+        available: String,
+    },
     /// A scene given as colliders has no mesh. Give a file with at least one mesh.
     #[error("the collider scene has no mesh")]
     NoColliderMesh,

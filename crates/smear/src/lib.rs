@@ -163,9 +163,9 @@ pub use stream::{Stream, StreamOptions, DEFAULT_STREAM_HISTORY};
 pub use stylize::{
     apply_stages, hise_curve, voronoi_f1, warp_offset, CompiledEffects, CompiledLines,
     ElongateStyle, Expression, FunctionSpec, LinesStyle, MultiplesStyle, ObjectEffects,
-    ObjectStyle, Param, Stage, Style, StyleError, StyleFunction, StyleOps, WeightAttribute,
-    WeightGroup, WeightSource, DEFAULT_LINE_COUNT, DEFAULT_LINE_THICKNESS, DEFAULT_MULTIPLE_COLOR,
-    EXPRESSION_INPUTS, MAX_EXPRESSION_VARIABLES,
+    ObjectStyle, Param, SizeReference, SpeedUnits, Stage, Style, StyleError, StyleFunction,
+    StyleOps, StyleUnits, WeightAttribute, WeightGroup, WeightSource, DEFAULT_LINE_COUNT,
+    DEFAULT_LINE_THICKNESS, DEFAULT_MULTIPLE_COLOR, EXPRESSION_INPUTS, MAX_EXPRESSION_VARIABLES,
 };
 pub use surface::SurfacePoint;
 pub use velocity::{camera_vertex_velocities, causal_vertex_velocities, speeds, vertex_velocities};

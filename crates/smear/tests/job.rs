@@ -32,10 +32,11 @@ fn example_style(name: &str) -> Style {
 #[test]
 fn second_stylize_reuses_prepared_offsets() {
     let scene = robot_dance();
-    // Live tuning: the animator drags the elongation strength from 6 to 3 (paper Fig. 11c).
+    // Live tuning: the animator drags the elongation strength from 1.5 to 0.75 (paper
+    // Fig. 11c, in sizes per second).
     let first_style = example_style("fig11c_speed.toml");
     let second_style = Style::from_toml_str(
-        "[elongate]\nfunction = { stages = [{ op = \"speed\" }, { op = \"scale\", by = 3 }] }",
+        "[elongate]\nfunction = { stages = [{ op = \"speed\" }, { op = \"scale\", by = 0.75 }] }",
     )
     .unwrap();
     assert_ne!(first_style, second_style);

@@ -162,7 +162,9 @@ def stylize(
     ``style`` is a dict with the keys of the TOML style files (``elongate``, ``multiples``,
     ``lines``, ``weights``, ``objects``; see ``examples/smear/``) or the path of such a file.
     A style without ``offsets`` uses the prepared ones; different ``offsets`` are an error
-    (prepare again to change them). Returns a :class:`Stylized` with ``.elongated``
+    (prepare again to change them). Speeds and lengths are in the character's own size
+    (bounding-box diagonals, speeds per second) unless the style says
+    ``speed_units = "scene"`` (docs/smear-units.md). Returns a :class:`Stylized` with ``.elongated``
     ``(frames, vertices, 3)``, ``.multiples`` and ``.lines`` (per-frame meshes with
     per-vertex ``alpha``), ``.report`` and ``.save(path)`` (``.glb``, ``.usda``, ``.usdc``,
     ``.usdz`` or ``.abc``, as the CLI writes them). The GIL is released while computing.

@@ -195,7 +195,8 @@ pub struct Lines {
     /// User expression for τ (replaces the linear one), e.g. "tau_max * speed * past(delta)".
     #[arg(long)]
     pub length_expr: Option<String>,
-    /// Tube radius in scene units (default: 0.002 × bounding-box diagonal); keyframeable.
+    /// Tube radius in size units (one unit = the character's bounding-box diagonal; scene
+    /// units with --speed-units scene), default 0.002 × the body's diagonal; keyframeable.
     #[arg(long, conflicts_with = "thickness_expr")]
     pub thickness: Option<Param>,
     /// User expression for the tube radius along the line (`t` = 0 at the surface), e.g.
@@ -208,7 +209,9 @@ pub struct Lines {
     /// Gap between surface and line, in frames along the trajectory; keyframeable.
     #[arg(long, default_value = "0")]
     pub gap: Param,
-    /// Seeds slower than this (units per frame) draw no line; keyframeable.
+    /// Seeds slower than this draw no line, in size units per second (one unit = the
+    /// character's bounding-box diagonal; scene units per frame with --speed-units scene);
+    /// keyframeable.
     #[arg(long, default_value = "0")]
     pub min_speed: Param,
     /// Line colour, linear R,G,B in [0, 1] (default near-black).
@@ -249,7 +252,7 @@ impl Lines {
                 .is_err()
             {
                 return flag(format!(
-                    "--thickness {t}: the tube radius must be a positive number (scene units)"
+                    "--thickness {t}: the tube radius must be a positive number"
                 ));
             }
         }
@@ -290,11 +293,20 @@ impl Lines {
         })
     }
 
-    /// The tube radius: `--thickness`, or 0.002 × the bounding-box diagonal of the body.
-    pub fn radius(&self, prepared: &Prepared) -> Param {
-        self.thickness.clone().unwrap_or(Param::Constant(
-            crate::DEFAULT_LINE_THICKNESS * prepared.animation(0).bbox().diagonal(),
-        ))
+    /// The tube radius in scene units: `--thickness` (in the units of `effect`), or 0.002 ×
+    /// the bounding-box diagonal of the body.
+    ///
+    /// # Errors
+    /// An unknown `--size-reference` object.
+    pub fn radius(&self, effect: &EffectArgs, prepared: &Prepared) -> Result<Param, FlagError> {
+        let u = &effect.units;
+        let units = prepared.units(u.speed_units.unwrap_or_default(), u.size_reference.as_ref())?;
+        Ok(match &self.thickness {
+            Some(t) => units.length_param_to_scene(t),
+            None => Param::Constant(
+                crate::DEFAULT_LINE_THICKNESS * prepared.animation(0).bbox().diagonal(),
+            ),
+        })
     }
 
     /// The style: the offsets `prepared` was made with and the lines of `plan`.
@@ -307,17 +319,28 @@ impl Lines {
         plan: &LinesPlan,
         prepared: &Prepared,
     ) -> Result<Style, FlagError> {
-        let thickness = match &self.thickness_expr {
-            Some(e) => FunctionSpec::expr(e, &[]),
-            None => FunctionSpec::stages(vec![Stage::Set {
-                value: self.radius(prepared),
-            }]),
+        // No thickness given: the style's default (a fraction of the body's diagonal).
+        let thickness = match (&self.thickness_expr, &self.thickness) {
+            (Some(e), _) => Some(FunctionSpec::expr(e, &[])),
+            (None, Some(t)) => Some(FunctionSpec::stages(vec![Stage::Set { value: t.clone() }])),
+            // In scene units the body's default radius as given before units existed (bit
+            // for bit); in size units the style's default, the same fraction of the body.
+            (None, None) if effect.units.speed_units == Some(crate::SpeedUnits::Scene) => {
+                Some(FunctionSpec::stages(vec![Stage::Set {
+                    value: Param::Constant(
+                        crate::DEFAULT_LINE_THICKNESS * prepared.animation(0).bbox().diagonal(),
+                    ),
+                }]))
+            }
+            (None, None) => None,
         };
         let flag = match self.thickness_expr {
             Some(_) => "--thickness-expr",
             None => "--thickness",
         };
-        check(&thickness, flag)?;
+        if let Some(t) = &thickness {
+            check(t, flag)?;
+        }
         Ok(Style {
             lines: Some(LinesStyle {
                 enabled: true,
@@ -331,7 +354,7 @@ impl Lines {
                 step: effect.step,
                 color: plan.color.clone(),
                 length: plan.length.clone(),
-                thickness: Some(thickness),
+                thickness,
                 opacity: plan.opacity.clone(),
             }),
             ..effect.base_style(prepared)?

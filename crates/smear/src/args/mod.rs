@@ -11,8 +11,8 @@ pub use effects::{Elongate, ElongatePreset, Lines, LinesPlan, Multiples, Multipl
 use clap::Args;
 
 use crate::{
-    CameraSelect, ContactStyle, FunctionSpec, OffsetOptions, Prepared, SmearError, Stage, Style,
-    WeightAttribute, WeightGroup, WeightSource,
+    CameraSelect, ContactStyle, FunctionSpec, OffsetOptions, Prepared, SizeReference, SmearError,
+    SpeedUnits, Stage, Style, WeightAttribute, WeightGroup, WeightSource,
 };
 
 /// A flag whose value cannot be used, in the user's terms (`--step must be ≥ 1 …`).
@@ -98,15 +98,16 @@ pub struct EffectArgs {
     /// `.b`, `.a`), clamped to [0, 1].
     #[arg(long, conflicts_with = "weight_expr")]
     pub weight_attribute: Option<String>,
-    /// Painted weights ω as an expression of the rest position `x, y, z`, clamped to [0, 1],
-    /// e.g. "clamp01(y / 2)".
+    /// Painted weights ω as an expression of the rest position `x, y, z` (size units, scene
+    /// units with --speed-units scene), clamped to [0, 1], e.g. "clamp01(y / 0.5)".
     #[arg(long)]
     pub weight_expr: Option<String>,
     /// Adaptive subdivision: split output edges longer than TOL × their rest length, or whose
     /// smear curves away from them by more than 5 % × (TOL − 1) of it (TOL ≥ 1, e.g. 2). The mesh then changes per frame: write .glb, .usda, .usdc, .usdz or .abc.
     #[arg(long, value_name = "TOL")]
     pub subdivide: Option<f32>,
-    /// A ground plane y = Y that the in-betweens never cross.
+    /// A ground plane y = Y that the in-betweens never cross (Y in size units, scene units
+    /// with --speed-units scene).
     #[arg(long, value_name = "Y", allow_negative_numbers = true)]
     pub ground: Option<f32>,
     /// With --ground: squash on impact, the height scaled by 1 − AMOUNT (volume kept),
@@ -124,6 +125,39 @@ pub struct EffectArgs {
     /// An object of the input used as a collider (repeatable): not smeared, not written.
     #[arg(long, value_name = "NAME")]
     pub collider_object: Vec<String>,
+    /// Units of the style's speeds and lengths.
+    #[command(flatten)]
+    pub units: UnitArgs,
+}
+
+/// What a style's speeds and lengths are measured in (`docs/smear-units.md`).
+#[derive(Debug, Clone, Args)]
+pub struct UnitArgs {
+    /// Units of speeds (the `speed` input, --min-speed, thresholds) and lengths (--thickness,
+    /// --ground, `x, y, z`, noise κ per length): `size` = the character's own size (one unit
+    /// = its bounding-box diagonal at the first frame, or --size-reference), speeds per
+    /// second, so a style looks the same in centimetres and in metres; `scene` = scene units,
+    /// speeds per frame (the paper's numbers). With --style: overrides the file's
+    /// `speed_units`.
+    #[arg(long, value_enum, value_name = "UNITS")]
+    pub speed_units: Option<SpeedUnits>,
+    /// One size unit: a length in scene units (e.g. 1.8) or the name of an object whose
+    /// bounding-box diagonal at the first frame it is. With --style: overrides the file's
+    /// `size_reference`.
+    #[arg(long, value_name = "NODE|LENGTH")]
+    pub size_reference: Option<SizeReference>,
+}
+
+impl UnitArgs {
+    /// Sets the flags' units on `style` (flags given win over the file's).
+    pub fn apply(&self, style: &mut Style) {
+        if let Some(u) = self.speed_units {
+            style.speed_units = u;
+        }
+        if let Some(r) = &self.size_reference {
+            style.size_reference = Some(r.clone());
+        }
+    }
 }
 
 impl EffectArgs {
@@ -198,12 +232,20 @@ impl EffectArgs {
     /// As [`EffectArgs::shaping`].
     pub fn base_style(&self, prepared: &Prepared) -> Result<Style, FlagError> {
         let (subdivide, contact) = self.shaping()?;
-        Ok(Style {
+        // A function of the rest position reads it in the flags' units: resolved with the
+        // style, not at preparation.
+        let weights = self
+            .weight_source()
+            .filter(|w| matches!(w, WeightSource::Function(_)));
+        let mut style = Style {
             offsets: prepared.options().offsets.clone(),
             subdivide,
             contact,
+            weights,
             ..Style::default()
-        })
+        };
+        self.units.apply(&mut style);
+        Ok(style)
     }
 }
 

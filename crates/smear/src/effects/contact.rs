@@ -16,7 +16,9 @@ pub const MAX_SQUASH: f32 = 0.9;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ContactStyle {
-    /// Height of the ground plane (world units, Y up).
+    /// Height of the ground plane (Y up): in a [`Style`](crate::Style), size units (one unit
+    /// = the character's bounding-box diagonal) or scene units with `speed_units = "scene"`;
+    /// scene units once compiled.
     pub ground: f32,
     /// Squash on impact: the height scales by `1 − squash` at the impact frame (widths by
     /// `1/√(1 − squash)`, so the volume is kept), easing back over `squash_frames`. 0 = off.

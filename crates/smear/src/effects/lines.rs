@@ -82,6 +82,8 @@ pub struct LineFrame {
     pub mesh: Mesh,
     /// Number of lines drawn.
     pub lines: usize,
+    /// Summed length of the lines drawn, along their centres (scene units).
+    pub length: f32,
     rings: Vec<Ring>,
 }
 
@@ -90,6 +92,7 @@ impl Default for LineFrame {
         LineFrame {
             mesh: Mesh::new("motion_lines", Vec::new(), Vec::new()),
             lines: 0,
+            length: 0.0,
             rings: Vec::new(),
         }
     }
@@ -159,6 +162,7 @@ fn trace(
         c.clear();
     }
     out.lines = 0;
+    out.length = 0.0;
     let tr = seeds.trajectories();
     let scale = options.step as f32;
     let [r, g, b] = options
@@ -219,6 +223,11 @@ fn trace(
         }
         if sweep(&out.rings, options.sides, &mut out.mesh) {
             out.lines += 1;
+            out.length += out
+                .rings
+                .windows(2)
+                .map(|w| w[0].center.distance(w[1].center))
+                .sum::<f32>();
         }
     }
 }

@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use anim::{Camera, MeshAnimation, SampledScene};
+use anim::{Aabb, Camera, MeshAnimation, SampledScene};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
@@ -12,8 +12,8 @@ use crate::revolve::{replace_offsets, revolving_objects, target_arcs, Arcs};
 use crate::solver::SolvedField;
 use crate::velocity::{buffer_velocities, camera_buffer_velocities, CameraSpace};
 use crate::{
-    Collider, EffectInputs, MotionOffsets, OffsetMode, OffsetOptions, Result, SmearError,
-    SurfacePoint, WeightSource,
+    Collider, EffectInputs, MotionOffsets, OffsetMode, OffsetOptions, Result, SizeReference,
+    SmearError, SpeedUnits, StyleUnits, SurfacePoint, WeightSource,
 };
 
 /// What [`prepare`] computes once for any number of [`stylize`](crate::stylize) calls.
@@ -25,7 +25,8 @@ use crate::{
 pub struct PrepareOptions {
     /// Motion-offset options (SMEAR Section 3).
     pub offsets: OffsetOptions,
-    /// Painted weights ω of every vertex (SMEAR Fig. 15b), resolved once; a style's own
+    /// Painted weights ω of every vertex (SMEAR Fig. 15b), resolved once (a function of the
+    /// rest position reads it in size units, see [`Prepared::size`]); a style's own
     /// `weights` replace them in [`stylize`](crate::stylize).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub weights: Option<WeightSource>,
@@ -99,6 +100,17 @@ pub struct Prepared {
     targets: Vec<Target>,
     colliders: Vec<Collider>,
     report: PrepareReport,
+    /// The character's size: bounding-box diagonal of every object at the first frame.
+    size: f32,
+}
+
+/// Bounding-box diagonal of the first frame of every object of `scene` (0 without objects).
+fn first_frame_diagonal<'a>(animations: impl Iterator<Item = &'a MeshAnimation>) -> f32 {
+    animations
+        .filter(|a| a.frame_count() > 0)
+        .map(|a| Aabb::from_points(a.frame(0)))
+        .reduce(Aabb::union)
+        .map_or(0.0, |b| b.diagonal())
 }
 
 /// Takes the objects named in `names` out of `scene` as colliders.
@@ -223,6 +235,8 @@ pub fn prepare(mut scene: SampledScene, options: &PrepareOptions) -> Result<Prep
     let solve_seconds = start.elapsed().as_secs_f64();
     let objects = object_reports(&scene, |i| field.mode(i), &per_object);
     let causal = options.offsets.causal;
+    let size = first_frame_diagonal(scene.objects.iter().map(|o| &o.animation));
+    let weight_units = StyleUnits::size(size as f64, scene.fps as f64);
     let velocities = |anim: &MeshAnimation| {
         let (p, f, n) = (anim.positions(), anim.frame_count(), anim.vertex_count());
         match &camera {
@@ -230,7 +244,7 @@ pub fn prepare(mut scene: SampledScene, options: &PrepareOptions) -> Result<Prep
             None => buffer_velocities(p, f, n, causal),
         }
     };
-    let resolve = |w: &WeightSource, i: usize| w.vertex_weights(&scene, i);
+    let resolve = |w: &WeightSource, i: usize| w.vertex_weights_in(&scene, i, &weight_units);
     let (merged, targets) = match &options.merge {
         Some(name) => {
             if scene.objects.is_empty() {
@@ -298,6 +312,7 @@ pub fn prepare(mut scene: SampledScene, options: &PrepareOptions) -> Result<Prep
         targets,
         colliders,
         report,
+        size,
     })
 }
 
@@ -396,19 +411,72 @@ impl Prepared {
         self.targets[i].weights.as_deref()
     }
 
-    /// Painted weights of object `i` from another source (a style's `weights`).
+    /// Painted weights of object `i` from another source (a style's `weights`); a function
+    /// of the rest position reads it in the default size units ([`Prepared::size`]).
     ///
     /// # Errors
     /// Unknown joint or attribute, or a function that does not compile.
     pub fn resolve_weights(&self, source: &WeightSource, i: usize) -> Result<Vec<f32>> {
+        let units = self.units(SpeedUnits::Size, None)?;
+        self.resolve_weights_in(source, i, &units)
+    }
+
+    /// [`Prepared::resolve_weights`] with the rest position of a function in `units`.
+    ///
+    /// # Errors
+    /// As [`Prepared::resolve_weights`].
+    pub fn resolve_weights_in(
+        &self,
+        source: &WeightSource,
+        i: usize,
+        units: &StyleUnits,
+    ) -> Result<Vec<f32>> {
         if self.merged.is_none() {
-            return source.vertex_weights(&self.scene, i);
+            return source.vertex_weights_in(&self.scene, i, units);
         }
         let mut all = Vec::with_capacity(self.animation(0).vertex_count());
         for k in 0..self.scene.objects.len() {
-            all.extend(source.vertex_weights(&self.scene, k)?);
+            all.extend(source.vertex_weights_in(&self.scene, k, units)?);
         }
         Ok(all)
+    }
+
+    /// The character's size in scene units: the bounding-box diagonal of every object at
+    /// the first frame (colliders excluded) — one size unit of a style in
+    /// [`SpeedUnits::Size`] without a `size_reference`.
+    pub fn size(&self) -> f32 {
+        self.size
+    }
+
+    /// How a style's numbers convert into this scene's units: nothing in
+    /// [`SpeedUnits::Scene`]; in [`SpeedUnits::Size`] one length unit is `reference` (a
+    /// length, or an object's bounding-box diagonal at the first frame) or
+    /// [`Prepared::size`], and speeds are per second at the scene's frame rate.
+    ///
+    /// # Errors
+    /// [`SmearError::UnknownSizeReference`] for an object name the scene does not have.
+    pub fn units(
+        &self,
+        units: SpeedUnits,
+        reference: Option<&SizeReference>,
+    ) -> Result<StyleUnits> {
+        let size = match (units, reference) {
+            (SpeedUnits::Scene, _) => return Ok(StyleUnits::SCENE),
+            (SpeedUnits::Size, None) => self.size,
+            (SpeedUnits::Size, Some(SizeReference::Length(l))) => *l,
+            (SpeedUnits::Size, Some(SizeReference::Node(name))) => {
+                let Some(o) = self.scene.objects.iter().find(|o| &o.name == name) else {
+                    let available: Vec<&str> =
+                        self.scene.objects.iter().map(|o| o.name.as_str()).collect();
+                    return Err(SmearError::UnknownSizeReference {
+                        name: name.clone(),
+                        available: available.join(", "),
+                    });
+                };
+                first_frame_diagonal(std::iter::once(&o.animation))
+            }
+        };
+        Ok(StyleUnits::size(size as f64, self.report.fps as f64))
     }
 
     /// The effect inputs of object `i`'s vertices — positions, offsets, velocities borrowed

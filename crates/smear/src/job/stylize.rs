@@ -62,6 +62,9 @@ pub struct ObjectReport {
     /// Most lines drawn in one frame.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lines_max: Option<usize>,
+    /// Mean length of the lines drawn (scene units, along their centres; 0 without lines).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lines_length_mean: Option<f64>,
     /// With subdivision: the largest output edge length over its rest length (issue #22).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub subdivision_max_stretch: Option<f32>,
@@ -95,6 +98,10 @@ pub struct StylizeReport {
     pub seconds: StylizeTimings,
     /// Offset solves run by this call: always 0 — the offsets come from [`Prepared`].
     pub offset_solves: usize,
+    /// What the style's speeds and lengths were measured in.
+    pub speed_units: crate::SpeedUnits,
+    /// Scene length of one style length unit (the size; 1 in scene units).
+    pub size: f64,
 }
 
 /// Where an object's results sit in [`Stylized::flipbook`].
@@ -277,13 +284,21 @@ pub fn stylize_frames(
     let mut report = StylizeReport::default();
     let camera = prepared.camera();
     let merged = prepared.options().merge.is_some();
+    // The style's units into the scene's, once (docs/smear-units.md).
+    let units = prepared.units(style.speed_units, style.size_reference.as_ref())?;
+    report.speed_units = style.speed_units;
+    report.size = units.length;
+    let contact = style.contact.as_ref().map(|c| crate::ContactStyle {
+        ground: units.length_to_scene(c.ground),
+        ..c.clone()
+    });
     for i in 0..prepared.object_count() {
         let anim = prepared.animation(i);
         let name = prepared.name(i);
         let diagonal = Aabb::from_points(anim.frame(0)).diagonal();
-        let fx: CompiledEffects = style.for_object(name).compile(diagonal)?;
+        let fx: CompiledEffects = style.for_object(name).compile_in(diagonal, &units)?;
         let weights = match &fx.weights {
-            Some(w) => Some(prepared.resolve_weights(w, i)?),
+            Some(w) => Some(prepared.resolve_weights_in(w, i, &units)?),
             None => prepared.weights(i).map(<[f32]>::to_vec),
         };
         let mut stats = ObjectReport {
@@ -291,14 +306,14 @@ pub fn stylize_frames(
             vertices: anim.vertex_count(),
             ..ObjectReport::default()
         };
-        let ground = style.contact.as_ref().map(|c| c.ground);
+        let ground = contact.as_ref().map(|c| c.ground);
         let inputs = prepared.inputs(i, weights.clone())?.with_ground(ground);
-        let squash = match &style.contact {
+        let squash = match &contact {
             Some(c) => crate::squash_frames(anim, c),
             None => Vec::new(),
         };
         let squashed = squash.iter().filter(|s| s.is_some()).count();
-        if style.contact.as_ref().is_some_and(|c| c.squash > 0.0) {
+        if contact.as_ref().is_some_and(|c| c.squash > 0.0) {
             stats.squashed_frames = Some(squashed);
         }
         let mut parts = ObjectParts {
@@ -429,6 +444,9 @@ pub fn stylize_frames(
             };
             let line_frames = lines_range(&seeds, &line_style, &l.options, &frames)?;
             let drawn: Vec<usize> = line_frames.iter().map(|f| f.lines).collect();
+            let length: f64 = line_frames.iter().map(|f| f.length as f64).sum();
+            let count: usize = drawn.iter().sum();
+            stats.lines_length_mean = Some(length / count.max(1) as f64);
             stats.seeds = Some(points.len());
             stats.lines_max = Some(drawn.iter().copied().max().unwrap_or(0));
             stats.lines_per_frame = Some(drawn);

@@ -7,6 +7,7 @@ use exmex::{BinOp, Express, FlatEx, FloatOpsFactory, MakeOperators, Operator};
 
 use super::error::StyleError;
 use super::param::Param;
+use super::units::{scaled, StyleUnits};
 use super::voronoi::voronoi_f1;
 use super::warp::warp_offset;
 use crate::effects::StyleInput;
@@ -84,6 +85,20 @@ pub struct Expression {
     kappa: Param,
     seed: u64,
     uses_noise: bool,
+    /// Style units per scene unit of the inputs, and the output factor (all 1 in scene
+    /// units): see [`Expression::in_units`].
+    units: Option<InputUnits>,
+}
+
+/// Factors applied to an expression's inputs and result (style units, `docs/smear-units.md`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct InputUnits {
+    /// Style speed per scene speed (`speed`, `vx, vy, vz`).
+    speed: f64,
+    /// Style length per scene length (`x, y, z`).
+    length: f64,
+    /// Scene units of the result per style unit.
+    output: f64,
 }
 
 impl Expression {
@@ -179,7 +194,26 @@ impl Expression {
             kappa,
             seed,
             uses_noise,
+            units: None,
         })
+    }
+
+    /// The expression reading its inputs in a style's units: `speed` and `vx, vy, vz`
+    /// multiplied by `units.speed`, `x, y, z` divided by `units.length`, the `noise` κ
+    /// per style length; the result is multiplied by `output` (e.g. `units.length` for a
+    /// thickness). [`StyleUnits::SCENE`] with `output` 1 changes nothing.
+    pub fn in_units(mut self, units: &StyleUnits, output: f64) -> Self {
+        if units.is_scene() && output == 1.0 {
+            return self;
+        }
+        // κ per style length as κ per scene length (the noise reads scene positions).
+        self.kappa = scaled(&self.kappa, 1.0 / units.length);
+        self.units = Some(InputUnits {
+            speed: units.speed,
+            length: 1.0 / units.length,
+            output,
+        });
+        self
     }
 
     /// The expression text.
@@ -218,8 +252,21 @@ impl Expression {
                 Slot::Param(k) => self.params[k].at(i.frame) as f64,
             };
         }
+        let mut output = 1.0;
+        if let Some(u) = &self.units {
+            for (v, s) in vars.iter_mut().zip(&self.slots) {
+                match *s {
+                    // speed, vx, vy, vz
+                    Slot::Input(1 | 7..=9) => *v *= u.speed,
+                    // x, y, z
+                    Slot::Input(10..=12) => *v *= u.length,
+                    _ => {}
+                }
+            }
+            output = u.output;
+        }
         match self.flat.eval(&vars[..self.slots.len()]) {
-            Ok(x) if x.is_finite() => x as f32,
+            Ok(x) if x.is_finite() => (x * output) as f32,
             _ => 0.0,
         }
     }

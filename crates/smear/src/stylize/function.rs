@@ -8,6 +8,7 @@ use super::error::StyleError;
 use super::expr::Expression;
 use super::param::Param;
 use super::stage::{apply_stages, Stage};
+use super::units::StyleUnits;
 use crate::effects::{StyleInput, Stylize};
 
 /// A stylization function as written in a style file: either `stages` (a preset chain, see
@@ -121,6 +122,22 @@ impl FunctionSpec {
                 Ok(StyleFunction::Stages(self.stages.clone()))
             }
         }
+    }
+}
+
+impl FunctionSpec {
+    /// [`FunctionSpec::compile`] for a style in `units` (see [`StyleUnits`]): preset chains
+    /// are rewritten in scene units, expressions convert their inputs; the result is
+    /// multiplied by `output` (the scene length of a style length for a thickness, else 1).
+    /// In [`StyleUnits::SCENE`] with `output` 1 this is [`FunctionSpec::compile`], bit for bit.
+    ///
+    /// # Errors
+    /// As [`FunctionSpec::compile`].
+    pub fn compile_in(&self, units: &StyleUnits, output: f64) -> Result<StyleFunction, StyleError> {
+        Ok(match self.compile()? {
+            StyleFunction::Stages(s) => StyleFunction::Stages(units.stages_to_scene(&s, output)),
+            StyleFunction::Expr(e) => StyleFunction::Expr(Box::new(e.in_units(units, output))),
+        })
     }
 }
 

@@ -8,6 +8,8 @@
 //!   vx, vy, vz, x, y, z` and declared parameters.
 //! * [`Param`]: every numeric parameter is a constant or a keyframed curve.
 //! * [`Style`]: several effects with their functions and per-object overrides, read from TOML.
+//! * [`SpeedUnits`], [`SizeReference`], [`StyleUnits`]: a style's speeds and lengths are in
+//!   the character's own size by default (`docs/smear-units.md`).
 
 mod error;
 mod expr;
@@ -17,6 +19,7 @@ mod stage;
 mod style;
 #[cfg(test)]
 mod style_tests;
+mod units;
 mod voronoi;
 mod warp;
 mod weights;
@@ -30,6 +33,7 @@ pub use style::{
     CompiledEffects, CompiledLines, ElongateStyle, LinesStyle, MultiplesStyle, ObjectEffects,
     ObjectStyle, Style, DEFAULT_LINE_COUNT, DEFAULT_LINE_THICKNESS, DEFAULT_MULTIPLE_COLOR,
 };
+pub use units::{SizeReference, SpeedUnits, StyleUnits};
 pub use voronoi::voronoi_f1;
 pub use warp::{hise_curve, warp_offset};
 pub use weights::{WeightAttribute, WeightGroup, WeightSource};

@@ -34,13 +34,16 @@ pub enum Stage {
         /// The factor k.
         by: Param,
     },
-    /// x ← ‖v‖·x: the speed weighting of S_E^speed (Fig. 11c).
+    /// x ← ‖v‖·x: the speed weighting of S_E^speed (Fig. 11c); ‖v‖ in the style's units
+    /// (size units per second by default, scene units per frame with
+    /// `speed_units = "scene"`).
     Speed,
     /// x ← ω·x: painted weights ω ∈ [0, 1] (Fig. 15b).
     Weight,
     /// x ← F1(p(0), κ)·x: Voronoi noise at the rest position (Fig. 11d).
     Noise {
-        /// Scale κ applied to the rest position.
+        /// Scale κ applied to the rest position (per size unit, per scene unit with
+        /// `speed_units = "scene"`).
         kappa: Param,
         /// Seed of the feature-point jitter.
         #[serde(default)]
@@ -48,7 +51,8 @@ pub enum Stage {
     },
     /// x ← H(‖v‖ − v_min)·x: zero below a speed (Fig. 1 multiples and lines).
     Threshold {
-        /// Speed v_min in units per frame.
+        /// Speed v_min in size units per second (scene units per frame with
+        /// `speed_units = "scene"`).
         min_speed: Param,
     },
     /// x ← S_M(x, m; m_max) = H(x·m)·S((|x| − δ_m)/(1 − δ_m)), δ_m = (|m| − 1)/m_max (SMEAR Eq. 12,

@@ -9,6 +9,7 @@ use super::error::StyleError;
 use super::function::{FunctionSpec, StyleFunction};
 use super::param::Param;
 use super::stage::Stage;
+use super::units::{SizeReference, SpeedUnits, StyleUnits};
 use super::weights::WeightSource;
 use crate::{
     ContactStyle, ElongateOptions, LineOptions, MultiplesOptions, OffsetOptions, Spacing,
@@ -163,7 +164,9 @@ pub struct LinesStyle {
     pub seed: u64,
     /// Gap between the surface and the line, in frames along the trajectory; keyframeable.
     pub gap: Param,
-    /// Seeds slower than this (units per frame) draw no line; keyframeable.
+    /// Seeds slower than this draw no line; keyframeable. In size units per second (one
+    /// unit = the character's bounding-box diagonal), scene units per frame with
+    /// `speed_units = "scene"`.
     pub min_speed: Param,
     /// Only trace the past.
     pub past_only: bool,
@@ -178,8 +181,9 @@ pub struct LinesStyle {
     pub color: [Param; 3],
     /// S_L of SMEAR Eq. 13: signed length τ in frames (default S_L(δ; 1) = δ).
     pub length: FunctionSpec,
-    /// Tube radius in scene units along the line (default [`DEFAULT_LINE_THICKNESS`] × the
-    /// bounding-box diagonal).
+    /// Tube radius along the line, in size units (one unit = the character's bounding-box
+    /// diagonal; scene units with `speed_units = "scene"`). Default
+    /// [`DEFAULT_LINE_THICKNESS`] × the object's own bounding-box diagonal in either.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub thickness: Option<FunctionSpec>,
     /// Opacity along the line (default 1 − t, fading toward the end).
@@ -263,6 +267,13 @@ pub struct ObjectStyle {
 /// A whole style: the motion-offset options and up to three effects, each with its
 /// stylization functions, plus per-object overrides (paper Figs. 16, 17).
 ///
+/// Units (`docs/smear-units.md`): speeds (`speed`, `vx, vy, vz`, `threshold`,
+/// `lines.min_speed`) are in size units per second and lengths (`x, y, z`, noise κ per
+/// length, `lines.thickness`, `contact.ground`) in size units, one size unit being the
+/// character's bounding-box diagonal at the first frame (or [`Style::size_reference`]);
+/// `speed_units = "scene"` reads them as the paper does, in scene units (per frame).
+/// Displacements β, τ and spacings stay in frames.
+///
 /// ```
 /// let style = smear::Style::from_toml_str(r#"
 ///     [elongate]
@@ -280,6 +291,16 @@ pub struct ObjectStyle {
 pub struct Style {
     /// Motion-offset options (Section 3).
     pub offsets: OffsetOptions,
+    /// What the style's speeds and lengths are measured in: `"size"` (default, the
+    /// character's own size, speeds per second) or `"scene"` (scene units, speeds per
+    /// frame: the paper's numbers, reproduced bit for bit).
+    #[serde(skip_serializing_if = "SpeedUnits::is_size")]
+    pub speed_units: SpeedUnits,
+    /// One size unit: a length in scene units (`1.8`) or an object whose bounding-box
+    /// diagonal at the first frame it is (`"Body"`). Default: the diagonal of every object
+    /// at the first frame. Ignored with `speed_units = "scene"`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub size_reference: Option<SizeReference>,
     /// Painted weights ω (paper Fig. 15b): a weight group, a vertex attribute or a function
     /// of the rest position (see [`WeightSource`]). Default 1.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -372,6 +393,21 @@ impl Style {
 
     /// Compiles every function and checks every option.
     pub fn validate(&self) -> Result<(), StyleError> {
+        match &self.size_reference {
+            Some(SizeReference::Length(l)) if !(l.is_finite() && *l > 0.0) => {
+                return Err(StyleError::Parameter {
+                    name: "size_reference".into(),
+                    problem: format!("a length must be > 0 (scene units), got {l}"),
+                });
+            }
+            Some(SizeReference::Node(n)) if n.trim().is_empty() => {
+                return Err(StyleError::Parameter {
+                    name: "size_reference".into(),
+                    problem: "give a length or an object's name".into(),
+                });
+            }
+            _ => {}
+        }
         if let Some(t) = self.subdivide {
             if !(t.is_finite() && t >= 1.0) {
                 return Err(StyleError::Parameter {
@@ -527,25 +563,46 @@ pub struct CompiledLines {
 }
 
 impl ObjectEffects<'_> {
-    /// Compiles the functions; `diagonal` is the object's bounding-box diagonal (default line
-    /// thickness).
+    /// Compiles the functions of a style in scene units; `diagonal` is the object's
+    /// bounding-box diagonal (default line thickness).
     pub fn compile(&self, diagonal: f32) -> Result<CompiledEffects, StyleError> {
+        self.compile_in(diagonal, &StyleUnits::SCENE)
+    }
+
+    /// Compiles the functions of a style whose speeds and lengths are in `units`
+    /// ([`Prepared::units`](crate::Prepared::units)): the compiled functions and options
+    /// work in scene units per frame, as the effects do.
+    pub fn compile_in(
+        &self,
+        diagonal: f32,
+        units: &StyleUnits,
+    ) -> Result<CompiledEffects, StyleError> {
         Ok(CompiledEffects {
             weights: self.weights.cloned(),
             elongate: match self.elongate {
-                Some(e) => Some((e.function.compile()?, ElongateOptions { step: e.step })),
+                Some(e) => Some((
+                    e.function.compile_in(units, 1.0)?,
+                    ElongateOptions { step: e.step },
+                )),
                 None => None,
             },
             multiples: match self.multiples {
-                Some(m) => Some((m.opacity_spec().compile()?, m.options()?)),
+                Some(m) => Some((m.opacity_spec().compile_in(units, 1.0)?, m.options()?)),
                 None => None,
             },
             lines: match self.lines {
                 Some(l) => Some(CompiledLines {
-                    length: l.length.compile()?,
-                    thickness: l.thickness_spec(diagonal).compile()?,
-                    opacity: l.opacity.compile()?,
-                    options: l.options(),
+                    length: l.length.compile_in(units, 1.0)?,
+                    // The default is a fraction of the object's own diagonal in any units.
+                    thickness: match &l.thickness {
+                        Some(t) => t.compile_in(units, units.length)?,
+                        None => l.thickness_spec(diagonal).compile()?,
+                    },
+                    opacity: l.opacity.compile_in(units, 1.0)?,
+                    options: LineOptions {
+                        min_speed: units.speed_to_scene(&l.min_speed),
+                        ..l.options()
+                    },
                     count: l.seed_count(),
                     seed: l.seed,
                 }),

@@ -291,3 +291,32 @@ fn keyframes_survive_the_toml_text_the_studio_shows() {
     assert_eq!((by.at(0.0), by.at(20.0), by.at(40.0)), (1.0, 6.5, 12.0));
     assert_eq!(back.lines.as_ref().unwrap().count.at(10.0), 30.0);
 }
+
+#[test]
+fn units_read_and_survive_the_toml_text() {
+    let style = Style::from_toml_str("speed_units = \"scene\"\nsize_reference = \"Body\"").unwrap();
+    assert_eq!(style.speed_units, SpeedUnits::Scene);
+    assert_eq!(
+        style.size_reference,
+        Some(SizeReference::Node("Body".into()))
+    );
+    let text = style.to_toml_string().unwrap();
+    assert_eq!(Style::from_toml_str(&text).unwrap(), style, "{text}");
+    let size = Style::from_toml_str("size_reference = 1.8").unwrap();
+    assert_eq!(size.speed_units, SpeedUnits::Size);
+    assert_eq!(size.size_reference, Some(SizeReference::Length(1.8)));
+    // The default is not written out.
+    assert!(!Style::default()
+        .to_toml_string()
+        .unwrap()
+        .contains("speed_units"));
+    for bad in [
+        "size_reference = 0",
+        "size_reference = -2.0",
+        "size_reference = \"\"",
+    ] {
+        let e = Style::from_toml_str(bad).unwrap_err().to_string();
+        assert!(e.contains("size_reference"), "{bad}: {e}");
+    }
+    assert!(Style::from_toml_str("speed_units = \"metres\"").is_err());
+}

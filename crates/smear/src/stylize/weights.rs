@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::error::StyleError;
 use super::function::FunctionSpec;
+use super::units::StyleUnits;
 use crate::effects::{attribute_weights, group_weights, StyleInput, Stylize};
 use crate::SmearError;
 
@@ -114,7 +115,8 @@ impl WeightSource {
         out
     }
 
-    /// The weights of every vertex of object `object` of `scene`.
+    /// The weights of every vertex of object `object` of `scene`, a function reading the
+    /// rest position in scene units.
     ///
     /// # Errors
     /// An unknown joint or attribute (naming the available ones), an object index out of
@@ -124,6 +126,20 @@ impl WeightSource {
         scene: &SampledScene,
         object: usize,
     ) -> Result<Vec<f32>, SmearError> {
+        self.vertex_weights_in(scene, object, &StyleUnits::SCENE)
+    }
+
+    /// [`WeightSource::vertex_weights`] with a function reading the rest position `x, y, z`
+    /// in a style's length units (`units`, see [`StyleUnits`]).
+    ///
+    /// # Errors
+    /// As [`WeightSource::vertex_weights`].
+    pub fn vertex_weights_in(
+        &self,
+        scene: &SampledScene,
+        object: usize,
+        units: &StyleUnits,
+    ) -> Result<Vec<f32>, SmearError> {
         let obj = scene.objects.get(object).ok_or(SmearError::UnknownObject {
             index: object,
             count: scene.objects.len(),
@@ -132,10 +148,12 @@ impl WeightSource {
             WeightSource::Group(g) => group_weights(scene, object, &g.group, g.descendants),
             WeightSource::Attribute(a) => attribute_weights(&obj.animation.mesh, &a.attribute),
             WeightSource::Function(f) => {
-                let f = f.compile().map_err(|e| SmearError::InvalidParameter {
-                    name: "weights",
-                    reason: e.to_string(),
-                })?;
+                let f = f
+                    .compile_in(units, 1.0)
+                    .map_err(|e| SmearError::InvalidParameter {
+                        name: "weights",
+                        reason: e.to_string(),
+                    })?;
                 Ok(function_weights(&f, obj.animation.frame(0)))
             }
         }

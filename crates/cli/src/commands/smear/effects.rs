@@ -202,7 +202,7 @@ pub(crate) fn lines(ctx: &Context, args: LinesArgs) -> Result<()> {
     let plan = args.effect.plan(&args.offsets)?;
     let spinner = crate::progress::spinner("tracing motion lines", ctx.json);
     let p = prepare(&args.io, &args.offsets)?;
-    let radius = args.effect.radius(&p);
+    let radius = args.effect.radius(&args.offsets, &p)?;
     let style = args.effect.style(&args.offsets, &plan, &p)?;
     let out = run_style(&args.io, &p, &style)?;
     let t = Instant::now();

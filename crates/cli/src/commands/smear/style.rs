@@ -34,6 +34,8 @@ pub(crate) struct StyleArgs {
     #[arg(long)]
     pub(crate) gif: Option<PathBuf>,
     #[command(flatten)]
+    pub(crate) units: smear::args::UnitArgs,
+    #[command(flatten)]
     pub(crate) input_args: InputArgs,
 }
 
@@ -64,7 +66,8 @@ pub(crate) fn run(ctx: &Context, args: StyleArgs) -> Result<()> {
             output.display()
         );
     }
-    let style = read_style(style_path)?;
+    let mut style = read_style(style_path)?;
+    args.units.apply(&mut style);
     let sampled = input::open(input_path, &args.input_args)?;
     if sampled.objects.is_empty() {
         bail!("{}: the file has no mesh", input_path.display());
@@ -97,6 +100,8 @@ pub(crate) fn run(ctx: &Context, args: StyleArgs) -> Result<()> {
         "fps": book.fps,
         "parts": book.parts.len(),
         "objects": styled.report.objects,
+        "speed_units": styled.report.speed_units,
+        "size": styled.report.size,
         "timings": {"offsets": prepared.report().seconds, "elongate": seconds.elongate,
                     "multiples": seconds.multiples, "lines": seconds.lines,
                     "write": write_seconds},
