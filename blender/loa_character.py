@@ -73,53 +73,46 @@ class Reference:
 
 
 def write_bvh(armature, ref, path):
-    """Writes the skeleton of `armature` posed as `ref` (a `Reference`; world space);
-    returns {joint: bone name}."""
+    """Writes the skeleton of `armature` posed as `ref` (a `Reference`; world space) through
+    the toonkit module (`toonkit.loa.save_pose`, BVH by tkio); returns {joint: bone name}."""
+    import toonkit
+
     bones = armature.data.bones
     if len(bones) == 0:
         raise job.JobError(f"{armature.name}: the armature has no bones")
     w = armature.matrix_world
-    names = {}
-    lines = ["HIERARCHY"]
+    names, order, parents, heads = {}, [], [], []
 
-    def joint(bone, parent_head, depth, keyword):
-        pad = "  " * depth
+    def add(name, parent, at):
+        order.append(name)
+        parents.append(parent)
+        heads.append(tuple(at))
+        return len(order) - 1
+
+    def joint(bone, parent):
         n = _name(bone)
         if n in names:
             raise job.JobError(f"{armature.name}: two bones are named '{n}' in a BVH file")
         names[n] = bone.name
-        off = w @ ref.head(bone) - parent_head
-        lines.append(f"{pad}{keyword} {n}")
-        lines.append(f"{pad}{{")
-        lines.append(f"{pad}  OFFSET {off.x:.9g} {off.y:.9g} {off.z:.9g}")
-        if keyword == "ROOT":
-            lines.append(f"{pad}  CHANNELS 6 Xposition Yposition Zposition "
-                         "Zrotation Xrotation Yrotation")
-        else:
-            lines.append(f"{pad}  CHANNELS 3 Zrotation Xrotation Yrotation")
+        k = add(n, parent, w @ ref.head(bone))
         if bone.children:
             for c in bone.children:
-                joint(c, w @ ref.head(bone), depth + 1, "JOINT")
-        else:
-            tip = w @ ref.tip(armature, bone) - w @ ref.head(bone)
-            lines.extend([f"{pad}  End Site", f"{pad}  {{",
-                          f"{pad}    OFFSET {tip.x:.9g} {tip.y:.9g} {tip.z:.9g}", f"{pad}  }}"])
-        lines.append(f"{pad}}}")
+                joint(c, k)
+        else:  # the bone's tip: the file's End Site
+            add(f"{n}_end", k, w @ ref.tip(armature, bone))
 
     roots = [b for b in bones if b.parent is None]
     if len(roots) == 1:
-        joint(roots[0], Vector((0.0, 0.0, 0.0)), 0, "ROOT")
+        joint(roots[0], -1)
     else:
         names[VIRTUAL_ROOT] = None
-        lines += [f"ROOT {VIRTUAL_ROOT}", "{", "  OFFSET 0 0 0",
-                  "  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation"]
+        top = add(VIRTUAL_ROOT, -1, (0.0, 0.0, 0.0))
         for r in roots:
-            joint(r, Vector((0.0, 0.0, 0.0)), 1, "JOINT")
-        lines.append("}")
-    channels = 3 * (len(names) + 1)
-    lines += ["MOTION", "Frames: 1", "Frame Time: 0.0416667", " ".join(["0"] * channels)]
-    with open(path, "w", encoding="utf-8") as fh:
-        fh.write("\n".join(lines) + "\n")
+            joint(r, top)
+    try:
+        toonkit.loa.save_pose(path, order, parents, heads)
+    except (toonkit.ToonkitError, ValueError) as e:
+        raise job.JobError(f"{armature.name}: {job._one_line(e)}") from e
     return names
 
 

@@ -2,7 +2,7 @@
 
 import bpy
 
-from . import job
+from . import job, settings
 
 HOW_TO = (
     "1. Select the character's meshes",
@@ -37,7 +37,7 @@ class TOONKIT_PT_smear(bpy.types.Panel):
         col.active = s.elongate
         col.prop(s, "preset", text="")
         col.prop(s, "beta_max")
-        if s.preset == "NOISE":
+        if "kappa" in settings.CORE.get(s.preset.lower(), {}).get("parameters", ()):
             col.prop(s, "kappa")
         col.row().prop(s, "sign", expand=True)
         row = col.row(align=True)

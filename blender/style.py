@@ -1,30 +1,31 @@
-"""The panel's settings as a toonkit style (the CLI's `--style` TOML format) and back."""
+"""The panel's settings as a toonkit style (the CLI's `--style` TOML format) and back.
+
+The presets' stage chains come from the smear crate (`toonkit.smear.preset_function`) and style
+files are written by it (`toonkit.smear.save_style`): the panel only picks presets and values.
+"""
 
 import json
-import math
 import tomllib
 
-SIGN_STAGE = {"PAST": [{"op": "past"}], "FUTURE": [{"op": "future"}], "BOTH": []}
+from toonkit import smear as _core
+
+from .settings import PARAMS
+
+SIGN_STAGE = {"PAST": [{"op": "past"}], "FUTURE": [{"op": "future"}], "BOTH": [], "PRESET": []}
 
 
 def _weight_stage(s):
     return [{"op": "weight"}] if s.weight_group else []
 
 
-def _offset_stages(s):
-    """Warp, then the δ± restriction (SMEAR Fig. 12, Fig. 11d)."""
-    warp = [{"op": "warp", "s": s.warp_s, "p": s.warp_p}] if s.warp else []
-    return warp + SIGN_STAGE[s.sign]
-
-
 def elongation(s):
-    """S_E of SMEAR Eq. 10 for the preset."""
-    stages = _offset_stages(s)
-    if s.preset in ("SPEED", "NOISE"):
-        stages.append({"op": "speed"})
-    if s.preset == "NOISE":
-        stages.append({"op": "noise", "kappa": s.kappa})
-    return {"stages": stages + _weight_stage(s) + [{"op": "scale", "by": s.beta_max}]}
+    """S_E of SMEAR Eq. 10: the crate's preset chain, after the warp (SMEAR Fig. 12), with the
+    panel's δ± restriction in place of the preset's own unless "Preset" is chosen, times ω
+    last (as the CLI's `--weight-group` appends it)."""
+    warp = [{"op": "warp", "s": s.warp_s, "p": s.warp_p}] if s.warp else []
+    own = s.sign == "PRESET"
+    chain = _core.preset_function(s.preset.lower(), s.beta_max, s.kappa, signed=own)["stages"]
+    return {"stages": warp + SIGN_STAGE[s.sign] + chain + _weight_stage(s)}
 
 
 def weights(s, bones):
@@ -61,8 +62,9 @@ def from_settings(s, bones=()):
         lines = {
             "count": s.line_count, "seed": s.seed, "gap": s.line_gap, "step": step,
             "past_only": s.sign == "PAST",
-            "length": {"stages": SIGN_STAGE[s.sign] + [{"op": "speed"}] + _weight_stage(s)
-                       + [{"op": "scale", "by": s.line_length}]},
+            # S_L(δ; τ_max) = τ_max·δ (SMEAR Eq. 13), as the CLI's `smear lines` builds it.
+            "length": {"stages": SIGN_STAGE[s.sign] + [{"op": "scale", "by": s.line_length}]
+                       + _weight_stage(s)},
         }
         if s.line_thickness > 0:
             lines["thickness"] = {"stages": [{"op": "set", "value": s.line_thickness}]}
@@ -88,13 +90,21 @@ def _same(a, b, s):
     # A bone weight group reads back as an attribute without the skeleton: compare loosely.
     if s.weight_group and "weights" in b:
         a = dict(a, weights=b["weights"])
-    return json.loads(json.dumps(a)) == json.loads(json.dumps(b))
+    # Compared as the crate writes them: a file the crate wrote spells out its defaults.
+    return _core.style_toml(a) == _core.style_toml(b)
+
+
+def _whole(v):
+    """A count read from a style; a keyframed or fractional one does not fit the panel."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or v != int(v):
+        raise ValueError(f"{v!r} is not a whole number")
+    return int(v)
 
 
 def _apply(style, s):
     live, s.live = s.live, False
     try:
-        s.smooth = style.get("offsets", {}).get("smooth", 2)
+        s.smooth = style.get("offsets", {}).get("smooth", PARAMS["smooth"]["default"])
         w = style.get("weights")
         s.weight_group = (w.get("group") or [w.get("attribute")])[0] if w else ""
         e = style.get("elongate")
@@ -115,15 +125,19 @@ def _apply(style, s):
         m = style.get("multiples")
         s.multiples = m is not None
         if m:
-            s.past, s.future = m.get("past", 1), m.get("future", 1)
+            # Counts are numbers in a style (the crate writes 2.0): whole ones fit the panel.
+            s.past = _whole(m.get("past", PARAMS["past"]["default"]))
+            s.future = _whole(m.get("future", PARAMS["future"]["default"]))
             s.spacing_mode = "SPACING" if "spacing" in m else "OVERLAP"
-            s.spacing = m.get("spacing", 0.5)
-            s.overlap = m.get("overlap", 1)
+            s.spacing = m.get("spacing", PARAMS["spacing"]["default"])
+            s.overlap = _whole(m.get("overlap", 1))
             s.on_twos = m.get("step", 1) == 2
         ln = style.get("lines")
         s.lines = ln is not None
         if ln:
-            s.line_count, s.seed, s.line_gap = ln["count"], ln.get("seed", 7), ln.get("gap", 0.0)
+            s.line_count = _whole(ln.get("count", PARAMS["count"]["default"]))
+            s.line_gap = ln.get("gap", 0.0)
+            s.seed = ln.get("seed", PARAMS["seed"]["default"])
             s.on_twos = ln.get("step", 1) == 2
             s.line_length = [st for st in ln["length"]["stages"] if st["op"] == "scale"][0]["by"]
             th = ln.get("thickness")
@@ -138,46 +152,11 @@ def read(path):
         return tomllib.load(f)
 
 
-def _value(v):
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, (int, float)):
-        if isinstance(v, float) and not math.isfinite(v):
-            raise ValueError(f"style value {v} is not a number TOML can hold")
-        return repr(v)
-    if isinstance(v, str):
-        return json.dumps(v)
-    if isinstance(v, (list, tuple)):
-        return "[" + ", ".join(_value(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{ " + ", ".join(f"{k} = {_value(x)}" for k, x in v.items()) + " }"
-    raise ValueError(f"style value {v!r} cannot be written as TOML")
-
-
-def dumps(style):
-    """TOML text of a style dict: top-level values first, then one table per section."""
-    head = [f"{k} = {_value(v)}" for k, v in style.items() if not isinstance(v, dict)
-            or k == "weights"]
-    out = ["# toonkit style (Blender extension); `toonkit smear IN --style THIS -o OUT`", *head]
-    for k, v in style.items():
-        if isinstance(v, dict) and k != "weights":
-            out += ["", f"[{k}]", *(f"{kk} = {_value(x)}" for kk, x in v.items())]
-    return "\n".join(out) + "\n"
-
-
 def write(path, style):
-    """Writes a style file atomically."""
-    import os
-    import tempfile
+    """Writes a style file (checked, atomically) through the smear crate."""
+    import toonkit
 
-    text = dumps(style)
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
     try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
+        _core.save_style(path, style)
+    except toonkit.ToonkitError as e:  # a file error: the operator reports it as one line
+        raise OSError(str(e)) from e

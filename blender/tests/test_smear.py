@@ -248,7 +248,7 @@ def test_render_save_reload_unbake():
     select(meshes)
     s = scene.toonkit_smear
     s.live = False
-    s.preset, s.beta_max, s.lines, s.line_count, s.line_length = "LINEAR", 4.0, True, 40, 60.0
+    s.preset, s.beta_max, s.lines, s.line_count, s.line_length = "LINEAR", 4.0, True, 40, 4.0
     bake()
     smeared = render(scene, "smear.png")
     side_by_side(plain, smeared, "unbaked_and_smear.png")  # the README's picture

@@ -83,19 +83,6 @@ pub fn main() -> ExitCode {
         }
         Err(e) => e.exit(), // --help, --version
     };
-    // The main thread joins rayon's pool as its first worker, so the job's parallel loops
-    // start without handing work to another thread and waking it, and the second worker
-    // faults memory in while the input is read. Not for the studio: its jobs come from the
-    // server's threads.
-    if !matches!(cli.command, Command::Studio(_)) {
-        let _ = rayon::ThreadPoolBuilder::new()
-            .use_current_thread()
-            .build_global();
-        #[cfg(target_os = "linux")]
-        if rayon::current_num_threads() > 1 {
-            rayon::spawn(toonkit_alloc::populate);
-        }
-    }
     let ctx = cli.context(false);
     match run(&ctx, cli.command) {
         Ok(()) => ExitCode::SUCCESS,

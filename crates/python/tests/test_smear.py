@@ -112,7 +112,8 @@ def test_style_file_saves_what_the_cli_writes(robot, prepared, tmp_path):
 
 def test_elongated_equals_cli_elongate(robot, prepared, tmp_path):
     out = tmp_path / "elongated.pc2"
-    run_cli("smear", "elongate", asset(ROBOT), "--clip", "Dance", "--beta-max", "2", "-o", out)
+    run_cli("smear", "elongate", asset(ROBOT), "--clip", "Dance", "--preset", "linear",
+            "--beta-max", "2", "-o", out)
     expected = read_pc2(out)
     elongated = toonkit.smear.stylize(prepared, STRETCH).elongated
     assert elongated.dtype == np.float32 and elongated.shape == expected.shape

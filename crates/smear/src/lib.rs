@@ -161,11 +161,13 @@ pub use smooth::{
 pub use solver::{mesh_offsets, offset_solves, scene_offsets, OffsetMode, OffsetSolver};
 pub use stream::{Stream, StreamOptions, DEFAULT_STREAM_HISTORY};
 pub use stylize::{
-    apply_stages, hise_curve, voronoi_f1, warp_offset, CompiledEffects, CompiledLines,
-    ElongateStyle, Expression, FunctionSpec, LinesStyle, MultiplesStyle, ObjectEffects,
-    ObjectStyle, Param, SizeReference, SpeedUnits, Stage, Style, StyleError, StyleFunction,
-    StyleOps, StyleUnits, WeightAttribute, WeightGroup, WeightSource, DEFAULT_LINE_COUNT,
+    apply_stages, hise_curve, parameter, voronoi_f1, warp_offset, CompiledEffects, CompiledLines,
+    ElongatePreset, ElongateStyle, Expression, FunctionSpec, LinesStyle, MultiplesStyle,
+    ObjectEffects, ObjectStyle, Param, Parameter, SizeReference, SpeedUnits, Stage, Style,
+    StyleError, StyleFunction, StyleOps, StyleUnits, WeightAttribute, WeightGroup, WeightSource,
+    DEFAULT_BETA_MAX, DEFAULT_COPIES, DEFAULT_KAPPA, DEFAULT_LINE_COUNT, DEFAULT_LINE_LENGTH,
     DEFAULT_LINE_THICKNESS, DEFAULT_MULTIPLE_COLOR, EXPRESSION_INPUTS, MAX_EXPRESSION_VARIABLES,
+    PARAMETERS,
 };
 pub use surface::SurfacePoint;
 pub use velocity::{camera_vertex_velocities, causal_vertex_velocities, speeds, vertex_velocities};

@@ -189,3 +189,31 @@ fn urlencode(s: &str) -> String {
         })
         .collect()
 }
+
+#[tokio::test]
+async fn presets_and_parameter_ranges_are_the_smear_crates() {
+    let dir = tempfile::tempdir().unwrap();
+    let app = app(dir.path());
+    let answer: Value =
+        serde_json::from_slice(&send_ok(&app, get("/api/smear/presets")).await).unwrap();
+    // The page starts from the crate's default preset, with the crate's default parameters.
+    assert_eq!(answer["default"], smear::ElongatePreset::default().name());
+    assert_eq!(answer["parameters"], json!(smear::PARAMETERS));
+    for preset in smear::ElongatePreset::ALL {
+        let listed = answer["presets"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["name"] == preset.name())
+            .unwrap_or_else(|| panic!("preset {} not listed", preset.name()));
+        assert_eq!(
+            listed["style"]["elongate"]["function"],
+            json!(preset.default_function()),
+            "{}",
+            preset.name()
+        );
+        // Its TOML is the same style (what "export style" and the CLI's --style read).
+        let toml = smear::Style::from_toml_str(listed["toml"].as_str().unwrap()).unwrap();
+        assert_eq!(json!(toml), listed["style"]);
+    }
+}

@@ -107,10 +107,15 @@ export class SmearPanel {
     this.studio.view.setActionCamera(null);
     this.studio.view.setVertexColors(null);
     if (!this.presets) {
-      this.presets = (await getJSON('/api/smear/presets')).presets;
+      // The smear crate's presets, default and parameter ranges (one definition for every
+      // front end), then the example styles.
+      const answer = await getJSON('/api/smear/presets');
+      this.presets = answer.presets;
       for (const p of this.presets) $('preset').add(new Option(p.name, p.name));
-      $('preset').value = 'fig11c_speed';
-      this.style = structuredClone(this.presets.find((p) => p.name === 'fig11c_speed').style);
+      $('preset').value = answer.default;
+      this.style = structuredClone(this.presets.find((p) => p.name === answer.default).style);
+      const beta = answer.parameters.find((p) => p.name === 'beta_max');
+      Object.assign($('beta-max'), { min: beta.min, max: beta.max, title: beta.doc });
     }
     await this.reload();
   }

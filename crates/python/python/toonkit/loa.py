@@ -22,7 +22,26 @@ import os
 from . import _native
 from ._native import Line, Motion
 
-__all__ = ["Line", "Motion", "animate", "line"]
+__all__ = ["Line", "Motion", "animate", "line", "save_pose"]
+
+
+def save_pose(
+    path: Union[str, "os.PathLike[str]"],
+    names: Iterable[str],
+    parents: Iterable[int],
+    heads: Any,
+) -> str:
+    """Writes a posed skeleton as a character :func:`animate` reads (``.bvh``, by the core).
+
+    ``names`` and ``parents`` list the joints parents first (-1 for a root); ``heads`` is
+    ``(joints, 3)``: each joint's world position in the pose, which the character's rest pose
+    becomes (no rest rotation). A leaf named ``<parent>_end`` is its parent bone's tip (BVH
+    ``End Site``). Returns the path.
+    """
+    heads = np.ascontiguousarray(heads, dtype=np.float64)
+    return os.fspath(
+        _native.loa_save_pose(os.fspath(path), list(names), [int(p) for p in parents], heads)
+    )
 
 
 def _keystrokes_json(keystrokes: Iterable[Mapping[str, Any]], fps: Optional[float]) -> str:

@@ -23,3 +23,9 @@ def animate(
     progress: Optional[Callable[[str, float], Any]] = None,
     **options: Any,
 ) -> Motion: ...
+def save_pose(
+    path: Union[str, os.PathLike[str]],
+    names: Iterable[str],
+    parents: Iterable[int],
+    heads: Any,
+) -> str: ...

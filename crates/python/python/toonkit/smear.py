@@ -24,7 +24,63 @@ import numpy as np
 from . import _native
 from ._native import Prepared, Stream, Stylized
 
-__all__ = ["Prepared", "Stream", "Stylized", "offsets", "prepare", "stream", "stylize"]
+__all__ = [
+    "Prepared",
+    "Stream",
+    "Stylized",
+    "offsets",
+    "parameters",
+    "preset_function",
+    "presets",
+    "prepare",
+    "save_style",
+    "stream",
+    "style_toml",
+    "stylize",
+]
+
+
+def presets() -> list:
+    """The elongation presets S_E (SMEAR Section 5.2, Fig. 11), defined once in the smear
+    crate: a list of ``{"name", "doc", "parameters", "default", "function"}`` (``function``:
+    the preset's stage chain with the default parameters, as a style's ``elongate.function``;
+    ``default``: the preset front ends start from).
+
+    >>> [p["name"] for p in toonkit.smear.presets()]
+    ['linear', 'speed', 'noise']
+    """
+    return json.loads(_native.smear_presets())
+
+
+def parameters() -> dict:
+    """The style parameters every front end shows: name → ``{"name", "default", "min",
+    "max", "integer", "doc"}`` (the CLI's flag defaults, the Blender panel's and the studio's).
+
+    >>> toonkit.smear.parameters()["kappa"]["default"]
+    18.0
+    """
+    return {p["name"]: p for p in json.loads(_native.smear_parameters())}
+
+
+def preset_function(name: str, beta_max: Optional[float] = None, kappa: Optional[float] = None,
+                    signed: bool = True) -> dict:
+    """A preset's stage chain with these parameters (defaults: :func:`parameters`), as a
+    style's ``elongate.function`` dict. ``signed=False`` leaves out the preset's own δ±
+    restriction (for a front end that offers it as a separate choice)."""
+    table = parameters()
+    b = table["beta_max"]["default"] if beta_max is None else beta_max
+    k = table["kappa"]["default"] if kappa is None else kappa
+    return json.loads(_native.smear_preset_function(name, float(b), float(k), signed))
+
+
+def style_toml(style: Mapping[str, Any]) -> str:
+    """A style dict, checked, as the TOML text the CLI's ``--style`` reads."""
+    return _native.smear_style_toml(json.dumps(style))
+
+
+def save_style(path: Union[str, "os.PathLike[str]"], style: Mapping[str, Any]) -> str:
+    """Writes a style dict, checked, as a TOML style file (atomically). Returns the path."""
+    return os.fspath(_native.smear_save_style(os.fspath(path), json.dumps(style)))
 
 
 def _prune_list(prune: Iterable[str]) -> list:

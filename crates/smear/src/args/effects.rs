@@ -2,36 +2,25 @@
 //! the [`Style`] each describes. Expressions are those of `smear::Expression` with the
 //! effect's maximum bound as a parameter (`beta_max`, `m_max`, `tau_max`).
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 
 use super::{check, EffectArgs, FlagError};
 use crate::{
-    ElongateStyle, FunctionSpec, LineOptions, LinesStyle, MultiplesOptions, MultiplesStyle, Param,
-    Prepared, Spacing, Stage, Style,
+    ElongatePreset, ElongateStyle, FunctionSpec, LineOptions, LinesStyle, MultiplesOptions,
+    MultiplesStyle, Param, Prepared, Spacing, Stage, Style,
 };
-
-/// Presets of S_E (SMEAR Section 5.2).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ElongatePreset {
-    /// S_E(δ; β_max) = β_max·δ (SMEAR Eq. 10 example, Fig. 9b, 11b).
-    Linear,
-    /// S_E(δ; v, β_max) = β_max‖v‖δ (Fig. 11c).
-    Speed,
-    /// S_E(δ⁻; v, κ, β_max) = β_max‖v‖F1(p(0), κ)δ⁻ (Fig. 11d).
-    Noise,
-}
 
 /// Flags of the elongated in-betweens (SMEAR Eq. 10).
 #[derive(Debug, Clone, Args)]
 pub struct Elongate {
     /// Stylization preset S_E.
-    #[arg(long, value_enum, default_value_t = ElongatePreset::Linear)]
+    #[arg(long, value_enum, default_value_t = ElongatePreset::default())]
     pub preset: ElongatePreset,
     /// Maximum elongation β_max in frames; keyframes as FRAME:VALUE,... (e.g. 0:0,12:3).
-    #[arg(long, default_value = "1")]
+    #[arg(long, default_value_t = Param::Constant(crate::DEFAULT_BETA_MAX))]
     pub beta_max: Param,
     /// Noise scale κ of the `noise` preset (keyframeable).
-    #[arg(long, default_value = "1")]
+    #[arg(long, default_value_t = Param::Constant(crate::DEFAULT_KAPPA))]
     pub kappa: Param,
     /// User expression for β (replaces the preset), e.g. "beta_max * speed * past(delta)".
     #[arg(long)]
@@ -46,13 +35,10 @@ impl Elongate {
     pub fn function(&self, effect: &EffectArgs) -> Result<FunctionSpec, FlagError> {
         let spec = match &self.expr {
             Some(e) => FunctionSpec::expr(e, &[("beta_max", self.beta_max.clone())]),
-            None => effect.weighted(match self.preset {
-                ElongatePreset::Linear => FunctionSpec::linear(self.beta_max.clone()),
-                ElongatePreset::Speed => FunctionSpec::speed(self.beta_max.clone()),
-                ElongatePreset::Noise => {
-                    FunctionSpec::noise(self.kappa.clone(), self.beta_max.clone())
-                }
-            }),
+            None => effect.weighted(
+                self.preset
+                    .function(self.beta_max.clone(), self.kappa.clone()),
+            ),
         };
         let flag = match self.expr {
             Some(_) => "--expr",
@@ -82,10 +68,10 @@ impl Elongate {
 #[derive(Debug, Clone, Args)]
 pub struct Multiples {
     /// Copies in the past, m_p; keyframes (FRAME:VALUE,...) fade copies in and out.
-    #[arg(long, default_value = "1")]
+    #[arg(long, default_value_t = Param::Constant(crate::DEFAULT_COPIES))]
     pub past: Param,
     /// Copies in the future, m_n; keyframeable.
-    #[arg(long, default_value = "1")]
+    #[arg(long, default_value_t = Param::Constant(crate::DEFAULT_COPIES))]
     pub future: Param,
     /// Temporal spacing Δf between copies, in frames; keyframes as FRAME:VALUE,...
     #[arg(long, conflicts_with = "overlap")]
@@ -187,7 +173,7 @@ pub struct Lines {
     #[arg(long, default_value_t = Param::Constant(crate::DEFAULT_LINE_COUNT as f32))]
     pub count: Param,
     /// Maximum length τ_max in frames: S_L(δ; τ_max) = τ_max·δ (SMEAR Eq. 13); keyframeable.
-    #[arg(long, default_value = "1")]
+    #[arg(long, default_value_t = Param::Constant(crate::DEFAULT_LINE_LENGTH))]
     pub length_max: Param,
     /// Seed of every random choice (default: the tool's fixed seed; runs are reproducible).
     #[arg(long, value_name = "SEED")]

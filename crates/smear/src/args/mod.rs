@@ -6,7 +6,8 @@
 
 mod effects;
 
-pub use effects::{Elongate, ElongatePreset, Lines, LinesPlan, Multiples, MultiplesPlan};
+pub use crate::ElongatePreset;
+pub use effects::{Elongate, Lines, LinesPlan, Multiples, MultiplesPlan};
 
 use clap::Args;
 

@@ -15,6 +15,7 @@ mod error;
 mod expr;
 mod function;
 mod param;
+mod preset;
 mod stage;
 mod style;
 #[cfg(test)]
@@ -28,6 +29,10 @@ pub use error::StyleError;
 pub use expr::{Expression, StyleOps, EXPRESSION_INPUTS, MAX_EXPRESSION_VARIABLES};
 pub use function::{FunctionSpec, StyleFunction};
 pub use param::Param;
+pub use preset::{
+    parameter, ElongatePreset, Parameter, DEFAULT_BETA_MAX, DEFAULT_COPIES, DEFAULT_KAPPA,
+    DEFAULT_LINE_LENGTH, PARAMETERS,
+};
 pub use stage::{apply_stages, Stage};
 pub use style::{
     CompiledEffects, CompiledLines, ElongateStyle, LinesStyle, MultiplesStyle, ObjectEffects,

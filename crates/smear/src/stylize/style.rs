@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::error::StyleError;
 use super::function::{FunctionSpec, StyleFunction};
 use super::param::Param;
+use super::preset::{ElongatePreset, DEFAULT_COPIES, DEFAULT_LINE_LENGTH};
 use super::stage::Stage;
 use super::units::{SizeReference, SpeedUnits, StyleUnits};
 use super::weights::WeightSource;
@@ -54,7 +55,7 @@ impl Default for ElongateStyle {
         ElongateStyle {
             enabled: yes(),
             step: one(),
-            function: FunctionSpec::linear(1.0),
+            function: ElongatePreset::default().default_function(),
         }
     }
 }
@@ -91,8 +92,8 @@ impl Default for MultiplesStyle {
     fn default() -> Self {
         MultiplesStyle {
             enabled: yes(),
-            past: Param::Constant(1.0),
-            future: Param::Constant(1.0),
+            past: Param::Constant(DEFAULT_COPIES),
+            future: Param::Constant(DEFAULT_COPIES),
             spacing: None,
             overlap: None,
             step: one(),
@@ -203,7 +204,7 @@ impl Default for LinesStyle {
             samples: DEFAULT_LINE_SAMPLES,
             step: one(),
             color: LineOptions::default().color,
-            length: FunctionSpec::linear(1.0),
+            length: FunctionSpec::linear(DEFAULT_LINE_LENGTH),
             thickness: None,
             opacity: FunctionSpec::stages(vec![Stage::Set { value: 1.0.into() }, Stage::Fade]),
         }

@@ -12,7 +12,7 @@ use axum::response::Response;
 use axum::Json;
 use serde::Deserialize;
 use serde_json::{json, Value};
-use smear::{OffsetOptions, Style, WeightSource};
+use smear::{ElongatePreset, ElongateStyle, OffsetOptions, Style, WeightSource};
 
 use super::changes::pack_changes;
 use super::scene::ClipQuery;
@@ -54,15 +54,35 @@ pub(crate) const PRESETS: &[(&str, &str)] = &[
     ),
 ];
 
-/// `GET /api/smear/presets`: `{"presets": [{"name", "style", "toml"}]}`.
+/// `GET /api/smear/presets`: `{"presets": [{"name", "style", "toml"}], "default", "parameters"}`:
+/// the smear crate's named presets with their default parameters (the CLI's `--preset`, the
+/// Blender panel's), then the example styles; the preset the page starts from and the
+/// parameter table (default, min, max, doc) its controls take their ranges from.
 pub(crate) async fn presets() -> ApiResult<Json<Value>> {
     let mut out = Vec::new();
+    for preset in ElongatePreset::ALL {
+        let style = Style {
+            elongate: Some(ElongateStyle {
+                function: preset.default_function(),
+                ..ElongateStyle::default()
+            }),
+            ..Style::default()
+        };
+        let toml = style
+            .to_toml_string()
+            .map_err(|e| ApiError::internal(format!("preset {}: {e}", preset.name())))?;
+        out.push(json!({"name": preset.name(), "doc": preset.doc(), "style": style, "toml": toml}));
+    }
     for (name, text) in PRESETS {
         let style = Style::from_toml_str(text)
             .map_err(|e| ApiError::internal(format!("preset {name}: {e}")))?;
         out.push(json!({"name": name, "style": style, "toml": text}));
     }
-    Ok(Json(json!({ "presets": out })))
+    Ok(Json(json!({
+        "presets": out,
+        "default": ElongatePreset::default().name(),
+        "parameters": smear::PARAMETERS,
+    })))
 }
 
 /// `GET /api/smear/offsets?file=&clip=`: `offsets` (f32, frames × vertices, δ ∈ [−1, 1]).
