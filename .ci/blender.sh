@@ -2,7 +2,8 @@
 # Blender extension CI (issues 16 and 17), called by .ci/run after python.sh and caches.sh:
 # builds the extension zip (python blender/build.py, reusing python.sh's release wheel in
 # target/pywheels/ when it is there), then on real Blender through `bpy` from PyPI -- 4.2.0
-# LTS (reusing caches.sh's target/caches-venv) and 5.0.1 (own venv), each with numpy<2 --
+# LTS (reusing caches.sh's target/caches-venv), 4.5.15 LTS and 5.0.1 (own venvs), each with
+# numpy<2 --
 # installs the zip with bpy.ops.extensions.package_install_files and runs
 # blender/tests/test_smear.py, test_stopmo.py and test_loa.py (one PASS/FAIL line per test,
 # non-zero exit on a failure).
@@ -26,14 +27,20 @@ venv() {  # venv DIR BPY_VERSION
     "$1/bin/pip" install "${PIP[@]}" "bpy==$2" "numpy<2"
 }
 status=0
-for spec in "4.2.0:target/caches-venv" "5.0.1:target/blender-venv-5.0"; do
+# The benchmark tube (docs/blender.md, "Speed"): the smear test prints bake and restyle times
+# and Blender's own floor on it (cargo test has compiled the example).
+tube=target/blender-tube.glb
+cargo run -q -p toonkit-smear --example write_tube -- "$tube" 40
+export TOONKIT_TUBE="$ROOT/$tube"
+for spec in "4.2.0:target/caches-venv" "4.5.15:target/blender-venv-4.5" \
+    "5.0.1:target/blender-venv-5.0"; do
     version=${spec%%:*}
     dir=${spec#*:}
     venv "$dir" "$version"
     out="target/blender-out-$version"
     rm -rf "$out" "target/blender-user-$version"
     echo "== Blender $version"
-    for t in smear stopmo loa; do
+    for t in smear stopmo loa rigs; do
         rm -rf "target/blender-user-$version"
         BLENDER_USER_RESOURCES="$ROOT/target/blender-user-$version" \
             "$dir/bin/python" "blender/tests/test_$t.py" "$zip" "$out/$t" || status=1

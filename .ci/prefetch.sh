@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Started in the background by .ci/run before the Rust builds: installs the outside tools the
 # later phases use — Debian's chromium (studio) and assimp-utils (io), the Python venvs with
-# bpy 4.2 / 5.0.1, openjd-cli, usd-core and pymeshlab, the npm packages — while cargo compiles,
-# so ~2 GB of downloads overlap the build instead of following it. The requirement lists are
+# bpy 4.2 / 4.5.15 / 5.0.1, openjd-cli, usd-core and pymeshlab, the npm packages — while cargo
+# compiles, so ~2 GB of downloads overlap the build instead of following it. The requirement lists are
 # the phases' own (each phase still runs its install, a no-op when this got there first), so a
 # failure here costs time, never correctness; .ci/run prints this log before the first phase
 # that needs any of it.
@@ -39,6 +39,7 @@ mkdir -p target
 step "apt chromium assimp-utils" apt_tools
 # The same lists as .ci/caches.sh, .ci/blender.sh and .ci/meshlab.sh.
 step "bpy 4.2.0 venv" venv target/caches-venv "bpy==4.2.0" "numpy<2" "openjd-cli" "usd-core==26.11"
+step "bpy 4.5.15 venv" venv target/blender-venv-4.5 "bpy==4.5.15" "numpy<2"
 step "bpy 5.0.1 venv" venv target/blender-venv-5.0 "bpy==5.0.1" "numpy<2"
 step "pymeshlab venv" venv target/meshlab-venv pymeshlab
 step "npm studio tests" npm ci --prefix .ci/studio --no-audit --no-fund --loglevel=error

@@ -12,6 +12,7 @@ import numpy as np
 from . import results, sample, style
 
 _CACHE = {}  # scene name -> (Sample, toonkit Prepared)
+_PENDING = {}  # scene name -> _Pending: frames of the last live restyle not written yet
 
 
 class JobError(Exception):
@@ -52,6 +53,26 @@ def sources(context):
     return [o for o in objs if o.type == "MESH"]
 
 
+def bake_blocker(context):
+    """Why the bake cannot run now (one line for the panel and the greyed-out button), or
+    None."""
+    if not sources(context):
+        picked = context.selected_objects
+        what = (f"{picked[0].name} is a {picked[0].type.lower()}: " if picked else "")
+        return what + "select at least one mesh object (or its armature)"
+    scene = context.scene
+    if scene.frame_end <= scene.frame_start:
+        return (f"the scene range {scene.frame_start}-{scene.frame_end} needs at least two "
+                "frames")
+    return None
+
+
+def _moves(s):
+    """Whether any vertex of the sample moves over its frames (no copy of the frames)."""
+    first = s.positions[0]
+    return any(not np.array_equal(first, p) for p in s.positions[1:])
+
+
 def _prepare(context, objects, settings):
     toonkit = _toonkit()
     shown = []
@@ -68,6 +89,11 @@ def _prepare(context, objects, settings):
         for o, hidden, vp in shown:
             o.hide_viewport = vp
             o.hide_set(hidden)
+    if not _moves(s) and s.camera is None:
+        names = ", ".join(s.names[:3]) + (" …" if len(s.names) > 3 else "")
+        raise JobError(f"{names}: does not move over frames {s.frame_start}-"
+                       f"{s.frame_start + len(s.positions) - 1}, nothing to smear; animate it "
+                       "or set the scene range to where it moves")
     positions, skin = (sample.to_camera(s) if s.camera is not None
                        else (s.positions, s.skin))
     try:
@@ -91,10 +117,49 @@ def _world(s, points):
     return sample.from_camera(s.camera, points) if s.camera is not None else points
 
 
-def _show(scene, s, look):
-    """Creates or updates the result objects of `look` (elongation, copies, lines)."""
+class _Pending:
+    """The frames of a live restyle still to write: (mesh name, positions, alpha) per result
+    object, written one frame at a time as the scene reaches it (docs/blender.md, "Speed")."""
+
+    def __init__(self, start, writes):
+        self.start, self.writes = start, writes
+        self.frames = set(range(len(writes[0][1]))) if writes else set()
+
+    def write(self, frames):
+        import bpy
+
+        frames = [k for k in frames if k in self.frames]
+        for name, positions, alpha in self.writes if frames else ():
+            mesh = bpy.data.meshes.get(name)
+            if mesh is not None:
+                results.write_frames(mesh, self.start, positions, alpha, frames)
+        self.frames.difference_update(frames)
+
+    def write_current(self, scene):
+        n = len(self.writes[0][1]) if self.writes else 0
+        self.write([min(max(scene.frame_current - self.start, 0), n - 1)] if n else [])
+
+
+def write_pending(scene, frame_only=True):
+    """Writes the pending frames of `scene`'s last live restyle: the current frame, or all."""
+    p = _PENDING.get(scene.name)
+    if p is None:
+        return
+    if frame_only:
+        p.write_current(scene)
+    else:
+        p.write(sorted(p.frames))
+    if not p.frames:
+        _PENDING.pop(scene.name, None)
+
+
+def _show(scene, s, look, lazy=False):
+    """Creates or updates the result objects of `look` (elongation, copies, lines). `lazy`
+    writes the current frame only and leaves the others pending (`write_pending`)."""
     import bpy
 
+    _PENDING.pop(scene.name, None)
+    writes = []
     start, end = s.frame_start, s.frame_start + len(s.positions) - 1
     elongated = _world(s, look.elongated)
     bodies = {o[results.SOURCE]: o for o in results.owned("body")}
@@ -107,7 +172,7 @@ def _show(scene, s, look):
             mesh.name = f"{name} smear"
             body = results.make_body(scene, original, mesh, start, end)
             bodies[name] = body
-        results.write_frames(body.data, start, elongated[:, r.start:r.stop])
+        writes.append((body.data, elongated[:, r.start:r.stop], None))
         results.set_range(body, start, end)
 
     wanted = {}
@@ -125,7 +190,7 @@ def _show(scene, s, look):
         if obj is None:
             obj = results.make_copy(scene, bodies[key[0]], key[1], start, end)
             obj["toonkit_index"] = key[1]
-        results.write_frames(obj.data, start, _world(s, c["positions"]), c["alpha"])
+        writes.append((obj.data, _world(s, c["positions"]), c["alpha"]))
         results.set_range(obj, start, end)
 
     lines = {s.names[ln["object"]]: ln for ln in look.lines}
@@ -142,6 +207,21 @@ def _show(scene, s, look):
                       for k, f in enumerate(frames)]
         results.write_lines(obj.data, start, frames)
         results.set_range(obj, start, end)
+    _write(scene, start, writes, lazy)
+
+
+def _write(scene, start, writes, lazy):
+    """Writes every frame of `writes`, or (`lazy`) only the current frame of the result
+    meshes that already hold every frame, the rest pending."""
+    later = []
+    for mesh, positions, alpha in writes:
+        if lazy and mesh.attributes.get(f"tk_P{start}") is not None:
+            later.append((mesh.name, positions, alpha))
+        else:
+            results.write_frames(mesh, start, positions, alpha)
+    if later:
+        _PENDING[scene.name] = _Pending(start, later)
+        write_pending(scene)
 
 
 def bake(context, objects):
@@ -158,8 +238,10 @@ def bake(context, objects):
     return look
 
 
-def restyle(scene):
-    """Re-stylizes the baked result from the cached offsets; returns an error line or None."""
+def restyle(scene, lazy=False):
+    """Re-stylizes the baked result from the cached offsets; returns an error line or None.
+    `lazy` (a live slider) writes the current frame now and each other frame when the scene
+    reaches it."""
     import bpy
 
     settings = scene.toonkit_smear
@@ -171,7 +253,7 @@ def restyle(scene):
             cached = _prepare(bpy.context, objs, settings)
             _CACHE[scene.name] = cached
         s, prepared = cached
-        _show(scene, s, _stylize(s, prepared, settings))
+        _show(scene, s, _stylize(s, prepared, settings), lazy)
     except JobError as e:
         return str(e)
     return None
@@ -184,7 +266,29 @@ def timed_restyle(scene):
     return error, time.perf_counter() - t
 
 
+def write_all_pending():
+    """Writes every pending frame (before saving or rendering)."""
+    import bpy
+
+    for scene in bpy.data.scenes:
+        write_pending(scene, frame_only=False)
+
+
+def after_undo():
+    """An undo may restore result meshes with some frames of a live restyle pending: those
+    scenes are restyled again in full, from the restored settings."""
+    import bpy
+
+    names = list(_PENDING)
+    _PENDING.clear()
+    for name in names:
+        scene = bpy.data.scenes.get(name)
+        if scene is not None and is_baked(scene):
+            scene.toonkit_smear.last_error = restyle(scene) or ""
+
+
 def unbake(scene):
+    _PENDING.pop(scene.name, None)
     results.remove_all(scene)
     _CACHE.pop(scene.name, None)
 

@@ -2,6 +2,7 @@
 one line with `self.report({'ERROR'}, ...)` and leaves the scene as it was."""
 
 import bpy
+from bpy.app.handlers import persistent
 from bpy.props import StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
@@ -14,6 +15,13 @@ class TOONKIT_OT_smear_bake(bpy.types.Operator):
     bl_idname = "toonkit.smear_bake"
     bl_label = "Bake smear"
     bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        why = job.bake_blocker(context)
+        if why:
+            cls.poll_message_set(why)  # the greyed-out button's tooltip says why
+        return why is None
 
     def execute(self, context):
         objects = job.sources(context)
@@ -113,11 +121,37 @@ CLASSES = (TOONKIT_OT_smear_bake, TOONKIT_OT_smear_update, TOONKIT_OT_smear_unba
            TOONKIT_OT_style_load, TOONKIT_OT_style_save)
 
 
+@persistent
+def _frame_changed(scene, *args):
+    job.write_pending(scene)  # a live restyle's frame, as the scene reaches it
+
+
+@persistent
+def _write_all(*args):
+    job.write_all_pending()
+
+
+@persistent
+def _undone(*args):
+    job.after_undo()
+
+
+HANDLERS = (("frame_change_pre", _frame_changed), ("save_pre", _write_all),
+            ("render_init", _write_all), ("undo_post", _undone), ("redo_post", _undone))
+
+
 def register():
     for c in CLASSES:
         bpy.utils.register_class(c)
+    for name, handler in HANDLERS:
+        getattr(bpy.app.handlers, name).append(handler)
 
 
 def unregister():
+    job.write_all_pending()
+    for name, handler in HANDLERS:
+        handlers = getattr(bpy.app.handlers, name)
+        if handler in handlers:
+            handlers.remove(handler)
     for c in reversed(CLASSES):
         bpy.utils.unregister_class(c)

@@ -5,7 +5,7 @@ import bpy
 from . import job, settings
 
 HOW_TO = (
-    "1. Select the character's meshes",
+    "1. Select the character's meshes (or its armature)",
     "2. Bake: every frame of the scene range",
     "3. Drag a value: the smear updates",
     "4. Unbake removes every trace",
@@ -72,6 +72,9 @@ class TOONKIT_PT_smear(bpy.types.Panel):
         row.operator("toonkit.style_load", icon="FILE_FOLDER")
         row.operator("toonkit.style_save", icon="FILE_TICK")
         if not job.is_baked(context.scene):
+            why = job.bake_blocker(context)
+            if why:  # why the Bake button is greyed out
+                lay.label(text=why[0].upper() + why[1:], icon="INFO")
             col = lay.column(align=True)
             for line in HOW_TO:
                 col.label(text=line)

@@ -160,21 +160,34 @@ def mesh_like(source_mesh, name):
     return m
 
 
-def write_frames(mesh, start, positions, alpha=None):
-    """Per-frame attributes `tk_P<frame>` (and `tk_A<frame>`); frame 0 also as the rest."""
+def write_frames(mesh, start, positions, alpha=None, frames=None):
+    """Per-frame attributes `tk_P<frame>` (and `tk_A<frame>`) of the frame indices `frames`
+    (all when None). `positions` (frames, n, 3) and `alpha` (frames, n) are float32 arrays
+    whose frames are contiguous (the core's output): each frame goes to Blender straight from
+    its buffer, nothing is allocated per frame. A new mesh (no `tk_P` yet) also gets the first
+    frame as its rest vertices; later writes only tag the mesh for re-evaluation."""
     attrs = mesh.attributes
-    for k in range(len(positions)):
+    fresh = attrs.get(f"tk_P{start}") is None
+    for k in range(len(positions)) if frames is None else frames:
         f = start + k
-        for name, kind, data, field in (
-            (f"tk_P{f}", "FLOAT_VECTOR", positions, "vector"),
-            (f"tk_A{f}", "FLOAT", alpha, "value"),
-        ):
-            if data is None:
-                continue
-            a = attrs.get(name) or attrs.new(name, kind, "POINT")
-            a.data.foreach_set(field, np.ascontiguousarray(data[k], np.float32).ravel())
-    mesh.vertices.foreach_set("co", np.ascontiguousarray(positions[0], np.float32).ravel())
-    mesh.update()
+        _layer(attrs, f"tk_P{f}", "FLOAT_VECTOR").data.foreach_set(
+            "vector", _flat(positions[k]))
+        if alpha is not None:
+            _layer(attrs, f"tk_A{f}", "FLOAT").data.foreach_set("value", _flat(alpha[k]))
+    if fresh:
+        mesh.vertices.foreach_set("co", _flat(positions[0]))
+        mesh.update()
+    else:
+        mesh.update_tag()
+
+
+def _layer(attrs, name, kind):
+    return attrs.get(name) or attrs.new(name, kind, "POINT")
+
+
+def _flat(a):
+    """`a` as a flat float32 view (a copy only when it is not contiguous float32)."""
+    return np.ascontiguousarray(a, np.float32).reshape(-1)
 
 
 def write_lines(mesh, start, frames):

@@ -1,6 +1,18 @@
 """What Blender evaluates, as toonkit arrays: every frame of the scene range through the
 depsgraph (rigs, constraints, drivers, NLA, shape keys, bone parents all apply).
 
+Two ways to get a mesh's vertices per frame (docs/blender.md, "Sampling"):
+
+* **pose only** -- a mesh deformed only by Armature modifiers (vertex groups, linear blend),
+  or not deformed at all (a rigid prop, a keyed object): Blender evaluates the pose with the
+  mesh's Armature modifiers off, the bone and object matrices are read per frame, and
+  `toonkit.skin` skins the rest vertices in the core with the vertex groups normalized as the
+  Armature modifier normalizes them (deforming bones only; a vertex whose weights sum to at
+  most 1e-4 stays at rest). Preserve volume (dual quaternions), envelopes, B-Bones, a
+  modifier's vertex-group mask or multi-modifier blending take the evaluated path instead.
+* **evaluated** -- everything else (shape keys, other modifiers, two armatures): the
+  depsgraph's evaluated mesh per frame.
+
 Meshes deformed by one armature form one articulated group: that armature's pose gives the
 skeleton of SMEAR Eqs. 3-9 (joint world matrices per frame, skin weights from the vertex
 groups named after its bones). Meshes parented to one of its bones ride that bone; other
@@ -37,10 +49,12 @@ class Sample:
         return [(n, r) for n, r in zip(self.names, self.ranges)]
 
 
-def armature_of(obj):
-    """The armature deforming `obj` (an Armature modifier's object), if any."""
+def armature_of(obj, viewport=False):
+    """The armature deforming `obj` (an Armature modifier's object, shown in renders or in
+    the `viewport`), if any."""
     for m in obj.modifiers:
-        if m.type == "ARMATURE" and m.object is not None and m.show_render:
+        if m.type == "ARMATURE" and m.object is not None and (
+                m.show_viewport if viewport else m.show_render):
             return m.object
     return None
 
@@ -102,8 +116,176 @@ def _groups(obj, n):
     return out
 
 
-def sample(context, objects, camera_relative=False):
-    """Samples `objects` (meshes) over the scene range; restores the current frame."""
+#: A vertex whose deforming weights sum to at most this stays at rest (the Armature modifier's
+#: threshold).
+ARMATURE_MIN_WEIGHT = 1e-4
+
+
+def pose_only_reason(obj):
+    """Why the vertices of `obj` need Blender's evaluated mesh, or None when its rest vertices
+    and the pose give them (no modifiers, or Armature modifiers on one armature that blend
+    vertex groups linearly)."""
+    if obj.data.shape_keys is not None and len(obj.data.shape_keys.key_blocks) > 1:
+        return "shape keys"
+    armature = None
+    for m in obj.modifiers:
+        if not m.show_viewport:
+            continue
+        if m.type != "ARMATURE":
+            return f"modifier {m.name!r}"
+        if m.object is None:
+            continue
+        if armature is not None and m.object != armature:
+            return "two armatures"
+        if m.object.type != "ARMATURE":
+            return f"modifier {m.name!r}"
+        armature = m.object
+        if m.use_deform_preserve_volume:
+            return "preserve volume (dual quaternions)"
+        if m.use_bone_envelopes or not m.use_vertex_groups:
+            return "bone envelopes"
+        if m.vertex_group or m.use_multi_modifier:
+            return "a masked Armature modifier"
+    if armature is not None and any(b.use_deform and b.bbone_segments > 1
+                                    for b in armature.data.bones):
+        return "B-Bones"
+    return None
+
+
+def _rest(obj):
+    """Rest vertices (object space) and triangles of `obj`'s own mesh."""
+    mesh = obj.data
+    co = np.empty(len(mesh.vertices) * 3, np.float32)
+    mesh.vertices.foreach_get("co", co)
+    mesh.calc_loop_triangles()
+    tris = np.empty(len(mesh.loop_triangles) * 3, np.int32)
+    mesh.loop_triangles.foreach_get("vertices", tris)
+    return co.reshape(-1, 3), tris.reshape(-1, 3)
+
+
+def _matrix(m):
+    return np.array(m, np.float64)
+
+
+class _Pose:
+    """The pose-only objects of one sample: their rest vertices, and per frame the object and
+    armature matrices and the bones' pose matrices (read by foreach_get)."""
+
+    def __init__(self, objects, frames, groups):
+        self.objects = objects
+        self.armatures = []
+        self.armature_of = {o.name: armature_of(o, viewport=True) for o in objects}
+        for o in objects:
+            a = self.armature_of[o.name]
+            if a is not None and a not in self.armatures:
+                self.armatures.append(a)
+        self.rest = {}
+        self.tris = {}
+        for o in objects:
+            self.rest[o.name], self.tris[o.name] = _rest(o)
+        self.object_world = np.empty((frames, len(objects), 4, 4), np.float64)
+        self.arm_world = np.empty((frames, len(self.armatures), 4, 4), np.float64)
+        self.pose = [np.empty((frames, len(a.pose.bones) * 16), np.float32)
+                     for a in self.armatures]
+        self.groups = groups
+        self.muted = []
+
+    def first_frame(self, dg):
+        """The evaluated meshes' triangles (an n-gon's triangles follow its shape), then the
+        Armature modifiers off."""
+        for o in self.objects:
+            self.tris[o.name] = _evaluated(o, dg)[1]
+        self.mute()
+        dg.update()
+
+    def mute(self):
+        """Turns the Armature modifiers of the pose-only meshes off while sampling: Blender
+        evaluates the pose, not the meshes."""
+        for o in self.objects:
+            for m in o.modifiers:
+                if m.type == "ARMATURE" and m.show_viewport:
+                    m.show_viewport = False
+                    self.muted.append(m)
+
+    def unmute(self):
+        for m in self.muted:
+            m.show_viewport = True
+        self.muted.clear()
+
+    def read(self, k, dg):
+        """The matrices of frame `k` (the depsgraph evaluated at that frame)."""
+        for i, o in enumerate(self.objects):
+            self.object_world[k, i] = _matrix(o.evaluated_get(dg).matrix_world)
+        for i, a in enumerate(self.armatures):
+            ev = a.evaluated_get(dg)
+            self.arm_world[k, i] = _matrix(ev.matrix_world)
+            ev.pose.bones.foreach_get("matrix", self.pose[i][k])
+
+    def skin(self, toonkit):
+        """Every frame's world vertices of the pose-only objects, concatenated in their order:
+        one `toonkit.skin` call, float32 (frames, vertices, 3)."""
+        rests, indices, weights, matrices = [], [], [], []
+        self.ranges, start, slots = {}, 0, 0
+        for i, o in enumerate(self.objects):
+            rest = self.rest[o.name]
+            world = self.object_world[:, i]
+            a = self.armature_of[o.name]
+            if a is None:  # rigid: the object's matrix alone
+                m = world[:, None]
+                idx = np.zeros((len(rest), 1), np.int64)
+                w = np.ones((len(rest), 1), np.float32)
+            else:
+                m, idx, w = self._skinning(o, a, world)
+            rests.append(rest)
+            indices.append(np.where(idx >= 0, idx + slots, -1))
+            weights.append(w)
+            matrices.append(m)
+            slots += m.shape[1]
+            self.ranges[o.name] = range(start, start + len(rest))
+            start += len(rest)
+        width = max(i.shape[1] for i in indices)
+        indices = [np.pad(i, [(0, 0), (0, width - i.shape[1])], constant_values=-1)
+                   for i in indices]
+        weights = [np.pad(w, [(0, 0), (0, width - w.shape[1])]) for w in weights]
+        return toonkit.skin(np.concatenate(rests), np.concatenate(indices),
+                            np.concatenate(weights),
+                            np.concatenate(matrices, axis=1).astype(np.float32))
+
+    def _skinning(self, o, a, world):
+        """Per-frame skinning matrices of `o`'s deforming bones (world space: armature world ·
+        pose · bind⁻¹ · armature world⁻¹ · object world, as the Armature modifier maps object
+        space through the armature's) and the vertices' influences."""
+        k = self.armatures.index(a)
+        bones = a.data.bones
+        pose_names = [pb.name for pb in a.pose.bones]
+        deform = [i for i, n in enumerate(pose_names) if bones[n].use_deform]
+        frames = len(world)
+        # foreach_get gives each 4x4 in Blender's column-major memory order.
+        pose = self.pose[k].reshape(frames, -1, 4, 4).transpose(0, 1, 3, 2)[:, deform]
+        bind_inv = np.linalg.inv(np.stack([_matrix(bones[pose_names[i]].matrix_local)
+                                           for i in deform]))
+        arm = self.arm_world[:, k]
+        to_arm = np.linalg.inv(arm) @ world
+        matrices = arm[:, None] @ pose.astype(np.float64) @ bind_inv[None] @ to_arm[:, None]
+        groups = self.groups[o.name]
+        n = len(self.rest[o.name])
+        dense = np.zeros((n, len(deform)), np.float32)
+        for j, i in enumerate(deform):
+            g = groups.get(pose_names[i])
+            if g is not None:
+                np.maximum(g, 0.0, out=dense[:, j])
+        dense[dense.sum(axis=1) <= ARMATURE_MIN_WEIGHT] = 0.0
+        most = max(1, int((dense > 0).sum(axis=1).max(initial=0)))
+        order = np.argsort(-dense, axis=1, kind="stable")[:, :most]
+        weights = np.take_along_axis(dense, order, axis=1)
+        indices = np.where(weights > 0, order, -1).astype(np.int64)
+        return matrices, indices, weights
+
+
+def sample(context, objects, camera_relative=False, pose_only=True):
+    """Samples `objects` (meshes) over the scene range; restores the current frame.
+    `pose_only=False` evaluates every mesh (the reference the pose-only path is tested
+    against)."""
     scene = context.scene
     meshes = [o for o in objects if o.type == "MESH"]
     if not meshes:
@@ -113,69 +295,148 @@ def sample(context, objects, camera_relative=False):
     start, end = scene.frame_start, scene.frame_end
     if end <= start:
         raise SampleError(f"the scene range {start}-{end} needs at least two frames")
+    armature = _group_armature(meshes)
+    joint_names, parents = _joint_order(armature) if armature else ([], [])
+
+    frames = end - start + 1
+    groups = {o.name: _groups(o, len(o.data.vertices)) for o in meshes}
+    posed = _readers_evaluated(meshes, [o for o in meshes
+                                        if pose_only and pose_only_reason(o) is None])
+    evaluated = [o for o in meshes if o not in posed]
+    pose = _Pose(posed, frames, groups) if posed else None
+    rig = _Rig(armature, joint_names, frames) if armature is not None else None
+    current = scene.frame_current, scene.frame_subframe
+    per_object = {o.name: [] for o in evaluated}
+    tris, cams = {}, []
+    try:
+        for k in range(frames):
+            scene.frame_set(start + k)
+            dg = context.evaluated_depsgraph_get()
+            if k == 0 and pose is not None:
+                pose.first_frame(dg)  # the evaluated triangles, then the meshes off
+            for o in evaluated:
+                p, t = _evaluated(o, dg)
+                if k == 0:
+                    tris[o.name] = t
+                elif len(p) != len(per_object[o.name][0]):
+                    raise SampleError(
+                        f"{o.name}: its vertex count changes at frame {start + k} "
+                        "(a modifier changes topology); apply or disable it")
+                per_object[o.name].append(p)
+            if pose is not None:
+                pose.read(k, dg)
+            if rig is not None:
+                rig.read(k, dg)
+            if camera_relative:
+                cams.append(_matrix(scene.camera.evaluated_get(dg).matrix_world))
+    finally:
+        if pose is not None:
+            pose.unmute()
+        scene.frame_set(current[0], subframe=current[1])
+
+    if pose is not None:
+        tris.update(pose.tris)
+    counts = [len(pose.rest[o.name]) if o in posed else per_object[o.name][0].shape[0]
+              for o in meshes]
+    ranges, offset, all_tris = [], 0, []
+    for o, c in zip(meshes, counts):
+        ranges.append(range(offset, offset + c))
+        all_tris.append(tris[o.name] + offset)
+        offset += c
+    positions = _positions(context, meshes, ranges, frames, pose, per_object)
+    result = Sample(
+        names=[o.name for o in meshes], ranges=ranges, positions=positions,
+        triangles=np.concatenate(all_tris).astype(np.int32), frame_start=start,
+        fps=scene.render.fps / scene.render.fps_base, bones=joint_names)
+    _skin_and_attributes(result, meshes, counts, groups, armature, parents,
+                         rig.matrices() if rig is not None else None)
+    if camera_relative:
+        result.camera = np.stack(cams)
+    return result
+
+
+def _readers_evaluated(meshes, posed):
+    """`posed` without the meshes another sampled mesh's modifier reads (a Shrinkwrap onto
+    the body, say): their Armature modifiers must stay on while sampling."""
+    while True:
+        read = {getattr(m, attr, None) for o in meshes if o not in posed for m in o.modifiers
+                for attr in ("object", "target", "offset_object", "mirror_object")}
+        kept = [o for o in posed if o not in read]
+        if len(kept) == len(posed):
+            return kept
+        posed = kept
+
+
+def _group_armature(meshes):
+    """The armature most of `meshes` are deformed by or parented to (SMEAR's articulated
+    group), if any."""
     rigs = [armature_of(o) or _bone_parent(o)[0] for o in meshes]
     counts = {}
     for r in rigs:
         if r is not None:
             counts[r.name] = counts.get(r.name, 0) + 1
-    armature = None
-    if counts:
-        name = max(counts, key=counts.get)
-        armature = next(r for r in rigs if r is not None and r.name == name)
-    joint_names, parents = _joint_order(armature) if armature else ([], [])
+    if not counts:
+        return None
+    name = max(counts, key=counts.get)
+    return next(r for r in rigs if r is not None and r.name == name)
+
+
+class _Rig:
+    """The joint world matrices of the articulated group's armature per frame (SMEAR Eqs.
+    3-9), read with one foreach_get per frame."""
+
+    def __init__(self, armature, joint_names, frames):
+        self.armature = armature
+        order = {pb.name: i for i, pb in enumerate(armature.pose.bones)}
+        self.order = [order[n] for n in joint_names]
+        self.world = np.empty((frames, 4, 4), np.float64)
+        self.pose = np.empty((frames, len(order) * 16), np.float32)
+
+    def read(self, k, dg):
+        ev = self.armature.evaluated_get(dg)
+        self.world[k] = _matrix(ev.matrix_world)
+        ev.pose.bones.foreach_get("matrix", self.pose[k])
+
+    def matrices(self):
+        frames = len(self.world)
+        pose = self.pose.reshape(frames, -1, 4, 4).transpose(0, 1, 3, 2)[:, self.order]
+        return (self.world[:, None] @ pose.astype(np.float64)).astype(np.float32)
+
+
+def _positions(context, meshes, ranges, frames, pose, per_object):
+    """(frames, vertices, 3) float32 of `meshes` in order: the core's skinned array itself when
+    every mesh is pose-only, else both paths' vertices in their ranges."""
+    import toonkit
+
+    skinned = pose.skin(toonkit) if pose is not None else None
+    if skinned is not None and len(pose.objects) == len(meshes):
+        return skinned
+    positions = np.empty((frames, ranges[-1].stop, 3), np.float32)
+    for o, r in zip(meshes, ranges):
+        if o.name in per_object:
+            for k, p in enumerate(per_object[o.name]):
+                positions[k, r.start:r.stop] = p
+        else:
+            r0 = pose.ranges[o.name]
+            positions[:, r.start:r.stop] = skinned[:, r0.start:r0.stop]
+    return positions
+
+
+def _skin_and_attributes(result, meshes, counts, groups, armature, parents, matrices):
+    """SMEAR's skin (joint weights from the vertex groups named after the group armature's
+    bones, object parents) and the painted vertex groups as attributes."""
+    joint_names = result.bones
     joint_index = {n: i for i, n in enumerate(joint_names)}
-
-    frames = end - start + 1
-    current = scene.frame_current, scene.frame_subframe
-    per_frame, mats, cams, tris = [], [], [], None
-    try:
-        for k in range(frames):
-            scene.frame_set(start + k)
-            dg = context.evaluated_depsgraph_get()
-            ps, ts = [], []
-            for o in meshes:
-                p, t = _evaluated(o, dg)
-                ps.append(p)
-                ts.append(t)
-            if tris is None:
-                tris = ts
-                counts0 = [len(p) for p in ps]
-            elif [len(p) for p in ps] != counts0:
-                changed = next(o.name for o, p, c in zip(meshes, ps, counts0) if len(p) != c)
-                raise SampleError(
-                    f"{changed}: its vertex count changes at frame {start + k} "
-                    "(a modifier changes topology); apply or disable it")
-            per_frame.append(np.concatenate(ps))
-            if armature is not None:
-                ev = armature.evaluated_get(dg)
-                world = np.array(ev.matrix_world, dtype=np.float64)
-                mats.append(np.stack([world @ np.array(ev.pose.bones[n].matrix, np.float64)
-                                      for n in joint_names]))
-            if camera_relative:
-                cams.append(np.array(scene.camera.evaluated_get(dg).matrix_world, np.float64))
-    finally:
-        scene.frame_set(current[0], subframe=current[1])
-
-    ranges, offset, all_tris = [], 0, []
-    for c, t in zip(counts0, tris):
-        ranges.append(range(offset, offset + c))
-        all_tris.append(t + offset)
-        offset += c
-    positions = np.stack(per_frame)
-    result = Sample(
-        names=[o.name for o in meshes], ranges=ranges, positions=positions,
-        triangles=np.concatenate(all_tris).astype(np.int32), frame_start=start,
-        fps=scene.render.fps / scene.render.fps_base, bones=joint_names)
-
+    offset = result.ranges[-1].stop
     weights = np.zeros((offset, len(joint_names)), np.float32)
     object_parents = []
-    for o, r, c in zip(meshes, ranges, counts0):
+    for o, r, c in zip(meshes, result.ranges, counts):
         parent, bone = _bone_parent(o)
         object_parents.append(joint_index.get(bone, -1) if parent == armature else -1)
         if len(o.data.vertices) != c:
             continue  # a topology-changing modifier: no weights, a simple object
         skinned = armature is not None and armature_of(o) == armature
-        for name, values in _groups(o, c).items():
+        for name, values in groups[o.name].items():
             if skinned and name in joint_index:
                 weights[r.start:r.stop, joint_index[name]] = values
             else:
@@ -187,13 +448,10 @@ def sample(context, objects, camera_relative=False):
         result.skin = {
             "parents": np.array(parents, np.int64),
             "joint_names": joint_names,
-            "matrices": np.stack(mats).astype(np.float32),
+            "matrices": matrices,
             "weights": weights,
             "object_parents": object_parents,
         }
-    if camera_relative:
-        result.camera = np.stack(cams)
-    return result
 
 
 def to_camera(sample):

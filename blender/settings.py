@@ -22,7 +22,7 @@ def _restyle(self, context):
 
     if job.is_baked(context.scene):
         # A failing style leaves the last good result on screen; the panel shows the error.
-        self.last_error = job.restyle(context.scene) or ""
+        self.last_error = job.restyle(context.scene, lazy=True) or ""
 
 
 # Presets, defaults, ranges and tooltips come from the smear crate through the bundled module

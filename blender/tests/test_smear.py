@@ -87,6 +87,12 @@ def expected(objs, style=None):
     objs[:] = [bpy.data.objects[n] for n in s.names]  # the bake's object order
     positions = evaluated_with_originals(objs)
     check(positions.shape == s.positions.shape, f"{positions.shape} vs {s.positions.shape}")
+    # Pose-only sampling skins in the core: Blender's vertices within float precision
+    # (docs/blender.md); the smear, whose discrete choices float noise may flip, is then
+    # checked on the bake's own sample.
+    diag = float(np.linalg.norm(np.ptp(positions[0], axis=0)))
+    check(rel(positions, s.positions, diag) <= TOL, "the bake sampled other vertices")
+    positions = s.positions
     scene = toonkit.Scene.from_arrays(positions, s.triangles, fps=s.fps, skin=s.skin,
                                       objects=s.objects, attributes=s.attributes)
     settings = bpy.context.scene.toonkit_smear
@@ -133,7 +139,8 @@ def test_robot_bake_matches_the_module_on_every_frame():
     bpy.ops.toonkit.smear_unbake()
     before = evaluated(meshes)
     check(before.shape == (81, 7214, 3), f"robot Dance: {before.shape}")
-    np.testing.assert_array_equal(positions, before)  # hidden originals evaluate the same
+    diag = float(np.linalg.norm(np.ptp(before[0], axis=0)))
+    check(rel(positions, before, diag) <= TOL, "hidden originals evaluate otherwise")
     select(meshes)
     bake()
     scene.toonkit_smear.live = True

@@ -47,7 +47,7 @@ pub use rng::{mix, SplitMix64};
 pub use sample::{rest_transform, sample, sample_owned, MeshObject, SampleOptions, SampledScene};
 pub use scene::{MorphTarget, Node, Scene, SceneCamera, SceneMesh, SkinDef};
 pub use skeleton::{bones, Bone, Joint, SkeletalAnimation, Skeleton};
-pub use skin::{skin_positions, Skin, VertexWeights};
+pub use skin::{skin_frames, skin_positions, Skin, VertexWeights};
 pub use transform::Transform;
 
 pub use glam;

@@ -1,6 +1,7 @@
 //! Per-vertex joint weights and linear blend skinning.
 
 use glam::{Mat4, Vec3, Vec4};
+use rayon::prelude::*;
 
 use crate::{AnimError, Result};
 
@@ -183,6 +184,62 @@ pub fn skin_positions(weights: &VertexWeights, matrices: &[Mat4], rest: &[Vec3],
     }
 }
 
+/// Linear blend skinning of a whole clip: frame `f` of `out` (frame-major, `rest.len()`
+/// vertices per frame) is [`skin_positions`] with the `slots` matrices of frame `f` in
+/// `matrices` (frame-major too). This is what a host application that evaluates only the pose
+/// (Blender's bone matrices with the mesh's own evaluation off) needs to get the meshes of
+/// every frame.
+///
+/// # Errors
+/// [`AnimError::LengthMismatch`] when `weights`, `matrices` or `out` do not fit `rest` and
+/// `slots`; [`AnimError::Invalid`] when a weight refers to a slot past `slots`.
+///
+/// # Performance
+/// Parallel over frames, allocation-free: each frame writes its own part of `out`.
+pub fn skin_frames(
+    weights: &VertexWeights,
+    slots: usize,
+    matrices: &[Mat4],
+    rest: &[Vec3],
+    out: &mut [Vec3],
+) -> Result<()> {
+    let n = rest.len();
+    let mismatch = |what: &str, expected: usize, found: usize| {
+        Err(AnimError::LengthMismatch {
+            what: what.into(),
+            expected,
+            found,
+        })
+    };
+    if weights.vertex_count() != n {
+        return mismatch("skin weights", n, weights.vertex_count());
+    }
+    if weights.slot_count() > slots {
+        return Err(AnimError::Invalid(format!(
+            "skin weights refer to joint slot {} but there are {slots} matrices per frame",
+            weights.slot_count() - 1
+        )));
+    }
+    let frames = if slots == 0 {
+        0
+    } else {
+        matrices.len() / slots
+    };
+    if frames * slots != matrices.len() {
+        return mismatch("skin matrices", frames * slots, matrices.len());
+    }
+    if out.len() != frames * n {
+        return mismatch("skinned positions", frames * n, out.len());
+    }
+    if n == 0 {
+        return Ok(());
+    }
+    out.par_chunks_mut(n)
+        .zip(matrices.par_chunks(slots.max(1)))
+        .for_each(|(o, m)| skin_positions(weights, m, rest, o));
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -248,5 +305,26 @@ mod tests {
         let mut out = [Vec3::ZERO];
         skin_positions(&w, &m, &[Vec3::ZERO], &mut out);
         assert!(out[0].abs_diff_eq(Vec3::new(0.5, 0.5, 0.0), 1e-6));
+    }
+
+    /// Every frame of `skin_frames` is `skin_positions` with that frame's matrices.
+    #[test]
+    fn skin_frames_is_skin_positions_per_frame() {
+        let w = VertexWeights::from_influences((0..7).map(|v| vec![(0, 1.0 + v as f32), (1, 2.0)]));
+        let rest: Vec<Vec3> = (0..7).map(|v| Vec3::new(v as f32, 1.0, -0.5)).collect();
+        let m: Vec<Mat4> = (0..6)
+            .map(|k| {
+                Mat4::from_rotation_z(0.3 * k as f32) * Mat4::from_translation(Vec3::X * k as f32)
+            })
+            .collect();
+        let mut out = vec![Vec3::ZERO; 3 * 7];
+        skin_frames(&w, 2, &m, &rest, &mut out).unwrap();
+        for f in 0..3 {
+            let mut want = vec![Vec3::ZERO; 7];
+            skin_positions(&w, &m[2 * f..2 * f + 2], &rest, &mut want);
+            assert_eq!(&out[7 * f..7 * f + 7], &want[..]);
+        }
+        assert!(skin_frames(&w, 2, &m, &rest, &mut out[1..]).is_err());
+        assert!(skin_frames(&w, 1, &m, &rest, &mut out).is_err());
     }
 }

@@ -47,6 +47,12 @@ def load(
     clip: Optional[Union[str, int]] = None,
     fps: float = 24.0,
 ) -> Scene: ...
+def skin(
+    rest: npt.ArrayLike,
+    indices: npt.ArrayLike,
+    weights: npt.ArrayLike,
+    matrices: npt.ArrayLike,
+) -> npt.NDArray[np.float32]: ...
 def smear_offsets(
     scene: Scene,
     smooth: int = 2,

@@ -1,0 +1,389 @@
+"""Headless tests of the smear bake on the rigs users have, on real Blender via `bpy`:
+
+    python blender/tests/test_rigs.py dist/toonkit-<version>-<platform>.zip [OUT_DIR]
+
+Both sampling paths (pose only: bone matrices + `toonkit.skin`; evaluated meshes) agree on
+every scene; bone-parented props, several meshes, a scene range past the keys, a 2,000-frame
+clip, shape keys on a rig, an object that does not move, the panel's bake state. With
+TOONKIT_TUBE=tube.glb (written by `write_tube`, as .ci/blender.sh does) it prints the bake
+time, the slider + frame change time and Blender's own floor on the benchmark tube (printed,
+never asserted: docs/blender.md, "Speed").
+"""
+
+import json
+import os
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+os.environ.setdefault("BLENDER_USER_RESOURCES", os.path.join(
+    os.environ.get("TMPDIR", "/tmp"), f"toonkit-blender-user-{os.getpid()}"))
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+from harness import (ASSETS, argv_after_dashes, check, empty_scene, install, rel,  # noqa: E402
+                     run, tmpdir, world_positions)
+
+ARGS = argv_after_dashes()
+ZIP = os.path.abspath(ARGS[0])
+OUT = os.path.abspath(ARGS[1]) if len(ARGS) > 1 else tmpdir()
+os.makedirs(OUT, exist_ok=True)
+toonkit = install(ZIP)
+# Both paths skin in float32 (Blender's Armature modifier, the core), summing in their own
+# orders: a few ulps of the coordinates.
+PATHS_TOL = 1e-5
+REPORT = {"blender": bpy.app.version_string}
+
+
+def ext():
+    from bl_ext.user_default.toonkit import job, sample
+
+    return job, sample
+
+
+def select(objs):
+    for o in bpy.data.objects:
+        o.select_set(False)
+    for o in objs:
+        o.select_set(True)
+    bpy.context.view_layer.objects.active = objs[0]
+
+
+def imported(name, clip=None):
+    """A bundled glTF character, scene range = its armature's clip; returns its meshes."""
+    scene = empty_scene()
+    bpy.ops.import_scene.gltf(filepath=os.path.join(ASSETS, name))
+    arm = next(o for o in bpy.data.objects if o.type == "ARMATURE")
+    if clip is not None:
+        arm.animation_data.action = bpy.data.actions[f"{clip}_{arm.name}"]
+    first, last = arm.animation_data.action.frame_range
+    scene.frame_start, scene.frame_end = int(first), int(last)
+    # The importer's "Icosphere" is the bones' display shape, not the character.
+    return [o for o in bpy.data.objects if o.type == "MESH" and o.name != "Icosphere"]
+
+
+def rig(keyed_end, scene_end, shape_keys=False):
+    """A 3-bone chain skinning a 16-sided cylinder (vertex groups by height), the bones keyed
+    over frames 1..keyed_end, scene range 1..scene_end."""
+    scene = empty_scene()
+    arm_data = bpy.data.armatures.new("chain")
+    arm = bpy.data.objects.new("Chain", arm_data)
+    scene.collection.objects.link(arm)
+    bpy.context.view_layer.objects.active = arm
+    bpy.ops.object.mode_set(mode="EDIT")
+    parent = None
+    for k in range(3):
+        b = arm_data.edit_bones.new(f"b{k}")
+        b.head, b.tail, b.parent = (0, 0, k), (0, 0, k + 1), parent
+        parent = b
+    bpy.ops.object.mode_set(mode="OBJECT")
+    bpy.ops.mesh.primitive_cylinder_add(vertices=16, depth=3.0, location=(0, 0, 1.5))
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.mesh.subdivide(number_cuts=8)  # rings along the height
+    bpy.ops.object.mode_set(mode="OBJECT")
+    body = bpy.context.active_object
+    body.name = "Body"
+    z = np.array([(body.matrix_world @ v.co).z for v in body.data.vertices])
+    for k in range(3):
+        g = body.vertex_groups.new(name=f"b{k}")
+        for i, h in enumerate(z):
+            w = max(0.0, 1.0 - abs(h - (k + 0.5)))
+            if w > 0:
+                g.add([i], w * 0.7, "REPLACE")  # unnormalized, as painted weights often are
+    body.parent = arm
+    body.matrix_parent_inverse = arm.matrix_world.inverted()
+    body.modifiers.new("Armature", "ARMATURE").object = arm
+    if shape_keys:
+        body.shape_key_add(name="Basis")
+        bulge = body.shape_key_add(name="bulge")
+        for v in bulge.data:
+            v.co.x *= 1.5
+        bulge.value = 0.0
+        bulge.keyframe_insert("value", frame=1)
+        bulge.value = 1.0
+        bulge.keyframe_insert("value", frame=max(2, keyed_end // 2))
+    keys = sorted({1, max(2, keyed_end // 3), max(3, 2 * keyed_end // 3), keyed_end})
+    for i, f in enumerate(keys):
+        for k, pb in enumerate(arm.pose.bones):
+            pb.rotation_mode = "XYZ"
+            pb.rotation_euler = (0.4 * (-1) ** i * (k + 1), 0.2 * i, 0.0)
+            pb.keyframe_insert("rotation_euler", frame=f)
+    arm.location = (0.0, 0.0, 0.0)
+    arm.keyframe_insert("location", frame=1)
+    arm.location = (3.0, 0.0, 0.0)
+    arm.keyframe_insert("location", frame=keyed_end)
+    scene.frame_start, scene.frame_end = 1, scene_end
+    return [body]
+
+
+def both_paths(objs):
+    """The pose-only and the evaluated sample of `objs`: same vertices within float
+    tolerance, same skeleton; returns the pose-only sample."""
+    _, sample = ext()
+    a = sample.sample(bpy.context, objs, pose_only=True)
+    b = sample.sample(bpy.context, objs, pose_only=False)
+    check(a.names == b.names and a.ranges == b.ranges, f"{a.names} vs {b.names}")
+    diag = float(np.linalg.norm(np.ptp(b.positions.reshape(-1, 3), axis=0)))
+    worst = rel(a.positions, b.positions, diag)
+    check(worst <= PATHS_TOL, f"the two sampling paths differ by {worst:.2e} of the diagonal")
+    np.testing.assert_array_equal(a.triangles, b.triangles)
+    if b.skin is not None:
+        np.testing.assert_allclose(a.skin["matrices"], b.skin["matrices"], atol=1e-5)
+        np.testing.assert_array_equal(a.skin["weights"], b.skin["weights"])
+    return a, worst
+
+
+def pose_only(objs):
+    _, sample = ext()
+    return [o.name for o in objs if sample.pose_only_reason(o) is None]
+
+
+def bake():
+    r = bpy.ops.toonkit.smear_bake()
+    check(r == {"FINISHED"}, f"smear_bake returned {r}")
+
+
+def body_frames(objs, step=1):
+    """The baked bodies' evaluated world vertices at every `step`-th frame of the range."""
+    scene = bpy.context.scene
+    bodies = [bpy.data.objects[f"{o.name} smear"] for o in objs]
+    return np.stack([np.concatenate([world_positions(b, f) for b in bodies])
+                     for f in range(scene.frame_start, scene.frame_end + 1, step)])
+
+
+def matches_the_module(objs, step=1):
+    """The baked bodies at every `step`-th frame = `toonkit.smear` on the bake's own
+    sample."""
+    job, _ = ext()
+    from bl_ext.user_default.toonkit import style
+
+    s, prepared = job.cached(bpy.context.scene)
+    look = toonkit.smear.stylize(prepared, style.from_settings(bpy.context.scene.toonkit_smear,
+                                                               s.bones))
+    objs[:] = [bpy.data.objects[n] for n in s.names]
+    got = body_frames(objs, step)
+    diag = float(np.linalg.norm(np.ptp(look.elongated[0], axis=0)))
+    check(np.isfinite(got).all(), "NaN in a baked body")
+    worst = rel(got, look.elongated[::step], diag)
+    check(worst <= 1e-5, f"the bodies differ from the module by {worst:.2e}")
+    return s, look
+
+
+def test_both_paths_agree_on_every_scene():
+    worst = {}
+    meshes = imported("RobotExpressive.glb", "Dance")
+    posed = pose_only(meshes)
+    check("HandL_1" in posed and "ArmL" in posed, f"pose-only on the robot: {posed}")
+    check("Head_2" not in posed, "shape keys must take the evaluated path")
+    _, worst["robot"] = both_paths(meshes)
+    meshes = imported("CesiumMan.glb")
+    check(pose_only(meshes) == [o.name for o in meshes], "CesiumMan is not pose-only")
+    _, worst["cesium_man"] = both_paths(meshes)
+    for name, keyed, shape_keys in (("chain", 20, False), ("chain_shape_keys", 20, True)):
+        meshes = rig(keyed, 24, shape_keys)
+        check(bool(pose_only(meshes)) != shape_keys, f"{name}: pose-only {pose_only(meshes)}")
+        _, worst[name] = both_paths(meshes)
+    if os.environ.get("TOONKIT_TUBE"):
+        _, worst["tube"] = both_paths(tube())
+    REPORT["paths_worst_relative"] = worst
+    print("both sampling paths, worst difference / bbox diagonal:", json.dumps(worst))
+
+
+def test_robot_props_parented_to_bones_several_meshes_and_shape_keys():
+    meshes = imported("RobotExpressive.glb", "Dance")
+    select(meshes)
+    bake()
+    s, look = matches_the_module(meshes, step=8)
+    check(len(s.names) == len(meshes) > 10, f"baked {len(s.names)} meshes")
+    # Props ride their bones (SMEAR's articulated group), and they do smear.
+    arm = s.skin["object_parents"]
+    props = [o.name for o in meshes if o.parent_type == "BONE"]
+    check(len(props) >= 8, f"the robot's bone-parented props: {props}")
+    for prop in props:
+        i = s.names.index(prop)
+        check(s.bones[arm[i]] == bpy.data.objects[prop].parent_bone, f"{prop} rides no bone")
+    for prop in ("ArmL", "ArmR", "ShoulderL_1"):  # the arms swing in the Dance
+        r = s.ranges[s.names.index(prop)]
+        check(np.abs(look.elongated[:, r.start:r.stop] - s.positions[:, r.start:r.stop]).max()
+              > 1e-4, f"{prop} does not smear")
+    bpy.ops.toonkit.smear_unbake()
+
+
+def test_scene_range_longer_than_the_keys_and_a_2000_frame_clip():
+    meshes = rig(keyed_end=20, scene_end=40)
+    select(meshes)
+    bake()
+    s, look = matches_the_module(meshes)
+    check(len(s.positions) == 40, f"{len(s.positions)} frames baked, 40 in the scene range")
+    # After the keys the rig holds its pose: the body shows it, no frozen smear.
+    got = body_frames(meshes)
+    np.testing.assert_allclose(got[25:], s.positions[25:], atol=1e-5)
+    check(np.abs(got[3:15] - s.positions[3:15]).max() > 1e-3, "no smear while moving")
+
+    meshes = rig(keyed_end=2000, scene_end=2000)
+    select(meshes)
+    t = time.perf_counter()
+    bake()
+    REPORT["bake_2000_frames_s"] = round(time.perf_counter() - t, 2)
+    job, _ = ext()
+    s, prepared = job.cached(bpy.context.scene)
+    check(s.positions.shape[0] == 2000, f"{s.positions.shape}")
+    check(np.isfinite(np.asarray(prepared.offsets)).all(), "NaN in the offsets")
+    body = bpy.data.objects["Body smear"].data
+    for f in (1, 700, 1500, 2000):
+        a = body.attributes[f"tk_P{f}"]
+        v = np.empty(len(a.data) * 3, np.float32)
+        a.data.foreach_get("vector", v)
+        check(np.isfinite(v).all(), f"NaN in frame {f}'s positions")
+    for f in (1, 999, 2000):
+        check(np.isfinite(world_positions(bpy.data.objects["Body smear"], f)).all(),
+              f"NaN shown at frame {f}")
+
+
+def test_object_without_animation_says_so():
+    scene = empty_scene()
+    bpy.ops.mesh.primitive_cube_add()
+    cube = bpy.context.active_object
+    scene.frame_start, scene.frame_end = 1, 20
+    select([cube])
+    try:
+        bpy.ops.toonkit.smear_bake()
+    except RuntimeError as e:
+        msg = str(e)
+        check("does not move" in msg and "Traceback" not in msg, f"message {msg!r}")
+    else:
+        raise AssertionError("a still object baked without a word")
+    check(not [o for o in bpy.data.objects if "toonkit_role" in o], "the scene changed")
+
+
+def test_panel_says_what_to_select_and_why_bake_is_disabled():
+    job, _ = ext()
+    scene = empty_scene()
+    scene.frame_start, scene.frame_end = 1, 20
+    why = job.bake_blocker(bpy.context)
+    check(why and "select" in why.lower(), f"nothing selected: {why!r}")
+    check(not bpy.ops.toonkit.smear_bake.poll(), "bake enabled with nothing selected")
+    cam = bpy.data.objects.new("cam", bpy.data.cameras.new("cam"))
+    scene.collection.objects.link(cam)
+    select([cam])
+    why = job.bake_blocker(bpy.context)
+    check(why and "mesh" in why, f"a camera selected: {why!r}")
+    meshes = rig(10, 10)
+    select(meshes)
+    check(job.bake_blocker(bpy.context) is None, job.bake_blocker(bpy.context) or "")
+    check(bpy.ops.toonkit.smear_bake.poll(), "bake disabled with a rigged mesh selected")
+    scene = bpy.context.scene
+    scene.frame_end = scene.frame_start
+    why = job.bake_blocker(bpy.context)
+    check(why and "two frames" in why, f"a one-frame range: {why!r}")
+    # The panel draws its status line and how-to (no error while drawing headless).
+    from bl_ext.user_default.toonkit import panel
+
+    check(any("Select" in line for line in panel.HOW_TO), "the how-to does not say what to select")
+
+
+def attr_frame(mesh, f):
+    a = mesh.attributes[f"tk_P{f}"]
+    v = np.empty(len(a.data) * 3, np.float32)
+    a.data.foreach_get("vector", v)
+    return v.reshape(-1, 3)
+
+
+def test_live_restyle_writes_each_frame_when_the_scene_reaches_it():
+    meshes = rig(keyed_end=20, scene_end=24)
+    scene = bpy.context.scene
+    select(meshes)
+    bake()
+    mesh = bpy.data.objects["Body smear"].data
+    before = {f: attr_frame(mesh, f) for f in (5, 12)}
+    scene.frame_set(5)
+    scene.toonkit_smear.beta_max = 6.0  # a live slider change
+    check(np.abs(attr_frame(mesh, 5) - before[5]).max() > 1e-4, "the current frame kept")
+    np.testing.assert_array_equal(attr_frame(mesh, 12), before[12])  # not touched yet
+    scene.frame_set(12)
+    check(np.abs(attr_frame(mesh, 12) - before[12]).max() > 1e-4, "frame 12 not written")
+    # Saving writes every pending frame: the file holds the whole restyle.
+    scene.toonkit_smear.beta_max = 1.0
+    bpy.ops.wm.save_as_mainfile(filepath=os.path.join(OUT, "pending.blend"))
+    job, _ = ext()
+    from bl_ext.user_default.toonkit import style
+
+    s, prepared = job.cached(scene)
+    want = toonkit.smear.stylize(prepared, style.from_settings(scene.toonkit_smear)).elongated
+    got = np.stack([attr_frame(mesh, f) for f in range(1, 25)])
+    np.testing.assert_allclose(got, want, atol=1e-6)
+
+
+def tube():
+    """The benchmark tube (docs/blender.md, "Speed"), imported; its one mesh."""
+    scene = empty_scene()
+    bpy.ops.import_scene.gltf(filepath=os.environ["TOONKIT_TUBE"])
+    arm = next(o for o in bpy.data.objects if o.type == "ARMATURE")
+    first, last = arm.animation_data.action.frame_range
+    scene.frame_start, scene.frame_end = int(first), int(last)
+    return [o for o in bpy.data.objects if o.type == "MESH" and o.name != "Icosphere"]
+
+
+def test_tube_speed():
+    """Prints (never asserts) the bake, the slider + frame change and Blender's floor."""
+    if not os.environ.get("TOONKIT_TUBE"):
+        print("speed: TOONKIT_TUBE not set, skipped")
+        return
+    meshes = tube()
+    scene = bpy.context.scene
+    arm = next(o for o in bpy.data.objects if o.type == "ARMATURE")
+    # Blender's floor: the frame_set loop over the pose alone (the mesh's modifiers off).
+    mods = [m for o in meshes for m in o.modifiers if m.type == "ARMATURE"]
+    for m in mods:
+        m.show_viewport = False
+    floor = []
+    for _ in range(3):
+        t = time.perf_counter()
+        for f in range(scene.frame_start, scene.frame_end + 1):
+            scene.frame_set(f)
+            arm.evaluated_get(bpy.context.evaluated_depsgraph_get())
+        floor.append(time.perf_counter() - t)
+    for m in mods:
+        m.show_viewport = True
+    scene.frame_set(scene.frame_start)
+    select(meshes)
+    bakes = []
+    for _ in range(3):
+        bpy.ops.toonkit.smear_unbake()  # a bake hides its original
+        select(meshes)
+        t = time.perf_counter()
+        bake()
+        bakes.append(time.perf_counter() - t)
+    s = scene.toonkit_smear
+    slider = []
+    for i in range(20):
+        t = time.perf_counter()
+        s.beta_max = 2.0 + 0.1 * i  # the live update restyles
+        scene.frame_set(scene.frame_start + 5 + i % 20)
+        slider.append(time.perf_counter() - t)
+    figures = {"vertices": sum(len(o.data.vertices) for o in meshes),
+               "frames": scene.frame_end - scene.frame_start + 1,
+               "bake_ms": round(1000 * min(bakes), 1),
+               "slider_and_frame_change_median_ms": round(1000 * float(np.median(slider)), 2),
+               "floor_pose_frame_set_ms": round(1000 * min(floor), 1),
+               "load_average": os.getloadavg()[0]}
+    REPORT["tube"] = figures
+    print("speed on the tube:", json.dumps(figures), flush=True)
+
+
+if __name__ == "__main__":
+    code = run([
+        test_panel_says_what_to_select_and_why_bake_is_disabled,
+        test_object_without_animation_says_so,
+        test_both_paths_agree_on_every_scene,
+        test_robot_props_parented_to_bones_several_meshes_and_shape_keys,
+        test_scene_range_longer_than_the_keys_and_a_2000_frame_clip,
+        test_live_restyle_writes_each_frame_when_the_scene_reaches_it,
+        test_tube_speed,
+    ])
+    with open(os.path.join(OUT, "report.json"), "w") as f:
+        json.dump(REPORT, f, indent=1)
+    print("blender report:", json.dumps(REPORT), flush=True)
+    os._exit(code)  # bpy's interpreter teardown can crash after a headless run

@@ -1,0 +1,78 @@
+//! `toonkit.skin`: linear blend skinning of a whole clip from a host application's pose (its
+//! bone matrices per frame), through `anim::skin_frames`.
+
+use anim::glam::{Mat4, Vec3};
+use anim::VertexWeights;
+use numpy::PyArrayDyn;
+use pyo3::prelude::*;
+
+use crate::arrays::{output, shape, values, ArrayIn};
+use crate::errors::{anim_error, value_error};
+
+/// Skins ``rest`` (float32 ``(vertices, 3)``) with ``matrices`` (float32 ``(frames, bones, 4,
+/// 4)``, row-major, translation in column 3: each bone's skinning matrix, rest space to the
+/// frame's space) and per-vertex influences ``indices`` (int ``(vertices, k)``, a bone index
+/// or -1 for none) with ``weights`` (float32 ``(vertices, k)``). Weights are normalized to
+/// sum 1 per vertex (non-positive ones dropped); a vertex without influence keeps its rest
+/// position. Returns float32 ``(frames, vertices, 3)``, frame-major, ready for
+/// ``Scene.from_arrays``. The GIL is released while skinning (parallel over frames).
+///
+/// >>> p = toonkit.skin(rest, indices, weights, matrices)
+/// >>> p.shape == (len(matrices), len(rest), 3)
+/// True
+#[pyfunction]
+#[pyo3(signature = (rest, indices, weights, matrices))]
+pub(crate) fn skin<'py>(
+    py: Python<'py>,
+    rest: ArrayIn<'py, f32>,
+    indices: ArrayIn<'py, i64>,
+    weights: ArrayIn<'py, f32>,
+    matrices: ArrayIn<'py, f32>,
+) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
+    let n = shape(&rest, "rest", &[None, Some(3)])?[0];
+    let k = shape(&indices, "indices", &[Some(n), None])?[1];
+    shape(&weights, "weights", &[Some(n), Some(k)])?;
+    let m = shape(&matrices, "matrices", &[None, None, Some(4), Some(4)])?;
+    let (frames, bones) = (m[0], m[1]);
+    let (idx, w) = (values(&indices), values(&weights));
+    if let Some((i, &b)) = idx
+        .iter()
+        .enumerate()
+        .find(|(_, &b)| b < -1 || b >= bones as i64)
+    {
+        return Err(value_error(format!(
+            "indices[{}, {}] = {b}: a bone index must be -1 or below {bones}",
+            i / k.max(1),
+            i % k.max(1)
+        )));
+    }
+    let influences =
+        VertexWeights::from_influences(idx.chunks(k.max(1)).zip(w.chunks(k.max(1))).take(n).map(
+            |(i, w)| {
+                i.iter()
+                    .zip(w)
+                    .filter(|(b, _)| **b >= 0)
+                    .map(|(b, x)| (*b as u32, *x))
+            },
+        ));
+    let skinning: Vec<Mat4> = values(&matrices)
+        .chunks_exact(16)
+        .map(|m| Mat4::from_cols_slice(m).transpose())
+        .collect();
+    let rest: Vec<Vec3> = values(&rest)
+        .chunks_exact(3)
+        .map(Vec3::from_slice)
+        .collect();
+    let mut data = vec![0.0f32; frames * n * 3];
+    py.detach(|| {
+        anim::skin_frames(
+            &influences,
+            bones,
+            &skinning,
+            &rest,
+            bytemuck::cast_slice_mut(&mut data),
+        )
+    })
+    .map_err(|e| anim_error("<arrays>", e))?;
+    output(py, &[frames, n, 3], data)
+}

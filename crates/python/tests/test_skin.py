@@ -1,0 +1,49 @@
+"""`toonkit.skin`: linear blend skinning of a whole clip from per-frame bone matrices (the
+Blender extension's pose-only sampling, docs/blender.md)."""
+
+import numpy as np
+import pytest
+
+import toonkit
+
+
+def rotation_z(a, t):
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, -s, 0, t[0]], [s, c, 0, t[1]], [0, 0, 1, t[2]], [0, 0, 0, 1]])
+
+
+def test_skin_is_the_normalized_weighted_blend_per_frame():
+    rng = np.random.default_rng(7)
+    rest = rng.normal(size=(50, 3)).astype(np.float32)
+    indices = rng.integers(0, 4, size=(50, 3))
+    indices[::5, 2] = -1  # padding: no influence
+    weights = rng.uniform(0.1, 2.0, size=(50, 3)).astype(np.float32)  # unnormalized
+    mats = np.stack([[rotation_z(0.3 * f + b, (f, b, 0.5)) for b in range(4)]
+                     for f in range(6)]).astype(np.float32)
+    got = toonkit.skin(rest, indices, weights, mats)
+    assert got.shape == (6, 50, 3) and got.dtype == np.float32
+    w = np.where(indices >= 0, weights, 0.0).astype(np.float64)
+    w /= w.sum(axis=1, keepdims=True)
+    home = np.concatenate([rest, np.ones((50, 1), np.float32)], axis=1).astype(np.float64)
+    moved = np.einsum("fbij,vj->fvbi", mats.astype(np.float64), home)[..., :3]
+    want = np.einsum("fvki,vk->fvi", moved[:, np.arange(50)[:, None], np.maximum(indices, 0)], w)
+    np.testing.assert_allclose(got, want, atol=1e-5)
+
+
+def test_a_vertex_without_weights_stays_at_rest():
+    rest = np.array([[1.0, 2.0, 3.0], [0.0, 0.0, 0.0]], np.float32)
+    mats = np.tile(rotation_z(1.0, (5, 0, 0)), (3, 1, 1, 1)).astype(np.float32)
+    got = toonkit.skin(rest, [[-1], [0]], [[1.0], [0.0]], mats)
+    np.testing.assert_array_equal(got[:, 0], np.repeat(rest[:1], 3, axis=0))
+    np.testing.assert_array_equal(got[:, 1], np.repeat(rest[1:], 3, axis=0))
+
+
+def test_bad_inputs_are_one_line_value_errors():
+    rest = np.zeros((2, 3), np.float32)
+    mats = np.tile(np.eye(4, dtype=np.float32), (2, 2, 1, 1))
+    with pytest.raises(ValueError, match=r"indices\[1, 0\] = 2"):
+        toonkit.skin(rest, [[0], [2]], [[1.0], [1.0]], mats)
+    with pytest.raises(ValueError, match="weights must have shape"):
+        toonkit.skin(rest, [[0], [1]], [[1.0, 2.0], [1.0, 1.0]], mats)
+    with pytest.raises(ValueError, match="matrices must have shape"):
+        toonkit.skin(rest, [[0], [1]], [[1.0], [1.0]], mats[..., :3])
