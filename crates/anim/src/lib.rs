@@ -22,6 +22,7 @@
 
 mod camera;
 mod clip;
+mod curves;
 mod error;
 mod flipbook;
 mod human;
@@ -36,6 +37,7 @@ mod transform;
 
 pub use camera::{Camera, Projection};
 pub use clip::{frame_count, Channel, Clip, Interpolation, Property, MAX_FRAMES};
+pub use curves::Curves;
 pub use error::{AnimError, Result};
 pub use flipbook::{Flipbook, FlipbookPart};
 pub use human::human_number;

@@ -1,6 +1,6 @@
 //! Motion lines (Section 4.3, SMEAR Eq. 13): tubes traced along the trajectories of surface seeds.
 
-use anim::Mesh;
+use anim::{Curves, Mesh};
 use rayon::prelude::*;
 
 use super::inputs::{check_frame, check_step, held_frame};
@@ -82,6 +82,9 @@ pub struct LineFrame {
     pub mesh: Mesh,
     /// Number of lines drawn.
     pub lines: usize,
+    /// The same lines as curves: each tube's centre line, its diameter and colour per ring
+    /// (for scene files that draw curves, USD's `BasisCurves`).
+    pub curves: Curves,
     rings: Vec<Ring>,
 }
 
@@ -90,6 +93,7 @@ impl Default for LineFrame {
         LineFrame {
             mesh: Mesh::new("motion_lines", Vec::new(), Vec::new()),
             lines: 0,
+            curves: Curves::default(),
             rings: Vec::new(),
         }
     }
@@ -159,6 +163,7 @@ fn trace(
         c.clear();
     }
     out.lines = 0;
+    out.curves.clear();
     let tr = seeds.trajectories();
     let scale = options.step as f32;
     let [r, g, b] = options
@@ -219,6 +224,10 @@ fn trace(
         }
         if sweep(&out.rings, options.sides, &mut out.mesh) {
             out.lines += 1;
+            let rings = out.rings.iter();
+            let width = |r: f32| if r.is_finite() { 2.0 * r.max(0.0) } else { 0.0 };
+            out.curves
+                .push(rings.map(|r| (r.center, width(r.radius), r.color)));
         }
     }
 }
