@@ -6,7 +6,9 @@
 # 2. the same manifest as an Open Job Description template: `openjd check`, `openjd run` of
 #    every step, and the files equal those of `toonkit batch` byte for byte;
 # 3. Blender 4.2 (bpy, headless) imports every .abc and .usdc of the batch: one object, the
-#    frame range, vertex positions = the shot's .pc2 at 3 frames (.ci/blender_caches.py);
+#    frame range, vertex positions = the shot's .pc2 at 3 frames, velocities of the moving
+#    .usdc = the motion; motion lines (.usda BasisCurves) import as curves
+#    (.ci/blender_caches.py);
 # 4. Pixar's usd-core opens every .usdc/.usdz of the batch and its compliance checks pass
 #    (.ci/validate_usd.py; .ci/run checks those the Rust tests left in $TOONKIT_VALIDATE_DIR).
 # Python tools live in a venv under target/ (bpy 4.2 wants CPython 3.11).
@@ -71,6 +73,11 @@ done
 diff "$WORK/batch.files" "$WORK/openjd.files"
 while read -r f; do cmp "$WORK/batch/$f" "$WORK/openjd/$f"; done < "$WORK/batch.files"
 echo "openjd run: the same $(wc -l < "$WORK/batch.files") files as toonkit batch"
+
+# Motion lines as USD BasisCurves, for the Blender import check (curves) and Pixar's checks.
+mkdir -p "$WORK/batch/lines"
+"$TK" smear lines "$ASSETS/RobotExpressive.glb" --clip Punch --fps 12 --count 0:0,4:40 \
+    --length-max 4 -o "$WORK/batch/lines/robot_lines.usda"
 
 echo "== Blender 4.2 imports"
 "$VENV/bin/python" .ci/blender_caches.py "$WORK/batch"

@@ -16,7 +16,9 @@ Per layer:
    max(faceVertexIndices) + 1 <= len(points), sum(faceVertexCounts) == len(faceVertexIndices),
    every face count >= 3, UsdGeom.Mesh.ValidateTopology, finite points, an extent of two
    corners that contains every point, and vertex-interpolated primvars with one value per
-   point.
+   point; `velocities` one per point and equal to the points' central difference per second.
+   Every UsdGeom.BasisCurves likewise: linear, sum(curveVertexCounts) == len(points), every
+   curve >= 2 points, widths and vertex primvars one per point, finite points in the extent.
 Tested with usd-core 24.11 (ComplianceChecker) and 26.11 (UsdValidation).
 Prints one line per failure, then "USD validation: N passed, M failed"; exits 1 on any failure
 (and 1 when DIR holds no USD file at all, so a broken test setup cannot pass silently).
@@ -80,6 +82,33 @@ def time_codes(mesh):
     return sorted(times) if times else [Usd.TimeCode.Default()]
 
 
+def check_points(geom, primvars, tc, at, points):
+    """Failures of a point-based prim at one time code: finite points inside an extent of two
+    corners, vertex-interpolated primvars with one value per point."""
+    out = []
+    text = str(points).lower()  # formatted in C++: fast even for large arrays
+    if "nan" in text or "inf" in text:
+        out.append(f"{at}: non-finite point")
+    extent = geom.GetExtentAttr().Get(tc)
+    if extent is None or len(extent) != 2:
+        out.append(f"{at}: extent missing or not two corners")
+    elif len(points):
+        lo, hi = extent
+        # The points' own bounding box (computed by USD), then containment per axis.
+        plo, phi = UsdGeom.PointBased.ComputeExtent(points)
+        if any(plo[k] < lo[k] or phi[k] > hi[k] for k in range(3)):
+            out.append(f"{at}: points span {tuple(plo)}..{tuple(phi)}, outside extent "
+                       f"{tuple(lo)}..{tuple(hi)}")
+    for pv in primvars:
+        if pv.GetInterpolation() != UsdGeom.Tokens.vertex or not pv.HasValue():
+            continue
+        value = pv.Get(tc)
+        if value is not None and len(value) != len(points):
+            out.append(f"{at}: primvar {pv.GetPrimvarName()} has {len(value)} values for "
+                       f"{len(points)} points")
+    return out
+
+
 def check_mesh(mesh):
     """Failures (strings) of one mesh over all its time codes."""
     out = []
@@ -103,28 +132,63 @@ def check_mesh(mesh):
         ok, why = UsdGeom.Mesh.ValidateTopology(indices, counts, len(points))
         if not ok:
             out.append(f"{at}: ValidateTopology: {why}")
-        text = str(points).lower()  # formatted in C++: fast even for large arrays
-        if "nan" in text or "inf" in text:
-            out.append(f"{at}: non-finite point")
-        extent = mesh.GetExtentAttr().Get(tc)
-        if extent is None or len(extent) != 2:
-            out.append(f"{at}: extent missing or not two corners")
-        elif len(points):
-            lo, hi = extent
-            # The points' own bounding box (computed by USD), then containment per axis.
-            plo, phi = UsdGeom.PointBased.ComputeExtent(points)
-            if any(plo[k] < lo[k] or phi[k] > hi[k] for k in range(3)):
-                out.append(f"{at}: points span {tuple(plo)}..{tuple(phi)}, outside extent "
-                           f"{tuple(lo)}..{tuple(hi)}")
-        for pv in primvars:
-            if pv.GetInterpolation() != UsdGeom.Tokens.vertex or not pv.HasValue():
-                continue
-            value = pv.Get(tc)
-            if value is not None and len(value) != len(points):
-                out.append(f"{at}: primvar {pv.GetPrimvarName()} has {len(value)} values for "
-                           f"{len(points)} points")
+        out += check_points(mesh, primvars, tc, at, points)
+    out += check_velocities(mesh, where)
     if mesh.GetSubdivisionSchemeAttr().Get() != UsdGeom.Tokens.none:
         out.append(f"{where}: subdivisionScheme is not \"none\"")
+    return out
+
+
+def check_velocities(geom, where):
+    """Failures of `velocities`: one vector per point at every time code that has points, and
+    consistent with the motion (v ≈ (p(t+1) − p(t−1)) / 2 × timeCodesPerSecond inside)."""
+    out = []
+    attr = geom.GetVelocitiesAttr()
+    if not attr.HasAuthoredValue():
+        return out
+    stage = geom.GetPrim().GetStage()
+    fps = stage.GetTimeCodesPerSecond()
+    times = attr.GetTimeSamples()
+    for t in times:
+        points = geom.GetPointsAttr().Get(t) or []
+        v = attr.Get(t) or []
+        if len(v) != len(points):
+            out.append(f"{where} @ {t}: {len(v)} velocities for {len(points)} points")
+    for t in times[1:-1]:
+        before, after = geom.GetPointsAttr().Get(t - 1), geom.GetPointsAttr().Get(t + 1)
+        v = attr.Get(t)
+        if before is None or after is None or len(before) != len(v) or len(after) != len(v):
+            continue
+        for i in range(0, len(v), max(1, len(v) // 64)):
+            want = (after[i] - before[i]) * (fps / 2.0)
+            if (v[i] - want).GetLength() > 1e-3 * (1.0 + want.GetLength()):
+                out.append(f"{where} @ {t}: velocity {tuple(v[i])} of point {i} is not the "
+                           f"motion's {tuple(want)}")
+                break
+    return out
+
+
+def check_curves(curves):
+    """Failures of one BasisCurves prim over all its time codes: counts, widths and vertex
+    primvars per point, finite points inside the extent."""
+    out = []
+    where = str(curves.GetPath())
+    primvars = UsdGeom.PrimvarsAPI(curves).GetPrimvars()
+    for t in time_codes(curves):
+        tc = Usd.TimeCode(t) if not isinstance(t, Usd.TimeCode) else t
+        at = f"{where} @ {'default' if tc.IsDefault() else t}"
+        points = curves.GetPointsAttr().Get(tc) or []
+        counts = curves.GetCurveVertexCountsAttr().Get(tc) or []
+        if sum(counts) != len(points):
+            out.append(f"{at}: sum(curveVertexCounts) = {sum(counts)} != {len(points)} points")
+        if any(c < 2 for c in counts):
+            out.append(f"{at}: a linear curve has fewer than 2 points")
+        widths = curves.GetWidthsAttr().Get(tc)
+        if widths is None or len(widths) != len(points):
+            out.append(f"{at}: widths missing or not one per point")
+        out += check_points(curves, primvars, tc, at, points)
+    if curves.GetTypeAttr().Get() != UsdGeom.Tokens.linear:
+        out.append(f"{where}: curves are not linear")
     return out
 
 
@@ -155,6 +219,9 @@ def validate(path):
         failures.append("no Mesh prim")
     for mesh in meshes:
         failures += check_mesh(mesh)
+    for prim in stage.Traverse():
+        if prim.IsA(UsdGeom.BasisCurves):
+            failures += check_curves(UsdGeom.BasisCurves(prim))
     return failures
 
 

@@ -2,7 +2,7 @@
 //! per frame (e.g. motion lines) — what stylization results are, and what `tkio::save`
 //! writes and `render` previews.
 
-use crate::{Mesh, MeshAnimation};
+use crate::{Curves, Mesh, MeshAnimation};
 
 /// One part of a [`Flipbook`].
 // A flipbook has a handful of parts: the size of the inline point cache does not matter.
@@ -24,6 +24,9 @@ pub enum FlipbookPart {
         name: String,
         /// One mesh per frame.
         meshes: Vec<Mesh>,
+        /// The same frames as curves when the meshes are tubes swept along them (motion
+        /// lines): scene files that hold curves write these instead of the tubes.
+        curves: Option<Vec<Curves>>,
     },
 }
 

@@ -23,6 +23,7 @@
 pub mod budget;
 mod camera;
 mod clip;
+mod curves;
 mod error;
 mod flipbook;
 mod human;
@@ -38,6 +39,7 @@ mod transform;
 pub use budget::{check_budget, OverBudget};
 pub use camera::{Camera, Projection};
 pub use clip::{frame_count, Channel, Clip, Interpolation, Property, MAX_FRAMES};
+pub use curves::Curves;
 pub use error::{AnimError, Result};
 pub use flipbook::{Flipbook, FlipbookPart};
 pub use human::human_number;

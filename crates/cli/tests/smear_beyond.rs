@@ -236,3 +236,128 @@ fn elongate_stays_out_of_a_collider_file() {
     let msg = String::from_utf8_lossy(&bad.stderr);
     assert!(msg.contains("'Ramp'") && msg.contains("drop"), "{msg}");
 }
+
+/// Vertex count of every mesh of a `.glb`, in file order (a flipbook: one per frame).
+fn glb_mesh_vertices(path: &Path) -> Vec<usize> {
+    let v = json(&["info", s(path)]);
+    v["meshes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["vertices"].as_u64().unwrap() as usize)
+        .collect()
+}
+
+/// The `v` lines of every file of an OBJ sequence.
+fn obj_vertices(files: &serde_json::Value) -> Vec<usize> {
+    let files = files.as_array().unwrap();
+    files
+        .iter()
+        .map(|f| {
+            let text = std::fs::read_to_string(f.as_str().unwrap()).unwrap();
+            text.lines().filter(|l| l.starts_with("v ")).count()
+        })
+        .collect()
+}
+
+#[test]
+fn subdivided_smear_and_converted_flipbook_as_obj_sequences_keep_each_frames_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = write_drop(dir.path());
+    let args = |out: &Path| {
+        let args = [
+            "smear",
+            "elongate",
+            s(&input),
+            "--beta-max",
+            "4",
+            "--subdivide",
+            "2",
+        ];
+        let mut v: Vec<String> = args.iter().map(|a| a.to_string()).collect();
+        v.extend(["-o".into(), s(out).to_string()]);
+        v
+    };
+    let glb = dir.path().join("drop_smear.glb");
+    let a = args(&glb);
+    json(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let per_frame = glb_mesh_vertices(&glb);
+    assert_eq!(per_frame.len(), 16, "one mesh per frame");
+    assert!(
+        per_frame.iter().any(|&n| n != per_frame[0]),
+        "the subdivision changes the mesh from frame to frame: {per_frame:?}"
+    );
+
+    // The smear itself as an OBJ sequence: file f holds frame f's own mesh.
+    let obj = dir.path().join("seq").join("drop.obj");
+    std::fs::create_dir_all(obj.parent().unwrap()).unwrap();
+    let mut a = args(&obj);
+    a.extend(["--layout".into(), "sequence".into()]);
+    let v = json(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(obj_vertices(&v["files"]), per_frame, "{v}");
+    assert!(v["files"][0].as_str().unwrap().ends_with("drop_0001.obj"));
+    let v0 = v["subdivision_max_vertices"].as_u64().unwrap() as usize;
+    assert_eq!(v0, *per_frame.iter().max().unwrap());
+
+    // Without --layout sequence an .obj cannot hold 16 frames: a one-line refusal.
+    let bad = toonkit(
+        &a[..a.len() - 2]
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>(),
+    );
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--layout sequence"));
+
+    // The flipbook converted: each file the frame's visible mesh only (the hidden frames'
+    // nodes, scaled to zero, are left out).
+    let conv = dir.path().join("conv").join("flip.obj");
+    std::fs::create_dir_all(conv.parent().unwrap()).unwrap();
+    let v = json(&["convert", s(&glb), s(&conv), "--layout", "sequence"]);
+    assert_eq!(obj_vertices(&v["outputs"]), per_frame, "{v}");
+
+    // Multiples and motion lines as OBJ sequences: each file one `o` object per part shown.
+    let lines = dir.path().join("lines").join("drop.obj");
+    std::fs::create_dir_all(lines.parent().unwrap()).unwrap();
+    let v = json(&[
+        "smear",
+        "lines",
+        s(&input),
+        "--count",
+        "20",
+        "--length-max",
+        "3",
+        "--layout",
+        "sequence",
+        "-o",
+        s(&lines),
+    ]);
+    let drawn = v["lines_per_frame"].as_array().unwrap();
+    let files = v["files"].as_array().unwrap();
+    assert_eq!(files.len(), 16);
+    for (f, (file, n)) in files.iter().zip(drawn).enumerate() {
+        let text = std::fs::read_to_string(file.as_str().unwrap()).unwrap();
+        let objects = text.lines().filter(|l| l.starts_with("o ")).count();
+        let with_lines = n.as_u64().unwrap() > 0;
+        assert_eq!(objects, 1 + with_lines as usize, "frame {f}");
+        assert_eq!(text.contains("o motion_lines"), with_lines, "frame {f}");
+        // Reads back as one valid mesh (face indices of the second object run on).
+        tkio::obj::read(text.as_bytes()).unwrap();
+    }
+    let copies = dir.path().join("copies").join("drop.obj");
+    std::fs::create_dir_all(copies.parent().unwrap()).unwrap();
+    let v = json(&[
+        "smear",
+        "multiples",
+        s(&input),
+        "--past",
+        "2",
+        "--future",
+        "0",
+        "--layout",
+        "sequence",
+        "-o",
+        s(&copies),
+    ]);
+    assert_eq!(v["files"].as_array().unwrap().len(), 16, "{v}");
+}

@@ -124,6 +124,19 @@ fn smear_elongate_robot_punch_usda_matches_pc2() {
     );
     assert_eq!(max_difference(&text, &smeared), 0.0);
     assert!(v["max_displacement"].as_f64().unwrap() > 0.0);
+    // Velocities for motion blur: the smeared points' central difference per second.
+    let velocities = samples(&text, "vector3f[] velocities");
+    assert_eq!(velocities.len(), smeared.frame_count());
+    let f = smeared.frame_count() / 2;
+    let (before, after) = (smeared.frame(f - 1), smeared.frame(f + 1));
+    for (k, v) in vec3s(velocities[f]).iter().enumerate() {
+        let want = (after[k] - before[k]) * (24.0 / 2.0);
+        let got = anim::glam::Vec3::from_array(*v);
+        assert!(
+            got.distance(want) <= 1e-3 * (1.0 + want.length()),
+            "vertex {k}: {got} vs {want}"
+        );
+    }
     keep_for_validation(dir.path(), "usd_elongate");
 }
 
@@ -181,8 +194,12 @@ fn smear_lines_usda_changes_topology_per_frame() {
         "4",
     ]);
     let text = std::fs::read_to_string(&out).unwrap();
-    assert_eq!(mesh_names(&text), ["RobotExpressive", "motion_lines"]);
-    let lines = prim(&text, "motion_lines");
+    // The body is a Mesh, the lines are curves renderers draw as such.
+    assert_eq!(mesh_names(&text), ["RobotExpressive"]);
+    let start = text
+        .find("def BasisCurves \"motion_lines\"")
+        .expect("a BasisCurves prim");
+    let lines = &text[start..];
     let per_frame: Vec<u64> = v["lines_per_frame"]
         .as_array()
         .unwrap()
@@ -192,13 +209,31 @@ fn smear_lines_usda_changes_topology_per_frame() {
     // No line on frame 0 (count keyed to 0), lines later.
     assert_eq!(per_frame[0], 0);
     assert!(per_frame.iter().any(|&n| n > 0), "{per_frame:?}");
-    let counts = samples(lines, "int[] faceVertexCounts");
+    let counts = samples(lines, "int[] curveVertexCounts");
     assert_eq!(counts.len(), per_frame.len());
     let vis = samples(lines, "token visibility");
+    let widths = samples(lines, "float[] widths");
+    let opacity = samples(lines, "float[] primvars:displayOpacity");
+    let points = samples(lines, "point3f[] points");
     for (f, &n) in per_frame.iter().enumerate() {
-        // A frame with no line: empty topology and invisible.
-        assert_eq!(counts[f] == "[]", n == 0, "frame {f}: {n} lines");
+        // One curve per line drawn; a frame with no line: no curve and invisible.
+        let curves = counts[f]
+            .trim_matches(['[', ']'])
+            .split(", ")
+            .filter(|c| !c.is_empty());
+        assert_eq!(curves.count() as u64, n, "frame {f}: {}", counts[f]);
         assert_eq!(vis[f] == "\"invisible\"", n == 0, "frame {f}");
+        // A width and an opacity per point.
+        let k = vec3s(points[f]).len();
+        let w = widths[f]
+            .trim_matches(['[', ']'])
+            .split(", ")
+            .filter(|c| !c.is_empty());
+        let a = opacity[f]
+            .trim_matches(['[', ']'])
+            .split(", ")
+            .filter(|c| !c.is_empty());
+        assert_eq!((w.count(), a.count()), (k, k), "frame {f}");
     }
     keep_for_validation(dir.path(), "usd_lines");
 }

@@ -5,7 +5,9 @@
 //! [`Output::Flipbook`]: crate::Output::Flipbook
 
 use anim::glam::Vec3;
-use anim::{Channel, Clip, Flipbook, FlipbookPart, Mesh, MeshAnimation, Node, Scene, SceneMesh};
+use anim::{
+    Channel, Clip, Curves, Flipbook, FlipbookPart, Mesh, MeshAnimation, Node, Scene, SceneMesh,
+};
 
 use crate::usda::{UsdMesh, UsdStage};
 
@@ -29,7 +31,7 @@ fn part_mesh(part: &FlipbookPart, f: usize) -> Option<Mesh> {
             m.colors = colors.as_ref().map(|c| c[f * n..(f + 1) * n].to_vec());
             Some(m)
         }
-        FlipbookPart::Frames { name, meshes } => {
+        FlipbookPart::Frames { name, meshes, .. } => {
             let m = meshes.get(f)?;
             (!m.triangles.is_empty()).then(|| {
                 let mut m = m.clone();
@@ -38,6 +40,52 @@ fn part_mesh(part: &FlipbookPart, f: usize) -> Option<Mesh> {
             })
         }
     }
+}
+
+/// What the flipbook shows at frame `f`, one mesh per visible part named after the part: the
+/// frame of an OBJ/STL sequence. A part shows nothing when its frame has no triangles or
+/// [`shows`] nothing; a point cache's rest normals are dropped
+/// (they are wrong once the mesh deforms).
+pub(crate) fn frame_meshes(book: &Flipbook, f: usize) -> Vec<Mesh> {
+    book.parts
+        .iter()
+        .filter_map(|part| {
+            let mut m = part_mesh(part, f)?;
+            if !shows(&m.positions, m.colors.as_deref()) {
+                return None;
+            }
+            if matches!(part, FlipbookPart::Animation { .. }) {
+                m.normals = None;
+            }
+            m.name = part.name().to_string();
+            Some(m)
+        })
+        .collect()
+}
+
+/// Whether a point cache's frame draws anything: not when every position is the same point
+/// (a glTF flipbook's hidden node, read back) or every colour is fully transparent (a
+/// multiple in-between's copy between its appearances).
+pub(crate) fn shows(positions: &[Vec3], colors: Option<&[[f32; 4]]>) -> bool {
+    let collapsed = positions
+        .split_first()
+        .is_none_or(|(p, rest)| rest.iter().all(|q| q == p));
+    let transparent = colors.is_some_and(|c| c.iter().all(|c| c[3] <= 0.0));
+    !(collapsed || transparent)
+}
+
+/// A body and its motion lines at frame `f`, for an OBJ/STL sequence: the body's frame, and
+/// `motion_lines` when the frame has any.
+pub(crate) fn lines_frame(body: &MeshAnimation, lines: &[Mesh], f: usize) -> Vec<Mesh> {
+    let mut b = body.mesh_at(f);
+    b.normals = None;
+    let mut out = vec![b];
+    if let Some(l) = lines.get(f).filter(|l| !l.triangles.is_empty()) {
+        let mut l = l.clone();
+        l.name = "motion_lines".into();
+        out.push(l);
+    }
+    out
 }
 
 /// All parts as one glTF scene: one root node per part with one child per frame, the
@@ -86,8 +134,12 @@ pub(crate) fn flipbook_scene(book: &Flipbook) -> Scene {
 }
 
 /// All parts as one USD stage: one `Mesh` prim per part, point caches with their per-frame
-/// colours, per-frame meshes with per-frame topology.
-pub(crate) fn flipbook_stage(book: &Flipbook) -> UsdStage<'_> {
+/// colours, per-frame meshes with per-frame topology; parts that carry curves (motion lines)
+/// as `BasisCurves` prims when `holds_curves` accepts them, else as their tube meshes.
+pub(crate) fn flipbook_stage<'a>(
+    book: &'a Flipbook,
+    holds_curves: &dyn Fn(&[&Curves]) -> bool,
+) -> UsdStage<'a> {
     let meshes = book
         .parts
         .iter()
@@ -95,12 +147,31 @@ pub(crate) fn flipbook_stage(book: &Flipbook) -> UsdStage<'_> {
             FlipbookPart::Animation { animation, colors } => {
                 UsdMesh::animation(animation, colors.as_deref())
             }
-            FlipbookPart::Frames { name, meshes } => {
-                UsdMesh::frames(name.clone(), meshes.iter().collect())
-            }
+            FlipbookPart::Frames {
+                name,
+                meshes,
+                curves,
+            } => frames_prim(name, meshes, curves.as_deref(), holds_curves),
         })
         .collect();
     UsdStage::new(book.fps, meshes)
+}
+
+/// Per-frame meshes as a prim: their curves when there are some for every frame and the
+/// format holds them, else the meshes.
+fn frames_prim<'a>(
+    name: &str,
+    meshes: &'a [Mesh],
+    curves: Option<&'a [Curves]>,
+    holds_curves: &dyn Fn(&[&Curves]) -> bool,
+) -> UsdMesh<'a> {
+    let curves: Option<Vec<&Curves>> = curves
+        .filter(|c| c.len() == meshes.len())
+        .map(|c| c.iter().collect());
+    match curves {
+        Some(c) if holds_curves(&c) => UsdMesh::curves(name, c),
+        _ => UsdMesh::frames(name, meshes.iter().collect()),
+    }
 }
 
 /// A body and its motion lines as a glTF scene: the body (one node per frame, named
@@ -153,8 +224,14 @@ pub(crate) fn lines_scene(body: &MeshAnimation, lines: &[Mesh]) -> Scene {
 }
 
 /// A body and its motion lines as a USD stage: the body's point cache and one
-/// `motion_lines` mesh whose topology changes per frame.
-pub(crate) fn lines_stage<'a>(body: &'a MeshAnimation, lines: &'a [Mesh]) -> UsdStage<'a> {
-    let lines = UsdMesh::frames("motion_lines", lines.iter().collect());
+/// `motion_lines` prim, `BasisCurves` when the lines come with curves the format holds,
+/// else a mesh whose topology changes per frame.
+pub(crate) fn lines_stage<'a>(
+    body: &'a MeshAnimation,
+    lines: &'a [Mesh],
+    curves: Option<&'a [Curves]>,
+    holds_curves: &dyn Fn(&[&Curves]) -> bool,
+) -> UsdStage<'a> {
+    let lines = frames_prim("motion_lines", lines, curves, holds_curves);
     UsdStage::new(body.fps, vec![UsdMesh::animation(body, None), lines])
 }

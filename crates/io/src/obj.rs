@@ -346,6 +346,51 @@ pub fn write(mesh: &Mesh) -> String {
     out
 }
 
+/// Writes several meshes as one OBJ file, one `o` object per mesh (named after it), vertex
+/// indices running on across objects: what one frame of a flipbook (a body with its copies or
+/// motion lines) shows. Each mesh is written as [`write`] writes it alone.
+pub fn write_objects(meshes: &[Mesh]) -> String {
+    let mut out = String::from("# written by toonkit\n");
+    // Rows written so far of `v`, `vt` and `vn`: a later object's faces refer past them.
+    let mut written = [0u64; 3];
+    for mesh in meshes {
+        let mut named = mesh.clone();
+        if named.name.is_empty() {
+            named.name = "mesh".into();
+        }
+        let text = write(&named);
+        let mut rows = [0u64; 3];
+        for line in text.lines().skip(1) {
+            let key = line.split(' ').next().unwrap_or("");
+            if let Some(slot) = ["v", "vt", "vn"].iter().position(|k| *k == key) {
+                rows[slot] += 1;
+            }
+            match line.strip_prefix("f ") {
+                Some(corners) if written != [0; 3] => {
+                    out.push('f');
+                    for corner in corners.split(' ') {
+                        out.push(' ');
+                        for (slot, index) in corner.split('/').enumerate() {
+                            if slot > 0 {
+                                out.push('/');
+                            }
+                            if let Ok(k) = index.parse::<u64>() {
+                                let _ = write!(out, "{}", k + written[slot]);
+                            }
+                        }
+                    }
+                }
+                _ => out.push_str(line),
+            }
+            out.push('\n');
+        }
+        for (w, r) in written.iter_mut().zip(rows) {
+            *w += r;
+        }
+    }
+    out
+}
+
 /// The files of an OBJ sequence, starting at `first`.
 ///
 /// The frame number is the trailing run of digits of `first`'s file stem (`walk_0001.obj` →

@@ -92,6 +92,9 @@ pub enum Output<'a> {
         body: &'a MeshAnimation,
         /// The lines of every frame.
         lines: &'a [Mesh],
+        /// The same lines as curves (the tubes' centre lines with widths and colours): USD
+        /// layers write these as a `BasisCurves` prim instead of the tubes.
+        curves: Option<&'a [anim::Curves]>,
     },
     /// A whole USD stage (mesh prims with point caches or per-frame topology, e.g. motion
     /// lines) as a scene cache: `.usda`, `.usdc`, `.usdz` or `.abc` (one PolyMesh per prim).
@@ -194,6 +197,32 @@ pub fn save_with(path: &Path, output: &Output<'_>, options: SaveOptions) -> Resu
             }
         },
         Output::Stage(stage) => put(path, write_stage(path, stage)?)?,
+        Output::Parts { parts, layout } if output_format(path)?.holds_one_frame() => {
+            let frames = parts.first().map_or(0, |(a, _)| a.frame_count());
+            if layout != Layout::Sequence && frames > 1 {
+                return Err(IoError::FramesDoNotFit {
+                    path: Default::default(),
+                    frames,
+                    extension: output_format(path)?.extension(),
+                }
+                .at(path));
+            }
+            let frame = |f| {
+                let mut meshes = Vec::with_capacity(parts.len());
+                for (a, colors) in parts {
+                    let n = a.vertex_count();
+                    let colors = colors.and_then(|c| c.get(f * n..(f + 1) * n));
+                    if crate::flipbook::shows(a.frame(f), colors) {
+                        let mut m = a.mesh_at(f);
+                        m.normals = None;
+                        m.colors = colors.map(<[_]>::to_vec);
+                        meshes.push(m);
+                    }
+                }
+                meshes
+            };
+            write_frames(path, frames, &frame, &mut put)?;
+        }
         Output::Parts { parts, layout } => {
             if matches!(layout, Layout::Sequence | Layout::Frame(_)) {
                 return Err(IoError::unsupported(format!(
@@ -211,21 +240,36 @@ pub fn save_with(path: &Path, output: &Output<'_>, options: SaveOptions) -> Resu
             };
             put(path, bytes)?;
         }
+        Output::Flipbook(book) if output_format(path)?.holds_one_frame() => {
+            let frame = |f| crate::flipbook::frame_meshes(book, f);
+            write_frames(path, book.frames, &frame, &mut put)?;
+        }
+        Output::MotionLines { body, lines, .. } if output_format(path)?.holds_one_frame() => {
+            let frame = |f| crate::flipbook::lines_frame(body, lines, f);
+            write_frames(path, body.frame_count(), &frame, &mut put)?;
+        }
         Output::Flipbook(book) => {
             let bytes = if output_format(path)? == Format::Glb {
                 crate::gltf::write_glb_with(&crate::flipbook::flipbook_scene(book), glb)
                     .map_err(|e| e.at(path))?
             } else {
-                write_stage(path, &crate::flipbook::flipbook_stage(book))?
+                let holds = curves_in(output_format(path)?);
+                write_stage(path, &crate::flipbook::flipbook_stage(book, &holds))?
             };
             put(path, bytes)?;
         }
-        Output::MotionLines { body, lines } => {
+        Output::MotionLines {
+            body,
+            lines,
+            curves,
+        } => {
             let bytes = if output_format(path)? == Format::Glb {
                 crate::gltf::write_glb_with(&crate::flipbook::lines_scene(body, lines), glb)
                     .map_err(|e| e.at(path))?
             } else {
-                write_stage(path, &crate::flipbook::lines_stage(body, lines))?
+                let holds = curves_in(output_format(path)?);
+                let stage = crate::flipbook::lines_stage(body, lines, curves, &holds);
+                write_stage(path, &stage)?
             };
             put(path, bytes)?;
         }
@@ -247,6 +291,17 @@ fn output_format(path: &Path) -> Result<Format> {
         )
         .at(path)
     })
+}
+
+/// Which curves a scene cache format writes as curves (`BasisCurves`): all in `.usda`,
+/// those `openusd` encodes right in `.usdc`/`.usdz` ([`crate::usdc::holds_curves`]), none in
+/// `.abc` (whose writer holds meshes: the tubes are written).
+fn curves_in(format: Format) -> impl Fn(&[&anim::Curves]) -> bool {
+    move |curves| match format {
+        Format::Usda => true,
+        Format::Usdc | Format::Usdz => crate::usdc::holds_curves(curves),
+        _ => false,
+    }
 }
 
 /// A stage as a scene cache in the format `path` names.
@@ -402,6 +457,56 @@ fn write_sequence(
         }
     }
     Ok(())
+}
+
+/// A flipbook in a one-frame format (`.obj`, `.stl`): one file per frame holding that
+/// frame's own meshes (their topology may change from frame to frame), `name_0001.obj`, …;
+/// a one-frame flipbook is the named file itself. OBJ keeps each mesh as its own `o`
+/// object; STL holds one solid, so the meshes are joined.
+fn write_frames(
+    path: &Path,
+    frames: usize,
+    frame: &dyn Fn(usize) -> Vec<Mesh>,
+    put: &mut dyn FnMut(&Path, Vec<u8>) -> Result<()>,
+) -> Result<()> {
+    let format = output_format(path)?;
+    let base = sequence_base(path);
+    let stem = base.file_name().map(|s| s.to_string_lossy().into_owned());
+    let stem = stem.unwrap_or_else(|| "frame".into());
+    for f in 0..frames {
+        let p = if frames == 1 {
+            path.to_path_buf()
+        } else {
+            base.with_file_name(format!("{stem}_{:04}.{}", f + 1, format.extension()))
+        };
+        let meshes = frame(f);
+        let bytes = match format {
+            #[cfg(feature = "obj")]
+            Format::Obj => crate::obj::write_objects(&meshes).into_bytes(),
+            #[cfg(feature = "stl")]
+            Format::Stl => crate::stl::write_binary(&joined(&meshes)),
+            _ => {
+                return Err(
+                    IoError::unsupported("this build of toonkit cannot write that format").at(&p),
+                )
+            }
+        };
+        put(&p, bytes)?;
+    }
+    Ok(())
+}
+
+/// Meshes joined into one (positions and triangles only), for formats with one solid.
+#[cfg(feature = "stl")]
+fn joined(meshes: &[Mesh]) -> Mesh {
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for m in meshes {
+        let first = positions.len() as u32;
+        positions.extend_from_slice(&m.positions);
+        triangles.extend(m.triangles.iter().map(|t| t.map(|i| i + first)));
+    }
+    Mesh::new("frame", positions, triangles)
 }
 
 /// The rest mesh of a PC2/MDD cache, as a same-name `.obj` beside it.

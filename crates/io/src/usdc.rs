@@ -36,7 +36,7 @@ use anim::MeshAnimation;
 use openusd::gf;
 use openusd::sdf::{self, ChildrenKey, FieldKey, SpecType, Specifier, Value, Variability};
 
-use crate::usda::source::{check, extent, finite, ColorsOf, Source};
+use crate::usda::source::{check, finite, ColorsOf, Source};
 use crate::usda::{sanitize_name, UniqueNames, UsdStage};
 use crate::{IoError, Result};
 
@@ -69,6 +69,15 @@ pub fn write(stage: &UsdStage) -> Result<Vec<u8>> {
     children::retype_children(out.into_inner())
 }
 
+/// Whether curves with these counts per frame can be written as `.usdc` (an `int[]` of 4 to
+/// 15 elements cannot, see [`write()`]'s errors): motion lines are written as
+/// `BasisCurves` then, else as the tube meshes swept along them.
+pub fn holds_curves(curves: &[&anim::Curves]) -> bool {
+    curves
+        .iter()
+        .all(|c| !MISREAD_INT_ARRAYS.contains(&c.counts.len()))
+}
+
 /// Writes a stage as a `.usdz` package: one `.usdc` layer (named after the root prim) stored
 /// uncompressed and 64-byte aligned, as the USDZ specification asks.
 ///
@@ -98,6 +107,9 @@ fn layer(stage: &UsdStage) -> Result<sdf::Data> {
             let faces = source.faces(f);
             let (c, i) = (faces.counts().len(), faces.indices().len());
             MISREAD_INT_ARRAYS.contains(&c) || MISREAD_INT_ARRAYS.contains(&i)
+        });
+        let small = small.or_else(|| {
+            (0..frames).find(|&f| MISREAD_INT_ARRAYS.contains(&source.curve_counts(f).len()))
         });
         if let Some(f) = small {
             return Err(IoError::unsupported(format!(
@@ -149,11 +161,17 @@ fn layer(stage: &UsdStage) -> Result<sdf::Data> {
             properties: Vec::new(),
             t0,
         };
-        prim.mesh(source);
+        let kind = if source.is_curves() {
+            prim.curves(source);
+            "BasisCurves"
+        } else {
+            prim.mesh(source);
+            "Mesh"
+        };
         let properties = std::mem::take(&mut prim.properties);
         let spec = data.create_spec(path.clone(), SpecType::Prim);
         spec.add(FieldKey::Specifier, Value::Specifier(Specifier::Def));
-        spec.add(FieldKey::TypeName, Value::Token("Mesh".into()));
+        spec.add(FieldKey::TypeName, Value::Token(kind.into()));
         spec.add(ChildrenKey::PropertyChildren, Value::TokenVec(properties));
     }
     Ok(data)
@@ -179,17 +197,23 @@ enum Samples {
     PerFrame(Vec<Value>),
 }
 
+impl Samples {
+    /// One value when `is_static` (or one frame), else one per frame.
+    fn of(frames: usize, is_static: bool, value: &dyn Fn(usize) -> Value) -> Samples {
+        if is_static || frames == 1 {
+            Samples::Constant(value(0))
+        } else {
+            Samples::PerFrame((0..frames).map(value).collect())
+        }
+    }
+}
+
 impl Prim<'_> {
     /// The properties of a mesh prim, in the order of the `.usda` writer.
     fn mesh(&mut self, source: &Source) {
         let frames = source.frames;
-        let samples = |is_static: bool, value: &dyn Fn(usize) -> Value| {
-            if is_static || frames == 1 {
-                Samples::Constant(value(0))
-            } else {
-                Samples::PerFrame((0..frames).map(value).collect())
-            }
-        };
+        let samples =
+            |is_static: bool, value: &dyn Fn(usize) -> Value| Samples::of(frames, is_static, value);
         self.uniform_token("orientation", "rightHanded");
         self.uniform_token("subdivisionScheme", "none");
         let topology_static = source.topology_static();
@@ -206,10 +230,14 @@ impl Prim<'_> {
         let points = samples(points_static, &|f| vec3s(source.points(f)));
         self.attribute("points", "point3f[]", None, points);
         let extents = samples(points_static, &|f| {
-            let (lo, hi) = extent(source.points(f));
+            let (lo, hi) = source.extent(f);
             vec3s(&[lo, hi])
         });
         self.attribute("extent", "float3[]", None, extents);
+        if source.has_velocities() {
+            let v = Samples::PerFrame((0..frames).map(|f| vec3s(&source.velocities(f))).collect());
+            self.attribute("velocities", "vector3f[]", None, v);
+        }
 
         if let Some(uvs) = source.uvs() {
             let st = uvs
@@ -220,6 +248,40 @@ impl Prim<'_> {
             self.attribute("primvars:st", "texCoord2f[]", Some("vertex"), st);
         }
 
+        self.display(source);
+    }
+
+    /// The properties of a `BasisCurves` prim, in the order of the `.usda` writer.
+    fn curves(&mut self, source: &Source) {
+        let frames = source.frames;
+        let samples =
+            |is_static: bool, value: &dyn Fn(usize) -> Value| Samples::of(frames, is_static, value);
+        self.uniform_token("type", "linear");
+        self.uniform_token("wrap", "nonperiodic");
+        let counts = samples(source.topology_static(), &|f| {
+            Value::IntVec(source.curve_counts(f).iter().map(|&k| k as i32).collect())
+        });
+        self.attribute("curveVertexCounts", "int[]", None, counts);
+        let points_static = source.points_static();
+        let points = samples(points_static, &|f| vec3s(source.points(f)));
+        self.attribute("points", "point3f[]", None, points);
+        let extents = samples(points_static && source.widths_static(), &|f| {
+            let (lo, hi) = source.extent(f);
+            vec3s(&[lo, hi])
+        });
+        self.attribute("extent", "float3[]", None, extents);
+        let widths = samples(source.widths_static(), &|f| {
+            Value::FloatVec(source.widths(f).iter().map(|&w| finite(w)).collect())
+        });
+        self.attribute("widths", "float[]", Some("vertex"), widths);
+        self.display(source);
+    }
+
+    /// Display colour and opacity (vertex primvars) and visibility, for meshes and curves.
+    fn display(&mut self, source: &Source) {
+        let frames = source.frames;
+        let samples =
+            |is_static: bool, value: &dyn Fn(usize) -> Value| Samples::of(frames, is_static, value);
         if source.colors(0).is_some() {
             let colors = |f: usize| source.colors(f).unwrap_or(ColorsOf::Given(&[]));
             let colors_static = source.colors_static();

@@ -287,7 +287,7 @@ impl Stylized {
         let mut out = Vec::new();
         for (k, o) in self.stylized.objects.iter().enumerate() {
             let Some(i) = o.lines else { continue };
-            let Some(anim::FlipbookPart::Frames { name, meshes }) =
+            let Some(anim::FlipbookPart::Frames { name, meshes, .. }) =
                 self.stylized.flipbook.parts.get(i)
             else {
                 continue;

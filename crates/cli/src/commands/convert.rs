@@ -53,8 +53,14 @@ pub(crate) fn run(ctx: &Context, args: ConvertArgs) -> Result<()> {
         }
     }
     let sampled = input::sample(&args.input, &loaded, &args.input_args)?;
-    let merged = input::merged(&args.input, &sampled)?;
     let layout = args.layout.layout();
+    let one_frame_files = Format::from_extension(&args.output).is_some_and(Format::holds_one_frame);
+    if layout == tkio::Layout::Sequence && one_frame_files && sampled.objects.len() > 1 {
+        // Several objects (e.g. a flipbook's one node per frame): each file holds what its
+        // frame shows, so hidden objects are left out and the vertex count may change.
+        return write_frames(ctx, &args, sampled, start, &spinner);
+    }
+    let merged = input::merged(&args.input, &sampled)?;
     let written = output::write_animation(&args.output, &merged, layout, None, ctx.save)?;
     spinner.finish_and_clear();
     let summary = json!({
@@ -72,6 +78,50 @@ pub(crate) fn run(ctx: &Context, args: ConvertArgs) -> Result<()> {
             shared::frames_written(layout, merged.frame_count()),
             merged.vertex_count(),
             merged.fps
+        )
+    });
+    Ok(())
+}
+
+/// Writes every frame's visible objects as its own file of a sequence.
+fn write_frames(
+    ctx: &Context,
+    args: &ConvertArgs,
+    sampled: anim::SampledScene,
+    start: Instant,
+    spinner: &indicatif::ProgressBar,
+) -> Result<()> {
+    let book = anim::Flipbook {
+        fps: sampled.fps,
+        frames: sampled.frame_count,
+        parts: sampled
+            .objects
+            .into_iter()
+            .map(|o| {
+                let mut animation = o.animation;
+                animation.mesh.name = o.name;
+                anim::FlipbookPart::Animation {
+                    animation,
+                    colors: None,
+                }
+            })
+            .collect(),
+    };
+    let written = tkio::save_with(&args.output, &tkio::Output::Flipbook(&book), ctx.save)?;
+    spinner.finish_and_clear();
+    let summary = json!({
+        "input": args.input,
+        "outputs": written,
+        "frames": book.frames,
+        "objects": book.parts.len(),
+        "fps": book.fps,
+        "seconds": start.elapsed().as_secs_f64(),
+    });
+    ctx.report(&summary, || {
+        format!(
+            "wrote {} ({} frames, each file the objects its frame shows)",
+            shared::files(&written),
+            book.frames
         )
     });
     Ok(())

@@ -3,7 +3,7 @@
 //! mesh prim, so all three formats hold the same prims and samples.
 
 use anim::glam::Vec3;
-use anim::Mesh;
+use anim::{Curves, Mesh};
 
 use super::stage::{UsdGeometry, UsdMesh, UsdStage};
 use crate::{IoError, Result};
@@ -32,7 +32,7 @@ pub(crate) fn check<'a>(stage: &'a UsdStage<'a>) -> Result<Vec<Source<'a>>> {
     stage
         .meshes
         .iter()
-        .map(|m| Source::new(m, frames))
+        .map(|m| Source::new(m, frames, stage.fps))
         .collect()
 }
 
@@ -132,11 +132,13 @@ pub(crate) struct Source<'a> {
     pub(crate) geometry: &'a UsdGeometry<'a>,
     /// Frames of the stage.
     pub(crate) frames: usize,
+    /// Frames per second (velocities are per second).
+    fps: f32,
 }
 
 impl<'a> Source<'a> {
     /// Checks one mesh prim against the stage's frame count.
-    pub(crate) fn new(mesh: &'a UsdMesh<'a>, frames: usize) -> Result<Source<'a>> {
+    pub(crate) fn new(mesh: &'a UsdMesh<'a>, frames: usize, fps: f32) -> Result<Source<'a>> {
         let what = format!("USD mesh '{}'", mesh.name);
         match &mesh.geometry {
             UsdGeometry::Animation { animation, colors } => {
@@ -171,11 +173,95 @@ impl<'a> Source<'a> {
                     }
                 }
             }
+            UsdGeometry::Curves(curves) => {
+                for (f, c) in curves.iter().enumerate() {
+                    let n = c.points.len();
+                    let total: u64 = c.counts.iter().map(|&k| k as u64).sum();
+                    if total != n as u64
+                        || c.counts.iter().any(|&k| k < 2)
+                        || c.widths.len() != n
+                        || c.colors.len() != n
+                    {
+                        return Err(IoError::unsupported(format!(
+                            "{what} frame {}: curves of {total} points (each at least 2) with {} widths and {} colours for {n} points",
+                            f + 1,
+                            c.widths.len(),
+                            c.colors.len()
+                        )));
+                    }
+                }
+            }
         }
         Ok(Source {
             geometry: &mesh.geometry,
             frames,
+            fps,
         })
+    }
+
+    /// The curves of frame `f` when the prim is `BasisCurves` and the frame has some.
+    pub(crate) fn frame_curves(&self, f: usize) -> Option<&'a Curves> {
+        match self.geometry {
+            UsdGeometry::Curves(c) => c.get(f).copied().filter(|c| !c.is_empty()),
+            _ => None,
+        }
+    }
+
+    /// Whether the prim is `BasisCurves` (else `Mesh`).
+    pub(crate) fn is_curves(&self) -> bool {
+        matches!(self.geometry, UsdGeometry::Curves(_))
+    }
+
+    /// Points per curve of frame `f` (empty for meshes and absent frames).
+    pub(crate) fn curve_counts(&self, f: usize) -> &'a [u32] {
+        self.frame_curves(f).map_or(&[], |c| &c.counts)
+    }
+
+    /// Width of every point of frame `f` (empty for meshes and absent frames).
+    pub(crate) fn widths(&self, f: usize) -> &'a [f32] {
+        self.frame_curves(f).map_or(&[], |c| &c.widths)
+    }
+
+    /// The bounding box of frame `f` as written: the points' box ([`extent`]), grown by
+    /// half the widest curve for `BasisCurves` (USD's extent of curves covers their width).
+    pub(crate) fn extent(&self, f: usize) -> (Vec3, Vec3) {
+        let (lo, hi) = extent(self.points(f));
+        let half = self
+            .widths(f)
+            .iter()
+            .map(|&w| finite(w).abs())
+            .fold(0.0f32, f32::max)
+            / 2.0;
+        (lo - Vec3::splat(half), hi + Vec3::splat(half))
+    }
+
+    /// Whether the prim carries `velocities`: a point cache whose points move. (Per-frame
+    /// meshes and curves change their points' count or meaning from frame to frame.)
+    pub(crate) fn has_velocities(&self) -> bool {
+        matches!(self.geometry, UsdGeometry::Animation { .. })
+            && self.frames > 1
+            && !self.points(0).is_empty()
+            && !self.points_static()
+    }
+
+    /// Velocity of every point at frame `f` in units per second, the derivative of the
+    /// points as written: the central difference `(p(f+1) − p(f−1)) / 2` per frame,
+    /// one-sided at the first and last frame (as SPEC's smear velocities), times the frame
+    /// rate (USD's `velocities` are per second of time codes). So a renderer's motion blur
+    /// sweeps each point along the path the frames show (a smear's in-betweens included).
+    pub(crate) fn velocities(&self, f: usize) -> Vec<Vec3> {
+        let last = self.frames.saturating_sub(1);
+        let (a, b) = (f.saturating_sub(1), (f + 1).min(last));
+        let per_frame = if b > a { (b - a) as f32 } else { 1.0 };
+        let scale = self.fps / per_frame;
+        let (pa, pb) = (self.points(a), self.points(b));
+        pa.iter()
+            .zip(pb)
+            .map(|(p, q)| {
+                let v = (*q - *p) * scale;
+                Vec3::new(finite(v.x), finite(v.y), finite(v.z))
+            })
+            .collect()
     }
 
     /// The mesh of frame `f` when the geometry is per-frame and the frame has a drawable one.
@@ -185,7 +271,7 @@ impl<'a> Source<'a> {
                 .get(f)
                 .copied()
                 .filter(|m| m.vertex_count() > 0 && !m.triangles.is_empty()),
-            UsdGeometry::Animation { .. } => None,
+            _ => None,
         }
     }
 
@@ -197,6 +283,7 @@ impl<'a> Source<'a> {
                 _ => animation.frame(f),
             },
             UsdGeometry::Frames(_) => self.frame_mesh(f).map_or(&[], |m| &m.positions),
+            UsdGeometry::Curves(_) => self.frame_curves(f).map_or(&[], |c| &c.points),
         }
     }
 
@@ -207,6 +294,7 @@ impl<'a> Source<'a> {
             UsdGeometry::Frames(_) => self
                 .frame_mesh(f)
                 .map_or(Faces::Triangles(&[]), |m| Faces::of(m)),
+            UsdGeometry::Curves(_) => Faces::Triangles(&[]),
         }
     }
 
@@ -229,6 +317,9 @@ impl<'a> Source<'a> {
                     None => ColorsOf::Given(&[]),
                 })
             }
+            UsdGeometry::Curves(_) => Some(ColorsOf::Given(
+                self.frame_curves(f).map_or(&[], |c| &c.colors),
+            )),
         }
     }
 
@@ -246,6 +337,7 @@ impl<'a> Source<'a> {
                     && colors.is_none_or(|c| c[f * n..(f + 1) * n].iter().any(|c| c[3] > 0.0))
             }
             UsdGeometry::Frames(_) => self.frame_mesh(f).is_some(),
+            UsdGeometry::Curves(_) => self.frame_curves(f).is_some(),
         }
     }
 
@@ -256,8 +348,8 @@ impl<'a> Source<'a> {
 
     /// Whether every frame has the faces of frame 0.
     pub(crate) fn topology_static(&self) -> bool {
-        let first = self.faces(0);
-        self.all_frames(|f| self.faces(f) == first)
+        let (first, counts) = (self.faces(0), self.curve_counts(0));
+        self.all_frames(|f| self.faces(f) == first && self.curve_counts(f) == counts)
     }
 
     /// Whether every frame has the points of frame 0 (bitwise).
@@ -297,8 +389,17 @@ impl<'a> Source<'a> {
                     .as_deref()
                     .filter(|u| u.len() == n && n > 0)
             }
-            UsdGeometry::Frames(_) => None,
+            UsdGeometry::Frames(_) | UsdGeometry::Curves(_) => None,
         }
+    }
+
+    /// Whether the widths are the same on every frame.
+    pub(crate) fn widths_static(&self) -> bool {
+        let first = self.widths(0);
+        self.all_frames(|f| {
+            let w = self.widths(f);
+            w.len() == first.len() && w.iter().zip(first).all(|(a, b)| a.to_bits() == b.to_bits())
+        })
     }
 }
 

@@ -1,6 +1,6 @@
 //! The data model of a USD layer: a root `Xform` holding animated `Mesh` prims.
 
-use anim::{Mesh, MeshAnimation, DEFAULT_FPS};
+use anim::{Curves, Mesh, MeshAnimation, DEFAULT_FPS};
 
 use crate::{IoError, Result};
 
@@ -29,6 +29,9 @@ pub enum UsdGeometry<'a> {
     /// motion lines. A frame with no mesh, no vertex or no triangle is absent (empty arrays,
     /// `visibility` "invisible").
     Frames(Vec<&'a Mesh>),
+    /// Linear curves per frame, written as a `BasisCurves` prim (width and colour per
+    /// point): motion lines. A frame without a curve is absent (`visibility` "invisible").
+    Curves(Vec<&'a Curves>),
 }
 
 impl UsdGeometry<'_> {
@@ -37,11 +40,12 @@ impl UsdGeometry<'_> {
         match self {
             UsdGeometry::Animation { animation, .. } => animation.frame_count(),
             UsdGeometry::Frames(meshes) => meshes.len(),
+            UsdGeometry::Curves(curves) => curves.len(),
         }
     }
 }
 
-/// One `def Mesh` prim.
+/// One `def Mesh` (or `def BasisCurves`) prim.
 #[derive(Debug, Clone)]
 pub struct UsdMesh<'a> {
     /// Prim name; sanitized to `[A-Za-z_][A-Za-z0-9_]*` and made unique among its siblings
@@ -57,6 +61,14 @@ impl<'a> UsdMesh<'a> {
         UsdMesh {
             name: animation.mesh.name.clone(),
             geometry: UsdGeometry::Animation { animation, colors },
+        }
+    }
+
+    /// A `BasisCurves` prim with one set of curves per frame.
+    pub fn curves(name: impl Into<String>, curves: Vec<&'a Curves>) -> Self {
+        UsdMesh {
+            name: name.into(),
+            geometry: UsdGeometry::Curves(curves),
         }
     }
 

@@ -7,7 +7,7 @@ use anim::MeshAnimation;
 use rayon::prelude::*;
 
 use super::names::{sanitize_name, UniqueNames};
-use super::source::{check, extent, ColorsOf, Faces, Source};
+use super::source::{check, ColorsOf, Faces, Source};
 use super::stage::UsdStage;
 use crate::Result;
 
@@ -68,7 +68,16 @@ pub fn write(stage: &UsdStage) -> Result<String> {
         if i > 0 {
             out.push('\n');
         }
-        let _ = writeln!(out, "    def Mesh \"{}\"\n    {{", names.claim(&mesh.name));
+        let kind = if source.is_curves() {
+            "BasisCurves"
+        } else {
+            "Mesh"
+        };
+        let _ = writeln!(
+            out,
+            "    def {kind} \"{}\"\n    {{",
+            names.claim(&mesh.name)
+        );
         source.write(&mut out, t0);
         out.push_str("    }\n");
     }
@@ -108,6 +117,9 @@ impl Faces<'_> {
 impl Source<'_> {
     /// Writes every property of the prim.
     fn write(&self, out: &mut String, t0: f64) {
+        if self.is_curves() {
+            return self.write_curves(out, t0);
+        }
         let frames = self.frames;
         out.push_str(PROP);
         out.push_str("uniform token orientation = \"rightHanded\"\n");
@@ -138,7 +150,7 @@ impl Source<'_> {
 
         let points_static = self.points_static();
         let points = |o: &mut String, f: usize| write_points(o, self.points(f));
-        let extent = |o: &mut String, f: usize| write_extent(o, self.points(f));
+        let extent = |o: &mut String, f: usize| write_extent(o, self.extent(f));
         attribute(
             out,
             "point3f[] points",
@@ -157,6 +169,10 @@ impl Source<'_> {
             t0,
             &extent,
         );
+        if self.has_velocities() {
+            let v = |o: &mut String, f: usize| write_points(o, &self.velocities(f));
+            attribute(out, "vector3f[] velocities", None, false, frames, t0, &v);
+        }
 
         // Texture coordinates of a point cache (fixed topology): USD's `st` has v up from
         // the image's bottom, toonkit's (glTF's) v down from its top.
@@ -168,6 +184,50 @@ impl Source<'_> {
             attribute(out, decl, VERTEX, true, frames, t0, &st);
         }
 
+        self.write_display(out, t0);
+    }
+
+    /// A `BasisCurves` prim: linear, non-periodic curves with a width, colour and opacity
+    /// per point (what renderers draw as curves, and Blender imports as curves).
+    fn write_curves(&self, out: &mut String, t0: f64) {
+        let frames = self.frames;
+        out.push_str(PROP);
+        out.push_str("uniform token type = \"linear\"\n");
+        out.push_str(PROP);
+        out.push_str("uniform token wrap = \"nonperiodic\"\n");
+        let counts = |o: &mut String, f: usize| {
+            write_list(o, self.curve_counts(f).iter(), |o, &k| {
+                push_int(o, k as usize)
+            })
+        };
+        let topology_static = self.topology_static();
+        let decl = "int[] curveVertexCounts";
+        attribute(out, decl, None, topology_static, frames, t0, &counts);
+        let points_static = self.points_static();
+        let points = |o: &mut String, f: usize| write_points(o, self.points(f));
+        let decl = "point3f[] points";
+        attribute(out, decl, None, points_static, frames, t0, &points);
+        let extent = |o: &mut String, f: usize| write_extent(o, self.extent(f));
+        let extent_static = points_static && self.widths_static();
+        attribute(
+            out,
+            "float3[] extent",
+            None,
+            extent_static,
+            frames,
+            t0,
+            &extent,
+        );
+        let widths =
+            |o: &mut String, f: usize| write_list(o, self.widths(f).iter(), |o, &w| push_f32(o, w));
+        let (decl, is_static) = ("float[] widths", self.widths_static());
+        attribute(out, decl, VERTEX, is_static, frames, t0, &widths);
+        self.write_display(out, t0);
+    }
+
+    /// Display colour and opacity (vertex primvars) and visibility, for meshes and curves.
+    fn write_display(&self, out: &mut String, t0: f64) {
+        let frames = self.frames;
         if self.colors(0).is_some() {
             let colors_static = self.colors_static();
             let rgb = |o: &mut String, f: usize| self.colors(f).unwrap().write_rgb(o);
@@ -298,8 +358,7 @@ fn write_points(out: &mut String, points: &[Vec3]) {
     write_list(out, points.iter(), |o, p| push_tuple(o, &p.to_array()));
 }
 
-/// `[(min), (max)]` of the points as written (see [`extent`]).
-fn write_extent(out: &mut String, points: &[Vec3]) {
-    let (lo, hi) = extent(points);
+/// `[(min), (max)]` of a box (see [`Source::extent`]).
+fn write_extent(out: &mut String, (lo, hi): (Vec3, Vec3)) {
     write_list(out, [lo, hi].iter(), |o, p| push_tuple(o, &p.to_array()));
 }

@@ -1,6 +1,6 @@
 //! Motion lines (Section 4.3, SMEAR Eq. 13): tubes traced along the trajectories of surface seeds.
 
-use anim::Mesh;
+use anim::{Curves, Mesh};
 use rayon::prelude::*;
 
 use super::inputs::{check_frame, check_step, held_frame};
@@ -84,6 +84,9 @@ pub struct LineFrame {
     pub lines: usize,
     /// Summed length of the lines drawn, along their centres (scene units).
     pub length: f32,
+    /// The same lines as curves: each tube's centre line, its diameter and colour per ring
+    /// (for scene files that draw curves, USD's `BasisCurves`).
+    pub curves: Curves,
     rings: Vec<Ring>,
 }
 
@@ -93,6 +96,7 @@ impl Default for LineFrame {
             mesh: Mesh::new("motion_lines", Vec::new(), Vec::new()),
             lines: 0,
             length: 0.0,
+            curves: Curves::default(),
             rings: Vec::new(),
         }
     }
@@ -163,6 +167,7 @@ fn trace(
     }
     out.lines = 0;
     out.length = 0.0;
+    out.curves.clear();
     let tr = seeds.trajectories();
     let scale = options.step as f32;
     let [r, g, b] = options
@@ -228,6 +233,10 @@ fn trace(
                 .windows(2)
                 .map(|w| w[0].center.distance(w[1].center))
                 .sum::<f32>();
+            let rings = out.rings.iter();
+            let width = |r: f32| if r.is_finite() { 2.0 * r.max(0.0) } else { 0.0 };
+            out.curves
+                .push(rings.map(|r| (r.center, width(r.radius), r.color)));
         }
     }
 }

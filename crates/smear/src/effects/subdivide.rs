@@ -69,11 +69,17 @@ impl Blend {
 
     /// The midpoint of two blends (supports inside one input triangle: at most three vertices).
     fn mid(a: &Blend, b: &Blend) -> Blend {
-        let mut out: Vec<(u32, f32)> = Vec::with_capacity(6);
-        for (v, w) in a.support().chain(b.support()) {
+        Blend::average(&[a, b])
+    }
+
+    /// The average of blends inside one input triangle (a centroid: at most three vertices).
+    fn average(blends: &[&Blend]) -> Blend {
+        let share = 1.0 / blends.len() as f32;
+        let mut out: Vec<(u32, f32)> = Vec::with_capacity(9);
+        for (v, w) in blends.iter().flat_map(|b| b.support()) {
             match out.iter_mut().find(|e| e.0 == v) {
-                Some(e) => e.1 += 0.5 * w,
-                None => out.push((v, 0.5 * w)),
+                Some(e) => e.1 += share * w,
+                None => out.push((v, share * w)),
             }
         }
         out.sort_by(|x, y| y.1.total_cmp(&x.1));
@@ -117,6 +123,10 @@ pub struct SubdivisionStats {
     pub vertices: usize,
     /// Largest ratio of an output edge's length to its rest length.
     pub max_stretch: f32,
+    /// The achieved error: the largest distance (scene units) between the smear and the
+    /// output's flat triangles, measured where it is largest between vertices that lie on
+    /// the smear — at every edge's midpoint and every triangle's centroid.
+    pub max_error: f32,
 }
 
 /// One smeared frame, adaptively subdivided.
@@ -166,6 +176,11 @@ pub fn subdivide_frame(
         .map(|(k, t)| (*t, k as u32))
         .collect();
     let rest_len = |a: u32, b: u32| rest[a as usize].distance(rest[b as usize]);
+    // The rest length of an input triangle: its longest edge.
+    let face_rest = |t: u32| {
+        let [x, y, z] = mesh.triangles[t as usize];
+        rest_len(x, y).max(rest_len(y, z)).max(rest_len(z, x))
+    };
     let reference = |blends: &[Blend], a: u32, b: u32, t: u32| -> f32 {
         let mut s: Vec<u32> = blends[a as usize]
             .support()
@@ -176,10 +191,7 @@ pub fn subdivide_frame(
         s.dedup();
         match s.as_slice() {
             [u, v] => rest_len(*u, *v),
-            _ => {
-                let [x, y, z] = mesh.triangles[t as usize];
-                rest_len(x, y).max(rest_len(y, z)).max(rest_len(z, x))
-            }
+            _ => face_rest(t),
         }
     };
     let bend = (BEND * (tolerance - 1.0)).max(BEND_FLOOR);
@@ -218,6 +230,34 @@ pub fn subdivide_frame(
                 split.insert(key, mid);
             }
         }
+        // Face test: a triangle whose edges all follow the smear can still bulge away from
+        // it inside (β and the trajectories vary across it): its centroid on the smear is
+        // compared with the flat triangle's, and a bulging triangle splits all its edges.
+        for &(t, orig) in &tris {
+            let keys = [0, 1, 2].map(|k| {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                (a.min(b), a.max(b))
+            });
+            if keys
+                .iter()
+                .any(|key| matches!(split.get(key), Some(Some(_))))
+            {
+                continue;
+            }
+            let r = face_rest(orig);
+            let [u, v, w] = t.map(|v| &blends[v as usize]);
+            let c = Blend::average(&[u, v, w]);
+            let flat = t.iter().map(|&v| pos[v as usize]).sum::<Vec3>() / 3.0;
+            if r > 0.0 && place(&c).distance(flat) > bend * r {
+                for key in keys {
+                    let nb = Blend::mid(&blends[key.0 as usize], &blends[key.1 as usize]);
+                    let q = place(&nb);
+                    kept.remove(&key);
+                    split.insert(key, Some((nb, q)));
+                }
+                any = true;
+            }
+        }
         if !any {
             break;
         }
@@ -239,7 +279,7 @@ pub fn subdivide_frame(
         }
         tris = next;
     }
-    let mut max_stretch = 0.0f32;
+    let (mut max_stretch, mut max_error) = (0.0f32, 0.0f32);
     for &(t, orig) in &tris {
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
@@ -247,7 +287,14 @@ pub fn subdivide_frame(
             if r > 0.0 {
                 max_stretch = max_stretch.max(pos[a as usize].distance(pos[b as usize]) / r);
             }
+            if a < b {
+                let mid = place(&Blend::mid(&blends[a as usize], &blends[b as usize]));
+                max_error = max_error.max(mid.distance(0.5 * (pos[a as usize] + pos[b as usize])));
+            }
         }
+        let [u, v, w] = t.map(|v| &blends[v as usize]);
+        let flat = t.iter().map(|&v| pos[v as usize]).sum::<Vec3>() / 3.0;
+        max_error = max_error.max(place(&Blend::average(&[u, v, w])).distance(flat));
     }
     let mut out = Mesh::new(mesh.name.clone(), pos, tris.iter().map(|t| t.0).collect());
     out.normals = mesh.normals.as_ref().map(|n| {
@@ -287,6 +334,11 @@ pub fn subdivide_frame(
         triangles: out.triangle_count(),
         vertices: out.vertex_count(),
         max_stretch,
+        max_error: if max_error.is_finite() {
+            max_error
+        } else {
+            0.0
+        },
     };
     (out, stats)
 }

@@ -71,6 +71,15 @@ pub struct ObjectReport {
     /// With subdivision: the most triangles of the body in one frame.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub subdivision_max_triangles: Option<usize>,
+    /// With subdivision: the most vertices of the body in one frame (what the fidelity
+    /// costs).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub subdivision_max_vertices: Option<usize>,
+    /// With subdivision: the achieved error, the largest distance between the ideal smear
+    /// and the body's flat triangles over all frames (scene units; see
+    /// [`crate::SubdivisionStats::max_error`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub subdivision_max_error: Option<f32>,
     /// Frames squashed on impact with the ground.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub squashed_frames: Option<usize>,
@@ -342,7 +351,7 @@ pub fn stylize_frames(
                 let step = options.step.max(1);
                 let mut beta = vec![0.0f32; n];
                 let mut meshes = Vec::with_capacity(frames.len());
-                let (mut stretch, mut most) = (0.0f32, 0usize);
+                let (mut stretch, mut most, mut vertices, mut error) = (0.0f32, 0, 0, 0.0f32);
                 for frame in frames.clone() {
                     let h = crate::held_frame(frame, step);
                     for (k, b) in beta.iter_mut().enumerate() {
@@ -355,13 +364,18 @@ pub fn stylize_frames(
                     }
                     stretch = stretch.max(st.max_stretch);
                     most = most.max(st.triangles);
+                    vertices = vertices.max(st.vertices);
+                    error = error.max(st.max_error);
                     meshes.push(mesh);
                 }
                 stats.subdivision_max_stretch = Some(stretch);
                 stats.subdivision_max_triangles = Some(most);
+                stats.subdivision_max_vertices = Some(vertices);
+                stats.subdivision_max_error = Some(error);
                 book.parts.push(FlipbookPart::Frames {
                     name: anim.mesh.name.clone(),
                     meshes,
+                    curves: None,
                 });
             }
             _ => {
@@ -398,6 +412,7 @@ pub fn stylize_frames(
                     book.parts.push(FlipbookPart::Frames {
                         name: c.animation.mesh.name.clone(),
                         meshes,
+                        curves: None,
                     });
                     continue;
                 }
@@ -451,9 +466,11 @@ pub fn stylize_frames(
             stats.lines_max = Some(drawn.iter().copied().max().unwrap_or(0));
             stats.lines_per_frame = Some(drawn);
             parts.lines = Some(book.parts.len());
+            let (meshes, curves) = line_frames.into_iter().map(|f| (f.mesh, f.curves)).unzip();
             book.parts.push(FlipbookPart::Frames {
                 name: format!("{name}_lines"),
-                meshes: line_frames.into_iter().map(|f| f.mesh).collect(),
+                meshes,
+                curves: Some(curves),
             });
         }
         report.seconds.lines += t.elapsed().as_secs_f64();

@@ -3,6 +3,7 @@
 
 mod causal;
 mod contact;
+mod fidelity;
 mod legged;
 mod revolve;
 mod subdivide;

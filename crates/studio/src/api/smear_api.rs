@@ -256,7 +256,7 @@ pub(crate) async fn stylize(
                     );
                 }
             }
-            if let Some(anim::FlipbookPart::Frames { name, meshes }) =
+            if let Some(anim::FlipbookPart::Frames { name, meshes, .. }) =
                 o.lines.and_then(|i| s.flipbook.parts.get(i))
             {
                 let n = lines.len();

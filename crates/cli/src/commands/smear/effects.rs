@@ -5,13 +5,16 @@
 //! * `elongate IN -o OUT [--preset linear|speed|noise] [--beta-max X] [--kappa K]
 //!   [--expr "..."]`: every frame replaced by its elongated in-between (SMEAR Eq. 10); `.glb`
 //!   (flipbook or `--layout morph`), `.usda`, `.pc2`/`.mdd` + rest `.obj`, or an `.obj`
-//!   sequence (`--layout sequence`), on the input topology.
+//!   sequence (`--layout sequence`), on the input topology; with `--subdivide`, each
+//!   frame's own mesh (a scene file or an `.obj`/`.stl` sequence).
 //! * `multiples IN -o OUT.glb|OUT.usda --past M --future M [--spacing DF | --overlap N]
 //!   [--m-max X] [--opacity-expr "..."]`: the original plus displaced copies with per-vertex
-//!   opacity (SMEAR Eqs. 11–12), each an alpha-blended flipbook node (a Mesh prim in `.usda`).
+//!   opacity (SMEAR Eqs. 11–12), each an alpha-blended flipbook node (a Mesh prim in `.usda`);
+//!   or an `.obj` sequence (`--layout sequence`), each file the frame's body and copies.
 //! * `lines IN -o OUT.glb|OUT.usda --count K --length-max T [--seed S]
 //!   [--length-expr "..."]`: the original as a flipbook plus one motion-line tube mesh per
-//!   frame (SMEAR Eq. 13); in `.usda`, one Mesh prim whose topology changes per frame.
+//!   frame (SMEAR Eq. 13); in `.usda`, one Mesh prim whose topology changes per frame; in an
+//!   `.obj` sequence (`--layout sequence`), each file the frame's body and lines.
 //!
 //! Each command turns its flags into a [`smear::Style`] and calls [`smear::stylize`].
 //! Expressions are those of `smear::Expression` (inputs `delta`, `speed`, `weight`, `noise`,
@@ -54,6 +57,8 @@ pub(crate) struct MultiplesArgs {
     pub(crate) offsets: EffectArgs,
     #[command(flatten)]
     pub(crate) effect: Multiples,
+    #[command(flatten)]
+    pub(crate) layout: LayoutArgs,
 }
 
 /// Arguments of `toonkit smear lines`.
@@ -65,6 +70,34 @@ pub(crate) struct LinesArgs {
     pub(crate) offsets: EffectArgs,
     #[command(flatten)]
     pub(crate) effect: Lines,
+    #[command(flatten)]
+    pub(crate) layout: LayoutArgs,
+}
+
+/// Refuses an output that cannot hold a mesh that changes per frame (`why` says what
+/// changes it): scene files (`.glb`, `.usda`, `.usdc`, `.usdz`, `.abc`) can, and so can an
+/// OBJ/STL sequence (one file per frame, each with its frame's own mesh).
+fn require_frames(output: &std::path::Path, layout: &LayoutArgs, why: &str) -> Result<()> {
+    let format = Format::from_extension(output);
+    if format.is_some_and(Format::holds_one_frame) {
+        if layout.layout() != tkio::Layout::Sequence {
+            bail!(
+                "{}: {why}: write one file per frame with --layout sequence, or a .glb, .usda, \
+                 .usdc, .usdz or .abc",
+                output.display()
+            );
+        }
+        return Ok(());
+    }
+    if !matches!(layout.layout(), tkio::Layout::Flipbook) {
+        bail!(
+            "{}: {why}: the {} layout does not apply (use --layout sequence with .obj or .stl)",
+            output.display(),
+            layout.layout().name()
+        );
+    }
+    let why = format!("{why}, which only scene files hold: write .glb, .usda, .usdc, .usdz or .abc, or an .obj/.stl sequence (--layout sequence)");
+    Ok(shared::require_scenes(output, &why)?)
 }
 
 /// Runs the style on the prepared input, naming the input in errors.
@@ -84,10 +117,11 @@ pub(crate) fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
     args.effect.function(&args.offsets)?;
     args.offsets.shaping()?;
     if args.offsets.subdivide.is_some() {
-        let why = "--subdivide changes the mesh per frame, which .pc2/.mdd/.obj point caches \
-                   cannot store (one vertex count for all frames); write .glb, .usda, .usdc, \
-                   .usdz or .abc";
-        shared::require_scenes(&args.io.output, why)?;
+        require_frames(
+            &args.io.output,
+            &args.layout,
+            "--subdivide changes the mesh per frame",
+        )?;
     }
     let spinner = crate::progress::spinner("elongating", ctx.json);
     let p = prepare(&args.io, &args.offsets)?;
@@ -97,10 +131,7 @@ pub(crate) fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
     let layout = args.layout.layout();
     let written = match out.animation(0) {
         Some(body) => output::write_animation(&args.io.output, body, layout, None, ctx.save)?,
-        None => {
-            tkio::save_with(&args.io.output, &Output::Flipbook(&out.flipbook), ctx.save)?;
-            vec![args.io.output.clone()]
-        }
+        None => tkio::save_with(&args.io.output, &Output::Flipbook(&out.flipbook), ctx.save)?,
     };
     spinner.finish_and_clear();
     let stats = &out.report.objects[0];
@@ -110,6 +141,8 @@ pub(crate) fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
         "frames": body.frame_count(), "vertices": body.vertex_count(),
         "subdivision_max_stretch": stats.subdivision_max_stretch,
         "subdivision_max_triangles": stats.subdivision_max_triangles,
+        "subdivision_max_vertices": stats.subdivision_max_vertices,
+        "subdivision_max_error": stats.subdivision_max_error,
         "squashed_frames": stats.squashed_frames, "causal": args.offsets.offsets.causal,
         "objects": p.scene().objects.len(), "step": args.offsets.step,
         "weighted": p.weights(0).is_some(), "camera_speed": p.camera().is_some(),
@@ -131,9 +164,10 @@ pub(crate) fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
 /// Runs `toonkit smear multiples`.
 pub(crate) fn multiples(ctx: &Context, args: MultiplesArgs) -> Result<()> {
     let start = Instant::now();
-    shared::require_scenes(
+    require_frames(
         &args.io.output,
-        "smear multiples writes .glb, .usda, .usdc, .usdz or .abc",
+        &args.layout,
+        "smear multiples adds copies per frame",
     )?;
     let plan = args.effect.plan(&args.offsets)?;
     let spinner = crate::progress::spinner("drawing multiple in-betweens", ctx.json);
@@ -141,8 +175,9 @@ pub(crate) fn multiples(ctx: &Context, args: MultiplesArgs) -> Result<()> {
     let style = args.effect.style(&args.offsets, &plan, &p)?;
     let out = run_style(&args.io, &p, &style)?;
     let t = Instant::now();
+    let mut written = Vec::new();
     if args.offsets.subdivide.is_some() {
-        tkio::save_with(&args.io.output, &Output::Flipbook(&out.flipbook), ctx.save)?;
+        written = tkio::save_with(&args.io.output, &Output::Flipbook(&out.flipbook), ctx.save)?;
     }
     let parts: Vec<(&MeshAnimation, Option<&[[f32; 4]]>)> = out
         .flipbook
@@ -154,11 +189,11 @@ pub(crate) fn multiples(ctx: &Context, args: MultiplesArgs) -> Result<()> {
         })
         .collect();
     if args.offsets.subdivide.is_none() {
-        tkio::save_with(
+        written = tkio::save_with(
             &args.io.output,
             &Output::Parts {
                 parts: &parts,
-                layout: tkio::Layout::Flipbook,
+                layout: args.layout.layout(),
             },
             ctx.save,
         )?;
@@ -173,7 +208,7 @@ pub(crate) fn multiples(ctx: &Context, args: MultiplesArgs) -> Result<()> {
         })
         .collect();
     let summary = json!({
-        "input": args.io.input, "output": args.io.output,
+        "input": args.io.input, "output": args.io.output, "files": written,
         "frames": body.frame_count(), "vertices": body.vertex_count(),
         "spacing": plan.spacing, "spacing_keyframed": matches!(&plan.options.spacing, Spacing::Frames(Param::Curve(_))),
         "m_max": plan.m_max, "step": plan.options.step, "copies": copies_json,
@@ -183,7 +218,7 @@ pub(crate) fn multiples(ctx: &Context, args: MultiplesArgs) -> Result<()> {
     ctx.report(&summary, || {
         format!(
             "wrote {} ({} frames, {} copies spaced {:.3} frames)",
-            args.io.output.display(),
+            shared::files(&written),
             body.frame_count(),
             copies_json.len(),
             plan.spacing
@@ -195,9 +230,10 @@ pub(crate) fn multiples(ctx: &Context, args: MultiplesArgs) -> Result<()> {
 /// Runs `toonkit smear lines`.
 pub(crate) fn lines(ctx: &Context, args: LinesArgs) -> Result<()> {
     let start = Instant::now();
-    shared::require_scenes(
+    require_frames(
         &args.io.output,
-        "smear lines writes .glb, .usda, .usdc, .usdz or .abc",
+        &args.layout,
+        "smear lines adds new lines per frame",
     )?;
     let plan = args.effect.plan(&args.offsets)?;
     let spinner = crate::progress::spinner("tracing motion lines", ctx.json);
@@ -207,16 +243,17 @@ pub(crate) fn lines(ctx: &Context, args: LinesArgs) -> Result<()> {
     let out = run_style(&args.io, &p, &style)?;
     let t = Instant::now();
     let body = (out.animation(0)).context("internal: part 0 of the result is not a point cache")?;
-    let Some(FlipbookPart::Frames { meshes, .. }) =
+    let Some(FlipbookPart::Frames { meshes, curves, .. }) =
         out.objects[0].lines.and_then(|i| out.flipbook.parts.get(i))
     else {
         bail!("internal: the result has no motion lines");
     };
-    tkio::save_with(
+    let written = tkio::save_with(
         &args.io.output,
         &Output::MotionLines {
             body,
             lines: meshes,
+            curves: curves.as_deref(),
         },
         ctx.save,
     )?;
@@ -225,7 +262,7 @@ pub(crate) fn lines(ctx: &Context, args: LinesArgs) -> Result<()> {
     let per_frame = stats.lines_per_frame.clone().unwrap_or_default();
     let seed_total = stats.seeds.unwrap_or(0);
     let summary = json!({
-        "input": args.io.input, "output": args.io.output,
+        "input": args.io.input, "output": args.io.output, "files": written,
         "frames": body.frame_count(), "vertices": body.vertex_count(),
         "seeds": seed_total, "radius": radius, "weighted": p.weights(0).is_some(), "step": args.offsets.step,
         "lines_per_frame": per_frame,
@@ -235,7 +272,7 @@ pub(crate) fn lines(ctx: &Context, args: LinesArgs) -> Result<()> {
     ctx.report(&summary, || {
         format!(
             "wrote {} ({} frames, {} seeds, up to {} lines per frame)",
-            args.io.output.display(),
+            shared::files(&written),
             meshes.len(),
             seed_total,
             per_frame.iter().max().unwrap_or(&0)
