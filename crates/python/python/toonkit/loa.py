@@ -22,7 +22,12 @@ import os
 from . import _native
 from ._native import Line, Motion
 
-__all__ = ["Line", "Motion", "animate", "line"]
+__all__ = ["DAMPING_RANGE", "Line", "Motion", "STIFFNESS_RANGE", "animate", "line"]
+
+#: The documented stiffness range (1/s², inclusive); a keystroke outside it raises ValueError.
+STIFFNESS_RANGE: tuple = _native.LOA_STIFFNESS_RANGE
+#: The documented damping-ratio range (inclusive); a keystroke outside it raises ValueError.
+DAMPING_RANGE: tuple = _native.LOA_DAMPING_RANGE
 
 
 def _keystrokes_json(keystrokes: Iterable[Mapping[str, Any]], fps: Optional[float]) -> str:
