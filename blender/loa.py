@@ -57,10 +57,12 @@ class LoaSettings(bpy.types.PropertyGroup):
                            description="Comma-separated bones (when the set is 'Bones…')")
     bone_keys: CollectionProperty(type=LoaBoneKey, name="Bone sets per frame")
     mode: EnumProperty(name="Line", items=MODES, default="physics")
-    stiffness: FloatProperty(name="Stiffness", default=0.0, min=0.0,
-                             description="Spring stiffness of every keystroke (0: the default)")
-    damping: FloatProperty(name="Damping", default=0.0, min=0.0, max=1.0,
-                           description="Damping of every keystroke (0: the default)")
+    stiffness: FloatProperty(name="Stiffness", default=0.0, min=0.0, max=100.0,
+                             description="Spring stiffness of every keystroke, 5 to 100 "
+                                         "(0: the default)")
+    damping: FloatProperty(name="Damping", default=0.0, min=0.0, max=0.5,
+                           description="Damping ratio of every keystroke, 0.05 to 0.5 "
+                                       "(0: the default)")
     line_width: FloatProperty(name="Line width", default=0.0, min=0.0, precision=4,
                               description="Bevel of the line curve; 0 = 0.5 % of the height")
 

@@ -229,6 +229,14 @@ fn loa_errors() -> Vec<loa::LoaError> {
             value: f64::NAN,
             expected: "a number in [0.05, 0.5]",
         },
+        E::OutOfRange {
+            name: "stiffness",
+            value: 540.0,
+            min: 5.0,
+            max: 100.0,
+            keystroke: 1,
+            frame: 12,
+        },
         E::Json("line 1 column 2: expected value".into()),
         E::Xml("unexpected end of file".into()),
         E::SvgElement {

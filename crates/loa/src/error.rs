@@ -83,6 +83,28 @@ pub enum LoaError {
         /// What would be accepted.
         expected: &'static str,
     },
+    /// A keystroke's stiffness or damping lies outside its documented range
+    /// ([`STIFFNESS_RANGE`](crate::STIFFNESS_RANGE), [`DAMPING_RANGE`](crate::DAMPING_RANGE)),
+    /// where the sliders no longer act monotonically. Pick a value inside the range.
+    #[error(
+        "keystroke {keystroke} (frame {frame}): {name} = {} is outside the documented range \
+         [{}, {}]; pick a value inside it",
+        anim::human_number(*.value), anim::human_number(*.min), anim::human_number(*.max)
+    )]
+    OutOfRange {
+        /// `stiffness` or `damping`.
+        name: &'static str,
+        /// The rejected value.
+        value: f64,
+        /// Smallest accepted value.
+        min: f64,
+        /// Largest accepted value.
+        max: f64,
+        /// Index of the keystroke in input order.
+        keystroke: usize,
+        /// Its frame number.
+        frame: i64,
+    },
     /// The keystroke JSON does not parse or does not follow the layout documented in
     /// [`Keystrokes::from_json_str`](crate::Keystrokes::from_json_str).
     #[error("keystroke JSON: {0}")]

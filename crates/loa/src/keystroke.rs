@@ -1,5 +1,7 @@
 //! Keystrokes: strokes drawn at given frames, with the elastic parameters of the line.
 
+use std::ops::RangeInclusive;
+
 use glam::DVec2;
 use serde::Deserialize;
 
@@ -12,6 +14,13 @@ use crate::stroke::Stroke;
 pub const DEFAULT_STIFFNESS: f64 = 60.0;
 /// Default damping ratio `ζ` (1 = critical; below 1 the line overshoots and wobbles).
 pub const DEFAULT_DAMPING: f64 = 0.35;
+/// The documented stiffness range (1/s²): across it a stiffer line arrives strictly earlier
+/// and wobbles strictly faster, and no chain point moves more than 15 % of the line's length
+/// in a frame. Values outside are rejected ([`LoaError::OutOfRange`]).
+pub const STIFFNESS_RANGE: RangeInclusive<f64> = 5.0..=100.0;
+/// The documented damping-ratio range: across it more damping strictly lowers the overshoot.
+/// Values outside are rejected ([`LoaError::OutOfRange`]).
+pub const DAMPING_RANGE: RangeInclusive<f64> = 0.05..=0.5;
 /// Default frames per second when the input names none.
 pub const DEFAULT_FPS: f64 = 24.0;
 /// Largest frame span (last keystroke frame − first) accepted, to keep memory bounded.
@@ -102,8 +111,8 @@ impl Keystrokes {
                     previous: keys[i - 1].frame,
                 });
             }
-            check_non_negative("stiffness", k.stiffness)?;
-            check_non_negative("damping", k.damping)?;
+            check_range("stiffness", k.stiffness, &STIFFNESS_RANGE, i, k.frame)?;
+            check_range("damping", k.damping, &DAMPING_RANGE, i, k.frame)?;
         }
         let span = keys[keys.len() - 1].frame.saturating_sub(keys[0].frame);
         if span > MAX_FRAME_SPAN {
@@ -187,6 +196,27 @@ pub(crate) fn integral_frame(f: f64) -> Result<i64, LoaError> {
         });
     }
     Ok(f as i64)
+}
+
+/// `value` of keystroke `keystroke` (at `frame`) inside the documented `range`.
+fn check_range(
+    name: &'static str,
+    value: f64,
+    range: &RangeInclusive<f64>,
+    keystroke: usize,
+    frame: i64,
+) -> Result<(), LoaError> {
+    if range.contains(&value) {
+        return Ok(());
+    }
+    Err(LoaError::OutOfRange {
+        name,
+        value,
+        min: *range.start(),
+        max: *range.end(),
+        keystroke,
+        frame,
+    })
 }
 
 pub(crate) fn check_non_negative(name: &'static str, v: f64) -> Result<(), LoaError> {

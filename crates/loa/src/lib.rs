@@ -33,14 +33,15 @@
 //! The keystrokes stay at the frames the animator put them on; the parameters shape the
 //! motion between them (see `timing` below):
 //!
-//! * **stiffness** `k` (1/s², per keystroke, documented range 5–100): how quickly the line
-//!   heads for the next pose and how fast it wobbles (whip, ζ = 0.15: 90 % of the way after
-//!   13.7 / 13.0 / 10.9 / 8.9 frames at k = 20 / 25 / 35 / 50; stiffer than ≈ 100 the
+//! * **stiffness** `k` (1/s², per keystroke, range [`STIFFNESS_RANGE`] 5–100): how quickly
+//!   the line heads for the next pose and how fast it wobbles (whip, ζ = 0.15: 90 % of the
+//!   way after 13.7 / 13.0 / 10.9 / 8.9 frames at k = 20 / 25 / 35 / 50; near 100 the
 //!   approach is limited by the motion cap below).
-//! * **damping** `ζ` (per keystroke, documented range 0.05–0.5): how far the line overshoots
-//!   the next pose (whip, k = 120: overshoot strictly smaller at ζ = 0.1 < 0.25 < 0.5 < 1).
-//!   Damping above 0.5 is accepted but slows the approach past `t*`, and the sped-up replay
-//!   can then exceed the motion cap.
+//! * **damping** `ζ` (per keystroke, range [`DAMPING_RANGE`] 0.05–0.5): how far the line
+//!   overshoots the next pose (whip, k = 100: overshoot strictly smaller at
+//!   ζ = 0.1 < 0.25 < 0.5; not yet from 0.05, nor on every keystroke sequence:
+//!   `tests/monotone.rs`).
+//! * Values outside the ranges are rejected ([`LoaError::OutOfRange`], naming the range).
 //! * **settle** ([`PhysicsOptions::settle`], default one key interval): follow-through frames
 //!   after the last keystroke, ending on it at rest. A keystroke repeated at a later frame is a moving hold.
 //! * No setting in those ranges moves any chain point more than 15 % of the line's length in
@@ -176,8 +177,8 @@ pub use fit::{fit_chain, ChainFit, FitResidual, DEFAULT_ELEMENTS};
 pub use hermite::{interpolate_hermite, HermiteLine, HermiteTrack};
 pub use keypose::{fit_keystrokes, KeyPose};
 pub use keystroke::{
-    Keystroke, Keystrokes, DEFAULT_DAMPING, DEFAULT_FPS, DEFAULT_STIFFNESS, MAX_FRAME_SPAN,
-    MIN_RELATIVE_STROKE_LENGTH,
+    Keystroke, Keystrokes, DAMPING_RANGE, DEFAULT_DAMPING, DEFAULT_FPS, DEFAULT_STIFFNESS,
+    MAX_FRAME_SPAN, MIN_RELATIVE_STROKE_LENGTH, STIFFNESS_RANGE,
 };
 pub use onion::{to_svg_string, DEFAULT_SVG_WIDTH};
 pub use physics::{

@@ -79,10 +79,12 @@ pub struct Line {
 /// Eq. 1), interpolates them with the chosen mode (physics: LoA Section 3.2 and LoA Eq. 2),
 /// adds the settle frames and applies the wobbles.
 ///
-/// Orientation: a keystroke's start is the end that pairs better with the previous
-/// keystroke's ends (smaller sum of start–start and end–end distances than start–end and
-/// end–start); a keystroke drawn the other way round is reversed and reported, because the
-/// line would otherwise spin 180° about its root.
+/// Orientation: a keystroke is reversed (and reported, with the distances compared) when it
+/// is drawn the other way round from the previous keystroke — its chord (start → end) turns
+/// more than 90° from the previous one's *and* its ends pair better crossed (start–previous
+/// end plus end–previous start shorter than start–previous start plus end–previous end) —
+/// because the line would otherwise spin about its root. A keystroke that continues the
+/// previous one's direction (chords less than 90° apart) is never reversed.
 ///
 /// # Errors
 /// Invalid options (fps, sub-steps, element count, wobble frame) or a keystroke the fit
@@ -113,15 +115,8 @@ pub fn line(keys: &Keystrokes, options: &LineOptions) -> Result<Line, LoaError> 
     for w in &options.wobbles {
         animation = wobble(&animation, w, options.physics.substeps)?;
     }
-    let warnings = reversed
-        .iter()
-        .map(|f| {
-            format!(
-                "keystroke at frame {f} is drawn the other way round from the previous one; \
-                 reversed it (its start is the end nearer the previous keystroke's start)"
-            )
-        })
-        .collect();
+    let warnings = reversed.iter().map(Reversal::warning).collect();
+    let reversed = reversed.iter().map(|r| r.frame).collect();
     Ok(Line {
         animation,
         keys: poses,
@@ -131,18 +126,60 @@ pub fn line(keys: &Keystrokes, options: &LineOptions) -> Result<Line, LoaError> 
     })
 }
 
-/// Orients and smooths the keystrokes; returns them with the frames of reversed ones.
-fn prepare(keys: &Keystrokes, options: &LineOptions) -> Result<(Keystrokes, Vec<i64>), LoaError> {
+/// A keystroke drawn the other way round from the previous one, and why it was reversed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Reversal {
+    frame: i64,
+    /// Start–previous start plus end–previous end, as drawn.
+    straight: f64,
+    /// Start–previous end plus end–previous start.
+    crossed: f64,
+    /// Angle (degrees) between the chord as drawn and the previous keystroke's chord.
+    turn: f64,
+}
+
+impl Reversal {
+    /// The reversal of the keystroke at `frame` with ends `(a, b)` after a keystroke with ends
+    /// `(p0, p1)`, if the orientation rule of [`line()`] asks for one.
+    fn of(frame: i64, (a, b): (DVec2, DVec2), (p0, p1): (DVec2, DVec2)) -> Option<Reversal> {
+        let (chord, previous) = (b - a, p1 - p0);
+        let straight = (a - p0).length() + (b - p1).length();
+        let crossed = (a - p1).length() + (b - p0).length();
+        // Continuing the previous direction (or a degenerate chord) never reverses.
+        let opposed = chord.dot(previous) < 0.0;
+        (opposed && crossed < straight).then(|| Reversal {
+            frame,
+            straight,
+            crossed,
+            turn: previous.angle_to(chord).abs().to_degrees(),
+        })
+    }
+
+    fn warning(&self) -> String {
+        format!(
+            "keystroke at frame {} is drawn the other way round from the previous one (its \
+             direction turns {:.0}° from the previous one's, more than 90°, and its ends are \
+             nearer the previous keystroke's opposite ends: {:.1} crossed against {:.1} as drawn, \
+             start-to-start plus end-to-end); reversed it so the line does not spin about its \
+             root",
+            self.frame, self.turn, self.crossed, self.straight,
+        )
+    }
+}
+
+/// Orients and smooths the keystrokes; returns them with the reversed ones.
+fn prepare(
+    keys: &Keystrokes,
+    options: &LineOptions,
+) -> Result<(Keystrokes, Vec<Reversal>), LoaError> {
     let mut out: Vec<Keystroke> = Vec::with_capacity(keys.keys().len());
     let mut reversed = Vec::new();
     for k in keys.keys() {
         let mut k = k.clone();
         if let (true, Some(prev)) = (options.orient, out.last()) {
-            let (p0, p1) = ends(&prev.stroke);
-            let (a, b) = ends(&k.stroke);
-            if (a - p1).length() + (b - p0).length() < (a - p0).length() + (b - p1).length() {
+            if let Some(r) = Reversal::of(k.frame, ends(&k.stroke), ends(&prev.stroke)) {
                 k.stroke = k.stroke.reversed();
-                reversed.push(k.frame);
+                reversed.push(r);
             }
         }
         out.push(k);

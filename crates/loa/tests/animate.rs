@@ -99,7 +99,7 @@ fn fixed_bone_set_static_line_matches_robot() {
         "robot static line: mean 2D distance {:.2} % of line length (max {:.2} %), \
          {} iterations, energy {:.4} -> {:.4}",
         100.0 * r.line_distance_mean,
-        100.0 * r.line_distance_max,
+        100.0 * r.line_distance_worst.distance,
         r.planar.iterations,
         r.planar.initial_energy,
         r.planar.final_energy
@@ -212,7 +212,7 @@ fn runs_on_a_bvh_skeleton() {
     println!(
         "BVH 02_02 chain {names:?}: mean 2D distance {:.2} % (max {:.2} %)",
         100.0 * motion.report.line_distance_mean,
-        100.0 * motion.report.line_distance_max
+        100.0 * motion.report.line_distance_worst.distance
     );
     assert_eq!(names.first(), Some(&"lFoot"));
     assert_eq!(names.last(), Some(&"head"));

@@ -59,7 +59,7 @@ fn keystroke_input_errors_are_clear() {
     ));
     assert!(matches!(
         err(r#"{"keystrokes": [{"frame": 0, "points": [[0,0],[1,0]], "damping": -1}]}"#),
-        LoaError::InvalidParameter {
+        LoaError::OutOfRange {
             name: "damping",
             ..
         }

@@ -4,13 +4,13 @@
 
 mod common;
 
-use common::{example, with_params};
+use common::{example, max_jump, with_params};
 use glam::DVec2;
 use loa::{Animation, Keystrokes, LineOptions, PhysicsOptions, Settle};
 
 /// Documented ranges (crate docs, "Parameters").
-const STIFFNESS_RANGE: [f64; 2] = [5.0, 100.0];
-const DAMPING_RANGE: [f64; 2] = [0.05, 0.5];
+const STIFFNESS_RANGE: [f64; 2] = [*loa::STIFFNESS_RANGE.start(), *loa::STIFFNESS_RANGE.end()];
+const DAMPING_RANGE: [f64; 2] = [*loa::DAMPING_RANGE.start(), *loa::DAMPING_RANGE.end()];
 
 fn physics_line(keys: &Keystrokes, settle: u32) -> loa::Line {
     let options = LineOptions {
@@ -97,22 +97,6 @@ fn settle_frequency(a: &Animation) -> f64 {
         .map_or(0.0, |i| 0.02 * i as f64)
 }
 
-/// Largest per-frame motion of any chain point over the line's length.
-fn max_jump(a: &Animation) -> f64 {
-    a.frames
-        .windows(2)
-        .map(|w| {
-            let length = w[0].chain.total_length().max(w[1].chain.total_length());
-            let (p, q) = (w[0].chain.joints(), w[1].chain.joints());
-            p.iter()
-                .zip(&q)
-                .map(|(a, b)| (*a - *b).length())
-                .fold(0.0, f64::max)
-                / length
-        })
-        .fold(0.0, f64::max)
-}
-
 fn strictly_increasing(v: &[f64]) -> bool {
     v.windows(2).all(|w| w[1] > w[0])
 }
@@ -120,8 +104,8 @@ fn strictly_increasing(v: &[f64]) -> bool {
 #[test]
 fn keystrokes_stay_at_their_frames_for_every_setting() {
     let whip = example("whip.json");
-    for k in [5.0, 60.0, 1000.0] {
-        for z in [0.05, 0.35, 2.0] {
+    for k in [5.0, 60.0, 100.0] {
+        for z in [0.05, 0.35, 0.5] {
             let line = physics_line(&with_params(&whip, Some(k), Some(z)), 0);
             for key in &line.keys {
                 let c = line.animation.chain_at(key.frame).unwrap();
@@ -136,12 +120,14 @@ fn keystrokes_stay_at_their_frames_for_every_setting() {
 #[test]
 fn damping_sets_the_overshoot_monotonically() {
     let whip = example("whip.json");
-    let values: Vec<f64> = [0.1, 0.25, 0.5, 1.0]
+    // Not yet from the bottom of the range: at ζ = 0.05 whip overshoots less than at 0.1
+    // (see the random keystrokes of tests/monotone.rs).
+    let values: Vec<f64> = [0.1, 0.25, 0.5]
         .iter()
-        .map(|&z| overshoot(&physics_line(&with_params(&whip, Some(120.0), Some(z)), 0).animation))
+        .map(|&z| overshoot(&physics_line(&with_params(&whip, Some(100.0), Some(z)), 0).animation))
         .collect();
     println!(
-        "whip overshoot (fraction of the key-to-key motion) at ζ = 0.1, 0.25, 0.5, 1: {values:.3?}"
+        "whip overshoot (fraction of the key-to-key motion) at ζ = 0.1, 0.25, 0.5: {values:.3?}"
     );
     assert!(values.windows(2).all(|w| w[1] < w[0]), "{values:?}");
     assert!(values[0] > 0.0, "low damping overshoots: {values:?}");
@@ -257,7 +243,15 @@ fn a_reversed_stroke_is_oriented_with_a_warning() {
     let b = physics_line(&flipped, 0);
     assert_eq!(b.reversed, vec![22]);
     assert_eq!(b.warnings.len(), 1);
+    println!("{}", b.warnings[0]);
     assert!(b.warnings[0].contains("frame 22"), "{:?}", b.warnings);
+    // The warning states the rule with the distances it compared.
+    assert!(
+        b.warnings[0].contains("crossed against"),
+        "{:?}",
+        b.warnings
+    );
+    assert!(b.warnings[0].contains("more than 90°"), "{:?}", b.warnings);
     assert!(a.warnings.is_empty());
     // The same motion as the correctly drawn strokes.
     for (x, y) in a.animation.frames.iter().zip(&b.animation.frames) {
@@ -287,4 +281,55 @@ fn wobble_option_hits_the_line() {
         .fold(0.0, f64::max);
     assert!(d > 5.0, "{d}");
     assert!("20:1.5:0,1".parse::<loa::Wobble>().is_err());
+}
+
+#[test]
+fn values_outside_the_documented_ranges_are_rejected_naming_the_range() {
+    let stroke = r#""points": [[0, 0], [50, -30], [100, 0]]"#;
+    for (field, value, range) in [
+        ("stiffness", "540", "[5, 100]"),
+        ("stiffness", "4.9", "[5, 100]"),
+        ("damping", "0.6", "[0.05, 0.5]"),
+        ("damping", "0", "[0.05, 0.5]"),
+    ] {
+        let text = format!(
+            r#"{{"keystrokes": [{{"frame": 0, {stroke}}}, {{"frame": 12, {stroke}, "{field}": {value}}}]}}"#
+        );
+        let e = Keystrokes::from_json_str(&text).unwrap_err();
+        let message = e.to_string();
+        println!("{message}");
+        assert!(matches!(
+            e,
+            loa::LoaError::OutOfRange {
+                keystroke: 1,
+                frame: 12,
+                ..
+            }
+        ));
+        assert!(
+            message.contains(field) && message.contains(range),
+            "{message}"
+        );
+    }
+    // The ends of the ranges are accepted.
+    let text = format!(
+        r#"{{"stiffness": 100, "damping": 0.05, "keystrokes": [{{"frame": 0, {stroke}}}, {{"frame": 12, {stroke}, "stiffness": 5, "damping": 0.5}}]}}"#
+    );
+    assert!(Keystrokes::from_json_str(&text).is_ok());
+}
+
+#[test]
+fn a_stroke_continuing_the_previous_direction_is_never_reversed() {
+    let key = |frame, points: &[[f64; 2]]| {
+        let stroke = loa::Stroke::new(points.iter().map(|p| DVec2::new(p[0], p[1]))).unwrap();
+        loa::Keystroke::new(frame, stroke)
+    };
+    // The second stroke starts next to the first one's end and heads on (84° from its
+    // direction): its ends pair better crossed (10 + 1020 against 90 + 1005 as drawn), but it
+    // continues the previous direction, so it is kept as drawn.
+    let first = key(0, &[[0.0, 0.0], [50.0, 0.0], [100.0, 0.0]]);
+    let second = key(12, &[[90.0, 0.0], [145.0, 500.0], [200.0, 1000.0]]);
+    let line = physics_line(&Keystrokes::new(vec![first, second], None).unwrap(), 0);
+    assert!(line.reversed.is_empty(), "{:?}", line.warnings);
+    assert!(line.warnings.is_empty(), "{:?}", line.warnings);
 }

@@ -49,6 +49,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(smear_presets::save_style, m)?)?;
     m.add_function(wrap_pyfunction!(smear_presets::style_toml, m)?)?;
     m.add_class::<loa_py::Line>()?;
+    // The documented slider ranges, defined once in the loa crate.
+    let range = |r: std::ops::RangeInclusive<f64>| (*r.start(), *r.end());
+    m.add("LOA_STIFFNESS_RANGE", range(loa::STIFFNESS_RANGE))?;
+    m.add("LOA_DAMPING_RANGE", range(loa::DAMPING_RANGE))?;
     m.add_function(wrap_pyfunction!(loa_py::line, m)?)?;
     m.add_function(wrap_pyfunction!(loa_character::save_pose, m)?)?;
     m.add_class::<stopmo_py::Segmented>()?;

@@ -77,7 +77,14 @@ impl Motion {
         let r = &self.motion.report;
         let d = PyDict::new(py);
         d.set_item("line_distance_mean", r.line_distance_mean)?;
-        d.set_item("line_distance_max", r.line_distance_max)?;
+        d.set_item("line_distance_p95", r.line_distance_p95)?;
+        let worst = PyDict::new(py);
+        worst.set_item("distance", r.line_distance_worst.distance)?;
+        worst.set_item("joint", &r.line_distance_worst.joint)?;
+        worst.set_item("frame", r.line_distance_worst.frame)?;
+        d.set_item("line_distance_worst", worst)?;
+        d.set_item("measured_joints", &r.measured_joints)?;
+        d.set_item("unmeasured_frames", &r.unmeasured_frames)?;
         d.set_item("max_rotation_step", r.max_rotation_step)?;
         d.set_item("contact_error_max", r.contact_error_max)?;
         d.set_item("height", r.height)?;

@@ -1,6 +1,7 @@
 """toonkit.loa against `toonkit loa line` on the examples' keystrokes."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -92,3 +93,17 @@ def test_animate_bad_input(robot):
     arrays = toonkit.Scene.from_arrays(robot.positions, robot.triangles)
     with pytest.raises(ValueError, match="not a character"):
         toonkit.loa.animate(arrays, line)
+
+
+def test_values_outside_the_documented_ranges_raise_naming_the_range():
+    assert toonkit.loa.STIFFNESS_RANGE == (5.0, 100.0)
+    assert toonkit.loa.DAMPING_RANGE == (0.05, 0.5)
+    stroke = np.array([[0.0, 0.0], [50.0, -30.0], [100.0, 0.0]])
+    for opt, value, text in [("stiffness", 540, "[5, 100]"), ("damping", 0.9, "[0.05, 0.5]")]:
+        keys = [{"frame": 0, "points": stroke}, {"frame": 12, "points": stroke, opt: value}]
+        with pytest.raises(ValueError, match=re.escape(text)):
+            toonkit.loa.line(keys)
+    lo, hi = toonkit.loa.STIFFNESS_RANGE
+    ok = [{"frame": 0, "points": stroke, "stiffness": lo},
+          {"frame": 12, "points": stroke, "stiffness": hi}]
+    assert toonkit.loa.line(ok).points.shape[0] > 12

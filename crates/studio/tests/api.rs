@@ -139,6 +139,20 @@ async fn bad_bodies_get_json_errors_and_the_server_keeps_serving() {
     .await;
     assert_eq!(status, StatusCode::BAD_REQUEST);
     error_of(&body);
+    // A stiffness outside the documented range: a JSON error naming the range.
+    let stroke = json!([[0, 0], [50, -30], [100, 0]]);
+    let (status, body) = send(
+        &app,
+        post(
+            "/api/loa/animate",
+            json!({"keystrokes": [{"frame": 0, "points": stroke},
+                                  {"frame": 12, "points": stroke, "stiffness": 540}],
+                   "width": 640, "height": 480}),
+        ),
+    )
+    .await;
+    assert_eq!(status, StatusCode::BAD_REQUEST);
+    assert!(error_of(&body).contains("[5, 100]"), "{}", error_of(&body));
     let (status, body) = send(&app, get("/api/nothing")).await;
     assert_eq!(status, StatusCode::NOT_FOUND);
     error_of(&body);

@@ -287,11 +287,21 @@ pub struct AnimateReport {
     pub planar: StageReport,
     /// 3D stage (Section 4.1), when twists or contacts were given.
     pub spatial: Option<StageReport>,
-    /// Mean over frames of the mean 2D distance between the constrained chain points and
-    /// their line targets, as a fraction of the line's length at that frame.
+    /// Mean 2D distance between the character and the line: over every constrained chain
+    /// point ([`measured_joints`](Self::measured_joints)) of every frame that has one, each
+    /// as a fraction of the line's length at its frame. Frames without constrained points
+    /// ([`unmeasured_frames`](Self::unmeasured_frames)) cannot be measured and are listed
+    /// instead of counted.
     pub line_distance_mean: f64,
-    /// Largest per-frame value of that distance (fraction of the line's length).
-    pub line_distance_max: f64,
+    /// 95th percentile of the same distances (nearest rank).
+    pub line_distance_p95: f64,
+    /// The single point farthest from the line, over every frame.
+    pub line_distance_worst: WorstPoint,
+    /// Names of the measured points' joints (a leaf's tip is `NAME (tip)`), in joint order.
+    pub measured_joints: Vec<String>,
+    /// Frames with no constrained point (no bone set in force there), left out of the
+    /// distance figures.
+    pub unmeasured_frames: Vec<i64>,
     /// Largest rotation (radians) of any joint's local orientation between consecutive
     /// frames.
     pub max_rotation_step: f64,
@@ -300,6 +310,17 @@ pub struct AnimateReport {
     pub contact_error_max: f64,
     /// Body height used for contacts.
     pub height: f64,
+}
+
+/// The point of the character farthest from the line ([`AnimateReport::line_distance_worst`]).
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
+pub struct WorstPoint {
+    /// Its distance to the line, as a fraction of the line's length at that frame.
+    pub distance: f64,
+    /// The joint (`NAME (tip)` for the end of a leaf bone).
+    pub joint: String,
+    /// The frame.
+    pub frame: i64,
 }
 
 /// A synthesized motion: world transforms of every joint per frame.

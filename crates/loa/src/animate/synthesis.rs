@@ -18,7 +18,7 @@ use super::targets::{
     OrientTarget,
 };
 use super::terms::{log, point_position, Columns};
-use super::{AnimateOptions, AnimateReport, Character, Motion, DEFAULT_MAX_ITERATIONS};
+use super::{AnimateOptions, AnimateReport, Character, Motion, WorstPoint, DEFAULT_MAX_ITERATIONS};
 use crate::Animation;
 
 fn joint_index(rig: &Rig, name: &str) -> Result<usize, AnimateError> {
@@ -363,7 +363,15 @@ pub(crate) fn run(
 
     // Output and measurements.
     let worlds = poses.worlds(rig);
-    let report = measure(rig, &camera, &targets, &contact_targets, &worlds, height);
+    let report = measure(
+        rig,
+        &camera,
+        &targets,
+        &contact_targets,
+        &worlds,
+        height,
+        first,
+    );
     let n = rig.len();
     let mut positions = Vec::with_capacity(frames * n);
     let mut rotations = Vec::with_capacity(frames * n);
@@ -418,6 +426,64 @@ fn piecewise_linear(keys: &[(usize, f64)], f: usize) -> f64 {
     }
 }
 
+/// The character's distances to the line over every constrained point of every frame
+/// (see [`AnimateReport`]), `first` being the first frame's number.
+fn line_distances(
+    rig: &Rig,
+    camera: &ActionCamera,
+    targets: &[FrameTargets],
+    worlds: &[WorldPose],
+    first: i64,
+) -> AnimateReport {
+    let name = |p: ChainPoint| match p {
+        ChainPoint::Joint(j) => rig.names[j].clone(),
+        ChainPoint::Tip(j) => format!("{} (tip)", rig.names[j]),
+    };
+    let mut all = Vec::new();
+    let mut worst = WorstPoint::default();
+    let mut measured = std::collections::BTreeSet::new();
+    let mut unmeasured_frames = Vec::new();
+    for ((t, w), frame) in targets.iter().zip(worlds).zip(first..) {
+        if t.points.is_empty() || t.line_length <= 0.0 {
+            unmeasured_frames.push(frame);
+            continue;
+        }
+        for p in &t.points {
+            let d = (camera.project(point_position(rig, w, p.point)) - p.target).length()
+                / t.line_length;
+            measured.insert(p.point);
+            all.push(d);
+            if d > worst.distance {
+                worst = WorstPoint {
+                    distance: d,
+                    joint: name(p.point),
+                    frame,
+                };
+            }
+        }
+    }
+    let mean = if all.is_empty() {
+        0.0
+    } else {
+        all.iter().sum::<f64>() / all.len() as f64
+    };
+    all.sort_by(f64::total_cmp);
+    // Nearest rank: the smallest value with at least 95 % of the distances at or below it.
+    let p95 = match all.len() {
+        0 => 0.0,
+        n => all[((0.95 * n as f64).ceil() as usize).clamp(1, n) - 1],
+    };
+    AnimateReport {
+        line_distance_mean: mean,
+        line_distance_p95: p95,
+        line_distance_worst: worst,
+        measured_joints: measured.into_iter().map(name).collect(),
+        unmeasured_frames,
+        ..AnimateReport::default()
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
 fn measure(
     rig: &Rig,
     camera: &ActionCamera,
@@ -425,25 +491,8 @@ fn measure(
     contacts: &[Vec<ContactTarget>],
     worlds: &[WorldPose],
     height: f64,
+    first: i64,
 ) -> AnimateReport {
-    let mut sum = 0.0;
-    let mut counted = 0usize;
-    let mut max: f64 = 0.0;
-    for (t, w) in targets.iter().zip(worlds) {
-        if t.points.is_empty() || t.line_length <= 0.0 {
-            continue;
-        }
-        let d: f64 = t
-            .points
-            .iter()
-            .map(|p| (camera.project(point_position(rig, w, p.point)) - p.target).length())
-            .sum::<f64>()
-            / t.points.len() as f64
-            / t.line_length;
-        sum += d;
-        counted += 1;
-        max = max.max(d);
-    }
     let mut step: f64 = 0.0;
     for pair in worlds.windows(2) {
         for j in 0..rig.len() {
@@ -462,15 +511,9 @@ fn measure(
         }
     }
     AnimateReport {
-        line_distance_mean: if counted > 0 {
-            sum / counted as f64
-        } else {
-            0.0
-        },
-        line_distance_max: max,
         max_rotation_step: step,
         contact_error_max: contact,
         height,
-        ..AnimateReport::default()
+        ..line_distances(rig, camera, targets, worlds, first)
     }
 }

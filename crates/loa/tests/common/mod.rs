@@ -57,3 +57,19 @@ pub(crate) fn character(rel: &str, pose: &str) -> (anim::Scene, loa::animate::Ch
     let character = loa::animate::Character::from_scene(&scene, &pose, 24.0).unwrap();
     (scene, character)
 }
+
+/// Largest per-frame motion of any chain point over the line's length.
+pub(crate) fn max_jump(a: &loa::Animation) -> f64 {
+    a.frames
+        .windows(2)
+        .map(|w| {
+            let length = w[0].chain.total_length().max(w[1].chain.total_length());
+            let (p, q) = (w[0].chain.joints(), w[1].chain.joints());
+            p.iter()
+                .zip(&q)
+                .map(|(a, b)| (*a - *b).length())
+                .fold(0.0, f64::max)
+                / length
+        })
+        .fold(0.0, f64::max)
+}

@@ -22,7 +22,21 @@ import os
 from . import _native
 from ._native import Line, Motion
 
-__all__ = ["Line", "Motion", "animate", "line", "save_pose"]
+#: The documented stiffness range (1/s², inclusive); a keystroke outside it raises ValueError.
+STIFFNESS_RANGE: tuple = _native.LOA_STIFFNESS_RANGE
+#: The documented damping-ratio range (inclusive); a keystroke outside it raises ValueError.
+DAMPING_RANGE: tuple = _native.LOA_DAMPING_RANGE
+
+
+__all__ = [
+    "DAMPING_RANGE",
+    "Line",
+    "Motion",
+    "STIFFNESS_RANGE",
+    "animate",
+    "line",
+    "save_pose",
+]
 
 
 def save_pose(

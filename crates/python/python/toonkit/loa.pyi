@@ -6,6 +6,9 @@ import os
 
 from ._native import Line as Line, Motion as Motion, Scene
 
+STIFFNESS_RANGE: tuple[float, float]
+DAMPING_RANGE: tuple[float, float]
+
 def line(
     keystrokes: Iterable[Mapping[str, Any]],
     mode: str = "physics",

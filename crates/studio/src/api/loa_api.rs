@@ -249,7 +249,8 @@ pub(crate) async fn animate(
             "warnings": line.warnings,
             "report": {
                 "line_distance_mean": rep.line_distance_mean,
-                "line_distance_max": rep.line_distance_max,
+                "line_distance_p95": rep.line_distance_p95,
+                "line_distance_worst": rep.line_distance_worst,
                 "max_rotation_step": rep.max_rotation_step,
                 "height": rep.height,
             },

@@ -153,8 +153,16 @@ pub(crate) fn run(ctx: &Context, args: AnimateArgs) -> Result<()> {
             .map(|&(j, p)| format!("{}->{}", names[j], names[p])).collect::<Vec<_>>(),
         "planar": rep.planar,
         "spatial": rep.spatial,
+        // Over every constrained point of every frame with a bone set (see AnimateReport).
         "line_distance_mean_percent": 100.0 * rep.line_distance_mean,
-        "line_distance_max_percent": 100.0 * rep.line_distance_max,
+        "line_distance_p95_percent": 100.0 * rep.line_distance_p95,
+        "line_distance_worst": {
+            "percent": 100.0 * rep.line_distance_worst.distance,
+            "joint": rep.line_distance_worst.joint,
+            "frame": rep.line_distance_worst.frame,
+        },
+        "line_distance_joints": rep.measured_joints,
+        "line_distance_unmeasured_frames": rep.unmeasured_frames,
         "max_rotation_step_degrees": rep.max_rotation_step.to_degrees(),
         "contact_error_max_percent": 100.0 * rep.contact_error_max,
         "solve_seconds": solve_seconds,
@@ -162,18 +170,32 @@ pub(crate) fn run(ctx: &Context, args: AnimateArgs) -> Result<()> {
     });
     ctx.report(&summary, || {
         format!(
-            "{}: {} frames, {} joints; line distance {:.2} % (max {:.2} %), max joint step {:.1}°{} \
-             in {:.0} ms (solve {:.0} ms)",
+            "{}: {} frames, {} joints; line distance mean {:.2} %, p95 {:.2} %, worst {:.2} % \
+             ({} at frame {}){}, max joint step {:.1}°{} in {:.0} ms (solve {:.0} ms)",
             args.output.display(),
             motion.frames(),
             motion.joints,
             100.0 * rep.line_distance_mean,
-            100.0 * rep.line_distance_max,
+            100.0 * rep.line_distance_p95,
+            100.0 * rep.line_distance_worst.distance,
+            rep.line_distance_worst.joint,
+            rep.line_distance_worst.frame,
+            if rep.unmeasured_frames.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    " ({} frames without a bone set not measured)",
+                    rep.unmeasured_frames.len()
+                )
+            },
             rep.max_rotation_step.to_degrees(),
             if options.contacts.is_empty() {
                 String::new()
             } else {
-                format!(", contact error {:.2} % of height", 100.0 * rep.contact_error_max)
+                format!(
+                    ", contact error {:.2} % of height",
+                    100.0 * rep.contact_error_max
+                )
             },
             seconds * 1e3,
             solve_seconds * 1e3

@@ -1,0 +1,249 @@
+//! Damping and stiffness read the way an animator reads the sliders, on keystrokes nobody
+//! tuned for: seeded random sequences of 2–5 keystrokes (arcs, lines and upright strokes of
+//! varied lengths, orientations and spacing). Over the documented ranges
+//! ([`loa::STIFFNESS_RANGE`], [`loa::DAMPING_RANGE`]):
+//!
+//! * more damping → strictly less overshoot of the chain's angles past the next keystroke;
+//! * more stiffness → strictly earlier arrival on the next keystroke and a strictly higher
+//!   wobble frequency;
+//! * no chain point moves more than 15 % of the line's length in one frame.
+//!
+//! These are the acceptance target and do not hold yet: the interpolation's first pass (the
+//! first local minimum of LoA Eq. 2's distance) jumps between swings of the fast bending modes
+//! as the parameters change, and the sped-up replay of a late first pass carries more velocity
+//! with more damping. Run them with `--ignored`; they print the sequences that fail.
+
+mod common;
+
+use std::f64::consts::PI;
+
+use common::max_jump;
+use glam::DVec2;
+use loa::{Animation, Keystroke, Keystrokes, LineOptions, Mode, PhysicsOptions, Settle, Stroke};
+
+/// Random sequences drawn (the acceptance asks for at least 200).
+const SEQUENCES: u64 = 260;
+/// The per-frame motion promise, as a fraction of the line's length.
+const MAX_JUMP: f64 = 0.15;
+
+/// The seeded generator of the random keystrokes (same draws on every run).
+struct Rng(anim::SplitMix64);
+
+impl Rng {
+    fn new(seed: u64) -> Self {
+        Rng(anim::SplitMix64::new(seed, 51))
+    }
+
+    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.0.next_f64()
+    }
+
+    fn below(&mut self, n: u64) -> u64 {
+        self.0.below(n as usize) as u64
+    }
+}
+
+/// One drawn stroke: an arc (bend up to ±100°), a straight line or an upright stroke, of
+/// length `length`, centred near `centre`, leaning by `angle`.
+fn stroke(rng: &mut Rng, centre: DVec2, length: f64, angle: f64) -> Stroke {
+    let (bend, angle) = match rng.below(3) {
+        0 => (rng.uniform(-1.75, 1.75), angle),
+        1 => (0.0, angle),
+        _ => (rng.uniform(-0.4, 0.4), PI / 2.0 + rng.uniform(-0.3, 0.3)),
+    };
+    let samples = 24;
+    let dir = DVec2::from_angle(angle);
+    let normal = DVec2::new(-dir.y, dir.x);
+    let points = (0..=samples).map(|i| {
+        let u = i as f64 / samples as f64 - 0.5;
+        // A circular arc of turning angle `bend` through the centre, parametrized by arc length.
+        let (along, across) = if bend.abs() < 1e-6 {
+            (u * length, 0.0)
+        } else {
+            let radius = length / bend;
+            let phi = u * bend;
+            (radius * phi.sin(), radius * (1.0 - phi.cos()))
+        };
+        centre + along * dir + across * normal
+    });
+    Stroke::new(points).unwrap()
+}
+
+/// A random keystroke sequence with every keystroke's stiffness `k` and damping `z` (set later).
+fn sequence(seed: u64) -> Vec<Keystroke> {
+    let mut rng = Rng::new(seed);
+    let count = 2 + rng.below(4) as usize;
+    let length = rng.uniform(80.0, 400.0);
+    let mut frame = 0;
+    let mut centre = DVec2::new(rng.uniform(-200.0, 200.0), rng.uniform(-200.0, 200.0));
+    let mut angle = rng.uniform(-PI, PI);
+    (0..count)
+        .map(|_| {
+            let scale = rng.uniform(0.8, 1.25);
+            let s = stroke(&mut rng, centre, length * scale, angle);
+            let key = Keystroke::new(frame, s);
+            let gap = 10 + rng.below(21) as i64;
+            frame += gap;
+            // The next pose: a turn and a move the keystrokes' own spacing can carry
+            // (at most 0.7 % of the length per frame for the move, 3° per frame for the turn).
+            angle += rng.uniform(-1.0, 1.0) * (0.05 * gap as f64).min(1.0);
+            centre += DVec2::from_angle(rng.uniform(-PI, PI)) * length * 0.007 * gap as f64;
+            key
+        })
+        .collect()
+}
+
+fn with(keys: &[Keystroke], k: f64, z: f64) -> Keystrokes {
+    let keys = keys
+        .iter()
+        .cloned()
+        .map(|mut key| {
+            key.stiffness = k;
+            key.damping = z;
+            key
+        })
+        .collect();
+    Keystrokes::new(keys, Some(24.0)).unwrap()
+}
+
+fn run(keys: &Keystrokes, mode: Mode, settle: Settle) -> loa::Line {
+    let options = LineOptions {
+        mode,
+        physics: PhysicsOptions {
+            settle,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    loa::line(keys, &options).unwrap()
+}
+
+/// Progress of the chain's angles from keystroke `k0` toward `k1` at `frame`, projected on
+/// the key-to-key change: 0 on `k0`, 1 on `k1`, > 1 past it.
+fn progress(a: &Animation, k0: i64, k1: i64, frame: i64) -> f64 {
+    let angles = |f: i64| a.chain_at(f).unwrap().angles().to_vec();
+    let (g0, g1, g) = (angles(k0), angles(k1), angles(frame));
+    let (mut num, mut den) = (0.0, 0.0);
+    for ((a0, a1), x) in g0.iter().zip(&g1).zip(&g) {
+        num += (x - a0) * (a1 - a0);
+        den += (a1 - a0) * (a1 - a0);
+    }
+    num / den
+}
+
+/// Largest overshoot of the angles past the next keystroke, relative to the change, over
+/// every interval and the settle after the last keystroke (measured against the last change).
+fn overshoot(a: &Animation) -> f64 {
+    let k = &a.keystroke_frames;
+    let end = a.frames.last().unwrap().frame;
+    let mut worst: f64 = 0.0;
+    for (i, w) in k.windows(2).enumerate() {
+        let last = if i + 2 == k.len() { end } else { w[1] };
+        for f in w[0] + 1..last {
+            worst = worst.max(progress(a, w[0], w[1], f) - 1.0);
+        }
+    }
+    worst
+}
+
+/// Mean over the intervals of the fraction of the interval after which the angles have
+/// covered 90 % of the change.
+fn arrival(a: &Animation) -> f64 {
+    let k = &a.keystroke_frames;
+    let mut sum = 0.0;
+    for w in k.windows(2) {
+        let mut prev = 0.0;
+        let mut at = (w[1] - w[0]) as f64;
+        for f in w[0] + 1..=w[1] {
+            let p = progress(a, w[0], w[1], f);
+            if p >= 0.9 {
+                at = (f - 1 - w[0]) as f64 + (0.9 - prev) / (p - prev);
+                break;
+            }
+            prev = p;
+        }
+        sum += at / (w[1] - w[0]) as f64;
+    }
+    sum / (k.len() - 1) as f64
+}
+
+/// `n` values spread geometrically over `range`, ends included.
+fn grid(range: std::ops::RangeInclusive<f64>, n: usize) -> Vec<f64> {
+    let (lo, hi) = (*range.start(), *range.end());
+    (0..n)
+        .map(|i| lo * (hi / lo).powf(i as f64 / (n - 1) as f64))
+        .collect()
+}
+
+/// Sequences whose own keystrokes the Hermite in-betweens already carry at ≤ 8 % of the
+/// line's length per frame (no interpolation can keep a faster key-to-key change under 15 %);
+/// at least 200 of them.
+fn sequences() -> Vec<(u64, Vec<Keystroke>)> {
+    let kept: Vec<(u64, Vec<Keystroke>)> = (0..SEQUENCES)
+        .map(|seed| (seed, sequence(seed)))
+        .filter(|(_, keys)| {
+            let hermite = run(&with(keys, 60.0, 0.35), Mode::Hermite, Settle::Frames(0));
+            max_jump(&hermite.animation) <= 0.08
+        })
+        .collect();
+    assert!(kept.len() >= 200, "only {} usable sequences", kept.len());
+    kept
+}
+
+#[test]
+#[ignore = "acceptance target not met yet (see the module docs)"]
+fn damping_lowers_the_overshoot_on_any_keystrokes() {
+    let dampings = grid(loa::DAMPING_RANGE, 6);
+    let mut worst_jump: f64 = 0.0;
+    let mut failures = Vec::new();
+    for (seed, keys) in sequences() {
+        let k = grid(loa::STIFFNESS_RANGE, 4)[seed as usize % 4];
+        let values: Vec<f64> = dampings
+            .iter()
+            .map(|&z| {
+                let line = run(&with(&keys, k, z), Mode::Physics, Settle::KeyInterval);
+                worst_jump = worst_jump.max(max_jump(&line.animation));
+                overshoot(&line.animation)
+            })
+            .collect();
+        if !values.windows(2).all(|w| w[1] < w[0]) {
+            failures.push(format!("seed {seed} k={k:.1}: overshoot {values:.4?}"));
+        }
+    }
+    println!("largest per-frame motion: {:.1} %", 100.0 * worst_jump);
+    println!("{} of {SEQUENCES} not strictly monotone:", failures.len());
+    for f in failures.iter().take(12) {
+        println!("  {f}");
+    }
+    assert!(failures.is_empty());
+    assert!(worst_jump <= MAX_JUMP, "{worst_jump}");
+}
+
+#[test]
+#[ignore = "acceptance target not met yet (see the module docs)"]
+fn stiffness_brings_the_arrival_earlier_on_any_keystrokes() {
+    let stiffnesses = grid(loa::STIFFNESS_RANGE, 6);
+    let mut worst_jump: f64 = 0.0;
+    let mut failures = Vec::new();
+    for (seed, keys) in sequences() {
+        let z = grid(loa::DAMPING_RANGE, 4)[seed as usize % 4];
+        let values: Vec<f64> = stiffnesses
+            .iter()
+            .map(|&k| {
+                let line = run(&with(&keys, k, z), Mode::Physics, Settle::Frames(0));
+                worst_jump = worst_jump.max(max_jump(&line.animation));
+                arrival(&line.animation)
+            })
+            .collect();
+        if !values.windows(2).all(|w| w[1] < w[0]) {
+            failures.push(format!("seed {seed} ζ={z:.3}: arrival {values:.4?}"));
+        }
+    }
+    println!("largest per-frame motion: {:.1} %", 100.0 * worst_jump);
+    println!("{} of {SEQUENCES} not strictly monotone:", failures.len());
+    for f in failures.iter().take(12) {
+        println!("  {f}");
+    }
+    assert!(failures.is_empty());
+    assert!(worst_jump <= MAX_JUMP, "{worst_jump}");
+}
