@@ -28,9 +28,10 @@ venv() {  # venv DIR BPY_VERSION
 }
 status=0
 # The benchmark tube (docs/blender.md, "Speed"): the smear test prints bake and restyle times
-# and Blender's own floor on it (cargo test has compiled the example).
+# and Blender's own floor on it (the build phase's `--all-targets` compiled the example; a
+# `cargo run -p` here would resolve other features and rebuild much of the workspace).
 tube=target/blender-tube.glb
-cargo run -q -p toonkit-smear --example write_tube -- "$tube" 40
+target/debug/examples/write_tube "$tube" 40
 export TOONKIT_TUBE="$ROOT/$tube"
 for spec in "4.2.0:target/caches-venv" "4.5.15:target/blender-venv-4.5" \
     "5.0.1:target/blender-venv-5.0"; do

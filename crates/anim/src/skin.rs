@@ -220,11 +220,7 @@ pub fn skin_frames(
             weights.slot_count() - 1
         )));
     }
-    let frames = if slots == 0 {
-        0
-    } else {
-        matrices.len() / slots
-    };
+    let frames = matrices.len().checked_div(slots).unwrap_or(0);
     if frames * slots != matrices.len() {
         return mismatch("skin matrices", frames * slots, matrices.len());
     }

@@ -101,7 +101,7 @@ impl Drop for Studio {
 #[test]
 fn over_budget_requests_are_refused_and_the_studio_stays_up_under_a_memory_limit() {
     let dir = tempfile::tempdir().unwrap();
-    let studio = Studio::start("characters/RobotExpressive.glb", dir.path());
+    let mut studio = Studio::start("characters/RobotExpressive.glb", dir.path());
     let (status, _) = studio.request("GET", "/api/info", "");
     assert_eq!(status, 200);
     println!("studio peak after start: {:.0} MiB", studio.peak_mib());

@@ -260,7 +260,17 @@ fn smear_style_fig16_usda_has_every_part() {
         s(&out),
     ]);
     let text = std::fs::read_to_string(&out).unwrap();
-    let names = mesh_names(&text);
+    // Bodies and multiples are meshes; motion lines are BasisCurves prims.
+    let mut names = mesh_names(&text);
+    names.extend(
+        text.lines()
+            .filter_map(|l| l.trim().strip_prefix("def BasisCurves \""))
+            .map(|l| l.trim_end_matches('"')),
+    );
+    assert!(
+        text.contains("def BasisCurves \""),
+        "the style's motion lines are curves"
+    );
     assert_eq!(
         names.len() as u64,
         v["parts"].as_u64().unwrap(),

@@ -205,17 +205,17 @@ mod tests {
         let (a, b) = (dir.path().join("a.obj"), dir.path().join("b.obj"));
         std::fs::write(&a, b"a").unwrap();
         std::fs::write(&b, b"b").unwrap();
+        let barrier = std::sync::Barrier::new(2);
+        let job = |p: &Path| {
+            let scope = ReadScope::open();
+            barrier.wait();
+            note_read(p);
+            barrier.wait();
+            assert!(check_not_input(&a).is_err() && check_not_input(&b).is_err());
+            barrier.wait();
+            scope.files()
+        };
         let (sa, sb) = std::thread::scope(|s| {
-            let barrier = std::sync::Barrier::new(2);
-            let job = |p: &Path| {
-                let scope = ReadScope::open();
-                barrier.wait();
-                note_read(p);
-                barrier.wait();
-                assert!(check_not_input(&a).is_err() && check_not_input(&b).is_err());
-                barrier.wait();
-                scope.files()
-            };
             let ha = s.spawn(|| job(&a));
             let hb = s.spawn(|| job(&b));
             (ha.join().unwrap(), hb.join().unwrap())
