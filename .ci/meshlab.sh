@@ -4,7 +4,10 @@
 # part, with the debug build `cargo test --workspace` left behind), and of a cut whose solids
 # cross themselves as built and are regularized (the seam through both eyes): every solid must
 # be watertight with 0 self-intersecting faces. The crate's tests check the same with an exact
-# integer test; this is the independent check.
+# integer test; this is the independent check. Both runs mount the pieces with magnets (a
+# pocket cut by an exact boolean in every piece and mount), and the first writes library.3mf,
+# which lib3mf (the 3MF Consortium's reader, PyPI) must load as watertight millimetre meshes,
+# one per piece (.ci/threemf_check.py).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export CARGO_TERM_COLOR=never
@@ -13,19 +16,21 @@ VENV=target/meshlab-venv
 OUT=target/meshlab-stopmo
 
 [ -x "$VENV/bin/python" ] || "$PY" -m venv "$VENV"
-"$VENV/bin/pip" --disable-pip-version-check --quiet install pymeshlab
+"$VENV/bin/pip" --disable-pip-version-check --quiet install pymeshlab lib3mf
 # `cargo test --workspace` builds target/debug/toonkit (CARGO_BIN_EXE of the CLI tests).
 [ -x target/debug/toonkit ] || cargo build --workspace --quiet
 rm -rf "$OUT"
 start=$(date +%s)
 target/debug/toonkit stopmo run assets/face/ict-face-talk.glb -o "$OUT" --fps 2 \
-    --part upper=point:0,10,13 --part lower=point:0,-14,10 --pieces 8
+    --part upper=point:0,10,13 --part lower=point:0,-14,10 --pieces 8 \
+    --magnets 3x2 --print-format stl,3mf
 echo "meshlab: stopmo run took $(( $(date +%s) - start )) s"
 "$VENV/bin/python" .ci/meshlab_check.py "$OUT/pieces"
+"$VENV/bin/python" .ci/threemf_check.py "$OUT"
 rm -rf "$OUT"
 start=$(date +%s)
 target/debug/toonkit stopmo run assets/face/ict-face-talk.glb -o "$OUT" --fps 2 \
-    --part upper=point:0,15,8 --part lower=point:0,-8,12 --pieces 8
+    --part upper=point:0,15,8 --part lower=point:0,-8,12 --pieces 8 --magnets 3x2
 echo "meshlab: stopmo run (seam through the eyes) took $(( $(date +%s) - start )) s"
 # The regularization must have had work to do, or this checks nothing new.
 "$VENV/bin/python" -c 'import json, sys

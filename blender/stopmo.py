@@ -46,6 +46,24 @@ class StopmoSettings(bpy.types.PropertyGroup):
     print_height_mm: FloatProperty(name="Print height (mm)", default=60.0, min=1.0)
     plugs: BoolProperty(name="Plugs", default=False,
                         description="Registration plugs between parts")
+    magnets: BoolProperty(
+        name="Magnets", default=False,
+        description="A pocket for a disc magnet in every piece, at one place of its part's "
+                    "back all pieces share, and the matching pocket in the part's mount")
+    magnet_diameter_mm: FloatProperty(name="Magnet diameter (mm)", default=3.0, min=0.5,
+                                      max=100.0)
+    magnet_height_mm: FloatProperty(name="Magnet height (mm)", default=2.0, min=0.5,
+                                    max=100.0)
+    clearance_mm: FloatProperty(
+        name="Clearance (mm)", default=0.0, min=0.0, max=5.0,
+        description="Clearance of fits (magnet pockets, key sockets, plugs); 0: from the "
+                    "printer resolution (0.15 mm)")
+    print_format: EnumProperty(name="Print format", default="stl", items=[
+        ("stl", "STL", "One STL per piece"),
+        ("3mf", "3MF", "One library.3mf: every piece a named object on build plates"),
+        ("stl,3mf", "STL and 3MF", "Both")])
+    plate_mm: FloatVectorProperty(name="Build plate (mm)", size=2, default=(120.0, 68.0),
+                                  min=10.0, max=2000.0)
     print_solids: BoolProperty(
         name="Printable solids", default=True,
         description="Build the STL solids; off, the pieces' surfaces, labels and errors only "
@@ -107,6 +125,14 @@ def options(s):
             "print_height_mm": s.print_height_mm, "print": bool(s.print_solids)}
     if s.plugs:
         opts["plugs"] = {}
+    if s.print_solids:
+        opts["print_format"] = s.print_format
+        opts["plate_mm"] = [float(v) for v in s.plate_mm]
+        if s.magnets:
+            opts["magnets"] = {"diameter_mm": s.magnet_diameter_mm,
+                               "height_mm": s.magnet_height_mm}
+        if s.clearance_mm > 0.0:
+            opts["clearance_mm"] = s.clearance_mm
     return opts
 
 

@@ -97,7 +97,13 @@ class TOONKIT_PT_stopmo(bpy.types.Panel):
         lay.prop(s, {"EACH": "pieces", "BUDGET": "budget", "MAX_ERROR": "max_error_mm"}[s.count])
         col = lay.column(align=True)
         for name in ("lam", "restarts", "seed", "print_height_mm", "print_solids", "plugs",
-                     "directory"):
+                     "magnets"):
+            col.prop(s, name)
+        if s.magnets:
+            row = col.row(align=True)
+            row.prop(s, "magnet_diameter_mm", text="D")
+            row.prop(s, "magnet_height_mm", text="H")
+        for name in ("clearance_mm", "print_format", "plate_mm", "directory"):
             col.prop(s, name)
         lay.operator("toonkit.stopmo_run", icon="MOD_BUILD")
         img = bpy.data.images.get("toonkit error curve")

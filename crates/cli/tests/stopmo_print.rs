@@ -300,3 +300,82 @@ fn printing_switches_and_bad_printing_inputs() {
     check(base(&a), "back surface");
     assert!(!out.join("report.json").exists());
 }
+
+/// `--magnets`, `--clearance`, `--print-format 3mf` and `--plate`: no STL per piece, one
+/// `library.3mf` with every piece, the mounts with the matching pockets, the plates and the
+/// pieces in report.json and assembly.md; bad values are refused naming the flag.
+#[test]
+fn magnets_clearance_and_one_3mf_per_library() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("held");
+    let mut args = PARTS.to_vec();
+    args.extend([
+        "--pieces",
+        "2",
+        "--magnets",
+        "3x2",
+        "--clearance",
+        "0.25",
+        "--print-format",
+        "3mf",
+        "--plate",
+        "50x40",
+    ]);
+    run(&out, "1", &args);
+    let rep = report(&out);
+    let printing = &rep["printing"];
+    assert_eq!(printing["clearance_mm"], 0.25);
+    assert_eq!(printing["print_format"], "3mf");
+    assert_eq!(printing["magnet"]["diameter_mm"], 3.0);
+    let pieces = printing["pieces"].as_array().unwrap();
+    assert_eq!(pieces.len(), 4);
+    for p in pieces {
+        assert_eq!(p["magnet"], true);
+        assert!(p["plate"].as_u64().unwrap() >= 1);
+        assert!(p["volume_mm3"].as_f64().unwrap() > 0.0);
+    }
+    for part in printing["parts"].as_array().unwrap() {
+        let q = &part["magnet_pocket"];
+        assert!(
+            (q["radius_mm"].as_f64().unwrap() - 1.75).abs() < 1e-6,
+            "{q}"
+        );
+        assert!((q["depth_mm"].as_f64().unwrap() - 2.25).abs() < 1e-6, "{q}");
+    }
+    // A 50 × 40 mm plate holds few face pieces: several plates, each listed.
+    let plates = printing["plates"].as_array().unwrap();
+    assert!(plates.len() >= 2, "{plates:?}");
+    let names: Vec<String> = std::fs::read_dir(out.join("pieces"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    let stls: Vec<&String> = names.iter().filter(|n| n.ends_with(".stl")).collect();
+    assert_eq!(stls.len(), 2, "only the mounts: {stls:?}");
+    for part in ["upper", "lower"] {
+        let mount = stl(&out.join(format!("pieces/{part}_back.stl")));
+        assert!(check_solid(&mount).is_closed_manifold(), "{part} mount");
+        assert_eq!(components(&mount).len(), 1, "{part} mount");
+    }
+    let bytes = std::fs::read(out.join("library.3mf")).unwrap();
+    assert_eq!(&bytes[..2], b"PK");
+    let md = std::fs::read_to_string(out.join("assembly.md")).unwrap();
+    assert!(md.contains("Magnets: 3 x 2 mm"), "{md}");
+    assert!(md.contains("| upper_00 | 1-00 | upper |"), "{md}");
+
+    let face = face();
+    let bad = dir.path().join("bad");
+    for (flag, value, needle) in [
+        ("--magnets", "3", "--magnets 3"),
+        ("--magnets", "0x2", "--magnets"),
+        ("--magnets", "40x30", "part upper"),
+        ("--clearance", "-1", "--clearance"),
+        ("--print-format", "obj", "--print-format obj"),
+        ("--plate", "5x5", "--plate 5x5"),
+    ] {
+        let mut a: Vec<&str> = vec!["stopmo", "run", s(&face), "-o", s(&bad), "--fps", "1"];
+        a.extend(PARTS);
+        a.extend(["--pieces", "2", "--restarts", "1", flag, value]);
+        assert_bad_input(&a, needle);
+    }
+    assert!(!bad.join("report.json").exists());
+}

@@ -29,6 +29,7 @@ pub mod obj;
 pub mod pc2;
 #[cfg(feature = "stl")]
 pub mod stl;
+pub mod threemf;
 pub mod usda;
 pub mod usdc;
 

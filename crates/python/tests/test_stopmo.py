@@ -96,3 +96,30 @@ def test_solids_that_cross_as_built_are_regularized(face, tmp_path):
     assert any("regularized to the material it encloses" in w for w in lib.report["warnings"])
     written = lib.save(tmp_path / "py")
     assert any(name.endswith(".stl") for name in written)
+
+
+def test_magnets_clearance_and_3mf_are_the_cli_flags(face, tmp_path):
+    """``magnets``, ``clearance_mm``, ``print_format`` and ``plate_mm`` are ``--magnets``,
+    ``--clearance``, ``--print-format`` and ``--plate``: the same pieces, pockets and plates."""
+    cli = tmp_path / "cli"
+    run_cli("stopmo", "run", asset(FACE), "-o", cli, "--fps", "2",
+            "--part", "upper=point:0,10,13", "--part", "lower=point:0,-14,10",
+            "--pieces", "2", "--restarts", "1", "--magnets", "3x2", "--clearance", "0.2",
+            "--print-format", "stl,3mf", "--plate", "80x60")
+    lib = toonkit.stopmo.run(face, parts=PARTS, pieces=2, restarts=1, magnets="3x2",
+                             clearance_mm=0.2, print_format="stl,3mf", plate_mm=(80, 60))
+    py = tmp_path / "py"
+    lib.save(py)
+    ours = json.loads((py / "report.json").read_text())["printing"]
+    theirs = json.loads((cli / "report.json").read_text())["printing"]
+    assert ours["magnet"] == {"diameter_mm": 3.0, "height_mm": 2.0}
+    assert ours["clearance_mm"] == 0.2
+    for key in ("magnet", "clearance_mm", "plates", "pieces", "print_format"):
+        assert ours[key] == theirs[key], key
+    assert [p["magnet_pocket"] for p in ours["parts"]] == [
+        p["magnet_pocket"] for p in theirs["parts"]]
+    assert all(p["magnet_pocket"]["cover_mm"] >= 1.0 for p in ours["parts"])
+    for name in ("library.3mf", "pieces/upper_back.stl", "pieces/lower_back.stl"):
+        assert (py / name).is_file() and (cli / name).is_file(), name
+    with pytest.raises(ValueError, match="magnet"):
+        toonkit.stopmo.run(face, parts=PARTS, pieces=2, restarts=1, magnets="3 by 2")

@@ -250,10 +250,28 @@ pub struct LibraryOptionsArgs {
     /// Plug length (boss + pin) in millimetres.
     #[arg(long, value_name = "MM", requires = "plugs", default_value_t = DEFAULT_PLUG_LENGTH_MM)]
     pub plug_length: f64,
-    /// Radial clearance between pin and socket in millimetres (tune to the printer).
-    #[arg(long, value_name = "MM", requires = "plugs",
-          default_value_t = DEFAULT_PLUG_CLEARANCE_MM)]
-    pub plug_clearance: f64,
+    /// Radial clearance between pin and socket in millimetres (tune to the printer;
+    /// default: --clearance when given, else 0.15).
+    #[arg(long, value_name = "MM", requires = "plugs")]
+    pub plug_clearance: Option<f64>,
+    /// A disc magnet DIAMETERxHEIGHT in millimetres (e.g. 3x2): every piece gets a pocket
+    /// for it at one place of its part's back that all pieces share (so one magnet in the
+    /// head holds every piece), and the part's mount pieces/<part>_back.stl the matching
+    /// pocket.
+    #[arg(long, value_name = "DxH", conflicts_with = "no_print")]
+    pub magnets: Option<String>,
+    /// Clearance of printed fits in millimetres (magnet pockets, the mount's key sockets and
+    /// plugs); default: 3 × --resolution, at least 0.1 (0.15 at 0.05 mm: a tight resin fit;
+    /// 0.3 gives a loose one).
+    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
+    pub clearance: Option<f64>,
+    /// Files of the printable solids: one STL per piece, one library.3mf (every piece a
+    /// named object, one colour per part, laid out on build plates), or both.
+    #[arg(long, value_name = "stl|3mf|stl,3mf", default_value = "stl")]
+    pub print_format: String,
+    /// Build plate WIDTHxDEPTH in millimetres where library.3mf lays the pieces out.
+    #[arg(long, value_name = "WxD", default_value = "120x68")]
+    pub plate: String,
     /// Printer resolution in millimetres: pieces that differ from a sibling by less are
     /// reported (a warning and report.json "printing.parts[].below_resolution").
     #[arg(long, value_name = "MM", default_value_t = crate::DEFAULT_RESOLUTION_MM)]
@@ -295,6 +313,25 @@ impl LibraryOptionsArgs {
         if !(self.thickness.is_finite() && self.thickness > 0.0) {
             bail!("--thickness must be a positive number of millimetres");
         }
+        if let Some(c) = self.clearance {
+            if !(c.is_finite() && (0.0..=5.0).contains(&c)) {
+                bail!("--clearance must be between 0 and 5 millimetres, got {c}");
+            }
+        }
+        let magnets = match &self.magnets {
+            Some(m) => Some(
+                crate::library::MagnetOptions::parse(m)
+                    .with_context(|| format!("--magnets {m}"))?,
+            ),
+            None => None,
+        };
+        let Some(print_format) = crate::PrintFormat::parse(&self.print_format) else {
+            bail!(
+                "--print-format {}: expected stl, 3mf or stl,3mf",
+                self.print_format
+            );
+        };
+        let plate_mm = parse_plate(&self.plate)?;
         let saliency = match &self.saliency {
             Some(p) => Some(read_saliency(p)?),
             None => None,
@@ -317,7 +354,10 @@ impl LibraryOptionsArgs {
             plugs: self.plugs.then(|| PlugOptions {
                 radius_mm: self.plug_radius,
                 length_mm: self.plug_length,
-                clearance_mm: self.plug_clearance,
+                clearance_mm: self
+                    .plug_clearance
+                    .or(self.clearance)
+                    .unwrap_or(DEFAULT_PLUG_CLEARANCE_MM),
                 ..PlugOptions::default()
             }),
             saliency,
@@ -327,6 +367,10 @@ impl LibraryOptionsArgs {
             resolution_mm: self.resolution,
             keys: !self.no_keys,
             ids: !self.no_ids,
+            magnets,
+            clearance_mm: self.clearance,
+            print_format,
+            plate_mm,
             print: !self.no_print,
         })
     }
@@ -338,6 +382,9 @@ impl LibraryOptionsArgs {
             (Some("saliency"), Some(p), _) => p.display().to_string(),
             (Some("fixed"), _, Some(d)) => format!("--fixed {}", d.display()),
             (Some("resolution_mm"), _, _) => format!("--resolution {}", self.resolution),
+            (Some("magnets"), _, _) => {
+                format!("--magnets {}", self.magnets.as_deref().unwrap_or(""))
+            }
             (Some("pieces"), _, _) => format!("--pieces {}", self.pieces.as_deref().unwrap_or("")),
             _ => input.display().to_string(),
         };
@@ -345,6 +392,25 @@ impl LibraryOptionsArgs {
             at,
             source: Box::new(e),
         }
+    }
+}
+
+/// Parses `--plate`: `WxD` in millimetres, each between 10 and 2000.
+fn parse_plate(spec: &str) -> Result<[f64; 2]> {
+    let parsed = spec
+        .trim()
+        .split_once(['x', 'X'])
+        .and_then(|(w, d)| Some([w.trim().parse::<f64>().ok()?, d.trim().parse::<f64>().ok()?]));
+    match parsed {
+        Some(p)
+            if p.iter()
+                .all(|v| v.is_finite() && (10.0..=2000.0).contains(v)) =>
+        {
+            Ok(p)
+        }
+        _ => bail!(
+            "--plate {spec}: expected WIDTHxDEPTH in millimetres (10 to 2000 each), e.g. 120x68"
+        ),
     }
 }
 

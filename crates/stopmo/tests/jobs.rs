@@ -5,7 +5,7 @@
 mod common;
 mod segment_support;
 
-use anim::{MeshAnimation, SampleOptions};
+use anim::MeshAnimation;
 use glam::Vec3;
 use segment_support::talking_tube;
 use stopmo::segment::{PartSpec, Seed};
@@ -16,20 +16,6 @@ fn tube_parts() -> Vec<PartSpec> {
         PartSpec::new("upper", vec![Seed::Point(Vec3::new(0.0, 0.95, 1.0))]),
         PartSpec::new("lower", vec![Seed::Point(Vec3::new(0.0, -0.95, 1.0))]),
     ]
-}
-
-/// The face's single mesh sampled at `fps`.
-fn face(fps: f32) -> MeshAnimation {
-    let scene = tkio::gltf::read(&common::asset("face/ict-face-talk.glb")).unwrap();
-    let s = anim::sample(
-        &scene,
-        &SampleOptions {
-            fps,
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    s.objects.into_iter().next().unwrap().animation
 }
 
 #[test]
@@ -250,7 +236,7 @@ fn options_come_from_json_and_bad_options_name_themselves() {
 
 #[test]
 fn face_run_equals_segment_then_library_and_searches_a_size() {
-    let anim = face(1.0);
+    let anim = common::face(1.0);
     assert_eq!(anim.frame_count(), 60);
     let opts = RunOptions {
         segment: SegmentJobOptions {

@@ -219,13 +219,26 @@ export class StopmoPanel {
   /** Builds the library of a curve point, then shows its reconstruction beside the face. */
   build(pieces) {
     for (const c of document.querySelectorAll('#stopmo-chart circle')) c.classList.toggle('picked', Number(c.dataset.pieces) === pieces);
-    this.start('/api/stopmo/build', { pieces, print: $('stopmo-print').checked }, async (r) => {
+    this.start('/api/stopmo/build', { pieces, ...this.printOptions() }, async (r) => {
       const { header, buffers } = await getPack('/api/stopmo/reconstruction');
       this.setReconstruction(header, buffers);
       this.built = r;
       $('stopmo-built').textContent = `library of ${r.pieces} pieces per part (${r.total_pieces} in all${r.printed ? '' : ', surfaces only'}): mean error ${r.errors_mm.position_mean.toFixed(3)} mm, max ${r.errors_mm.position_max.toFixed(3)} mm` + (r.warnings.length ? '\n' + r.warnings.join('\n') : '');
       $('stopmo-export').disabled = false;
     });
+  }
+
+  /** The printing fields of the panel as the build request's options (empty fields: the
+   * tool's defaults). */
+  printOptions() {
+    const opts = { print: $('stopmo-print').checked, print_format: $('stopmo-format').value };
+    const magnets = $('stopmo-magnets').value.trim();
+    if (magnets) opts.magnets = magnets;
+    const clearance = $('stopmo-clearance').value.trim();
+    if (clearance) opts.clearance_mm = Number(clearance);
+    const plate = $('stopmo-plate').value.trim();
+    if (plate) opts.plate_mm = plate.split(/x/i).map(Number);
+    return opts;
   }
 
   setReconstruction(header, buffers) {

@@ -103,7 +103,10 @@ def library(
     parts) or ``max_error_mm=E`` (the smallest library within that error) replace it; other
     ``options`` are the stopmo
     crate's ``LibraryJobOptions`` (``restarts``, ``seed``, ``method``, ``print_height_mm``,
-    ``plugs``, ...). Returns a :class:`Library` with ``.labels`` ``(frames, parts)``,
+    ``plugs``, ...); printing: ``magnets="3x2"`` (a disc magnet, mm: a pocket in every piece
+    and the part's mount), ``clearance_mm`` (fits; default 3 x the printer resolution),
+    ``print_format="stl"|"3mf"|"stl,3mf"`` and ``plate_mm=(w, d)`` (``library.3mf``'s build
+    plates), as the CLI's ``--magnets``, ``--clearance``, ``--print-format``, ``--plate``. Returns a :class:`Library` with ``.labels`` ``(frames, parts)``,
     ``.pieces``, ``.assembly``, ``.report`` and ``.save(dir)`` (the CLI's layout).
     """
     opts = _library_options(pieces, options)

@@ -38,7 +38,9 @@ pub struct OutputFile<'a> {
 impl LibraryResult {
     /// Every file of the output layout: `pieces/<part>_<NN>.obj` and `.stl` (no `.stl` when
     /// the job did not print),
-    /// `pieces/<part>_back.obj` (the shared back surface, mm), `assembly.csv`,
+    /// (none either with `print_format` `3mf`), `pieces/<part>_back.obj` (the shared back
+    /// surface, mm), `pieces/<part>_back.stl` (the mount, with magnets), `library.3mf` (with
+    /// the 3MF print format), `assembly.csv`,
     /// `assembly.md`, `catalogue.png`, `assembly_shotNN.png` (one per shot),
     /// `shooting_order.csv`, `report.json`, `reconstruction.glb`,
     /// `reconstruction.pc2` + `rest.obj`, `error_curve.csv` / `.png` after a size search and,
@@ -64,12 +66,18 @@ impl LibraryResult {
                 format!("pieces/{}.obj", p.id),
                 FileData::Mesh(&p.surface),
             ));
-            if let Some(solid) = &p.solid {
+            if let Some(solid) = p.solid.as_ref().filter(|_| self.writes_stl()) {
                 out.push(file(format!("pieces/{}.stl", p.id), FileData::Mesh(solid)));
             }
         }
         for b in &self.backs {
             out.push(file(format!("pieces/{}.obj", b.name), FileData::Mesh(b)));
+        }
+        for m in &self.mounts {
+            out.push(file(format!("pieces/{}.stl", m.name), FileData::Mesh(m)));
+        }
+        if let Some(bytes) = &self.library_3mf {
+            out.push(file("library.3mf", FileData::Bytes(bytes.clone())));
         }
         out.push(file("assembly.csv", FileData::Text(self.assembly_csv())));
         out.push(file(
@@ -102,6 +110,14 @@ impl LibraryResult {
         }
         out.push(file("report.json", FileData::Text(self.report.to_json())));
         Ok(out)
+    }
+
+    /// Whether the pieces' solids are written as STL files (the print format says so).
+    fn writes_stl(&self) -> bool {
+        self.report
+            .printing
+            .as_ref()
+            .is_none_or(|p| p.print_format.stl())
     }
 
     /// All parts' reconstructions merged into one point cache, in part order (the vertex

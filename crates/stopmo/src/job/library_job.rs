@@ -7,6 +7,7 @@ use anim::MeshAnimation;
 
 use super::error::{Error, Result};
 use super::options::{LibraryJobOptions, PieceCount, RunOptions};
+use super::plates::library_3mf;
 use super::print::{print_pieces, surface_pieces, PrintSettings};
 use super::report::{InputErrors, LibraryReport, ReportInputs};
 use super::result::LibraryResult;
@@ -314,6 +315,7 @@ pub(super) fn finish(
         None => Vec::new(),
     };
     let segments = opts.plugs.map(|p| p.segments);
+    check_print_options(opts)?;
     let errors = input_errors(&lib, anims, inputs, &opts.cuts)?;
     let printed = if opts.print {
         print_pieces(
@@ -328,11 +330,17 @@ pub(super) fn finish(
                 plugs: &plugs,
                 plug_segments: segments.unwrap_or(crate::library::DEFAULT_PLUG_SEGMENTS),
                 backs: &opts.backs,
+                magnet: opts.magnets,
+                clearance_mm: opts.clearance(),
+                plate_mm: opts.plate_mm,
+                print_format: opts.print_format,
             },
         )?
     } else {
         surface_pieces(&lib, anims, opts.resolution_mm)?
     };
+    let mut printed = printed;
+    let library_3mf = lay_out_plates(&mut printed, names, opts)?;
     let catalogue = catalogue_png(&lib, anims)?;
     let assembly = lib.assembly();
     let sheets = assembly_sheets(&lib, anims, &assembly, &opts.cuts)?;
@@ -373,6 +381,8 @@ pub(super) fn finish(
         library: lib,
         pieces: printed.pieces,
         backs: printed.backs,
+        mounts: printed.mounts,
+        library_3mf,
         assembly,
         shooting_order: order,
         plugs,
@@ -381,6 +391,68 @@ pub(super) fn finish(
         sheets,
         report,
     })
+}
+
+/// `library.3mf` when it was asked for: the pieces laid out on build plates, the plates
+/// and every piece's plate in the report, a warning for pieces larger than a plate.
+fn lay_out_plates(
+    printed: &mut super::print::Printed,
+    names: &[String],
+    opts: &LibraryJobOptions,
+) -> Result<Option<Vec<u8>>> {
+    let Some(report) = printed.report.as_mut() else {
+        return Ok(None);
+    };
+    if !opts.print_format.three_mf() {
+        return Ok(None);
+    }
+    let (plates, bytes, too_large) = library_3mf(&printed.pieces, names, opts.plate_mm)?;
+    for piece in &mut report.pieces {
+        piece.plate = plates
+            .iter()
+            .find(|p| p.pieces.contains(&piece.id))
+            .map(|p| p.plate);
+    }
+    if !too_large.is_empty() {
+        printed.warnings.push(format!(
+            "{} pieces are larger than the {} x {} mm build plate and do not fit on it: {}; give a larger --plate",
+            too_large.len(),
+            opts.plate_mm[0],
+            opts.plate_mm[1],
+            too_large.join(", ")
+        ));
+    }
+    report.plates = plates;
+    Ok(Some(bytes))
+}
+
+/// Refuses magnets, clearances and plates no printer can use.
+fn check_print_options(opts: &LibraryJobOptions) -> Result<()> {
+    if let Some(m) = &opts.magnets {
+        m.validate()
+            .map_err(|e| Error::option_error("magnets", e.to_string()))?;
+    }
+    let c = opts.clearance();
+    if !(c.is_finite() && (0.0..=5.0).contains(&c)) {
+        return Err(Error::option_error(
+            "clearance_mm",
+            format!("must be between 0 and 5 millimetres, got {c}"),
+        ));
+    }
+    if !opts
+        .plate_mm
+        .iter()
+        .all(|v| v.is_finite() && (10.0..=2000.0).contains(v))
+    {
+        return Err(Error::option_error(
+            "plate_mm",
+            format!(
+                "the build plate must be 10 to 2000 millimetres each way, got {:?}",
+                opts.plate_mm
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// One plug per seam between two parts, placed on the average geometry in millimetres (the

@@ -5,7 +5,9 @@ mod error;
 mod figure;
 mod files;
 mod library_job;
+mod magnets;
 mod options;
+mod plates;
 mod print;
 mod report;
 mod result;
@@ -17,9 +19,14 @@ mod text;
 pub use error::{Error, Result};
 pub use files::{save_files, FileData, OutputFile};
 pub use library_job::{file_safe_name, library, run};
-pub use options::{LibraryJobOptions, PieceCount, RunOptions, SegmentJobOptions, DEFAULT_PIECES};
+pub use options::{
+    default_clearance_mm, LibraryJobOptions, PieceCount, PrintFormat, RunOptions,
+    SegmentJobOptions, CLEARANCE_PER_RESOLUTION, DEFAULT_PIECES, DEFAULT_PLATE_MM,
+    MAX_DEFAULT_CLEARANCE_MM,
+};
+pub use plates::Plate;
 pub use print::{
-    piece_label, PartPrintReport, Piece, PrintReport, PrintTime, DEFAULT_RESOLUTION_MM,
+    piece_label, PartPrintReport, Piece, PieceReport, PrintReport, PrintTime, DEFAULT_RESOLUTION_MM,
 };
 pub use report::{LibraryReport, OrderReport, PartReport, PlugReport};
 pub use result::LibraryResult;

@@ -8,9 +8,77 @@ use serde::{Deserialize, Serialize};
 
 use super::print::DEFAULT_RESOLUTION_MM;
 use crate::library::{
-    Method, PlugOptions, SolveOptions, DEFAULT_PRINT_HEIGHT_MM, DEFAULT_THICKNESS_MM,
+    MagnetOptions, Method, PlugOptions, SolveOptions, DEFAULT_PRINT_HEIGHT_MM, DEFAULT_THICKNESS_MM,
 };
 use crate::segment::{PartSpec, SavedSegmentation, SegmentOptions};
+
+/// Clearance of printed fits per millimetre of printer resolution: 0.15 mm at the default
+/// 0.05 mm, the tight fit a resin printer holds (±0.15 mm; ≥ 0.3 mm gives a loose fit).
+pub const CLEARANCE_PER_RESOLUTION: f64 = 3.0;
+
+/// Largest clearance derived from the printer resolution (mm): a fit looser than this holds
+/// nothing, whatever resolution is given (a huge one flags every piece as too close).
+pub const MAX_DEFAULT_CLEARANCE_MM: f64 = 1.0;
+
+/// The clearance used when none is given: [`CLEARANCE_PER_RESOLUTION`] times the printer
+/// resolution, from 0.1 mm to [`MAX_DEFAULT_CLEARANCE_MM`].
+pub fn default_clearance_mm(resolution_mm: f64) -> f64 {
+    let c = resolution_mm * CLEARANCE_PER_RESOLUTION;
+    if c.is_finite() {
+        c.clamp(0.1, MAX_DEFAULT_CLEARANCE_MM)
+    } else {
+        0.1
+    }
+}
+
+/// Build plate of a small resin printer (mm): where `library.3mf` lays the pieces out and
+/// what the print-time estimate assumes when no plate is given.
+pub const DEFAULT_PLATE_MM: [f64; 2] = [120.0, 68.0];
+
+/// Which files hold the printable solids.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum PrintFormat {
+    /// One STL per piece (`pieces/<part>_<NN>.stl`).
+    #[default]
+    #[serde(rename = "stl")]
+    Stl,
+    /// One `library.3mf` with every piece as a named object, laid out on build plates.
+    #[serde(rename = "3mf")]
+    ThreeMf,
+    /// Both.
+    #[serde(rename = "stl,3mf")]
+    Both,
+}
+
+impl PrintFormat {
+    /// Parses `stl`, `3mf` or `stl,3mf` (either order).
+    pub fn parse(text: &str) -> Option<PrintFormat> {
+        let mut stl = false;
+        let mut three = false;
+        for f in text.split(',') {
+            match f.trim().to_ascii_lowercase().as_str() {
+                "stl" => stl = true,
+                "3mf" => three = true,
+                _ => return None,
+            }
+        }
+        Some(match (stl, three) {
+            (true, true) => PrintFormat::Both,
+            (false, true) => PrintFormat::ThreeMf,
+            _ => PrintFormat::Stl,
+        })
+    }
+
+    /// Whether one STL per piece is written.
+    pub fn stl(self) -> bool {
+        self != PrintFormat::ThreeMf
+    }
+
+    /// Whether `library.3mf` is written.
+    pub fn three_mf(self) -> bool {
+        self != PrintFormat::Stl
+    }
+}
 
 /// Pieces per part when no size is given.
 pub const DEFAULT_PIECES: usize = 20;
@@ -95,6 +163,18 @@ pub struct LibraryJobOptions {
     pub keys: bool,
     /// Piece ID (`P-NN`) embossed on the back of every piece.
     pub ids: bool,
+    /// A disc magnet (millimetres): every piece gets a pocket for it at one place of its
+    /// part's back that all pieces share, and the part's mount (`pieces/<part>_back.stl`)
+    /// the matching pocket.
+    pub magnets: Option<MagnetOptions>,
+    /// Clearance of printed fits (millimetres): magnet pockets and the mount's key sockets
+    /// are this much wider; `None`: [`default_clearance_mm`] of the printer resolution.
+    /// Plugs keep their own `plugs.clearance_mm` (the CLI fills it from `--clearance`).
+    pub clearance_mm: Option<f64>,
+    /// Which files hold the printable solids: one STL per piece, `library.3mf`, or both.
+    pub print_format: PrintFormat,
+    /// Build plate width and depth (millimetres) where `library.3mf` lays the pieces out.
+    pub plate_mm: [f64; 2],
     /// Build the printable solids (`pieces/*.stl`, the back surfaces, keys, IDs and the
     /// report's `"printing"`). Off, the job stops at the pieces' surfaces, the labels and the
     /// errors — a quick look at a library size before printing it (on the face, the solids
@@ -118,8 +198,21 @@ impl Default for LibraryJobOptions {
             resolution_mm: DEFAULT_RESOLUTION_MM,
             keys: true,
             ids: true,
+            magnets: None,
+            clearance_mm: None,
+            print_format: PrintFormat::Stl,
+            plate_mm: DEFAULT_PLATE_MM,
             print: true,
         }
+    }
+}
+
+impl LibraryJobOptions {
+    /// The clearance of fits: [`LibraryJobOptions::clearance_mm`] or the default from the
+    /// printer resolution.
+    pub fn clearance(&self) -> f64 {
+        self.clearance_mm
+            .unwrap_or_else(|| default_clearance_mm(self.resolution_mm))
     }
 }
 

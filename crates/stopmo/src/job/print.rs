@@ -11,10 +11,11 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::error::{Error, Result};
+use super::magnets::{cut_mount, cut_piece_pocket, find_pocket, MagnetPlan};
 use crate::library::{
-    add_plugs, build_shells, material, piece_id, regularize, self_intersecting_triangles, Bitmap,
-    Key, KeyOptions, Library, MaterialEstimate, PartShell, Plug, ShellInput, ShellOptions,
-    ShellStats, DEFAULT_ID_RELIEF_MM,
+    add_plugs, build_shells, material, piece_id, regularize, self_intersecting_triangles, volume,
+    Bitmap, Key, KeyOptions, Library, MagnetOptions, MaterialEstimate, PartShell, Plug, Pocket,
+    ShellInput, ShellOptions, ShellStats, DEFAULT_ID_RELIEF_MM,
 };
 
 /// Resin layer height assumed by the print-time estimate (mm).
@@ -22,8 +23,6 @@ const LAYER_MM: f64 = 0.05;
 /// Seconds per resin layer (exposure plus peel), independent of how many pieces are on the
 /// plate.
 const SECONDS_PER_LAYER: f64 = 8.0;
-/// Build plate of a small resin printer (mm).
-const PLATE_MM: [f64; 2] = [120.0, 68.0];
 
 /// Printer resolution assumed when none is given (mm).
 pub const DEFAULT_RESOLUTION_MM: f64 = 0.05;
@@ -42,6 +41,14 @@ pub(crate) struct PrintSettings<'a> {
     pub(crate) ids: bool,
     pub(crate) plugs: &'a [Plug],
     pub(crate) plug_segments: usize,
+    /// Disc magnet whose pocket every piece and mount gets.
+    pub(crate) magnet: Option<MagnetOptions>,
+    /// Clearance of fits (key sockets, magnet pockets; mm).
+    pub(crate) clearance_mm: f64,
+    /// Build plate (mm): the print-time estimate's.
+    pub(crate) plate_mm: [f64; 2],
+    /// Files of the solids.
+    pub(crate) print_format: super::options::PrintFormat,
     /// Printed back surfaces by part name (see [`crate::LibraryJobOptions::backs`]).
     pub(crate) backs: &'a std::collections::BTreeMap<String, Vec<Vec3>>,
 }
@@ -57,6 +64,9 @@ pub(crate) struct Printed {
     pub(crate) warnings: Vec<String>,
     /// The back surface of every part before keys and IDs (`pieces/<part>_back.obj`).
     pub(crate) backs: Vec<Mesh>,
+    /// With magnets, every part's mount with the matching pocket and key sockets
+    /// (`pieces/<part>_back.stl`).
+    pub(crate) mounts: Vec<Mesh>,
 }
 
 /// One part in [`PrintReport`].
@@ -90,6 +100,9 @@ pub struct PartPrintReport {
     /// Volume of what regularizing dropped (mm³): chips of material apart from a piece and
     /// sealed cavities inside it (filled).
     pub dropped_volume_mm3: f64,
+    /// The magnet pocket every piece of the part has, and the mount has at the same place
+    /// (`null` without magnets).
+    pub magnet_pocket: Option<Pocket>,
 }
 
 /// The print-time estimate.
@@ -111,6 +124,25 @@ pub struct PrintTime {
     pub assumes: String,
 }
 
+/// One printed piece in [`PrintReport::pieces`]: what a print shop and an animator look up.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PieceReport {
+    /// Identifier `<part>_<NN>` (file stem, 3MF object name).
+    pub id: String,
+    /// The ID embossed on its back (`P-NN`).
+    pub label: String,
+    /// Part name.
+    pub part: String,
+    /// Frames (0-based) the piece is on, in frame order.
+    pub frames: Vec<usize>,
+    /// Volume of its solid (mm³).
+    pub volume_mm3: f64,
+    /// Whether it has a magnet pocket (at its part's `magnet_pocket`).
+    pub magnet: bool,
+    /// Build plate of `library.3mf` it is on (1-based; `null` without a 3MF).
+    pub plate: Option<usize>,
+}
+
 /// `report.json` `"printing"`: material, print time, resolution check, keys and IDs.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PrintReport {
@@ -124,8 +156,21 @@ pub struct PrintReport {
     pub keys: bool,
     /// Whether IDs were embossed.
     pub ids: bool,
+    /// Clearance of the fits (mm): magnet pockets are this much wider (radius) and deeper
+    /// than the magnet, the mount's key sockets and ID recess wider and deeper than the key
+    /// or ID; from `--clearance`, else 3 × the printer resolution.
+    pub clearance_mm: f64,
+    /// The disc magnet every piece holds (`null` without magnets).
+    pub magnet: Option<MagnetOptions>,
+    /// Files of the solids: `"stl"`, `"3mf"` or `"stl,3mf"`.
+    pub print_format: super::options::PrintFormat,
+    /// Build plates of `library.3mf` (empty without a 3MF): several plates are laid side by
+    /// side along x in its one build, each listed here with its origin and pieces.
+    pub plates: Vec<super::plates::Plate>,
     /// Per part.
     pub parts: Vec<PartPrintReport>,
+    /// Per piece: ID, part, frames used, volume, magnet, plate.
+    pub pieces: Vec<PieceReport>,
 }
 
 /// One printable piece.
@@ -191,6 +236,7 @@ pub(crate) fn print_pieces(
     let mut parts_report = Vec::new();
     let mut warnings = Vec::new();
     let mut pieces_out: Vec<Piece> = Vec::new();
+    let mut mounts_out: Vec<Mesh> = Vec::new();
     // One back surface per part, seam walls shared between the parts that meet.
     let averages: Vec<Vec<Vec3>> = anims
         .iter()
@@ -237,12 +283,39 @@ pub(crate) fn print_pieces(
         let part = &lib.parts[p];
         let a = anims[p];
         let seams = shell.shared_seams(&avg, &boundaries, p);
+        // The mount is the back as it is before keys and IDs (what the pieces seat on).
+        let mount = s.magnet.map(|m| {
+            shell.mount(
+                MagnetPlan::new(&m, s).mount_mm,
+                &format!("{}_back", part.name),
+            )
+        });
         let keys = if s.keys {
             shell.add_seam_keys(&KeyOptions::for_print_height(s.print_height_mm), &seams)?
         } else {
             Vec::new()
         };
         let pixel = (s.print_height_mm * 0.02).clamp(0.3, 1.0);
+        let refs: Vec<&[Vec3]> = pieces_mm.iter().map(Vec::as_slice).collect();
+        let pocket = match &s.magnet {
+            Some(m) => Some(find_pocket(
+                &shell,
+                &refs,
+                &MagnetPlan::new(m, s),
+                &keys,
+                &part.name,
+            )?),
+            None => None,
+        };
+        // The ID keeps away from the pocket as it keeps away from the keys.
+        let id_keys: Vec<Key> = keys
+            .iter()
+            .cloned()
+            .chain(pocket.map(|q| q.as_key()))
+            .collect();
+        if let (Some(mount), Some(q)) = (mount, &pocket) {
+            mounts_out.push(cut_mount(&shell, &mount, q, &keys, &id_keys, s)?);
+        }
         let made: Vec<Made> = (0..pieces_mm.len())
             .into_par_iter()
             .map(|k| -> Result<Made> {
@@ -258,7 +331,7 @@ pub(crate) fn print_pieces(
                     &id,
                     pixel,
                     DEFAULT_ID_RELIEF_MM,
-                    &keys,
+                    &id_keys,
                 )?;
                 // Measured on what is written (keys and ID included), not assumed: a
                 // coordinate beyond the exact test's range counts every triangle.
@@ -281,6 +354,14 @@ pub(crate) fn print_pieces(
                         (r.mesh, c, Some(r.dropped_volume))
                     }
                     _ => (solid, built, None),
+                };
+                let (solid, crossing) = match &pocket {
+                    Some(q) => {
+                        let cut = cut_piece_pocket(&solid, q, s.thickness_mm as f32)?;
+                        let c = count(&cut);
+                        (cut, c)
+                    }
+                    None => (solid, crossing),
                 };
                 let solid = add_plugs(&solid, p, s.plugs, s.plug_segments);
                 let piece = Piece {
@@ -318,7 +399,6 @@ pub(crate) fn print_pieces(
             .filter_map(|m| m.surface_crossing.map(|(n, at)| (&m.piece, n, at)))
             .collect();
         let surface_triangles: usize = surface.iter().map(|(_, n, _)| n).sum();
-        let refs: Vec<&[Vec3]> = pieces_mm.iter().map(Vec::as_slice).collect();
         let thinnest = shell.thinnest_wall(&refs);
         if let Some(t) = thinnest {
             shell.stats.min_wall_mm = t.mm;
@@ -394,6 +474,7 @@ pub(crate) fn print_pieces(
             built_self_intersecting_triangles: built_crossing,
             regularized_pieces,
             dropped_volume_mm3: dropped_mm3,
+            magnet_pocket: pocket,
         });
         pieces_out.extend(made);
     }
@@ -401,18 +482,45 @@ pub(crate) fn print_pieces(
     let solids: Vec<&Mesh> = pieces_out.iter().filter_map(|p| p.solid.as_ref()).collect();
     let report = PrintReport {
         material: material(solids.iter().copied()),
-        print_time: print_time(&solids),
+        print_time: print_time(&solids, s.plate_mm),
         resolution_mm: s.resolution_mm,
         keys: s.keys,
         ids: s.ids,
+        clearance_mm: s.clearance_mm,
+        magnet: s.magnet,
+        print_format: s.print_format,
+        plates: Vec::new(),
         parts: parts_report,
+        pieces: piece_reports(lib, &pieces_out, s.magnet.is_some()),
     };
     Ok(Printed {
         pieces: pieces_out,
         report: Some(report),
         warnings,
         backs,
+        mounts: mounts_out,
     })
+}
+
+/// The per-piece lines of the report (plates are filled in once `library.3mf` is laid out).
+fn piece_reports(lib: &Library, pieces: &[Piece], magnet: bool) -> Vec<PieceReport> {
+    pieces
+        .iter()
+        .map(|p| {
+            let labels = &lib.parts[p.part].solution.labels;
+            PieceReport {
+                id: p.id.clone(),
+                label: piece_label(p.part, p.index),
+                part: lib.parts[p.part].name.clone(),
+                frames: (0..labels.len())
+                    .filter(|&f| labels[f] as usize == p.index)
+                    .collect(),
+                volume_mm3: p.solid.as_ref().map_or(0.0, volume),
+                magnet,
+                plate: None,
+            }
+        })
+        .collect()
 }
 
 /// The pieces' surfaces alone, without solids, backs or the `"printing"` report (a look at a
@@ -456,6 +564,7 @@ pub(crate) fn surface_pieces(
         report: None,
         warnings,
         backs: Vec::new(),
+        mounts: Vec::new(),
     })
 }
 
@@ -522,7 +631,7 @@ fn below_resolution(name: &str, pieces_mm: &[Vec<Vec3>], resolution_mm: f64) -> 
 
 /// Resin print time: plates by footprint (pieces laid on their smallest extent, 50 % margin),
 /// layers by the tallest piece.
-fn print_time(solids: &[&Mesh]) -> PrintTime {
+fn print_time(solids: &[&Mesh], plate_mm: [f64; 2]) -> PrintTime {
     let tallest = solids
         .iter()
         .map(|s| {
@@ -540,7 +649,7 @@ fn print_time(solids: &[&Mesh]) -> PrintTime {
             d[1] * d[2] * 1.5
         })
         .sum();
-    let plates = (footprint / (PLATE_MM[0] * PLATE_MM[1])).ceil().max(1.0);
+    let plates = (footprint / (plate_mm[0] * plate_mm[1])).ceil().max(1.0);
     let layers = (tallest / LAYER_MM).ceil();
     PrintTime {
         hours: plates * layers * SECONDS_PER_LAYER / 3600.0,
@@ -548,7 +657,7 @@ fn print_time(solids: &[&Mesh]) -> PrintTime {
         layers_per_plate: layers,
         layer_mm: LAYER_MM,
         seconds_per_layer: SECONDS_PER_LAYER,
-        plate_mm: PLATE_MM,
+        plate_mm,
         assumes: "resin printer, pieces laid flat on their smallest extent".into(),
     }
 }

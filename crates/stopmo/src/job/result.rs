@@ -21,6 +21,12 @@ pub struct LibraryResult {
     /// The back surface every piece of a part seats on (millimetres, before keys and IDs;
     /// `pieces/<part>_back.obj`, read back by `--fixed`).
     pub backs: Vec<anim::Mesh>,
+    /// With magnets, every part's mount: the back thickened towards the head with the pocket
+    /// matching the pieces', key sockets and an ID recess (`pieces/<part>_back.stl`).
+    pub mounts: Vec<anim::Mesh>,
+    /// `library.3mf` (every piece a named object, laid out on build plates) when the print
+    /// format asks for it.
+    pub library_3mf: Option<Vec<u8>>,
     /// Which piece of each part goes on each frame.
     pub assembly: Assembly,
     /// A proposed order to shoot the frames with few piece swaps.

@@ -59,7 +59,78 @@ impl LibraryResult {
             let _ = writeln!(md, "| {range} | {} |", ids[f].join(" | "));
             f = end + 1;
         }
+        self.print_markdown(&mut md);
         md
+    }
+
+    /// The printing half of `assembly.md`: fits, magnets, plates and one line per piece.
+    fn print_markdown(&self, md: &mut String) {
+        let Some(p) = &self.report.printing else {
+            return;
+        };
+        let _ = writeln!(md, "\n## Printing\n");
+        let _ = writeln!(
+            md,
+            "Millimetres. Clearance of fits: {} mm. Files: {}.",
+            p.clearance_mm,
+            match p.print_format {
+                super::options::PrintFormat::Stl => "pieces/<ID>.stl",
+                super::options::PrintFormat::ThreeMf => "library.3mf",
+                super::options::PrintFormat::Both => "pieces/<ID>.stl and library.3mf",
+            }
+        );
+        if let Some(m) = &p.magnet {
+            let _ = writeln!(
+                md,
+                "Magnets: {} x {} mm discs, one in every piece and one in each part's mount (pieces/<part>_back.stl), at the same place:",
+                m.diameter_mm, m.height_mm
+            );
+            for part in &p.parts {
+                if let Some(q) = &part.magnet_pocket {
+                    let _ = writeln!(
+                        md,
+                        "- {}: pocket {:.2} mm wide, {:.2} mm deep at ({:.1}, {:.1}, {:.1}); {:.2} mm of material in front of it",
+                        part.name,
+                        2.0 * q.radius_mm,
+                        q.depth_mm,
+                        q.center[0],
+                        q.center[1],
+                        q.center[2],
+                        q.cover_mm
+                    );
+                }
+            }
+        }
+        for plate in &p.plates {
+            let _ = writeln!(
+                md,
+                "Plate {} ({} x {} mm): {}.",
+                plate.plate,
+                plate.size_mm[0],
+                plate.size_mm[1],
+                plate.pieces.join(", ")
+            );
+        }
+        let _ = writeln!(
+            md,
+            "\n| piece | ID | part | frames | volume (mm³) | magnet | plate |\n|---|---|---|---|---|---|---|"
+        );
+        for q in &p.pieces {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {:.1} | {} | {} |",
+                q.id,
+                q.label,
+                q.part,
+                q.frames.len(),
+                q.volume_mm3,
+                if q.magnet { "yes" } else { "no" },
+                q.plate.map_or("–".to_string(), |k| k.to_string())
+            );
+        }
+        for w in &self.report.warnings {
+            let _ = writeln!(md, "\nWarning: {w}");
+        }
     }
 
     /// `shooting_order.csv`: header `shot,<part>,...,frames`, one row per shot with its

@@ -50,6 +50,7 @@ mod error;
 mod fabricate;
 mod input_errors;
 mod intersect;
+mod magnet;
 mod metrics;
 mod nearest;
 mod piece_id;
@@ -69,10 +70,10 @@ pub use assembly::{
     DEFAULT_TWO_OPT_PASSES,
 };
 pub use back_surface::{
-    build_shells, DirectionField, PartShell, ShellInput, ShellOptions, ShellStats, ThinnestWall,
-    DEFAULT_BACK_SMOOTHING_ITERATIONS, DEFAULT_CAP_FRACTION, DEFAULT_EDGE_RING_RADIUS_MM,
-    DEFAULT_ENVELOPE_LATERAL, DEFAULT_ENVELOPE_REACH, DEFAULT_NORMAL_SMOOTHING_MM,
-    DEFAULT_REPAIR_ROUNDS, DEFAULT_RESOLVE_ROUNDS,
+    build_shells, DirectionField, PartShell, Pocket, ShellInput, ShellOptions, ShellStats,
+    ThinnestWall, DEFAULT_BACK_SMOOTHING_ITERATIONS, DEFAULT_CAP_FRACTION,
+    DEFAULT_EDGE_RING_RADIUS_MM, DEFAULT_ENVELOPE_LATERAL, DEFAULT_ENVELOPE_REACH,
+    DEFAULT_NORMAL_SMOOTHING_MM, DEFAULT_REPAIR_ROUNDS, DEFAULT_RESOLVE_ROUNDS,
 };
 pub use borders::BORDER_RINGS;
 pub use build::{
@@ -85,6 +86,8 @@ pub use fabricate::{
 };
 pub use input_errors::compare_frames;
 pub use intersect::{intersecting_pairs, self_intersecting_triangles, MAX_EXACT_COORDINATE};
+pub(crate) use magnet::{cut_pocket, cylinder};
+pub use magnet::{MagnetOptions, DEFAULT_POCKET_SEGMENTS, MIN_MAGNET_WALL_MM};
 pub use metrics::{ErrorSummary, FrameErrors};
 pub use nearest::{closest_point_on_triangle, TriangleGrid};
 pub use piece_id::{
@@ -96,6 +99,7 @@ pub use plugs::{
     DEFAULT_PLUG_LENGTH_MM, DEFAULT_PLUG_RADIUS_MM, DEFAULT_PLUG_SEGMENTS, DEFAULT_PLUG_WALL_MM,
 };
 pub use problem::{PartProblem, PartSetup};
+pub(crate) use regularize::exact_difference;
 pub use regularize::{regularize, Regularized};
 pub use size::{allocate_budget, CurvePoint};
 pub use solver::{

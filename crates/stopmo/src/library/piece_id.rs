@@ -337,7 +337,7 @@ impl PartShell {
     }
 
     /// Centre and reading frame (right, up) of the ID on the back surface, seen from behind.
-    fn id_frame(&self, keys: &[Key]) -> (Vec3, Vec3, Vec3) {
+    pub(crate) fn id_frame(&self, keys: &[Key]) -> (Vec3, Vec3, Vec3) {
         let back = self.back();
         let from_boundary = distances(back, &self.boundary_points());
         let centres: Vec<Vec3> = keys.iter().map(|k| Vec3::from_array(k.center)).collect();

@@ -9,3 +9,17 @@ pub(crate) fn asset(rel: &str) -> PathBuf {
     assert!(p.exists(), "missing test asset {}", p.display());
     p
 }
+
+/// The face's single mesh sampled at `fps`.
+pub(crate) fn face(fps: f32) -> anim::MeshAnimation {
+    let scene = tkio::gltf::read(&asset("face/ict-face-talk.glb")).unwrap();
+    let s = anim::sample(
+        &scene,
+        &anim::SampleOptions {
+            fps,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    s.objects.into_iter().next().unwrap().animation
+}

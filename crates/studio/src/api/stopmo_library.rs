@@ -46,6 +46,22 @@ pub(crate) struct BuildRequest {
     /// errors, ~10× sooner on the face (`LibraryJobOptions::print`).
     #[serde(default = "printed_by_default")]
     print: bool,
+    /// A disc magnet, `"DxH"` in millimetres (`LibraryJobOptions::magnets`).
+    #[serde(default)]
+    magnets: Option<stopmo::library::MagnetOptions>,
+    /// Clearance of fits in millimetres (default from the printer resolution).
+    #[serde(default)]
+    clearance_mm: Option<f64>,
+    /// `"stl"`, `"3mf"` or `"stl,3mf"`.
+    #[serde(default)]
+    print_format: stopmo::PrintFormat,
+    /// Build plate of `library.3mf` (millimetres).
+    #[serde(default = "default_plate")]
+    plate_mm: [f64; 2],
+}
+
+fn default_plate() -> [f64; 2] {
+    LibraryJobOptions::default().plate_mm
 }
 
 fn printed_by_default() -> bool {
@@ -118,7 +134,8 @@ pub(crate) async fn curve(
     Ok(Json(json!({ "job": id })))
 }
 
-/// `POST /api/stopmo/build` (`{"pieces", "print"?}`): `{"job": id}`; the result is
+/// `POST /api/stopmo/build` (`{"pieces", "print"?, "magnets"?: "DxH", "clearance_mm"?,
+/// "print_format"?: "stl"|"3mf"|"stl,3mf", "plate_mm"?: [w, d]}`): `{"job": id}`; the result is
 /// `{"pieces", "parts", "frame_ids" (per frame, the piece id of every part), "errors_mm",
 /// "total_pieces", "printed", "warnings"}`.
 pub(crate) async fn build(
@@ -153,6 +170,10 @@ pub(crate) async fn build(
         let solved = curve.library(r.pieces).ok_or("the curve lost its point")?;
         let options = LibraryJobOptions {
             print: r.print,
+            magnets: r.magnets,
+            clearance_mm: r.clearance_mm,
+            print_format: r.print_format,
+            plate_mm: r.plate_mm,
             ..LibraryJobOptions::default()
         };
         let result =

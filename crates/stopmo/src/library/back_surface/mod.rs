@@ -40,6 +40,7 @@ mod direction;
 mod envelope;
 mod measure;
 mod options;
+mod pocket;
 mod repair;
 mod resolve;
 mod seams;
@@ -54,6 +55,7 @@ pub use options::{
     DEFAULT_ENVELOPE_REACH, DEFAULT_NORMAL_SMOOTHING_MM, DEFAULT_REPAIR_ROUNDS,
     DEFAULT_RESOLVE_ROUNDS,
 };
+pub use pocket::Pocket;
 pub use seams::{build_shells, ShellInput};
 
 /// Largest sideways slide of a back boundary point per millimetre of wall depth.
