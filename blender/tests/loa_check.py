@@ -17,7 +17,10 @@ from harness import check
 def grease_pencil(scene, keys, depth=0.0):
     """A Grease Pencil object with one stroke per (frame, world points), in this Blender's API,
     plus a short second stroke per frame (the longest one is the keystroke)."""
-    data = (getattr(bpy.data, "grease_pencils_v3", None) or bpy.data.grease_pencils).new("Line")
+    # 4.3-4.5 keep the legacy `grease_pencils` (annotations) beside `grease_pencils_v3`; an
+    # empty collection is falsy, so test for the attribute, not its truth.
+    v3 = getattr(bpy.data, "grease_pencils_v3", None)
+    data = (v3 if v3 is not None else bpy.data.grease_pencils).new("Line")
     obj = bpy.data.objects.new("Line", data)
     scene.collection.objects.link(obj)
     layer = data.layers.new("strokes")

@@ -57,7 +57,11 @@ def imported(name, clip=None):
     bpy.ops.import_scene.gltf(filepath=os.path.join(ASSETS, name))
     arm = next(o for o in bpy.data.objects if o.type == "ARMATURE")
     if clip is not None:
-        arm.animation_data.action = bpy.data.actions[f"{clip}_{arm.name}"]
+        # The glTF importer names a clip's action `<clip>_<armature>` up to 4.3 and `<clip>`
+        # (one slotted action per clip) from 4.4 on.
+        names = (f"{clip}_{arm.name}", clip)
+        arm.animation_data.action = next(bpy.data.actions[n] for n in names
+                                         if n in bpy.data.actions)
     first, last = arm.animation_data.action.frame_range
     scene.frame_start, scene.frame_end = int(first), int(last)
     # The importer's "Icosphere" is the bones' display shape, not the character.

@@ -214,12 +214,22 @@ impl<'a> Source<'a> {
 
     /// Points per curve of frame `f` (empty for meshes and absent frames).
     pub(crate) fn curve_counts(&self, f: usize) -> &'a [u32] {
-        self.frame_curves(f).map_or(&[], |c| &c.counts)
+        match self.geometry {
+            UsdGeometry::Curves(_) => self
+                .frame_curves(f)
+                .map_or(&HIDDEN_CURVE_COUNTS, |c| &c.counts),
+            _ => &[],
+        }
     }
 
     /// Width of every point of frame `f` (empty for meshes and absent frames).
     pub(crate) fn widths(&self, f: usize) -> &'a [f32] {
-        self.frame_curves(f).map_or(&[], |c| &c.widths)
+        match self.geometry {
+            UsdGeometry::Curves(_) => self
+                .frame_curves(f)
+                .map_or(&HIDDEN_CURVE_WIDTHS, |c| &c.widths),
+            _ => &[],
+        }
     }
 
     /// The bounding box of frame `f` as written: the points' box ([`extent`]), grown by
@@ -283,7 +293,9 @@ impl<'a> Source<'a> {
                 _ => animation.frame(f),
             },
             UsdGeometry::Frames(_) => self.frame_mesh(f).map_or(&[], |m| &m.positions),
-            UsdGeometry::Curves(_) => self.frame_curves(f).map_or(&[], |c| &c.points),
+            UsdGeometry::Curves(_) => self
+                .frame_curves(f)
+                .map_or(&HIDDEN_CURVE_POINTS, |c| &c.points),
         }
     }
 
@@ -318,7 +330,8 @@ impl<'a> Source<'a> {
                 })
             }
             UsdGeometry::Curves(_) => Some(ColorsOf::Given(
-                self.frame_curves(f).map_or(&[], |c| &c.colors),
+                self.frame_curves(f)
+                    .map_or(&HIDDEN_CURVE_COLORS, |c| &c.colors),
             )),
         }
     }
@@ -436,3 +449,15 @@ impl ColorsOf<'_> {
                 .all(|i| self.get(i).map(f32::to_bits) == other.get(i).map(f32::to_bits))
     }
 }
+
+// A frame without motion lines still holds one curve: two points at the origin, zero width,
+// transparent, and the prim is `invisible` there. Blender 4.2's USD importer crashes on
+// `BasisCurves` whose time samples hold empty arrays; USD itself allows them.
+/// Points per curve of the hidden curve that stands in for a frame with no curves.
+static HIDDEN_CURVE_COUNTS: [u32; 1] = [2];
+/// Widths of the hidden curve.
+static HIDDEN_CURVE_WIDTHS: [f32; 2] = [0.0; 2];
+/// Points of the hidden curve.
+static HIDDEN_CURVE_POINTS: [Vec3; 2] = [Vec3::ZERO; 2];
+/// Colours of the hidden curve (transparent).
+static HIDDEN_CURVE_COLORS: [[f32; 4]; 2] = [[0.0; 4]; 2];
