@@ -487,6 +487,41 @@ def test_style_files_round_trip():
           "the CLI example is not kept as written")
 
 
+def smeared_relative(scale):
+    """The speed preset's elongation on the robot with every root object scaled by `scale`:
+    mean and largest vertex displacement over the clip, relative to the bounding-box diagonal."""
+    scene, meshes = robot("Punch")
+    for o in bpy.data.objects:
+        if o.parent is None:
+            o.scale = [c * scale for c in o.scale]
+    bpy.context.view_layer.update()
+    s = scene.toonkit_smear
+    s.live = False
+    s.preset, s.beta_max = "SPEED", 1.0
+    bake()
+    s.live = True
+    smeared = evaluated(bodies(meshes))
+    s.live = False
+    bpy.ops.toonkit.smear_unbake()
+    before = evaluated(meshes)
+    diag = float(np.linalg.norm(np.ptp(before[0], axis=0)))
+    moved = np.linalg.norm(smeared - before, axis=2) / diag
+    return float(moved.mean()), float(moved.max())
+
+
+def test_a_style_means_the_same_in_centimetres_and_metres():
+    # Speeds are in character sizes per second (docs/smear-units.md): a scene at 0.01x or
+    # 100x scale smears the same relative to its size, with no special case for units.
+    base = smeared_relative(1.0)
+    check(base[0] > 1e-4, f"the speed preset smears nothing: {base}")
+    for scale in (0.01, 100.0):
+        got = smeared_relative(scale)
+        for a, b, what in zip(got, base, ("mean", "largest")):
+            check(abs(a - b) <= 0.01 * b, f"x{scale}: {what} elongation {a:.5f} of the "
+                  f"diagonal vs {b:.5f} at 1x (tolerance 1 %)")
+    REPORT["scale_invariance"] = {"mean": base[0], "largest": base[1]}
+
+
 if __name__ == "__main__":
     code = run([
         test_style_files_round_trip,
@@ -497,6 +532,7 @@ if __name__ == "__main__":
         test_bone_parented_prop_and_non_bone_vertex_groups,
         test_cesium_man_and_camera_relative_speed,
         test_render_save_reload_unbake,
+        test_a_style_means_the_same_in_centimetres_and_metres,
     ])
     with open(os.path.join(OUT, "report.json"), "w") as f:
         json.dump(REPORT, f, indent=1)
