@@ -4,7 +4,7 @@
 //! external buffers of a `.gltf`, the rest `.obj` of a point cache, the frames of an OBJ
 //! sequence, style and option files read through [`read_file`](crate::read_file)) while a
 //! [`ReadScope`] is open, and every atomic write ([`write_atomic`](crate::write_atomic) and
-//! its siblings, hence [`save`](crate::save)) refuses a target that is one of them. Files are
+//! its siblings, hence `save`) refuses a target that is one of them. Files are
 //! compared by device and inode, so a symlink, a hard link or another spelling of the path
 //! (`./fox.glb`, `../o2/fox.glb`) is the same file.
 //!

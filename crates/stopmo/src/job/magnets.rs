@@ -6,7 +6,7 @@ use anim::Mesh;
 use glam::Vec3;
 
 use super::error::{Error, Result};
-use super::print::PrintSettings;
+use super::options::PrintSettings;
 use crate::library::{
     check_solid, cut_pocket, cylinder, exact_difference, Key, MagnetOptions, PartShell, Pocket,
     DEFAULT_ID_RELIEF_MM, DEFAULT_POCKET_SEGMENTS, MIN_MAGNET_WALL_MM,

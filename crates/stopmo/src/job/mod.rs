@@ -7,6 +7,7 @@ mod files;
 mod library_job;
 mod magnets;
 mod options;
+mod piece;
 mod plates;
 mod print;
 mod report;

@@ -6,7 +6,6 @@ use std::collections::BTreeMap;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use super::print::DEFAULT_RESOLUTION_MM;
 use crate::library::{
     MagnetOptions, Method, PlugOptions, SolveOptions, DEFAULT_PRINT_HEIGHT_MM, DEFAULT_THICKNESS_MM,
 };
@@ -224,4 +223,28 @@ pub struct RunOptions {
     pub segment: SegmentJobOptions,
     /// How to build the library of the segmented parts.
     pub library: LibraryJobOptions,
+}
+
+/// Printer resolution assumed when none is given (mm).
+pub const DEFAULT_RESOLUTION_MM: f64 = 0.05;
+
+/// How the pieces are printed.
+pub(crate) struct PrintSettings<'a> {
+    pub(crate) thickness_mm: f64,
+    pub(crate) print_height_mm: f64,
+    pub(crate) resolution_mm: f64,
+    pub(crate) keys: bool,
+    pub(crate) ids: bool,
+    pub(crate) plugs: &'a [crate::library::Plug],
+    pub(crate) plug_segments: usize,
+    /// Disc magnet whose pocket every piece and mount gets.
+    pub(crate) magnet: Option<MagnetOptions>,
+    /// Clearance of fits (key sockets, magnet pockets; mm).
+    pub(crate) clearance_mm: f64,
+    /// Build plate (mm): the print-time estimate's.
+    pub(crate) plate_mm: [f64; 2],
+    /// Files of the solids.
+    pub(crate) print_format: PrintFormat,
+    /// Printed back surfaces by part name (see [`crate::LibraryJobOptions::backs`]).
+    pub(crate) backs: &'a BTreeMap<String, Vec<Vec3>>,
 }

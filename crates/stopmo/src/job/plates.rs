@@ -10,7 +10,7 @@ use anim::Mesh;
 use serde::Serialize;
 
 use super::error::{Error, Result};
-use super::print::Piece;
+use super::piece::Piece;
 
 /// Space between pieces on a plate (mm).
 const PIECE_GAP_MM: f32 = 3.0;

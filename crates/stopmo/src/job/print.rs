@@ -12,9 +12,12 @@ use serde::Serialize;
 
 use super::error::{Error, Result};
 use super::magnets::{cut_mount, cut_piece_pocket, find_pocket, MagnetPlan};
+pub(crate) use super::options::PrintSettings;
+pub use super::options::DEFAULT_RESOLUTION_MM;
+pub use super::piece::Piece;
 use crate::library::{
     add_plugs, build_shells, material, piece_id, regularize, self_intersecting_triangles, volume,
-    Bitmap, Key, KeyOptions, Library, MagnetOptions, MaterialEstimate, PartShell, Plug, Pocket,
+    Bitmap, Key, KeyOptions, Library, MagnetOptions, MaterialEstimate, PartShell, Pocket,
     ShellInput, ShellOptions, ShellStats, DEFAULT_ID_RELIEF_MM,
 };
 
@@ -24,33 +27,9 @@ const LAYER_MM: f64 = 0.05;
 /// plate.
 const SECONDS_PER_LAYER: f64 = 8.0;
 
-/// Printer resolution assumed when none is given (mm).
-pub const DEFAULT_RESOLUTION_MM: f64 = 0.05;
-
 /// The ID embossed on piece `k` of part `part` (`P-NN`, 1-based part number).
 pub fn piece_label(part: usize, k: usize) -> String {
     format!("{}-{k:02}", part + 1)
-}
-
-/// How the pieces are printed.
-pub(crate) struct PrintSettings<'a> {
-    pub(crate) thickness_mm: f64,
-    pub(crate) print_height_mm: f64,
-    pub(crate) resolution_mm: f64,
-    pub(crate) keys: bool,
-    pub(crate) ids: bool,
-    pub(crate) plugs: &'a [Plug],
-    pub(crate) plug_segments: usize,
-    /// Disc magnet whose pocket every piece and mount gets.
-    pub(crate) magnet: Option<MagnetOptions>,
-    /// Clearance of fits (key sockets, magnet pockets; mm).
-    pub(crate) clearance_mm: f64,
-    /// Build plate (mm): the print-time estimate's.
-    pub(crate) plate_mm: [f64; 2],
-    /// Files of the solids.
-    pub(crate) print_format: super::options::PrintFormat,
-    /// Printed back surfaces by part name (see [`crate::LibraryJobOptions::backs`]).
-    pub(crate) backs: &'a std::collections::BTreeMap<String, Vec<Vec3>>,
 }
 
 /// What [`print_pieces`] makes.
@@ -171,23 +150,6 @@ pub struct PrintReport {
     pub parts: Vec<PartPrintReport>,
     /// Per piece: ID, part, frames used, volume, magnet, plate.
     pub pieces: Vec<PieceReport>,
-}
-
-/// One printable piece.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Piece {
-    /// Identifier `<part>_<NN>` (the file stem of `pieces/<id>.stl`); the ID embossed on
-    /// the back is [`piece_label`](crate::piece_label)`(part, index)`.
-    pub id: String,
-    /// Index of the part.
-    pub part: usize,
-    /// Index of the piece in its part's library (fixed pieces first).
-    pub index: usize,
-    /// The piece's surface in model units, with the part's topology and UVs.
-    pub surface: Mesh,
-    /// The printable solid in millimetres (with the part's plug shells, if any); `None` when
-    /// the job was asked for surfaces alone ([`LibraryJobOptions::print`](crate::LibraryJobOptions::print)).
-    pub solid: Option<Mesh>,
 }
 
 /// One piece as [`print_pieces`] made it.
