@@ -207,6 +207,12 @@ impl ElasticChain {
         &self.mass
     }
 
+    /// Angular frequencies (rad/s) of the undamped vibration modes in the order of the modal
+    /// coordinates ([`ElasticChain::modal_state`]).
+    pub fn modal_frequencies(&self) -> &[f64] {
+        &self.omega
+    }
+
     /// Angular frequencies (rad/s) of the undamped vibration modes, ascending.
     pub fn mode_frequencies(&self) -> Vec<f64> {
         let mut w = self.omega.clone();
@@ -286,6 +292,25 @@ impl ElasticChain {
             self.z[i] += 0.5 * h * (v + v_new);
             self.zdot[i] = v_new;
         }
+    }
+}
+
+/// Natural frequency (rad/s) of `pose`'s elastic chain (stiffness `k`) moving rigidly along
+/// the angle change `direction`: the Rayleigh quotient `√(dᵀ K d / dᵀ M d)`, i.e. the chain's
+/// dynamics reduced to that one degree of freedom (Rayleigh–Ritz). Proportional to `√k`;
+/// `√k` itself for a zero direction.
+pub(crate) fn change_frequency(pose: &Chain, stiffness: f64, direction: &[f64]) -> f64 {
+    let n = pose.elements();
+    let mass = mass_matrix(pose);
+    let k = stiffness_diagonal(&mass, n, stiffness.max(0.0));
+    let mut md = vec![0.0; n];
+    apply(&mass, n, direction, &mut md);
+    let inertia: f64 = md.iter().zip(direction).map(|(a, b)| a * b).sum();
+    let elastic: f64 = k.iter().zip(direction).map(|(a, b)| a * b * b).sum();
+    if inertia > 0.0 && elastic.is_finite() && inertia.is_finite() {
+        (elastic / inertia).sqrt()
+    } else {
+        stiffness.max(0.0).sqrt()
     }
 }
 

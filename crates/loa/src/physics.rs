@@ -37,9 +37,10 @@ pub const MAX_SIMULATED_STEPS: u64 = 2_000_000;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SimulatedFrames {
-    /// A fixed count `M` (the paper uses 40), retimed onto each interval.
+    /// A fixed count `M` (the paper uses 40): the window LoA Eq. 2 searches for the
+    /// reported `t*`.
     Fixed(u32),
-    /// As many frames as the interval has: no retiming when `t*` is the last frame.
+    /// As many frames as the interval has.
     FrameGap,
 }
 
@@ -131,6 +132,8 @@ pub struct Simulation {
     step: f64,
     target: Vec<f64>,
     to_angles: Vec<f64>,
+    /// Undamped frequency (rad/s) of each modal coordinate.
+    omega: Vec<f64>,
     z: Vec<f64>,
     zdot: Vec<f64>,
 }
@@ -191,12 +194,32 @@ impl Simulation {
     /// Angles at fractional simulated frame `tau` (cubic Hermite between sub-steps, using the
     /// simulated velocities).
     pub fn angles_at(&self, tau: f64) -> Vec<f64> {
+        self.to_angles(&self.modal_at(tau), true)
+    }
+
+    /// Undamped frequencies (rad/s) of the modal coordinates, in the simulation's order.
+    pub(crate) fn modal_frequencies(&self) -> &[f64] {
+        &self.omega
+    }
+
+    /// The motion of the angles from the start to fractional frame `tau`, each mode `i`
+    /// weighted by `weights[i]` (1 keeps it, 0 leaves it out).
+    pub(crate) fn weighted_motion(&self, tau: f64, weights: &[f64]) -> Vec<f64> {
+        let (now, start) = (self.modal_at(tau), self.modal(&self.z, 0));
+        let z: Vec<f64> = (0..self.elements)
+            .map(|j| weights[j] * (now[j] - start[j]))
+            .collect();
+        self.to_angles(&z, false)
+    }
+
+    /// Modal state at fractional simulated frame `tau` (cubic Hermite between sub-steps).
+    fn modal_at(&self, tau: f64) -> Vec<f64> {
         let last = self.states() - 1;
         let s = (tau * self.substeps as f64).clamp(0.0, last as f64);
         let i = (s.floor() as usize).min(last.saturating_sub(1));
         let u = s - i as f64;
         if last == 0 || u == 0.0 {
-            return self.state(i);
+            return self.modal(&self.z, i).to_vec();
         }
         let h = self.step;
         let (u2, u3) = (u * u, u * u * u);
@@ -208,10 +231,9 @@ impl Simulation {
         );
         let (a0, a1) = (self.modal(&self.z, i), self.modal(&self.z, i + 1));
         let (v0, v1) = (self.modal(&self.zdot, i), self.modal(&self.zdot, i + 1));
-        let z: Vec<f64> = (0..self.elements)
+        (0..self.elements)
             .map(|j| h00 * a0[j] + h10 * h * v0[j] + h01 * a1[j] + h11 * h * v1[j])
-            .collect();
-        self.to_angles(&z, true)
+            .collect()
     }
 }
 
@@ -257,6 +279,7 @@ pub fn simulate(
         step,
         target: chain.target().to_vec(),
         to_angles: chain.modal_to_angles().to_vec(),
+        omega: chain.modal_frequencies().to_vec(),
         z,
         zdot,
     })
@@ -275,15 +298,19 @@ pub struct Retarget {
     pub t_star: usize,
     /// Euclidean norm of the correction `Δγ` (radians).
     pub correction: f64,
-    /// The simulated frame actually laid onto the interval: the first local minimum of
-    /// LoA Eq. 2's distance (≤ `t_star`; Eq. 2's global minimum can be a later swing, whose
-    /// sped-up replay would strobe). Its correction is the one blended in.
-    pub first_pass: usize,
-    /// Output frames after `from_frame` at which the line reaches the next pose: `t*` at the
-    /// simulation's own speed, later when the per-frame motion cap slowed the approach, and
-    /// the whole interval when `t*` lies beyond it (then the simulation is sped up, as in
-    /// the paper). The rest of the interval is follow-through.
+    /// Output frames after `from_frame` until the line first reaches the next pose (the
+    /// dominant mode's first arrival; the whole interval when it only gets there on the
+    /// keystroke). Earlier with more stiffness.
     pub arrival: f64,
+    /// Largest swing past the next pose on the interval's frames, as a fraction of the
+    /// key-to-key change (the dominant mode's, before landing). Smaller with more damping.
+    pub overshoot: f64,
+    /// Damping ratio used: the keystroke's, raised when the interval is too short for its
+    /// swing to land within the per-frame motion cap.
+    pub damping: f64,
+    /// Time scale over the spring's own: above 1 the approach was sped up to arrive inside
+    /// the interval, below 1 slowed down by the per-frame motion cap.
+    pub time_scale: f64,
 }
 
 /// The physically interpolated line and what the re-targeting did per interval.

@@ -1,38 +1,59 @@
-//! How a simulated interval is laid onto the animator's frames (a toonkit decision; the paper
-//! re-times `0..=t*` onto the whole interval, see the crate docs' "SPEC decisions").
+//! How each keyframe interval is laid onto the animator's frames (a toonkit decision; the
+//! paper re-times `0..=t*` onto the whole interval; why and what instead:
+//! `docs/loa-timing.md`).
 //!
-//! The keystrokes stay at their frames. Within an interval of `gap` frames:
+//! The keystrokes stay at their frames. Within an interval from pose `γ_A` to `γ_B`
+//! (change `Δ = γ_B − γ_A`) the angles are
 //!
-//! 1. **Approach** (output frames `0..t_a`): the simulated frames `0..=t*` (LoA Eq. 2), with
-//!    the correction `Δγ = γ(t_k+1) − γ(t*)` blended in, played at the simulation's own speed
-//!    (`t_a = t*`, so stiffer springs arrive sooner) — slowed down only as far as needed so
-//!    that no chain point moves more than [`MAX_FRAME_MOTION`] of the line's length per frame,
-//!    and sped up (as in the paper) only when `t*` is later than the next keystroke.
-//! 2. **Follow-through** (`t_a..gap`): the line arrives on the next pose with the velocity it
-//!    had and the same springs keep pulling it there, so it overshoots (more with less
-//!    damping) and wobbles at the spring's frequency (higher with more stiffness); a second
-//!    correction, blended over this phase, lands it exactly on the keystroke. A repeated
-//!    keystroke is therefore a moving hold: the line swings through it and settles.
-//! 3. **Settle** after the last keystroke: the same springs, faded out by a smoothstep window
-//!    so the last frame is the last keystroke, at rest.
+//! `γ(t) = γ_A + p(t) Δ + d(t)`
+//!
+//! * `p(t)` — the **progress** along the change, the dominant mode's step response
+//!   ([`Progress`]): stiffness sets when the line arrives, damping how far it swings past
+//!   the next pose before landing on it at its frame.
+//! * `d(t)` — the **shape**: the elastic chain simulated from `γ_A` toward `γ_B` (LoA §3.2,
+//!   [`simulate`]) on the progress's time scale, with its component along `Δ` removed (the
+//!   progress carries that) — the overlap, anticipation and follow-through of the joints —
+//!   and LoA Eq. 2's correction blended in so that it vanishes on the keystroke.
+//!
+//! The line leaves a keystroke with the shape's velocity, made orthogonal to the next
+//! change, so every interval starts where the previous one left it (C1 with the smoothstep
+//! blend) and its progress does not depend on how the previous interval ended. The root and
+//! the element lengths follow their Hermite curves in real time (LoA §3.2: "for the root
+//! position, we simply interpolate the position between keyframes"). After the last
+//! keystroke the line settles: the dominant mode's free response to the velocity it arrived
+//! with, faded out by a smoothstep window so the last frame is the last keystroke, at rest.
 
 use crate::animation::{Animation, AnimationFrame};
+use crate::dynamics::change_frequency;
 use crate::hermite::HermiteLine;
 use crate::keypose::KeyPose;
-use crate::physics::{
-    simulate, PhysicsAnimation, PhysicsOptions, Retarget, SimulatedFrames, Simulation,
-};
+use crate::mode::free_response;
+use crate::physics::{simulate, PhysicsAnimation, PhysicsOptions, Retarget, SimulatedFrames};
+use crate::progress::Progress;
 use crate::retarget::{closest_frame, Blend};
 use crate::{Chain, LoaError};
 
-/// Largest per-frame motion of any chain point the approach is allowed, as a fraction of the
-/// line's length (the promise is ≤ 15 %; the margin covers the follow-through phase).
-pub const MAX_FRAME_MOTION: f64 = 0.1;
+/// Changes (radians, Euclidean norm of the angle change) below this are holds: no progress
+/// direction.
+const HOLD: f64 = 1e-9;
+/// Modes of the shape around the frames' Nyquist rate (π radians per output frame) and above
+/// would alias into jitter: each mode is weighted by `1 / (1 + (ω/SHAPE_CUTOFF)⁴)` (ω in
+/// radians per output frame): ½ at 2.5, 0.28 at π, 0.03 at 2π.
+const SHAPE_CUTOFF: f64 = 2.5;
+/// Most frames over which the velocity of faded modes is let out after a keystroke.
+const RELEASE_FRAMES: f64 = 6.0;
+/// Per-frame motion of any chain point the shape is scaled down to keep (fraction of the
+/// line's length; the promise is 15 %).
+const MAX_JUMP: f64 = 0.145;
+/// Bisection steps of the shape's scale.
+const SCALE_STEPS: usize = 12;
+/// Most simulated frames per output frame for the shape (a near-zero stiffness would
+/// otherwise ask for an unbounded simulation).
+const MAX_TIME_SCALE: f64 = 64.0;
 
 /// Physically-based interpolation of the key poses (Section 3.2). The result passes exactly
-/// through every key pose at its frame; see the `timing` notes in the crate docs for how each
-/// simulated interval is laid onto the keystrokes' frames, and [`PhysicsOptions::settle`] for
-/// the frames added after the last keystroke.
+/// through every key pose at its frame; see the module documentation for how each interval
+/// is laid out, and [`PhysicsOptions::settle`] for the frames added after the last keystroke.
 pub fn interpolate_physics(
     keys: &[KeyPose],
     options: &PhysicsOptions,
@@ -41,255 +62,268 @@ pub fn interpolate_physics(
     let Some(first) = keys.first() else {
         return Err(LoaError::NoKeystrokes);
     };
-    let n = first.chain.elements();
     let line = HermiteLine::new(keys);
     let mut frames = vec![AnimationFrame {
         frame: first.frame,
         chain: first.chain.clone(),
     }];
     let mut retargets = Vec::with_capacity(keys.len().saturating_sub(1));
-    let mut velocity = vec![0.0; n];
-    for pair in keys.windows(2) {
-        let (from, to) = (&pair[0], &pair[1]);
-        let m = match options.simulated_frames {
-            SimulatedFrames::Fixed(m) => m,
-            SimulatedFrames::FrameGap => u32::try_from(to.frame - from.frame).unwrap_or(u32::MAX),
-        };
-        let sim = simulate(from, to.chain.angles(), &velocity, m, options)?;
-        let whole: Vec<Vec<f64>> = (0..=sim.frames()).map(|i| sim.frame(i)).collect();
-        let t_star = closest_frame(&whole, to.chain.angles());
-        let delta = |t: usize| -> Vec<f64> {
-            let at = sim.frame(t);
-            to.chain
-                .angles()
-                .iter()
-                .zip(&at)
-                .map(|(a, b)| a - b)
-                .collect()
-        };
-        let correction = delta(t_star);
-        // The first pass: the first local minimum of LoA Eq. 2's distance (a later, closer swing
-        // would force a sped-up replay of several swings, which strobes).
-        let first = first_pass(&whole, to.chain.angles()).min(t_star);
-        let applied = delta(first);
+    // Angular velocity (radians per frame) leaving the last laid keystroke.
+    let mut velocity = vec![0.0; first.chain.elements()];
+    for (i, pair) in keys.windows(2).enumerate() {
         let interval = Interval {
-            from,
-            to,
+            from: &pair[0],
+            to: &pair[1],
+            next: keys.get(i + 2),
             line: &line,
             options,
         };
-        let laid = interval.lay(&sim, first, &applied)?;
-        for (f, chain) in (from.frame + 1..).zip(laid.chains) {
+        let laid = interval.lay(&velocity)?;
+        for (f, chain) in (pair[0].frame + 1..).zip(laid.chains) {
             frames.push(AnimationFrame { frame: f, chain });
         }
         velocity = laid.velocity;
-        retargets.push(Retarget {
-            from_frame: from.frame,
-            to_frame: to.frame,
-            simulated_frames: m,
-            t_star,
-            correction: correction.iter().map(|d| d * d).sum::<f64>().sqrt(),
-            first_pass: first,
-            arrival: laid.arrival,
-        });
+        retargets.push(laid.retarget);
     }
     let last = &keys[keys.len() - 1];
     let key_frames: Vec<i64> = keys.iter().map(|k| k.frame).collect();
     let tail = options.settle.frames(&key_frames);
-    for (f, chain) in (last.frame + 1..).zip(settle(last, &velocity, tail, options)?) {
+    let omega = match keys {
+        [.., before, last] => {
+            let change = difference(last.chain.angles(), before.chain.angles());
+            change_frequency(&last.chain, last.stiffness, &change)
+        }
+        _ => last.stiffness.max(0.0).sqrt(),
+    };
+    for (f, chain) in (last.frame + 1..).zip(settle(last, omega, &velocity, tail, options.fps)?) {
         frames.push(AnimationFrame { frame: f, chain });
     }
     Ok(PhysicsAnimation {
-        animation: Animation::new(options.fps, keys.iter().map(|k| k.frame).collect(), frames),
+        animation: Animation::new(options.fps, key_frames, frames),
         retargets,
     })
 }
 
-/// One interval between two keystrokes.
+/// One interval between two keystrokes (and the keystroke after it, if any).
 struct Interval<'a> {
-    pub from: &'a KeyPose,
-    pub to: &'a KeyPose,
-    pub line: &'a HermiteLine,
-    pub options: &'a PhysicsOptions,
+    from: &'a KeyPose,
+    to: &'a KeyPose,
+    next: Option<&'a KeyPose>,
+    line: &'a HermiteLine,
+    options: &'a PhysicsOptions,
 }
 
-/// The frames of one interval (after its first keystroke, up to and including the second)
-/// and what the re-timing did.
+/// The frames of one interval (after its first keystroke, up to and including the second).
 struct Laid {
-    pub chains: Vec<Chain>,
-    /// Output velocity (rad/s) leaving the second keystroke.
-    pub velocity: Vec<f64>,
-    /// Output frames from the first keystroke to the arrival on the next pose.
-    pub arrival: f64,
+    chains: Vec<Chain>,
+    /// Angular velocity (radians per frame) leaving the second keystroke.
+    velocity: Vec<f64>,
+    retarget: Retarget,
 }
 
 impl Interval<'_> {
-    fn gap(&self) -> f64 {
-        (self.to.frame - self.from.frame) as f64
-    }
-
-    /// Lays the approach simulation `sim` (from the first keystroke, LoA Eq. 2's `t_star` and
-    /// correction) onto the interval.
-    pub(crate) fn lay(
-        &self,
-        sim: &Simulation,
-        t_star: usize,
-        correction: &[f64],
-    ) -> Result<Laid, LoaError> {
-        let gap = self.gap();
-        let length = self
-            .from
-            .chain
-            .total_length()
-            .max(self.to.chain.total_length());
-        // The approach at the simulation's own speed; slowed down (once, in proportion) when
-        // one of its frames would move a chain point by more than the cap.
-        let mut arrival = (t_star as f64).min(gap);
-        let laid = self.lay_at(sim, t_star, correction, arrival)?;
-        let approach = &laid.chains[..(arrival.floor() as usize).min(laid.chains.len())];
-        let jump = max_jump(&self.from.chain, approach);
-        if arrival >= gap || jump.is_nan() || jump <= MAX_FRAME_MOTION * length {
-            return Ok(laid);
-        }
-        arrival = (arrival * jump / (MAX_FRAME_MOTION * length)).min(gap);
-        self.lay_at(sim, t_star, correction, arrival)
-    }
-
-    fn lay_at(
-        &self,
-        sim: &Simulation,
-        t_star: usize,
-        correction: &[f64],
-        arrival: f64,
-    ) -> Result<Laid, LoaError> {
-        let (gap, options) = (self.gap(), self.options);
-        let frame_time = 1.0 / options.fps;
-        let speed = t_star as f64 / arrival.max(1e-9);
-        let blend = options.blend;
-        let mut chains = Vec::with_capacity(gap as usize);
-        // Velocity on arrival, in seconds of output time.
-        let arrive_velocity: Vec<f64> = sim
-            .state_velocity(t_star * options.substeps as usize)
-            .iter()
-            .zip(correction)
-            .map(|(v, d)| v * speed + d * blend.slope(1.0) / (arrival * frame_time))
-            .collect();
-        let rest = gap - arrival;
-        let follow = if rest > 1e-9 {
-            let mut from = self.to.clone();
-            from.stiffness = self.from.stiffness;
-            from.damping = self.from.damping;
-            let frames = rest.ceil() as u32 + 1;
-            let sim2 = simulate(
-                &from,
-                self.to.chain.angles(),
-                &arrive_velocity,
-                frames,
-                options,
-            )?;
-            let end = sim2.angles_at(rest);
-            let landing: Vec<f64> = self
-                .to
-                .chain
-                .angles()
-                .iter()
-                .zip(&end)
-                .map(|(a, b)| a - b)
-                .collect();
-            Some((sim2, landing))
+    fn lay(&self, velocity: &[f64]) -> Result<Laid, LoaError> {
+        let (from, to, options) = (self.from, self.to, self.options);
+        let gap = (to.frame - from.frame) as f64;
+        let start = from.chain.angles();
+        let change = difference(to.chain.angles(), start);
+        let axis = unit(&change, HOLD);
+        let length = from.chain.total_length().max(to.chain.total_length());
+        let reach = if length > 0.0 {
+            reach(&from.chain, &change, to.chain.root() - from.chain.root()) / length
         } else {
-            None
+            0.0
         };
-        for f in 1..=gap as i64 {
-            let t = f as f64;
-            let angles: Vec<f64> = if f == gap as i64 {
-                self.to.chain.angles().to_vec()
-            } else if t <= arrival {
-                let tau = t * speed;
-                let w = blend.weight(tau / t_star as f64);
-                add_scaled(&sim.angles_at(tau), correction, w)
-            } else if let Some((sim2, landing)) = &follow {
-                let s = t - arrival;
-                add_scaled(&sim2.angles_at(s), landing, blend.weight(s / rest))
-            } else {
-                self.to.chain.angles().to_vec()
-            };
-            // Root and lengths follow the approach: their Hermite curves are replayed over
-            // the approach and hold the next keystroke's during the follow-through.
-            let time = self.from.frame as f64 + gap * (t / arrival).min(1.0);
-            chains.push(Chain::new(
-                self.line.root_at(time),
-                angles,
-                self.line.lengths_at(time),
-            )?);
-        }
-        let velocity = match &follow {
-            None => arrive_velocity,
-            Some((sim2, landing)) => {
-                let s = (rest * options.substeps as f64).round() as usize;
-                sim2.state_velocity(s)
-                    .iter()
-                    .zip(landing)
-                    .map(|(v, d)| v + d * blend.slope(1.0) / (rest * frame_time))
-                    .collect()
+        let omega = change_frequency(&from.chain, from.stiffness, &change);
+        let progress = Progress::new(omega, from.damping, gap, options.fps, reach);
+        let (t_star, correction, m) = self.closest_frame(velocity)?;
+
+        // The shape: the chain simulated on the progress's time scale, `Δ` removed.
+        let rate = progress.time_scale().min(MAX_TIME_SCALE);
+        let mut pose = from.clone();
+        pose.damping = progress.damping();
+        let sim_velocity: Vec<f64> = velocity.iter().map(|v| v * options.fps / rate).collect();
+        let sim_frames = (gap * rate).ceil() as u32 + 2;
+        let sim = simulate(&pose, to.chain.angles(), &sim_velocity, sim_frames, options)?;
+        // Modes faster than the frames can show would strobe: they are faded out.
+        let weights: Vec<f64> = sim
+            .modal_frequencies()
+            .iter()
+            .map(|w| 1.0 / (1.0 + (w * rate / options.fps / SHAPE_CUTOFF).powi(4)))
+            .collect();
+        let shape = |t: f64| -> Vec<f64> {
+            let mut d = sim.weighted_motion(t * rate, &weights);
+            if let Some(a) = &axis {
+                remove(&mut d, a);
             }
+            d
         };
-        if let Some(last) = chains.last_mut() {
-            *last = self.to.chain.clone();
+        // The part of the arriving velocity those faded modes carried, let out over the
+        // first frames so the line leaves the keystroke as it arrived.
+        let h = 1e-3;
+        let carried = shape(h);
+        let lost: Vec<f64> = velocity
+            .iter()
+            .zip(&carried)
+            .map(|(v, c)| v - c / h)
+            .collect();
+        let release = (0.5 * gap).min(RELEASE_FRAMES);
+        // LoA Eq. 2's correction of the shape, blended in so it vanishes on the keystroke.
+        let blend = options.blend;
+        let landing = shape(gap);
+        let mut leave: Vec<f64> = difference(&shape(gap + h), &shape(gap - h))
+            .iter()
+            .zip(&landing)
+            .map(|(v, d)| v / (2.0 * h) - d * blend.slope(1.0) / gap)
+            .collect();
+        // Leave the keystroke orthogonal to the next change too (a kick that fades in over
+        // the interval's end and is orthogonal to this change).
+        let kick = self.next.and_then(|n| {
+            let mut e = difference(n.chain.angles(), to.chain.angles());
+            if let Some(a) = &axis {
+                remove(&mut e, a);
+            }
+            let e = unit(&e, HOLD)?;
+            let along = dot(&leave, &e);
+            for (v, x) in leave.iter_mut().zip(&e) {
+                *v -= along * x;
+            }
+            Some((e, along))
+        });
+
+        // Per inner frame: the progress (and the released velocity), and the shape.
+        let (mut base, mut part) = (Vec::new(), Vec::new());
+        for f in 1..to.frame - from.frame {
+            let t = f as f64;
+            let p = progress.at(t);
+            let g = if t < release {
+                t * (1.0 - t / release) * (1.0 - t / release)
+            } else {
+                0.0
+            };
+            base.push(
+                (0..start.len())
+                    .map(|j| start[j] + p * change[j] + g * lost[j])
+                    .collect::<Vec<f64>>(),
+            );
+            let w = blend.weight(t / gap);
+            let mut d: Vec<f64> = shape(t)
+                .iter()
+                .zip(&landing)
+                .map(|(d, l)| d - w * l)
+                .collect();
+            if let Some((e, along)) = &kick {
+                // β(t) = −(gap − t)(t/gap)²: 0 with zero slope at the start, slope 1 at the end.
+                let beta = -(gap - t) * (t / gap) * (t / gap);
+                for (x, y) in d.iter_mut().zip(e) {
+                    *x -= beta * along * y;
+                }
+            }
+            part.push(d);
         }
+        let frames = Frames {
+            interval: self,
+            base: &base,
+            shape: &part,
+        };
+        let scale = frames.shape_scale(length)?;
+        let chains = frames.chains(scale)?;
+        let leave: Vec<f64> = leave.iter().map(|v| v * scale).collect();
         Ok(Laid {
             chains,
-            velocity,
-            arrival,
+            velocity: leave,
+            retarget: Retarget {
+                from_frame: from.frame,
+                to_frame: to.frame,
+                simulated_frames: m,
+                t_star,
+                correction,
+                arrival: progress.arrival(),
+                overshoot: progress.overshoot(),
+                damping: progress.damping(),
+                time_scale: progress.time_scale(),
+            },
         })
+    }
+
+    /// LoA Eq. 2 on the paper's simulation (`M` frames from the keystroke at the spring's own
+    /// speed, with the velocity the line arrives with): `t*`, the norm of its correction, `M`.
+    fn closest_frame(&self, velocity: &[f64]) -> Result<(usize, f64, u32), LoaError> {
+        let (from, to, options) = (self.from, self.to, self.options);
+        let m = match options.simulated_frames {
+            SimulatedFrames::Fixed(m) => m,
+            SimulatedFrames::FrameGap => u32::try_from(to.frame - from.frame).unwrap_or(u32::MAX),
+        };
+        let per_second: Vec<f64> = velocity.iter().map(|v| v * options.fps).collect();
+        let sim = simulate(from, to.chain.angles(), &per_second, m, options)?;
+        let whole: Vec<Vec<f64>> = (0..=sim.frames()).map(|i| sim.frame(i)).collect();
+        let t_star = closest_frame(&whole, to.chain.angles());
+        let offset = difference(to.chain.angles(), &sim.frame(t_star));
+        Ok((t_star, dot(&offset, &offset).sqrt(), m))
     }
 }
 
-/// `settle` frames after the last keystroke `key`, entered with `velocity` (rad/s): the
-/// springs of `key` pull the line back onto it and a smoothstep window fades the offset out,
-/// so the last frame is `key` at rest.
-fn settle(
-    key: &KeyPose,
-    velocity: &[f64],
-    settle: u32,
-    options: &PhysicsOptions,
-) -> Result<Vec<Chain>, LoaError> {
-    if settle == 0 {
-        return Ok(Vec::new());
+/// An interval's inner frames as progress plus a shape that can be scaled down.
+struct Frames<'a, 'b> {
+    interval: &'a Interval<'b>,
+    base: &'a [Vec<f64>],
+    shape: &'a [Vec<f64>],
+}
+
+impl Frames<'_, '_> {
+    /// The chains of the inner frames and the second keystroke, with the shape scaled by
+    /// `scale`.
+    fn chains(&self, scale: f64) -> Result<Vec<Chain>, LoaError> {
+        let (from, line) = (self.interval.from, self.interval.line);
+        let mut chains = Vec::with_capacity(self.base.len() + 1);
+        for (f, (b, d)) in self.base.iter().zip(self.shape).enumerate() {
+            let time = (from.frame + 1 + f as i64) as f64;
+            let angles = b.iter().zip(d).map(|(x, y)| x + scale * y).collect();
+            chains.push(Chain::new(
+                line.root_at(time),
+                angles,
+                line.lengths_at(time),
+            )?);
+        }
+        chains.push(self.interval.to.chain.clone());
+        Ok(chains)
     }
-    let sim = simulate(key, key.chain.angles(), velocity, settle, options)?;
-    let target = key.chain.angles();
-    (1..=settle)
-        .map(|f| {
-            let u = f as f64 / settle as f64;
-            let keep = 1.0 - Blend::Smoothstep.weight(u);
-            let angles = sim
-                .frame(f as usize)
-                .iter()
-                .zip(target)
-                .map(|(a, t)| t + keep * (a - t))
-                .collect();
-            Chain::new(key.chain.root(), angles, key.chain.lengths().to_vec())
-        })
-        .collect()
+
+    /// The most of the shape (a scale in `[0, 1]`) for which no chain point moves more than
+    /// [`MAX_JUMP`] of the line's `length` per frame. The shape is orthogonal to the change,
+    /// so this never alters the progress.
+    fn shape_scale(&self, length: f64) -> Result<f64, LoaError> {
+        let limit = MAX_JUMP * length;
+        if limit.is_nan() || limit <= 0.0 {
+            return Ok(1.0);
+        }
+        largest(|scale| Ok(max_jump(&self.interval.from.chain, &self.chains(scale)?) <= limit))
+    }
 }
 
-/// The first simulated frame `i ≥ 1` whose distance to `target` is not larger than the next
-/// frame's (the first local minimum of LoA Eq. 2's objective).
-fn first_pass(frames: &[Vec<f64>], target: &[f64]) -> usize {
-    let dist = |a: &[f64]| -> f64 { a.iter().zip(target).map(|(x, y)| (x - y) * (x - y)).sum() };
-    (1..frames.len())
-        .find(|&i| i + 1 >= frames.len() || dist(&frames[i]) <= dist(&frames[i + 1]))
-        .unwrap_or(1)
-}
-
-fn add_scaled(a: &[f64], d: &[f64], w: f64) -> Vec<f64> {
-    a.iter().zip(d).map(|(x, y)| x + w * y).collect()
+/// The largest `x` in `[0, 1]` (bisected) for which `fits(x)` holds; 0 when none does.
+fn largest(fits: impl Fn(f64) -> Result<bool, LoaError>) -> Result<f64, LoaError> {
+    if fits(1.0)? {
+        return Ok(1.0);
+    }
+    if !fits(0.0)? {
+        return Ok(0.0);
+    }
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..SCALE_STEPS {
+        let mid = 0.5 * (lo + hi);
+        if fits(mid)? {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Ok(lo)
 }
 
 /// Largest distance any chain point moves between consecutive chains (`first` precedes
 /// `chains`).
-pub(crate) fn max_jump(first: &Chain, chains: &[Chain]) -> f64 {
+fn max_jump(first: &Chain, chains: &[Chain]) -> f64 {
     let mut prev = first.joints();
     let mut worst: f64 = 0.0;
     for c in chains {
@@ -300,4 +334,88 @@ pub(crate) fn max_jump(first: &Chain, chains: &[Chain]) -> f64 {
         prev = joints;
     }
     worst
+}
+
+/// `settle` frames after the last keystroke `key`, entered with `velocity` (radians per
+/// frame): the dominant mode's free response (natural frequency `omega` rad/s — the chain's
+/// along the last change — damping ratio `ζ`), faded out
+/// by a smoothstep window so the last frame is `key` at rest.
+fn settle(
+    key: &KeyPose,
+    omega: f64,
+    velocity: &[f64],
+    settle: u32,
+    fps: f64,
+) -> Result<Vec<Chain>, LoaError> {
+    let natural = omega / fps;
+    (1..=settle)
+        .map(|f| {
+            let t = f as f64;
+            let keep = 1.0 - Blend::Smoothstep.weight(t / settle as f64);
+            let swing = if natural > 0.0 {
+                free_response(natural * t, key.damping) / natural
+            } else {
+                t
+            };
+            let angles = key
+                .chain
+                .angles()
+                .iter()
+                .zip(velocity)
+                .map(|(a, v)| a + keep * swing * v)
+                .collect();
+            Chain::new(key.chain.root(), angles, key.chain.lengths().to_vec())
+        })
+        .collect()
+}
+
+/// Fastest chain point's motion per unit of progress along `change` from `chain`, over
+/// progress −0.25..=2 (the approach and its swing), counting the root's key-to-key `shift`
+/// as if it moved with the progress (it follows its curve in real time, but its motion adds
+/// to every point's).
+fn reach(chain: &Chain, change: &[f64], shift: glam::DVec2) -> f64 {
+    let at = |u: f64| -> Vec<glam::DVec2> {
+        let angles = chain
+            .angles()
+            .iter()
+            .zip(change)
+            .map(|(a, c)| a + u * c)
+            .collect();
+        Chain::new(chain.root() + u * shift, angles, chain.lengths().to_vec())
+            .map(|c| c.joints())
+            .unwrap_or_default()
+    };
+    let du = 0.01;
+    (0..=9)
+        .map(|i| {
+            let u = -0.25 + 0.25 * i as f64;
+            let (a, b) = (at(u), at(u + du));
+            a.iter()
+                .zip(&b)
+                .map(|(p, q)| (*q - *p).length() / du)
+                .fold(0.0, f64::max)
+        })
+        .fold(0.0, f64::max)
+}
+
+fn difference(a: &[f64], b: &[f64]) -> Vec<f64> {
+    a.iter().zip(b).map(|(x, y)| x - y).collect()
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// `v / |v|`, or `None` when `|v|` is below `floor`.
+fn unit(v: &[f64], floor: f64) -> Option<Vec<f64>> {
+    let n = dot(v, v).sqrt();
+    (n > floor && n.is_finite()).then(|| v.iter().map(|x| x / n).collect())
+}
+
+/// Removes the component of `v` along the unit vector `axis`.
+fn remove(v: &mut [f64], axis: &[f64]) {
+    let along = dot(v, axis);
+    for (x, a) in v.iter_mut().zip(axis) {
+        *x -= along * a;
+    }
 }
