@@ -32,3 +32,20 @@ def first_point(armature, ref, path, pose, names, preset, joints):
     if first is None:
         return None
     return armature.matrix_world @ ref.head(armature.data.bones[first])
+
+
+def off_virtual_root(path, pose, bones):
+    """`bones` (`--bones` values) with a set whose chain starts at the BVH's virtual root (an
+    armature of several root bones, e.g. `spine-head`) started at the real root bone after it
+    instead: the virtual root sits at the world origin, no bone is there."""
+    toonkit = job._toonkit()
+    from .loa_character import VIRTUAL_ROOT
+
+    out = []
+    for b in bones:
+        text, _, frame = b.rpartition("@")
+        chain = toonkit.loa.bone_chain(path, text, pose=pose)
+        if len(chain) > 2 and chain[0] == VIRTUAL_ROOT:
+            text = f"{chain[1]},{chain[-1]}"
+        out.append(f"{text}@{frame}")
+    return out

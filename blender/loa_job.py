@@ -46,6 +46,8 @@ def solve(context, armature):
     path = loa_character.bvh_path(folder)
     try:
         names = loa_character.write_bvh(armature, ref, path)
+        if loa_character.VIRTUAL_ROOT in names:
+            bones = loa_bones.off_virtual_root(path, loa_character.POSE, bones)
         first = loa_bones.first_point(armature, ref, path, loa_character.POSE, names, s.bones,
                                       s.joints)
         strokes = loa_strokes.oriented(strokes, view, first)

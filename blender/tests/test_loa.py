@@ -369,6 +369,25 @@ def test_loa_layer_transform():
     follows(scene, arm, cam, keys, layer_matrix=layer)
 
 
+def test_loa_spine_head_on_several_root_bones():
+    """An armature of several root bones is handed over under a virtual root at the origin:
+    `spine-head` still starts at the real root bone."""
+    from bl_ext.user_default.toonkit import loa_job
+
+    scene, arm, cam = robot()
+    bpy.ops.object.mode_set(mode="EDIT")
+    extra = arm.data.edit_bones.new("ExtraRoot")
+    extra.head, extra.tail = (0.01, 0.0, 0.0), (0.01, 0.0, 0.005)
+    bpy.ops.object.mode_set(mode="OBJECT")
+    check(len([b for b in arm.data.bones if b.parent is None]) == 2, "one root bone")
+    grease_pencil(scene, [(f, stroke(f)) for f in (1, 12, 24)])
+    scene.toonkit_loa.bones = "spine-head"
+    measured = loa_job.animate(bpy.context, arm).motion.report["measured_joints"]
+    print(f"  spine-head: {', '.join(measured)}")
+    check(measured[0] == "Bone" and measured[-1] == "Head (tip)"
+          and "toonkit_loa_root" not in measured, f"{measured}")
+
+
 def test_loa_errors():
     scene, arm, cam = robot()
     before = (sorted(o.name for o in bpy.data.objects), sorted(a.name for a in bpy.data.actions),
@@ -409,5 +428,6 @@ if __name__ == "__main__":
                 test_loa_cesium_turned_camera, test_loa_cesium_name_preset,
                 test_loa_hierarchy_head_with_raised_arms,
                 test_loa_robot_feet_sets_differ_and_match_the_cli,
-                test_loa_keyframe_of_several_strokes_is_one_line, test_loa_layer_transform])
+                test_loa_keyframe_of_several_strokes_is_one_line, test_loa_layer_transform,
+                test_loa_spine_head_on_several_root_bones])
     os._exit(code)  # bpy's interpreter teardown can crash after a headless run
