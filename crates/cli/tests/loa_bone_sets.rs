@@ -73,7 +73,7 @@ fn raised_arm_preset_runs_from_the_foot_to_the_hand() {
         "rest",
         "right-leg-spine-arm",
     );
-    for joint in ["FootR", "UpperLegR", "Torso_1", "UpperArmR", "LowerArmR"] {
+    for joint in ["FootR", "LowerLegR", "Torso_1", "UpperArmR", "LowerArmR"] {
         assert!(chain.iter().any(|j| j == joint), "{joint}: {chain:?}");
     }
     assert!(!chain.iter().any(|j| j.starts_with("Head")), "{chain:?}");

@@ -124,9 +124,11 @@ def test_bone_set_presets_come_from_the_core_and_resolve_like_the_cli(tmp_path):
     assert chain[0] == "FootR" and chain[1] == "LowerLegR" and chain[-1] == "Head"
     assert toonkit.loa.bone_chain(asset(ROBOT), "FootL,Head")[:2] == ["FootL", "LowerLegL"]
     out = tmp_path / "cli.bvh"
-    report = json.loads(run_cli("loa", "animate", asset(ROBOT), example("loa/jump.json"),
-                                "-o", out, "--bones", "foot-head@0").stdout)
+    report = json.loads(run_cli("--json", "loa", "animate", asset(ROBOT),
+                                example("loa/jump.json"), "-o", out,
+                                "--bones", "foot-head@0").stdout)
     measured = {j.replace(" (tip)", "") for j in report["line_distance_joints"]}
-    assert measured == set(toonkit.loa.bone_chain(asset(ROBOT), "foot-head"))
+    chain = toonkit.loa.bone_chain(asset(ROBOT), "foot-head")
+    assert measured <= set(chain) and {chain[0], chain[-1]} <= measured
     with pytest.raises(ValueError, match="NoSuchBone"):
         toonkit.loa.bone_chain(asset(ROBOT), "FootL,NoSuchBone")
