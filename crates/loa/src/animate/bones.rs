@@ -14,7 +14,8 @@ use super::rig::Rig;
 
 /// Named bone sets: humanoid ones found from joint names (RobotExpressive `FootR`, BVH `rFoot`
 /// / `RightFoot`, Mixamo `mixamorig:RightFoot`, `foot.R`, `foot_r`, …), and two found from the
-/// skeleton's hierarchy alone, for any joint names (see [`spine`]).
+/// skeleton's hierarchy alone, for any joint names (the spine is followed through the
+/// children that have no mirrored twin).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Preset {
     /// Right foot → right leg → spine → head.
