@@ -12,23 +12,18 @@ import bpy
 from bpy.props import (CollectionProperty, EnumProperty, FloatProperty, IntProperty,
                        StringProperty)
 
+from toonkit import loa as _core  # noqa: E402  (the extension's wheel, installed with it)
+
 from . import loa_bones
 
-# The CLI's preset names (`toonkit loa animate --bones NAME`, found from humanoid bone names),
-# the presets read from the armature's hierarchy (`loa_bones`, for any bone names), and a
-# custom joint list.
+# The bone-set presets, defined once in the loa crate (`toonkit.loa.BONE_SETS`): found from
+# humanoid bone names (the CLI's `--bones NAME`) or from the hierarchy (`foot-head`,
+# `spine-head`, for any bone names); then a custom bone list.
 PRESETS = [
-    ("right-leg-spine-head", "Right leg, spine, head",
-     "Right foot → right leg → spine → head"),
-    ("left-leg-spine-head", "Left leg, spine, head", "Left foot → left leg → spine → head"),
-    ("arm-spine", "Right arm, spine", "Right hand → right arm → spine → hips"),
-    ("left-arm-spine", "Left arm, spine", "Left hand → left arm → spine → hips"),
-    ("arms", "Arms", "Left hand → arms and shoulders → right hand"),
-    ("legs", "Legs", "Left foot → legs → right foot"),
-    ("full-body", "Full body", "Left foot → left leg → spine → right arm → right hand"),
-    *loa_bones.PRESETS,
+    *(tuple(p) for p in _core.BONE_SETS),
     ("CUSTOM", "Bones…", "A comma-separated list of bones along the line (e.g. FootR,Head)"),
 ]
+HIERARCHY = ("foot-head", "spine-head")  # presets that read no bone names
 
 MODES = [
     ("physics", "Physics", "An elastic chain re-targeted onto every keystroke (LoA Eqs. 1-2)"),
@@ -67,12 +62,11 @@ class LoaSettings(bpy.types.PropertyGroup):
                               description="Bevel of the line curve; 0 = 0.5 % of the height")
 
 
-def bone_sets(s, first_frame, armature, ref):
-    """The `--bones` values: the first set at `first_frame`, then the per-frame ones
-    (hierarchy presets resolved on `armature` posed as `ref`)."""
-    out = [f"{loa_bones.bone_set(armature, ref, s.bones, s.joints)}@{first_frame}"]
+def bone_sets(s, first_frame):
+    """The `--bones` values: the first set at `first_frame`, then the per-frame ones."""
+    out = [f"{loa_bones.bone_set(s.bones, s.joints)}@{first_frame}"]
     for k in sorted(s.bone_keys, key=lambda k: k.frame):
-        out.append(f"{loa_bones.bone_set(armature, ref, k.preset, k.joints)}@{k.frame}")
+        out.append(f"{loa_bones.bone_set(k.preset, k.joints)}@{k.frame}")
     return out
 
 

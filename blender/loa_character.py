@@ -18,7 +18,9 @@ translations follow the same chain), so `basis_b = R_b⁻¹ · R_parent · Q_par
 position `h`: `M_root = matrix_local · basis` puts the head at `head_local + R_b · loc`, so
 `loc = R_b⁻¹ · (h − head_local)`. Other bones keep the reference's location (and scale, when
 it is not 1) channel, so a child's head stays where its parent carries it, as the BVH offset
-does. With every `D_b` the identity the new action reproduces the reference pose.
+does — except a bone whose head the crate moved elsewhere (an IK foot under the root, which
+it attaches to the shin), whose location channel then puts its head there (`_location`).
+With every `D_b` the identity the new action reproduces the reference pose.
 """
 
 import os
@@ -29,6 +31,9 @@ from mathutils import Matrix, Quaternion, Vector
 from . import job, loa_bones
 
 VIRTUAL_ROOT = "toonkit_loa_root"  # joins several root bones under one BVH ROOT
+# The pose the crate starts from: the file's one frame, where every joint is (a BVH's rest
+# pose, its OFFSETs, has the root at the origin).
+POSE = "motion@0"
 
 
 def _name(bone):
@@ -40,7 +45,10 @@ def _name(bone):
 
 def leaf_tip(armature, bone):
     """Rest tip of a leaf bone (armature space): the glTF importer's `<bone>_end` empty parented
-    to it (the file's tip node, as the CLI reads it), else the bone's tail."""
+    to it (the file's tip node, on the node's +Y), else the bone's tail. Written as the BVH's
+    `End Site`, it gives the crate the bone's axis (a BVH joint has no rest orientation); the
+    crate puts the tip on that axis at the parent bone's length, as for the glTF file itself
+    (SPEC bones), so the CLI and the extension solve the same chain."""
     for child in armature.children:
         if (child.type == "EMPTY" and child.parent_type == "BONE"
                 and child.parent_bone == bone.name and child.name.startswith(f"{bone.name}_end")):
@@ -132,6 +140,7 @@ def pose_keys(armature, motion, names, ref):
     posed = {b.name: ref.matrix[b.name].to_quaternion() for b in bones}
     scale = {b.name: ref.scale[b.name] for b in bones
              if (ref.scale[b.name] - Vector((1.0, 1.0, 1.0))).length > 1e-6}
+    tol = 1e-5 * max(b.length for b in bones)
     keys, before = [], {}
     for f in range(rotations.shape[0]):
         world = {}
@@ -139,18 +148,18 @@ def pose_keys(armature, motion, names, ref):
             if bone is not None:
                 x, y, z, w = rotations[f, index[n]]
                 world[bone] = turn.inverted() @ Quaternion((w, x, y, z)) @ turn
-        by_bone = {bone: n for n, bone in names.items() if bone is not None}
+        heads = {bone: to_arm @ Vector(positions[f, index[n]])
+                 for n, bone in names.items() if bone is not None}
         q = {b.name: world[b.name] @ posed[b.name] for b in bones}  # Q_b = D_b · P_b
         pose = {}
         for b in bones:
             if b.parent is None:
                 basis = rest[b.name].inverted() @ q[b.name]
-                head = to_arm @ Vector(positions[f, index[by_bone[b.name]]])
-                loc = rest[b.name].inverted() @ (head - b.head_local)
+                loc = rest[b.name].inverted() @ (heads[b.name] - b.head_local)
             else:
                 p = b.parent.name
                 basis = (rest[b.name].inverted() @ rest[p] @ q[p].inverted() @ q[b.name])
-                loc = ref.location[b.name]
+                loc = _location(b, ref, q[p], heads[p], heads[b.name], tol)
             basis.normalize()
             if b.name in before and basis.dot(before[b.name]) < 0.0:
                 basis.negate()  # the same rotation, keyed without a flip between frames
@@ -158,6 +167,22 @@ def pose_keys(armature, motion, names, ref):
             pose[b.name] = (basis, loc, scale.get(b.name))
         keys.append((motion.first_frame + f, pose))
     return keys
+
+
+def _location(bone, ref, turn, parent_head, head, tol):
+    """The location channel of a child bone: the reference's, which keeps its head where its
+    parent carries it, unless the crate moved the head elsewhere (an IK foot parented to the
+    root, which the crate attaches to its shin while solving): then the channel that puts it
+    there. `M_b = M_parent · R_parent⁻¹ · R_b · basis` puts the head at
+    `M_parent · R_parent⁻¹ · R_b · loc`, with `M_parent` the parent's new pose (its head, its
+    rotation `turn`, the reference's scale)."""
+    p = bone.parent
+    carry = (Matrix.LocRotScale(parent_head, turn, ref.matrix[p.name].to_scale())
+             @ p.matrix_local.inverted() @ bone.matrix_local)
+    loc = ref.location[bone.name]
+    if (carry @ loc - head).length <= tol:
+        return loc
+    return carry.inverted() @ head
 
 
 def key_action(armature, keys):

@@ -21,10 +21,11 @@ class Result:
     """What `animate` made: the crate's line and motion, the new and previous actions and
     the line object."""
 
-    def __init__(self, line, motion, action, previous, curve, keystrokes):
+    def __init__(self, line, motion, action, previous, curve, keystrokes, joined):
         self.line, self.motion = line, motion
         self.action, self.previous = action, previous
         self.curve, self.keystrokes = curve, keystrokes
+        self.joined = joined  # {frame: strokes joined into its keystroke}
 
 
 def solve(context, armature):
@@ -33,44 +34,59 @@ def solve(context, armature):
     s = context.scene.toonkit_loa
     gp = loa_strokes.strokes_object(context, s.strokes)
     camera = loa_strokes.camera_of(context)
-    strokes = loa_strokes.keystrokes(gp)
+    strokes, joined = loa_strokes.read(gp)
     if len(strokes) < 1:
         raise job.JobError(f"'{gp.name}' has no keystroke")
     ref = loa_character.Reference(context.scene, armature, context.scene.frame_start)
     center, size = loa_character.center(armature, ref)
     view = loa_strokes.View(camera, center)
-    bones = loa.bone_sets(s, strokes[0][0], armature, ref)
-    first = loa_bones.first_point(armature, ref, s.bones, s.joints)
-    strokes = loa_strokes.oriented(strokes, view, first)
-    keys = []
-    for frame, pts in strokes:
-        k = {"frame": frame, "points": [view.screen(p) for p in pts]}
-        if s.stiffness > 0:
-            k["stiffness"] = s.stiffness
-        if s.damping > 0:
-            k["damping"] = s.damping
-        keys.append(k)
+    bones = loa.bone_sets(s, strokes[0][0])
     fps = context.scene.render.fps / context.scene.render.fps_base
     folder = tempfile.mkdtemp(prefix="toonkit-loa-")
+    path = loa_character.bvh_path(folder)
     try:
-        names = loa_character.write_bvh(armature, ref, loa_character.bvh_path(folder))
+        names = loa_character.write_bvh(armature, ref, path)
+        if loa_character.VIRTUAL_ROOT in names:
+            bones = loa_bones.off_virtual_root(path, loa_character.POSE, bones)
+        first = loa_bones.first_point(armature, ref, path, loa_character.POSE, names, s.bones,
+                                      s.joints)
+        strokes = loa_strokes.oriented(strokes, view, first)
+        keys = [_keystroke(s, frame, [view.screen(p) for p in pts]) for frame, pts in strokes]
         line = toonkit.loa.line(keys, mode=s.mode, fps=fps)
-        motion = toonkit.loa.animate(loa_character.bvh_path(folder), line, bones=bones,
+        motion = toonkit.loa.animate(path, line, bones=bones, pose=loa_character.POSE,
                                      **view.as_options())
         pose = loa_character.pose_keys(armature, motion, names, ref)
     except (toonkit.ToonkitError, ValueError, OSError) as e:
-        # The character file is ours and temporary: name the armature instead.
-        text = job._one_line(e).replace(loa_character.bvh_path(folder), armature.name)
-        role = re.search(r"no (\w+) joint found for the preset", text)
-        if role:  # a name preset on other bone names
-            used = sorted({b.split("@")[0] for b in bones} & {p[0] for p in loa.PRESETS})
-            text = (f"{armature.name}: the preset '{', '.join(used)}' finds no "
-                    f"{role.group(1)} bone by name; choose '{loa_bones.PRESETS[0][1]}' "
-                    f"or list bones ({_bone_list(armature)})")
-        raise job.JobError(text) from e
+        raise job.JobError(_message(e, path, armature, bones)) from e
     finally:
         shutil.rmtree(folder, ignore_errors=True)
-    return line, motion, pose, view, strokes, size
+    return line, motion, pose, view, strokes, size, joined
+
+
+def _keystroke(s, frame, points):
+    k = {"frame": frame, "points": points}
+    if s.stiffness > 0:
+        k["stiffness"] = s.stiffness
+    if s.damping > 0:
+        k["damping"] = s.damping
+    return k
+
+
+def _message(e, path, armature, bones):
+    """The crate's error as one line naming the armature (the character file is ours and
+    temporary), a name preset on other bone names pointing to the hierarchy preset."""
+    text = job._one_line(e).replace(path, armature.name)
+    role = re.search(r"no (\w+) joint found for the preset", text)
+    named = {p[0] for p in loa.PRESETS} - set(loa.HIERARCHY) - {"CUSTOM"}
+    used = sorted({b.split("@")[0] for b in bones} & named)
+    if role and used:
+        hierarchy = next(p[1] for p in loa.PRESETS if p[0] == "foot-head")
+        text = (f"{armature.name}: the preset '{', '.join(used)}' finds no "
+                f"{role.group(1)} bone by name; choose '{hierarchy}' "
+                f"or list bones ({_bone_list(armature)})")
+    elif role:
+        text += f" ({_bone_list(armature)})"
+    return text
 
 
 def _bone_list(armature, most=12):
@@ -81,12 +97,12 @@ def _bone_list(armature, most=12):
 
 def animate(context, armature):
     """Solves, then keys the new action and shows the line; returns a `Result`."""
-    line, motion, pose, view, strokes, size = solve(context, armature)
+    line, motion, pose, view, strokes, size, joined = solve(context, armature)
     action, previous = loa_character.key_action(armature, pose)
     width = context.scene.toonkit_loa.line_width or 0.005 * size
     curve = show_line(context.scene, armature, line, view, width)
     context.scene.frame_set(context.scene.frame_current)
-    return Result(line, motion, action, previous, curve, strokes)
+    return Result(line, motion, action, previous, curve, strokes, joined)
 
 
 def show_line(scene, armature, line, view, width):

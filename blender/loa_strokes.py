@@ -3,8 +3,15 @@ drawn in the camera view).
 
 Both Grease Pencil APIs are read: Blender 4.2's (object type `GPENCIL`: layers → frames →
 strokes → points `.co`) and 4.3+'s (object type `GREASEPENCIL`: layers → frames →
-`drawing.strokes` → points `.position`). Every Grease Pencil keyframe is one keystroke: its
-longest stroke (over all visible layers), in world space (4.3+ layer transforms applied).
+`drawing.strokes` → points `.position`), in world space: the object's transform after each
+layer's own location, rotation and scale (4.2's layer transform, 4.3+'s layer
+`translation`/`rotation`/`scale`). Layer parents are not followed.
+
+Every Grease Pencil keyframe is one keystroke. Several strokes on one keyframe (over all
+visible layers, in layer then drawing order) are pieces of that one line, as an animator
+lifting the pen mid-line means them: they are joined end to end, each piece continuing from
+the end of the line so far nearest one of its own ends (the first two by their nearest pair
+of ends), and the operator's report says which keyframes were joined (docs/blender.md).
 
 The camera is the loa crate's `ActionCamera` in world space (the space of the character
 handed to the loa crate): focal plane through the character's centre, image
@@ -15,7 +22,7 @@ with the identity screen map, so the line is exactly where the strokes are in th
 
 import math
 
-from mathutils import Matrix, Vector
+from mathutils import Euler, Matrix, Vector
 
 from . import job
 
@@ -54,26 +61,52 @@ def _length(points):
     return sum((b - a).length for a, b in zip(points, points[1:]))
 
 
-def keystrokes(obj):
-    """[(frame, [world points])] of `obj`, one per keyframe (its longest stroke), by frame."""
+def layer_matrix(obj, layer):
+    """A layer's own transform (inside the object): 4.2's `location`/`rotation`/`scale`, 4.3+'s
+    `translation`/`rotation`/`scale`, composed as Blender does (T · R_xyz · S)."""
+    at = layer.location if obj.type == "GPENCIL" else layer.translation
+    return Matrix.LocRotScale(Vector(at), Euler(layer.rotation, "XYZ"), Vector(layer.scale))
+
+
+def joined(pieces):
+    """One line from the strokes of one keyframe, in drawing order: the first two by their
+    nearest pair of ends, each later one from its end nearer the line's end."""
+    line = list(pieces[0])
+    for k, piece in enumerate(pieces[1:]):
+        piece = list(piece)
+        if k == 0:
+            gaps = [(line[-1] - piece[0]).length, (line[-1] - piece[-1]).length,
+                    (line[0] - piece[0]).length, (line[0] - piece[-1]).length]
+            best = gaps.index(min(gaps))
+            if best >= 2:
+                line.reverse()
+            if best % 2:
+                piece.reverse()
+        elif (line[-1] - piece[-1]).length < (line[-1] - piece[0]).length:
+            piece.reverse()
+        if (piece[0] - line[-1]).length == 0.0:
+            piece = piece[1:]
+        line += piece
+    return line
+
+
+def read(obj):
+    """([(frame, [world points])] by frame, {frame: strokes joined}) of `obj`: one keystroke
+    per keyframe, its strokes joined (`joined`) when it has several."""
     by_frame = {}
     for layer in obj.data.layers:
         if getattr(layer, "hide", False):
             continue
-        to_world = obj.matrix_world
-        if obj.type == "GREASEPENCIL":  # 4.3+: layers carry their own transform
-            to_world = to_world @ Matrix(layer.matrix_local)
+        to_world = obj.matrix_world @ layer_matrix(obj, layer)
         for frame in layer.frames:
             for stroke in _strokes(obj, frame):
                 pts = [to_world @ p for p in _stroke_points(obj, stroke)]
-                if len(pts) < 2 or _length(pts) <= 0.0:
-                    continue
-                old = by_frame.get(frame.frame_number)
-                if old is None or _length(pts) > _length(old):
-                    by_frame[frame.frame_number] = pts
+                if len(pts) >= 2 and _length(pts) > 0.0:
+                    by_frame.setdefault(frame.frame_number, []).append(pts)
     if not by_frame:
         raise job.JobError(f"'{obj.name}' has no stroke of two or more points")
-    return sorted(by_frame.items())
+    keys = [(f, joined(pieces)) for f, pieces in sorted(by_frame.items())]
+    return keys, {f: len(p) for f, p in sorted(by_frame.items()) if len(p) > 1}
 
 
 def oriented(strokes, view, first):

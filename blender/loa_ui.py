@@ -13,6 +13,14 @@ def _armature(context):
     return obj if obj is not None and obj.type == "ARMATURE" else None
 
 
+def joined_note(joined):
+    """` (frame 12: 2 strokes joined, …)` for keyframes whose strokes were joined into one
+    keystroke (`loa_strokes.read`), else empty."""
+    if not joined:
+        return ""
+    return " (" + ", ".join(f"frame {f}: {n} strokes joined" for f, n in joined.items()) + ")"
+
+
 class TOONKIT_OT_loa_animate(bpy.types.Operator):
     """Animate the active armature along the line of action drawn with Grease Pencil in the
     camera view (one keystroke per Grease Pencil keyframe); the result is a new Action"""
@@ -33,7 +41,7 @@ class TOONKIT_OT_loa_animate(bpy.types.Operator):
             return {"CANCELLED"}
         rep = r.motion.report
         self.report({"INFO"}, f"loa: action '{r.action.name}' from {len(r.keystrokes)} "
-                              f"keystrokes, mean distance to the line "
+                              f"keystrokes{joined_note(r.joined)}, mean distance to the line "
                               f"{100 * rep['line_distance_mean']:.1f} % of its length")
         return {"FINISHED"}
 
@@ -76,7 +84,8 @@ class TOONKIT_PT_loa(bpy.types.Panel):
     def draw(self, context):
         s = context.scene.toonkit_loa
         lay = self.layout
-        lay.label(text="Draw strokes in the camera view, one per keyframe")
+        lay.label(text="Draw the line in the camera view, one per keyframe")
+        lay.label(text="(strokes on one keyframe are joined)")
         lay.prop_search(s, "strokes", context.scene, "objects")
         lay.prop(s, "mode")
         col = lay.column(align=True)

@@ -9,14 +9,16 @@ import os
 
 import bpy
 import numpy as np
-from mathutils import Euler, Vector
+from mathutils import Euler, Matrix, Vector
 
 from harness import check
 
 
-def grease_pencil(scene, keys, depth=0.0):
-    """A Grease Pencil object with one stroke per (frame, world points), in this Blender's API,
-    plus a short second stroke per frame (the longest one is the keystroke)."""
+def grease_pencil(scene, keys, depth=0.0, layer_matrix=None):
+    """A Grease Pencil object with one stroke per (frame, world points) — or several, for a
+    (frame, [points, points, …]) — in this Blender's API. With `layer_matrix` (a layer
+    transform of location, rotation and scale) the layer carries it and the points are stored
+    in the layer's space, so that they land on the given world points."""
     # 4.3-4.5 keep the legacy `grease_pencils` (annotations) beside `grease_pencils_v3`; an
     # empty collection is falsy, so test for the attribute, not its truth.
     v3 = getattr(bpy.data, "grease_pencils_v3", None)
@@ -24,11 +26,21 @@ def grease_pencil(scene, keys, depth=0.0):
     obj = bpy.data.objects.new("Line", data)
     scene.collection.objects.link(obj)
     layer = data.layers.new("strokes")
+    inside = Matrix.Identity(4)
+    if layer_matrix is not None:
+        at, turn, size = layer_matrix.decompose()
+        if obj.type == "GPENCIL":
+            layer.location = at
+        else:
+            layer.translation = at
+        layer.rotation = turn.to_euler("XYZ")
+        layer.scale = size
+        inside = layer_matrix.inverted()
     for frame, pts in keys:
         fr = layer.frames.new(frame)
-        pts = [(x, y + depth, z) for x, y, z in pts]
-        for extra in (False, True):
-            p = pts[:3] if extra else pts
+        pieces = pts if isinstance(pts, list) and np.ndim(pts[0]) == 2 else [pts]
+        for piece in pieces:
+            p = [tuple(inside @ Vector((x, y + depth, z))) for x, y, z in piece]
             if obj.type == "GPENCIL":
                 s = fr.strokes.new()
                 s.points.add(len(p))
@@ -110,11 +122,12 @@ def fitted_camera(scene, arm, yaw_deg=0.0, margin=1.8):
     return cam
 
 
-def drawn_strokes(scene, arm, cam, frames, n=24, reverse=False):
+def drawn_strokes(scene, arm, cam, frames, n=24, reverse=False, ends=None):
     """Keystrokes drawn to the armature's size in `cam`'s view: from the skeleton's lowest
     point up to its highest (start frame), projected onto the camera-facing plane through its
     centre; straight at the first frame, bending to one side (45 % of the height), then to the
-    other (50 %), as the robot's strokes. `reverse`: drawn from the top down."""
+    other (50 %), as the robot's strokes. `reverse`: drawn from the top down. `ends`: from and
+    to these world points instead."""
     scene.frame_set(scene.frame_start)
     pts = bone_points(arm)
     m = cam.matrix_world
@@ -127,8 +140,8 @@ def drawn_strokes(scene, arm, cam, frames, n=24, reverse=False):
         d = p - eye
         return eye + d * (depth / d.dot(ahead))
 
-    foot = on_plane(min(pts, key=lambda p: p.z))
-    top = on_plane(max(pts, key=lambda p: p.z))
+    low, high = ends or (min(pts, key=lambda p: p.z), max(pts, key=lambda p: p.z))
+    foot, top = on_plane(low), on_plane(high)
     along = top - foot
     side = along.cross(ahead).normalized() * along.length
     t = np.linspace(0.0, 1.0, n)
@@ -143,13 +156,13 @@ def drawn_strokes(scene, arm, cam, frames, n=24, reverse=False):
     return keys
 
 
-def follows(scene, arm, cam, keys, out=None, name="loa"):
+def follows(scene, arm, cam, keys, out=None, name="loa", layer_matrix=None):
     """Runs `toonkit.loa_animate` on `arm` with strokes `keys` [(frame, world points)] seen
     by `cam` and checks the acceptance figures: the line passes through each stroke at its
     frame (≤ 2 % of the stroke's length, image plane) and the skeleton's mean distance to the
     line is below 0.6× the starting pose's. Returns (gaps, mean, mean of the start pose)."""
     previous = arm.animation_data.action if arm.animation_data else None
-    gp = grease_pencil(scene, keys)
+    gp = grease_pencil(scene, keys, layer_matrix=layer_matrix)
     scene.frame_set(scene.frame_start)
     start = skeleton(arm)
     if out:

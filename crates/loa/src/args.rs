@@ -129,9 +129,11 @@ impl LineFlags {
 /// initial pose and the solver's iteration cap.
 #[derive(Debug, Clone, Args)]
 pub struct MotionFlags {
-    /// Bone set at a keystroke frame: a preset (right-leg-spine-head, left-leg-spine-head,
-    /// arm-spine, left-arm-spine, arms, legs, full-body) or comma-separated joint names, then
-    /// `@FRAME`. Repeat for changing sets.
+    /// Bone set at a keystroke frame: a preset found by joint names (right-leg-spine-head,
+    /// left-leg-spine-head, arm-spine, left-arm-spine, arms, legs, full-body, and for a raised
+    /// arm right-leg-spine-arm, left-leg-spine-arm), one found from the hierarchy for any
+    /// names (foot-head, spine-head) or comma-separated joint names, then `@FRAME`. Repeat for
+    /// changing sets.
     #[arg(long = "bones")]
     pub bones: Vec<String>,
     /// Action-plane normal `x,y,z` (default: the view direction).

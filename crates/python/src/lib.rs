@@ -55,6 +55,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("LOA_DAMPING_RANGE", range(loa::DAMPING_RANGE))?;
     m.add_function(wrap_pyfunction!(loa_py::line, m)?)?;
     m.add_function(wrap_pyfunction!(loa_character::save_pose, m)?)?;
+    m.add_function(wrap_pyfunction!(loa_character::bone_chain, m)?)?;
+    m.add("LOA_BONE_SETS", loa_character::bone_set_presets())?;
     m.add_class::<stopmo_py::Segmented>()?;
     m.add_class::<stopmo_py::Library>()?;
     m.add_function(wrap_pyfunction!(stopmo_py::segment, m)?)?;

@@ -76,3 +76,45 @@ pub(crate) fn save_pose(
         .map_err(io_error)?;
     Ok(path)
 }
+
+/// The joints (names, in chain order) a bone set resolves to on the character file at `path`
+/// in `pose` (`"rest"` or `"CLIP@FRAME"`): a preset (found from names or from the hierarchy)
+/// or a comma-separated joint list, as `toonkit.loa.animate`'s `bones` take it (no `@FRAME`).
+#[pyfunction(name = "loa_bone_chain")]
+pub(crate) fn bone_chain(
+    py: Python<'_>,
+    path: PathBuf,
+    bones: String,
+    pose: String,
+) -> PyResult<Vec<String>> {
+    let source = path.display().to_string();
+    let bad = |e: loa::animate::AnimateError| value_error(format!("{source}: {e}"));
+    let set: loa::animate::BoneSet = bones.parse().map_err(bad)?;
+    let pose: loa::animate::InitialPose = pose.parse().map_err(bad)?;
+    let fps = f64::from(anim::DEFAULT_FPS);
+    let load = tkio::LoadOptions {
+        fps: fps as f32,
+        ..Default::default()
+    };
+    let loaded = py.detach(|| tkio::load(&path, &load)).map_err(io_error)?;
+    let tkio::Loaded::Scene(scene) = loaded else {
+        return Err(value_error(format!(
+            "{source}: not a character (use a skinned glTF/GLB or a BVH file)"
+        )));
+    };
+    let character = loa::animate::Character::from_scene(&scene, &pose, fps).map_err(bad)?;
+    let chain = character.bone_chain(&set).map_err(bad)?;
+    Ok(chain
+        .into_iter()
+        .map(|k| character.joint_names()[k].clone())
+        .collect())
+}
+
+/// `(name, label, description)` of every bone-set preset, defined once in the loa crate (the
+/// Blender panel lists them from here).
+pub(crate) fn bone_set_presets() -> Vec<(&'static str, &'static str, &'static str)> {
+    loa::animate::Preset::ALL
+        .iter()
+        .map(|&(p, name)| (name, p.label(), p.description()))
+        .collect()
+}

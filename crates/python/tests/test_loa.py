@@ -107,3 +107,28 @@ def test_values_outside_the_documented_ranges_raise_naming_the_range():
     ok = [{"frame": 0, "points": stroke, "stiffness": lo},
           {"frame": 12, "points": stroke, "stiffness": hi}]
     assert toonkit.loa.line(ok).points.shape[0] > 12
+
+
+def test_bone_set_presets_come_from_the_core_and_resolve_like_the_cli(tmp_path):
+    """`BONE_SETS` lists the core's presets (the CLI's `--bones` names, the raised-arm and the
+    hierarchy ones); `bone_chain` gives the chain `animate` maps onto the line, and the CLI
+    measures the same joints for it."""
+    from conftest import ROBOT, asset
+
+    names = [p[0] for p in toonkit.loa.BONE_SETS]
+    for name in ("right-leg-spine-head", "full-body", "right-leg-spine-arm", "foot-head",
+                 "spine-head"):
+        assert name in names
+    assert all(len(p) == 3 and all(p) for p in toonkit.loa.BONE_SETS)
+    chain = toonkit.loa.bone_chain(asset(ROBOT), "foot-head", pose="Dance@1")
+    assert chain[0] == "FootR" and chain[1] == "LowerLegR" and chain[-1] == "Head"
+    assert toonkit.loa.bone_chain(asset(ROBOT), "FootL,Head")[:2] == ["FootL", "LowerLegL"]
+    out = tmp_path / "cli.bvh"
+    report = json.loads(run_cli("--json", "loa", "animate", asset(ROBOT),
+                                example("loa/jump.json"), "-o", out,
+                                "--bones", "foot-head@0").stdout)
+    measured = {j.replace(" (tip)", "") for j in report["line_distance_joints"]}
+    chain = toonkit.loa.bone_chain(asset(ROBOT), "foot-head")
+    assert measured <= set(chain) and {chain[0], chain[-1]} <= measured
+    with pytest.raises(ValueError, match="NoSuchBone"):
+        toonkit.loa.bone_chain(asset(ROBOT), "FootL,NoSuchBone")

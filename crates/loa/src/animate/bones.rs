@@ -12,8 +12,10 @@ use std::str::FromStr;
 use super::error::AnimateError;
 use super::rig::Rig;
 
-/// Named humanoid bone sets, found from joint names (RobotExpressive `FootR`, BVH `rFoot` /
-/// `RightFoot`, Mixamo `mixamorig:RightFoot`, `foot.R`, `foot_r`, …).
+/// Named bone sets: humanoid ones found from joint names (RobotExpressive `FootR`, BVH `rFoot`
+/// / `RightFoot`, Mixamo `mixamorig:RightFoot`, `foot.R`, `foot_r`, …), and two found from the
+/// skeleton's hierarchy alone, for any joint names (the spine is followed through the
+/// children that have no mirrored twin).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Preset {
     /// Right foot → right leg → spine → head.
@@ -30,11 +32,19 @@ pub enum Preset {
     Legs,
     /// Left foot → left leg → spine → right arm → right hand: the long diagonal.
     FullBody,
+    /// Right foot → right leg → spine → right arm → right hand: a raised right arm.
+    RightLegSpineArm,
+    /// Left foot → left leg → spine → left arm → left hand: a raised left arm.
+    LeftLegSpineArm,
+    /// A foot → its leg → spine → head, found from the hierarchy (any joint names).
+    FootHead,
+    /// The root → spine → head, found from the hierarchy (any joint names).
+    SpineHead,
 }
 
 impl Preset {
     /// Every preset with its command-line name.
-    pub const ALL: [(Preset, &'static str); 7] = [
+    pub const ALL: [(Preset, &'static str); 11] = [
         (Preset::RightLegSpineHead, "right-leg-spine-head"),
         (Preset::LeftLegSpineHead, "left-leg-spine-head"),
         (Preset::RightArmSpine, "arm-spine"),
@@ -42,6 +52,10 @@ impl Preset {
         (Preset::Arms, "arms"),
         (Preset::Legs, "legs"),
         (Preset::FullBody, "full-body"),
+        (Preset::RightLegSpineArm, "right-leg-spine-arm"),
+        (Preset::LeftLegSpineArm, "left-leg-spine-arm"),
+        (Preset::FootHead, "foot-head"),
+        (Preset::SpineHead, "spine-head"),
     ];
 
     /// The command-line name.
@@ -50,6 +64,68 @@ impl Preset {
             .iter()
             .find(|(p, _)| *p == self)
             .map_or("?", |(_, n)| n)
+    }
+
+    /// A short label for menus (the Blender panel, the studio).
+    pub fn label(self) -> &'static str {
+        self.text().0
+    }
+
+    /// What the chain runs through, in one sentence (menu tooltips).
+    pub fn description(self) -> &'static str {
+        self.text().1
+    }
+
+    fn text(self) -> (&'static str, &'static str) {
+        match self {
+            Preset::RightLegSpineHead => (
+                "Right leg, spine, head",
+                "Right foot → right leg → spine → head (joints found by name)",
+            ),
+            Preset::LeftLegSpineHead => (
+                "Left leg, spine, head",
+                "Left foot → left leg → spine → head (joints found by name)",
+            ),
+            Preset::RightArmSpine => (
+                "Right arm, spine",
+                "Right hand → right arm → spine → hips (joints found by name)",
+            ),
+            Preset::LeftArmSpine => (
+                "Left arm, spine",
+                "Left hand → left arm → spine → hips (joints found by name)",
+            ),
+            Preset::Arms => (
+                "Arms",
+                "Left hand → arms and shoulders → right hand (joints found by name)",
+            ),
+            Preset::Legs => (
+                "Legs",
+                "Left foot → legs → right foot (joints found by name)",
+            ),
+            Preset::FullBody => (
+                "Full body",
+                "Left foot → left leg → spine → right arm → right hand (joints found by name)",
+            ),
+            Preset::RightLegSpineArm => (
+                "Right leg, spine, raised right arm",
+                "Right foot → right leg → spine → right arm → right hand, for a raised arm \
+                 (joints found by name)",
+            ),
+            Preset::LeftLegSpineArm => (
+                "Left leg, spine, raised left arm",
+                "Left foot → left leg → spine → left arm → left hand, for a raised arm \
+                 (joints found by name)",
+            ),
+            Preset::FootHead => (
+                "Foot to head (hierarchy)",
+                "A foot → its leg → spine → head, found from the skeleton's hierarchy for any \
+                 joint names (the head ends the spine, wherever the arms are)",
+            ),
+            Preset::SpineHead => (
+                "Spine and head (hierarchy)",
+                "Root → spine → head, found from the skeleton's hierarchy for any joint names",
+            ),
+        }
     }
 }
 
@@ -239,6 +315,81 @@ fn lca(rig: &Rig, a: usize, b: usize) -> usize {
     path.into_iter().min_by_key(|&k| depth(k)).unwrap_or(a)
 }
 
+/// Joints in each joint's kinematic subtree and that subtree's depth (a leaf: `(1, 0)`).
+fn shapes(rig: &Rig) -> Vec<(usize, usize)> {
+    let mut shape = vec![(1, 0); rig.len()];
+    for &k in rig.order.iter().rev() {
+        for &c in &rig.children[k] {
+            shape[k].0 += shape[c].0;
+            shape[k].1 = shape[k].1.max(shape[c].1 + 1);
+        }
+    }
+    shape
+}
+
+/// Children of `k` whose subtree has a twin among its siblings (the same joint count and
+/// depth: a left/right pair of limbs), and those without one.
+fn twins(rig: &Rig, shape: &[(usize, usize)], k: usize) -> (Vec<usize>, Vec<usize>) {
+    let kids = &rig.children[k];
+    kids.iter()
+        .copied()
+        .partition(|&c| kids.iter().any(|&d| d != c && shape[d] == shape[c]))
+}
+
+/// The spine, root first, found from the hierarchy alone (no names, no pose, so raised arms
+/// and any up axis are fine): from the root with the largest subtree, down through the
+/// child that has no twin among its siblings (legs and arms come in mirrored pairs, the
+/// spine, neck and head do not), the largest such child when there are several; it ends
+/// where every child has a twin or there is none (the head, or the joint the eyes hang from).
+pub(crate) fn spine(rig: &Rig) -> Vec<usize> {
+    let shape = shapes(rig);
+    let Some(root) = (0..rig.len())
+        .filter(|&k| rig.parent[k].is_none())
+        .max_by_key(|&k| (shape[k].0, std::cmp::Reverse(k)))
+    else {
+        return Vec::new();
+    };
+    let mut path = vec![root];
+    loop {
+        let k = path[path.len() - 1];
+        let (_, single) = twins(rig, &shape, k);
+        match single
+            .into_iter()
+            .max_by_key(|&c| (shape[c].0, std::cmp::Reverse(c)))
+        {
+            Some(c) => path.push(c),
+            None => return path,
+        }
+    }
+}
+
+/// The foot of the hierarchy's leg: along the spine from the root, the first pair of twin
+/// subtrees of two or more joints (the legs, branching at the hips below the arms; single
+/// IK targets hanging from the root are no legs); of the pair, the right one when its first
+/// joint's name says so, else the first; its deepest leaf.
+fn hierarchy_foot(rig: &Rig, spine: &[usize]) -> Option<usize> {
+    let shape = shapes(rig);
+    let right = |c: usize| {
+        side_variants(&rig.names[c])
+            .iter()
+            .any(|(s, _)| *s == Some(Side::Right))
+    };
+    let legs = spine.iter().find_map(|&k| {
+        let (paired, _) = twins(rig, &shape, k);
+        let legs: Vec<usize> = paired.into_iter().filter(|&c| shape[c].0 >= 2).collect();
+        (legs.len() >= 2).then_some(legs)
+    })?;
+    let mut k = legs.iter().copied().find(|&c| right(c)).unwrap_or(legs[0]);
+    // Down the deepest branch to its leaf.
+    while let Some(&c) = rig.children[k]
+        .iter()
+        .max_by_key(|&&c| (shape[c].1, std::cmp::Reverse(c)))
+    {
+        k = c;
+    }
+    Some(k)
+}
+
 /// Resolves a bone set into a chain on the rig.
 pub(crate) fn resolve(rig: &Rig, set: &BoneSet) -> Result<Chain3, AnimateError> {
     let waypoints: Vec<usize> = match set {
@@ -277,6 +428,26 @@ pub(crate) fn resolve(rig: &Rig, set: &BoneSet) -> Result<Chain3, AnimateError> 
                 Preset::Arms => vec![hand(Side::Left)?, hand(Side::Right)?],
                 Preset::Legs => vec![foot(Side::Left)?, foot(Side::Right)?],
                 Preset::FullBody => vec![foot(Side::Left)?, hand(Side::Right)?],
+                Preset::RightLegSpineArm => vec![foot(Side::Right)?, hand(Side::Right)?],
+                Preset::LeftLegSpineArm => vec![foot(Side::Left)?, hand(Side::Left)?],
+                Preset::FootHead | Preset::SpineHead => {
+                    let spine = spine(rig);
+                    let (Some(&root), Some(&head)) = (spine.first(), spine.last()) else {
+                        return Err(AnimateError::EmptySkeleton);
+                    };
+                    let start = if *p == Preset::FootHead {
+                        hierarchy_foot(rig, &spine).ok_or_else(|| AnimateError::PresetJoint {
+                            role: "leg",
+                            joints: rig.names.join(", "),
+                        })?
+                    } else {
+                        root
+                    };
+                    if start == head {
+                        return Err(AnimateError::EmptyBoneSet);
+                    }
+                    vec![start, head]
+                }
             }
         }
     };

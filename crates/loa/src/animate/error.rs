@@ -27,7 +27,8 @@ pub enum AnimateError {
     /// The bone-set name is not a preset and not a joint list.
     #[error(
         "unknown bone set '{0}'; use right-leg-spine-head, left-leg-spine-head, arm-spine, \
-         left-arm-spine, arms, legs, full-body, or a comma-separated list of joint names"
+         left-arm-spine, arms, legs, full-body, right-leg-spine-arm, left-leg-spine-arm, \
+         foot-head, spine-head, or a comma-separated list of joint names"
     )]
     UnknownPreset(String),
     /// A preset needs a joint the naming heuristics could not find; give the bone set as an

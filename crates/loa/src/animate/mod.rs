@@ -203,6 +203,18 @@ impl Character {
         })
     }
 
+    /// [`Character::new`] with explicit leaf bone axes (local directions; see
+    /// [`Character::from_scene`]).
+    fn with_axes(
+        skeleton: &Skeleton,
+        pose: &[Transform],
+        axes: Vec<Option<DVec3>>,
+    ) -> Result<Character, AnimateError> {
+        Ok(Character {
+            rig: Rig::with_axes(skeleton, pose, axes)?,
+        })
+    }
+
     /// A character in its rest (bind) pose.
     pub fn rest(skeleton: &Skeleton) -> Result<Character, AnimateError> {
         let pose: Vec<Transform> = skeleton.joints.iter().map(|j| j.bind_local).collect();
@@ -211,18 +223,7 @@ impl Character {
 
     /// A character in the pose given by world matrices (e.g. a sampled clip frame).
     pub fn from_world(skeleton: &Skeleton, world: &[Mat4]) -> Result<Character, AnimateError> {
-        if world.len() != skeleton.len() {
-            return Err(AnimateError::PoseLength {
-                expected: skeleton.len(),
-                found: world.len(),
-            });
-        }
-        let pose: Vec<Transform> = skeleton
-            .local_from_world(world)
-            .into_iter()
-            .map(Transform::from_matrix)
-            .collect();
-        Self::new(skeleton, &pose)
+        Self::new(skeleton, &local_pose(skeleton, world)?)
     }
 
     /// Joint names.
@@ -278,6 +279,21 @@ impl Character {
     pub fn bone_chain(&self, set: &BoneSet) -> Result<Vec<usize>, AnimateError> {
         Ok(bones::resolve(&self.rig, set)?.joints)
     }
+}
+
+/// Local transforms (relative to the skeleton parent) of a pose given by world matrices.
+fn local_pose(skeleton: &Skeleton, world: &[Mat4]) -> Result<Vec<Transform>, AnimateError> {
+    if world.len() != skeleton.len() {
+        return Err(AnimateError::PoseLength {
+            expected: skeleton.len(),
+            found: world.len(),
+        });
+    }
+    Ok(skeleton
+        .local_from_world(world)
+        .into_iter()
+        .map(Transform::from_matrix)
+        .collect())
 }
 
 /// Measurements of a synthesized motion.

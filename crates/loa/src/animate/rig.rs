@@ -40,8 +40,11 @@ pub(crate) struct Rig {
     pub rotation: Vec<DQuat>,
     /// Local scale.
     pub scale: Vec<DVec3>,
-    /// Leaf joints: tip offset along the local +Y (SPEC bone rule), in local units.
+    /// Leaf joints: tip offset along the bone axis (SPEC bone rule), in local units.
     pub leaf_tip: Vec<Option<DVec3>>,
+    /// Bone axis of a joint without a rest orientation, from its `End Site` (local units);
+    /// `None`: the local +Y (see [`Rig::with_axes`]).
+    pub axis: Vec<Option<DVec3>>,
 }
 
 /// World state of every joint in one pose.
@@ -73,6 +76,19 @@ impl Rig {
     /// Builds the rig from a skeleton and the local transforms of the initial pose (one per
     /// joint, relative to the skeleton parent).
     pub(super) fn new(skeleton: &Skeleton, pose: &[Transform]) -> Result<Rig, AnimateError> {
+        Rig::with_axes(skeleton, pose, Vec::new())
+    }
+
+    /// [`Rig::new`] with the bone axes of leaves the file gives explicitly: `axes[k]` is joint
+    /// k's bone direction in its local frame. A BVH joint has no rest orientation, so the SPEC
+    /// rule's local +Y means nothing there (it is world up); its `End Site` is where the bone
+    /// points. The tip stays at the parent bone's length along that axis (the SPEC rule), so
+    /// a skeleton handed over as BVH gets the same tips as the file it came from.
+    pub(super) fn with_axes(
+        skeleton: &Skeleton,
+        pose: &[Transform],
+        axes: Vec<Option<DVec3>>,
+    ) -> Result<Rig, AnimateError> {
         let n = skeleton.len();
         if n == 0 {
             return Err(AnimateError::EmptySkeleton);
@@ -106,6 +122,14 @@ impl Rig {
             rotation: pose.iter().map(|t| dquat(t.rotation)).collect(),
             scale: pose.iter().map(|t| t.scale.as_dvec3()).collect(),
             leaf_tip: vec![None; n],
+            axis: (0..n)
+                .map(|k| {
+                    axes.get(k)
+                        .copied()
+                        .flatten()
+                        .and_then(DVec3::try_normalize)
+                })
+                .collect(),
         };
         rig.rebuild_tree();
         rig.attach_detached_effectors();
@@ -136,8 +160,9 @@ impl Rig {
         self.update_leaf_tips();
     }
 
-    /// SPEC bone tips of leaves: local +Y scaled by the parent bone's length (in the leaf's
-    /// local units).
+    /// SPEC bone tips of leaves: the bone axis (local +Y, or the file's `End Site` axis for a
+    /// joint without rest orientation) scaled to the parent bone's length (in the leaf's local
+    /// units).
     fn update_leaf_tips(&mut self) {
         let world = self.world(&self.rotation, DVec3::ZERO);
         let n = self.len();
@@ -151,9 +176,14 @@ impl Rig {
             let tip = kids.iter().map(|&c| world.position[c]).sum::<DVec3>() / kids.len() as f64;
             let len = (tip - world.position[p]).length();
             let s = world.scale[k];
-            if len > 0.0 && s.y.abs() > 0.0 {
-                self.leaf_tip[k] = Some(DVec3::new(0.0, len / s.y, 0.0));
-            }
+            self.leaf_tip[k] = match self.axis[k] {
+                // The local step whose world length (through the accumulated scale) is `len`.
+                Some(axis) => {
+                    let unit = (s * axis).length();
+                    (len > 0.0 && unit > 0.0).then(|| axis * (len / unit))
+                }
+                None => (len > 0.0 && s.y.abs() > 0.0).then(|| DVec3::new(0.0, len / s.y, 0.0)),
+            };
         }
     }
 

@@ -82,6 +82,12 @@ impl Character {
     /// The character of a scene: its skin joints (or BVH skeleton) in `pose`, clips sampled
     /// at `fps` frames per second.
     ///
+    /// A leaf joint without a rest orientation (a BVH joint, whose rest rotation is the
+    /// identity) has no local +Y of its own to put its bone tip on (SPEC bones): its
+    /// `End Site` (a `<joint>_end` child node, see `tkio::bvh`) gives the bone's axis instead,
+    /// so that e.g. a shin ends at the ankle rather than pointing up into the thigh. The tip
+    /// stays at the parent bone's length, as for any leaf.
+    ///
     /// # Errors
     /// [`AnimateError::EmptySkeleton`] without joints, [`AnimateError::BadPose`] for an
     /// unknown clip or a frame past its end, [`AnimateError::Scene`] when the clip cannot be
@@ -91,12 +97,14 @@ impl Character {
         pose: &InitialPose,
         fps: f64,
     ) -> Result<Character, AnimateError> {
-        let (skeleton, _) = scene.skeleton();
+        let (skeleton, nodes) = scene.skeleton();
         if skeleton.is_empty() {
             return Err(AnimateError::EmptySkeleton);
         }
+        let axes = end_site_axes(scene, &skeleton, &nodes);
         let InitialPose::Clip { clip, frame } = pose else {
-            return Character::rest(&skeleton);
+            let rest: Vec<Transform> = skeleton.joints.iter().map(|j| j.bind_local).collect();
+            return Character::with_axes(&skeleton, &rest, axes);
         };
         let bad = |expected: String| AnimateError::BadPose {
             pose: pose.to_string(),
@@ -123,8 +131,38 @@ impl Character {
                 skeletal.frame_count()
             )));
         }
-        Character::from_world(&skeleton, skeletal.frame(*frame))
+        let local = super::local_pose(&skeleton, skeletal.frame(*frame))?;
+        Character::with_axes(&skeleton, &local, axes)
     }
+}
+
+/// Per joint of `skeleton` (the scene's, at `nodes`, see [`Scene::skeleton`]): the local bone axis of a
+/// leaf joint without rest orientation, from its `End Site` node — a `<joint>_end` child that
+/// is no joint and carries nothing (no mesh, camera or children).
+fn end_site_axes(
+    scene: &Scene,
+    skeleton: &anim::Skeleton,
+    nodes: &[usize],
+) -> Vec<Option<glam::DVec3>> {
+    let joint_node: std::collections::HashSet<usize> = nodes.iter().copied().collect();
+    skeleton
+        .joints
+        .iter()
+        .zip(nodes)
+        .map(|(joint, &node)| {
+            if joint.bind_local.rotation != glam::Quat::IDENTITY {
+                return None;
+            }
+            let name = format!("{}_end", joint.name);
+            let site = scene.nodes.get(node)?.children.iter().find_map(|&c| {
+                let n = scene.nodes.get(c)?;
+                let bare = n.mesh.is_none() && n.camera.is_none() && n.children.is_empty();
+                (bare && !joint_node.contains(&c) && n.name == name).then_some(n)
+            })?;
+            let t = site.transform.translation.as_dvec3();
+            (t.length() > 0.0).then_some(t)
+        })
+        .collect()
 }
 
 impl ActionCamera {

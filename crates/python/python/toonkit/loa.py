@@ -26,14 +26,20 @@ from ._native import Line, Motion
 STIFFNESS_RANGE: tuple = _native.LOA_STIFFNESS_RANGE
 #: The documented damping-ratio range (inclusive); a keystroke outside it raises ValueError.
 DAMPING_RANGE: tuple = _native.LOA_DAMPING_RANGE
+#: Every bone-set preset as ``(name, label, description)``, defined once in the core: found
+#: from joint names (``right-leg-spine-head``, ``right-leg-spine-arm`` for a raised arm, …) or
+#: from the hierarchy (``foot-head``, ``spine-head``, for any joint names).
+BONE_SETS: list = [tuple(p) for p in _native.LOA_BONE_SETS]
 
 
 __all__ = [
+    "BONE_SETS",
     "DAMPING_RANGE",
     "Line",
     "Motion",
     "STIFFNESS_RANGE",
     "animate",
+    "bone_chain",
     "line",
     "save_pose",
 ]
@@ -56,6 +62,20 @@ def save_pose(
     return os.fspath(
         _native.loa_save_pose(os.fspath(path), list(names), [int(p) for p in parents], heads)
     )
+
+
+def bone_chain(
+    character: Union[str, "os.PathLike[str]"], bones: str, pose: str = "rest"
+) -> list:
+    """The joint names, in chain order, that the bone set ``bones`` (a preset of
+    :data:`BONE_SETS` or a comma-separated joint list, without ``@FRAME``) resolves to on the
+    character file (glTF/GLB or BVH) in ``pose`` (``"rest"`` or ``"CLIP@FRAME"``): the chain
+    :func:`animate` maps onto the line, first joint at the stroke's start.
+
+    >>> toonkit.loa.bone_chain("assets/characters/RobotExpressive.glb", "foot-head")[-1]
+    'Head'
+    """
+    return list(_native.loa_bone_chain(os.fspath(character), str(bones), str(pose)))
 
 
 def _keystrokes_json(keystrokes: Iterable[Mapping[str, Any]], fps: Optional[float]) -> str:

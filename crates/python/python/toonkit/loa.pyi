@@ -8,6 +8,7 @@ from ._native import Line as Line, Motion as Motion, Scene
 
 STIFFNESS_RANGE: tuple[float, float]
 DAMPING_RANGE: tuple[float, float]
+BONE_SETS: list[tuple[str, str, str]]
 
 def line(
     keystrokes: Iterable[Mapping[str, Any]],
@@ -26,6 +27,9 @@ def animate(
     progress: Optional[Callable[[str, float], Any]] = None,
     **options: Any,
 ) -> Motion: ...
+def bone_chain(
+    character: Union[str, os.PathLike[str]], bones: str, pose: str = "rest"
+) -> list[str]: ...
 def save_pose(
     path: Union[str, os.PathLike[str]],
     names: Iterable[str],
