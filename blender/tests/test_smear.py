@@ -94,7 +94,7 @@ def expected(objs, style=None):
     check(rel(positions, s.positions, diag) <= TOL, "the bake sampled other vertices")
     positions = s.positions
     scene = toonkit.Scene.from_arrays(positions, s.triangles, fps=s.fps, skin=s.skin,
-                                      objects=s.objects, attributes=s.attributes)
+                                      objects=s.objects, attributes=s.attributes, rest=s.rest)
     settings = bpy.context.scene.toonkit_smear
     prepared = toonkit.smear.prepare(scene, smooth=settings.smooth)
     return positions, toonkit.smear.stylize(
