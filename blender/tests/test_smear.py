@@ -499,6 +499,7 @@ def smeared_relative(scale):
     s.live = False
     s.preset, s.beta_max = "SPEED", 1.0
     bake()
+    size = baked_size(scene)
     s.live = True
     smeared = evaluated(bodies(meshes))
     s.live = False
@@ -506,7 +507,15 @@ def smeared_relative(scale):
     before = evaluated(meshes)
     diag = float(np.linalg.norm(np.ptp(before[0], axis=0)))
     moved = np.linalg.norm(smeared - before, axis=2) / diag
-    return float(moved.mean()), float(moved.max())
+    return float(moved.mean()), float(moved.max()), size
+
+
+def baked_size(scene):
+    """The size unit the bake's style was measured in (docs/smear-units.md)."""
+    from bl_ext.user_default.toonkit import job
+
+    _, prepared = job.cached(scene)
+    return toonkit.smear.stylize(prepared, {"elongate": {}}).report["size"]
 
 
 def test_a_style_means_the_same_in_centimetres_and_metres():
@@ -514,12 +523,18 @@ def test_a_style_means_the_same_in_centimetres_and_metres():
     # 100x scale smears the same relative to its size, with no special case for units.
     base = smeared_relative(1.0)
     check(base[0] > 1e-4, f"the speed preset smears nothing: {base}")
+    # The size is the rest pose's, as the CLI and the module measure it on the same file.
+    robot = toonkit.load(os.path.join(ASSETS, "RobotExpressive.glb"), clip="Punch")
+    check(abs(base[2] - robot.size) <= 1e-4 * robot.size,
+          f"Blender's rest size {base[2]:.6f} vs the module's {robot.size:.6f}")
     for scale in (0.01, 100.0):
         got = smeared_relative(scale)
-        for a, b, what in zip(got, base, ("mean", "largest")):
+        check(abs(got[2] - scale * base[2]) <= 1e-4 * scale * base[2],
+              f"x{scale}: size {got[2]} vs {scale * base[2]}")
+        for a, b, what in zip(got[:2], base[:2], ("mean", "largest")):
             check(abs(a - b) <= 0.01 * b, f"x{scale}: {what} elongation {a:.5f} of the "
                   f"diagonal vs {b:.5f} at 1x (tolerance 1 %)")
-    REPORT["scale_invariance"] = {"mean": base[0], "largest": base[1]}
+    REPORT["scale_invariance"] = {"mean": base[0], "largest": base[1], "size": base[2]}
 
 
 if __name__ == "__main__":

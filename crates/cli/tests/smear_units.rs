@@ -12,6 +12,7 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use common::{data, json, ok, s, toonkit};
+use testdata::{glb_json, scaled_glb};
 
 /// The example styles of `examples/smear/` (size units), sorted.
 fn examples() -> Vec<PathBuf> {
@@ -24,52 +25,6 @@ fn examples() -> Vec<PathBuf> {
     v.sort();
     assert_eq!(v.len(), 7, "{v:?}");
     v
-}
-
-/// The GLB's JSON chunk and binary chunk.
-fn glb_json(bytes: &[u8]) -> (serde_json::Value, usize) {
-    let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-    assert_eq!(&bytes[16..20], b"JSON");
-    (serde_json::from_slice(&bytes[20..20 + len]).unwrap(), len)
-}
-
-/// `character` (a GLB of assets/characters) with its root node scaled by `scale` (its
-/// `scale`, or its `matrix` multiplied): the JSON chunk edited, the binary chunk kept.
-fn scaled(dir: &Path, character: &str, scale: f32) -> PathBuf {
-    let bytes = std::fs::read(data(&format!("characters/{character}.glb"))).unwrap();
-    let (mut doc, len) = glb_json(&bytes);
-    let roots = doc["scenes"][0]["nodes"].as_array().unwrap().clone();
-    assert_eq!(roots.len(), 1, "one root node");
-    let root = roots[0].as_u64().unwrap() as usize;
-    let node = &mut doc["nodes"][root];
-    if let Some(m) = node.get_mut("matrix").and_then(|m| m.as_array_mut()) {
-        // Column-major 4 × 4 (CesiumMan's Z_UP): scale × matrix scales its first three rows.
-        for (k, v) in m.iter_mut().enumerate() {
-            if k % 4 != 3 {
-                *v = serde_json::json!(v.as_f64().unwrap() * scale as f64);
-            }
-        }
-    } else {
-        assert!(node.get("scale").is_none());
-        node["scale"] = serde_json::json!([scale, scale, scale]);
-    }
-    let mut text = serde_json::to_vec(&doc).unwrap();
-    while !text.len().is_multiple_of(4) {
-        text.push(b' ');
-    }
-    let rest = &bytes[20 + len..];
-    let total = 12 + 8 + text.len() + rest.len();
-    let mut out = Vec::with_capacity(total);
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(text.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&text);
-    out.extend_from_slice(rest);
-    let path = dir.join(format!("{character}_{scale}.glb"));
-    std::fs::write(&path, out).unwrap();
-    path
 }
 
 /// `toonkit --json smear INPUT --style STYLE --clip Wave --fps FPS -o OUT` plus `extra`.
@@ -146,7 +101,12 @@ fn every_example_style_looks_the_same_in_centimetres_and_metres() {
     ] {
         let copies: Vec<(f32, PathBuf)> = [1.0, 0.01, 100.0]
             .into_iter()
-            .map(|k| (k, scaled(dir.path(), character, k)))
+            .map(|k| {
+                (
+                    k,
+                    scaled_glb(&format!("characters/{character}.glb"), k, dir.path()),
+                )
+            })
             .collect();
         for style in examples() {
             let name = style.file_name().unwrap().to_string_lossy().into_owned();
