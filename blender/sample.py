@@ -179,10 +179,14 @@ def _rest_matrices(context, meshes):
     own vertices (no modifier, basis shape) sit at the rest pose, whose bounding-box diagonal
     is a smear style's size unit (docs/smear-units.md)."""
     rigs = {r for o in meshes for r in (armature_of(o), _bone_parent(o)[0]) if r is not None}
-    changed = {r.data for r in rigs if r.data.pose_position != "REST"}
+    changed = []
     try:
-        for data in changed:
-            data.pose_position = "REST"
+        for data in {r.data for r in rigs if r.data.pose_position != "REST"}:
+            try:
+                data.pose_position = "REST"
+            except (AttributeError, RuntimeError):  # linked, read-only: measured as posed
+                continue
+            changed.append(data)
         dg = context.evaluated_depsgraph_get()
         dg.update()
         return {o.name: _matrix(o.evaluated_get(dg).matrix_world) for o in meshes}
