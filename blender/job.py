@@ -98,7 +98,8 @@ def _prepare(context, objects, settings):
                        else (s.positions, s.skin))
     try:
         scene = toonkit.Scene.from_arrays(positions, s.triangles, fps=s.fps, skin=skin,
-                                          objects=s.objects, attributes=s.attributes)
+                                          objects=s.objects, attributes=s.attributes,
+                                          rest=s.rest)
         prepared = toonkit.smear.prepare(scene, smooth=settings.smooth)
     except (toonkit.ToonkitError, ValueError) as e:
         raise JobError(_one_line(e)) from e

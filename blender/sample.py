@@ -43,6 +43,7 @@ class Sample:
     attributes: dict = field(default_factory=dict)
     bones: list = field(default_factory=list)
     camera: np.ndarray = None   # (frames, 4, 4) camera world matrices (camera-relative mode)
+    rest: np.ndarray = None     # (vertices, 3) float32 world space at the rest pose
 
     @property
     def objects(self):
@@ -152,19 +153,61 @@ def pose_only_reason(obj):
     return None
 
 
+def _co(obj):
+    """Rest vertices (object space) of `obj`'s own mesh: no modifier, the basis shape."""
+    co = np.empty(len(obj.data.vertices) * 3, np.float32)
+    obj.data.vertices.foreach_get("co", co)
+    return co.reshape(-1, 3)
+
+
 def _rest(obj):
     """Rest vertices (object space) and triangles of `obj`'s own mesh."""
     mesh = obj.data
-    co = np.empty(len(mesh.vertices) * 3, np.float32)
-    mesh.vertices.foreach_get("co", co)
+    co = _co(obj)
     mesh.calc_loop_triangles()
     tris = np.empty(len(mesh.loop_triangles) * 3, np.int32)
     mesh.loop_triangles.foreach_get("vertices", tris)
-    return co.reshape(-1, 3), tris.reshape(-1, 3)
+    return co, tris.reshape(-1, 3)
 
 
 def _matrix(m):
     return np.array(m, np.float64)
+
+
+def _rest_matrices(context, meshes):
+    """World matrix of each mesh with the armatures it follows in rest position: where its
+    own vertices (no modifier, basis shape) sit at the rest pose, whose bounding-box diagonal
+    is a smear style's size unit (docs/smear-units.md)."""
+    rigs = {r for o in meshes for r in (armature_of(o), _bone_parent(o)[0]) if r is not None}
+    changed = []
+    try:
+        for data in {r.data for r in rigs if r.data.pose_position != "REST"}:
+            try:
+                data.pose_position = "REST"
+            except (AttributeError, RuntimeError):  # linked, read-only: measured as posed
+                continue
+            changed.append(data)
+        dg = context.evaluated_depsgraph_get()
+        dg.update()
+        return {o.name: _matrix(o.evaluated_get(dg).matrix_world) for o in meshes}
+    finally:
+        for data in changed:
+            data.pose_position = "POSE"
+        context.evaluated_depsgraph_get().update()
+
+
+def _rest_positions(meshes, ranges, matrices, positions):
+    """(vertices, 3) float32: each mesh's own vertices through its rest matrix, or its first
+    frame when a modifier changed its vertex count."""
+    rest = np.empty((ranges[-1].stop, 3), np.float32)
+    for o, r in zip(meshes, ranges):
+        if len(o.data.vertices) != len(r):
+            rest[r.start:r.stop] = positions[0, r.start:r.stop]
+            continue
+        co = _co(o).astype(np.float64)
+        m = matrices[o.name]
+        rest[r.start:r.stop] = co @ m[:3, :3].T + m[:3, 3]
+    return rest
 
 
 class _Pose:
@@ -311,6 +354,8 @@ def sample(context, objects, camera_relative=False, pose_only=True):
     try:
         for k in range(frames):
             scene.frame_set(start + k)
+            if k == 0:
+                rest_matrices = _rest_matrices(context, meshes)
             dg = context.evaluated_depsgraph_get()
             if k == 0 and pose is not None:
                 pose.first_frame(dg)  # the evaluated triangles, then the meshes off
@@ -347,7 +392,8 @@ def sample(context, objects, camera_relative=False, pose_only=True):
     result = Sample(
         names=[o.name for o in meshes], ranges=ranges, positions=positions,
         triangles=np.concatenate(all_tris).astype(np.int32), frame_start=start,
-        fps=scene.render.fps / scene.render.fps_base, bones=joint_names)
+        fps=scene.render.fps / scene.render.fps_base, bones=joint_names,
+        rest=_rest_positions(meshes, ranges, rest_matrices, positions))
     _skin_and_attributes(result, meshes, counts, groups, armature, parents,
                          rig.matrices() if rig is not None else None)
     if camera_relative:

@@ -29,6 +29,7 @@ mod flipbook;
 mod human;
 mod mesh;
 mod mesh_animation;
+mod rest;
 mod rng;
 mod sample;
 mod scene;

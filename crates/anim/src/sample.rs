@@ -4,7 +4,9 @@ use glam::{Mat4, Vec3};
 use rayon::prelude::*;
 
 use crate::{
-    clip::frame_count, skin_positions, AnimError, Bone, Camera, Mesh, MeshAnimation, Result, Scene,
+    clip::frame_count,
+    rest::{rest_bounds, rest_world},
+    skin_positions, Aabb, AnimError, Bone, Camera, Mesh, MeshAnimation, Result, Scene,
     SkeletalAnimation, Skeleton, Skin, Transform, DEFAULT_FPS,
 };
 
@@ -45,6 +47,30 @@ pub struct MeshObject {
     pub skin: Option<Skin>,
     /// Nearest ancestor joint of an unskinned object (a rigid prop carried by a bone).
     pub parent_joint: Option<usize>,
+    /// World-space bounding box of the object at its rest pose, the mesh as modelled rather
+    /// than as the clip deforms it (`docs/smear-units.md`): a scene's base mesh skinned with
+    /// its joints at their own transforms, a point cache's rest mesh, else the first frame.
+    pub rest_bounds: Aabb,
+}
+
+impl MeshObject {
+    /// An object whose rest pose is `animation`'s mesh positions when it holds one per
+    /// vertex (a point cache read onto its rest mesh), else its first frame.
+    pub fn new(node: usize, name: impl Into<String>, animation: MeshAnimation) -> MeshObject {
+        let rest = if animation.mesh.positions.len() == animation.vertex_count() {
+            &animation.mesh.positions[..]
+        } else {
+            animation.frame(0)
+        };
+        MeshObject {
+            node,
+            name: name.into(),
+            rest_bounds: Aabb::from_points(rest),
+            animation,
+            skin: None,
+            parent_joint: None,
+        }
+    }
 }
 
 /// A clip sampled at a fixed rate.
@@ -80,13 +106,7 @@ impl SampledScene {
             fps: animation.fps,
             start_time: animation.start_time,
             frame_count: animation.frame_count(),
-            objects: vec![MeshObject {
-                node: 0,
-                name,
-                animation,
-                skin: None,
-                parent_joint: None,
-            }],
+            objects: vec![MeshObject::new(0, name, animation)],
             skeleton: Skeleton::default(),
             joint_nodes: Vec::new(),
             skeletal: None,
@@ -113,6 +133,17 @@ impl SampledScene {
             .iter()
             .map(|o| o.animation.vertex_count())
             .sum()
+    }
+
+    /// The bounding-box diagonal of every object at its rest pose
+    /// ([`MeshObject::rest_bounds`]), 0 without objects: one *size* unit of a smear style
+    /// (`docs/smear-units.md`).
+    pub fn rest_diagonal(&self) -> f32 {
+        self.objects
+            .iter()
+            .map(|o| o.rest_bounds)
+            .reduce(Aabb::union)
+            .map_or(0.0, |b| b.diagonal())
     }
 
     /// Bones of frame `f`.
@@ -253,6 +284,7 @@ fn sample_with(
         .map(|s| s.bones(&skeleton))
         .unwrap_or_default();
 
+    let rest = rest_world(scene, &order, clip, start);
     let mut objects = Vec::new();
     for node in scene.mesh_nodes() {
         let name = scene.object_name(node);
@@ -272,6 +304,7 @@ fn sample_with(
             fps,
             start,
             geometry,
+            rest_bounds(scene, node, &rest),
         )?);
     }
     if !options.meshes.is_empty() && objects.is_empty() {
@@ -325,6 +358,7 @@ fn sample_object(
     fps: f32,
     start: f32,
     geometry: Option<Mesh>,
+    rest_bounds: Aabb,
 ) -> Result<MeshObject> {
     let n = &scene.nodes[node];
     let sm = &scene.meshes[n.mesh.expect("mesh node")];
@@ -441,6 +475,7 @@ fn sample_object(
         animation,
         skin,
         parent_joint,
+        rest_bounds,
     })
 }
 

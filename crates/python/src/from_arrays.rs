@@ -3,7 +3,7 @@
 
 use anim::glam::{Mat4, Vec3};
 use anim::{
-    Joint, Mesh, MeshAnimation, SampledScene, SkeletalAnimation, Skeleton, Skin, Transform,
+    Aabb, Joint, Mesh, MeshAnimation, SampledScene, SkeletalAnimation, Skeleton, Skin, Transform,
     VertexWeights,
 };
 use pyo3::prelude::*;
@@ -22,6 +22,7 @@ pub(crate) fn sampled(
     skin: Option<&Bound<'_, PyDict>>,
     objects: Option<Vec<(String, usize, usize)>>,
     attributes: Vec<(String, Vec<f32>)>,
+    rest: Option<&ArrayIn<'_, f32>>,
 ) -> PyResult<SampledScene> {
     if !(fps.is_finite() && fps > 0.0) {
         return Err(value_error(format!(
@@ -37,6 +38,17 @@ pub(crate) fn sampled(
     }
     let p = values(positions);
     let points: Vec<Vec3> = p.chunks_exact(3).map(Vec3::from_slice).collect();
+    let rest: Vec<Vec3> = match rest {
+        Some(r) => {
+            shape(r, "rest", &[Some(vertices), Some(3)])?;
+            let r: Vec<Vec3> = values(r).chunks_exact(3).map(Vec3::from_slice).collect();
+            if !r.iter().all(|p| p.is_finite()) {
+                return Err(value_error("rest holds a position that is not finite"));
+            }
+            r
+        }
+        None => points[..vertices].to_vec(),
+    };
     let nt = shape(triangles, "triangles", &[None, Some(3)])?[0];
     let mut tris = Vec::with_capacity(nt);
     for (i, t) in values(triangles).chunks_exact(3).enumerate() {
@@ -64,6 +76,7 @@ pub(crate) fn sampled(
     let animation =
         MeshAnimation::new(mesh, fps, points).map_err(|e| value_error(at(SOURCE, e)))?;
     let mut scene = SampledScene::from_animation(animation);
+    scene.objects[0].rest_bounds = Aabb::from_points(&rest);
     let mut object_parents = None;
     if let Some(skin) = skin {
         add_skin(&mut scene, skin)?;
@@ -72,7 +85,7 @@ pub(crate) fn sampled(
         }
     }
     if let Some(objects) = objects {
-        split_objects(&mut scene, &objects, object_parents.as_deref())?;
+        split_objects(&mut scene, &objects, object_parents.as_deref(), &rest)?;
     }
     Ok(scene)
 }
@@ -80,10 +93,12 @@ pub(crate) fn sampled(
 /// Splits the one object of `scene` into `objects` (`(name, start, stop)` vertex ranges
 /// tiling the vertices in order). An object whose vertices have no skin weight is unskinned
 /// (a simple object, SMEAR Eq. 1), carried by `object_parents[i]` when that is a joint.
+/// `rest` holds every vertex at the rest pose.
 fn split_objects(
     scene: &mut SampledScene,
     objects: &[(String, usize, usize)],
     object_parents: Option<&[i64]>,
+    rest: &[Vec3],
 ) -> PyResult<()> {
     let whole = scene.objects.remove(0);
     let vertices = whole.animation.vertex_count();
@@ -151,11 +166,10 @@ fn split_objects(
             .and_then(|p| usize::try_from(p[k]).ok())
             .filter(|&j| j < scene.skeleton.len());
         scene.objects.push(anim::MeshObject {
-            node: k,
-            name: name.clone(),
-            animation,
             skin,
             parent_joint,
+            rest_bounds: Aabb::from_points(&rest[*a..*b]),
+            ..anim::MeshObject::new(k, name.clone(), animation)
         });
     }
     Ok(())

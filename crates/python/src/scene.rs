@@ -202,6 +202,10 @@ impl Scene {
     /// ``attributes`` (``{name: (vertices,) float32}``) are scalar per-vertex attributes, e.g.
     /// painted weights for a style's ``weights = { attribute = "name" }``.
     ///
+    /// ``rest`` (``(vertices, 3)`` world-space positions) is the character at its rest pose,
+    /// the mesh as modelled (bind pose, no shape key): its bounding-box diagonal is one size
+    /// unit of a smear style (docs/smear-units.md). Default: the first frame.
+    ///
     /// Arrays are read in place when they are C-contiguous float32 (int for indices).
     ///
     /// >>> s = toonkit.load("assets/characters/RobotExpressive.glb", clip="Dance")
@@ -209,7 +213,7 @@ impl Scene {
     /// >>> t.positions.shape == s.positions.shape
     /// True
     #[staticmethod]
-    #[pyo3(signature = (positions, triangles, fps=24.0, skin=None, objects=None, attributes=None))]
+    #[pyo3(signature = (positions, triangles, fps=24.0, skin=None, objects=None, attributes=None, rest=None))]
     fn from_arrays(
         py: Python<'_>,
         positions: crate::arrays::ArrayIn<'_, f32>,
@@ -218,6 +222,7 @@ impl Scene {
         skin: Option<&Bound<'_, PyDict>>,
         objects: Option<Vec<(String, Bound<'_, PyAny>)>>,
         attributes: Option<std::collections::BTreeMap<String, crate::arrays::ArrayIn<'_, f32>>>,
+        rest: Option<crate::arrays::ArrayIn<'_, f32>>,
     ) -> PyResult<Scene> {
         let attributes = attributes
             .unwrap_or_default()
@@ -238,8 +243,15 @@ impl Scene {
                     .collect::<PyResult<Vec<_>>>()
             })
             .transpose()?;
-        let sampled =
-            crate::from_arrays::sampled(&positions, &triangles, fps, skin, objects, attributes)?;
+        let sampled = crate::from_arrays::sampled(
+            &positions,
+            &triangles,
+            fps,
+            skin,
+            objects,
+            attributes,
+            rest.as_ref(),
+        )?;
         Scene::new(py, sampled, "<arrays>".to_string(), None, None)
     }
 
@@ -271,6 +283,14 @@ impl Scene {
     #[getter]
     fn vertex_count(&self) -> usize {
         self.sampled.vertex_count()
+    }
+
+    /// The character's size: the bounding-box diagonal of every object at its rest pose (the
+    /// mesh as modelled, see ``from_arrays``' ``rest``), one size unit of a smear style in
+    /// scene units (docs/smear-units.md).
+    #[getter]
+    fn size(&self) -> f32 {
+        self.sampled.rest_diagonal()
     }
 
     /// Names of the skeleton's joints (empty when nothing is skinned).

@@ -197,3 +197,64 @@ def test_offsets_release_the_gil(robot):
     assert delta.shape == robot.positions.shape[:2]
     assert seconds > 0.01
     assert ticks >= max(5, int(seconds / 0.001 * 0.2)), (ticks, seconds)
+
+
+def scaled_glb(tmp_path, rel, scale):
+    """The bundled GLB `rel` with its one root node scaled by `scale` (its `scale`, or its
+    `matrix` multiplied), the binary chunk kept: the character exported in other units."""
+    import json
+    import struct
+
+    data = asset(rel).read_bytes()
+    (length,) = struct.unpack_from("<I", data, 12)
+    doc = json.loads(data[20:20 + length])
+    (root,) = doc["scenes"][0]["nodes"]
+    node = doc["nodes"][root]
+    if "matrix" in node:
+        node["matrix"] = [v * scale if k % 4 != 3 else v for k, v in enumerate(node["matrix"])]
+    else:
+        node["scale"] = [scale] * 3
+    text = json.dumps(doc).encode()
+    text += b" " * (-len(text) % 4)
+    rest = data[20 + length:]
+    out = tmp_path / f"{asset(rel).stem}_{scale}.glb"
+    out.write_bytes(b"glTF" + struct.pack("<II", 2, 20 + len(text) + len(rest))
+                    + struct.pack("<I", len(text)) + b"JSON" + text + rest)
+    return out
+
+
+@pytest.mark.parametrize("rel,clip", [(ROBOT, "Wave"), ("characters/CesiumMan.glb", 0)])
+def test_a_style_means_the_same_in_centimetres_and_metres(tmp_path, rel, clip):
+    # docs/smear-units.md: speeds in sizes per second, the size the rest pose's diagonal.
+    style = example("smear/fig16_combined.toml")
+    runs = []
+    for scale in (1.0, 0.01, 100.0):
+        scene = toonkit.load(scaled_glb(tmp_path, rel, scale), clip=clip, fps=12)
+        look = toonkit.smear.stylize(toonkit.smear.prepare(scene), style)
+        size = look.report["size"]
+        assert size == pytest.approx(scene.size, rel=1e-6)
+        objects = look.report["objects"]
+        e = np.mean([o["elongation_mean"] for o in objects]) / size
+        lines = [o["lines_length_mean"] for o in objects if o.get("lines_length_mean")]
+        runs.append((scale, size, e, np.mean(lines) / size))
+    _, size, e, length = runs[0]
+    assert e > 1e-4 and length > 1e-4, runs
+    for scale, size_k, e_k, length_k in runs[1:]:
+        assert size_k == pytest.approx(size * scale, rel=1e-4)
+        assert e_k == pytest.approx(e, rel=0.01), f"x{scale}: elongation"
+        assert length_k == pytest.approx(length, rel=0.01), f"x{scale}: line length"
+
+
+def test_from_arrays_takes_the_rest_pose_for_the_size():
+    # Arrays' size is their `rest` pose's when given, else their first frame's.
+    robot = toonkit.load(asset(ROBOT), clip="Wave")
+    rest_size = robot.size
+    first = robot.positions[0]
+    assert toonkit.Scene.from_arrays(robot.positions, robot.triangles).size == pytest.approx(
+        float(np.linalg.norm(np.ptp(first, axis=0))), rel=1e-6)
+    stretched = first * np.float32(2.0)
+    given = toonkit.Scene.from_arrays(robot.positions, robot.triangles, rest=stretched)
+    assert given.size == pytest.approx(2 * float(np.linalg.norm(np.ptp(first, axis=0))), rel=1e-6)
+    assert rest_size > 0
+    with pytest.raises(ValueError, match="rest"):
+        toonkit.Scene.from_arrays(robot.positions, robot.triangles, rest=first[:10])

@@ -32,7 +32,7 @@ fn example_style(name: &str) -> Style {
 #[test]
 fn second_stylize_reuses_prepared_offsets() {
     let scene = robot_dance();
-    // Live tuning: the animator drags the elongation strength from 1.5 to 0.75 (paper
+    // Live tuning: the animator drags the elongation strength from 1.53 to 0.75 (paper
     // Fig. 11c, in sizes per second).
     let first_style = example_style("fig11c_speed.toml");
     let second_style = Style::from_toml_str(

@@ -39,13 +39,7 @@ fn rigid_scene(objects: Vec<MeshAnimation>, cameras: Vec<Camera>) -> SampledScen
         objects: objects
             .into_iter()
             .enumerate()
-            .map(|(i, a)| MeshObject {
-                node: i,
-                name: a.mesh.name.clone(),
-                animation: a,
-                skin: None,
-                parent_joint: None,
-            })
+            .map(|(i, a)| MeshObject::new(i, a.mesh.name.clone(), a))
             .collect(),
         skeleton: Default::default(),
         joint_nodes: Vec::new(),
@@ -176,11 +170,8 @@ fn fig14_whole_body_is_one_simple_object() {
     let hand: Vec<Vec3> = (0..6).map(|f| scene.bones_at(f)[2].tip).collect();
     let ball = translating(sphere(0.3), 6, |f| hand[f]);
     scene.objects.push(MeshObject {
-        node: 9,
-        name: "ball".into(),
-        animation: ball.clone(),
-        skin: None,
         parent_joint: Some(2),
+        ..MeshObject::new(9, "ball", ball.clone())
     });
 
     let whole = OffsetSolver::new(

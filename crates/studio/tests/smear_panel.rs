@@ -217,3 +217,56 @@ async fn presets_and_parameter_ranges_are_the_smear_crates() {
         assert_eq!(json!(toml), listed["style"]);
     }
 }
+
+/// The robot exported in other units gets the same smear from the studio relative to its
+/// size (`docs/smear-units.md`): fig16's style (elongation, multiples, lines) on the robot
+/// with its root scaled by 0.01, 1 and 100; the report's mean elongation and line length
+/// over the size agree within 1 %, and the size follows the scale.
+#[tokio::test]
+async fn a_style_means_the_same_on_the_robot_in_centimetres_and_metres() {
+    let dir = tempfile::tempdir().unwrap();
+    let toml = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../examples/smear/fig16_combined.toml"),
+    )
+    .unwrap();
+    let mut runs = Vec::new();
+    for scale in [1.0f32, 0.01, 100.0] {
+        let robot = testdata::scaled_glb("characters/RobotExpressive.glb", scale, dir.path());
+        let opened = vec![studio::files::OpenedFile::open(&robot).unwrap()];
+        let out = studio::files::output_folder(&dir.path().join("out")).unwrap();
+        let app = studio::router(
+            std::sync::Arc::new(studio::Studio::new(opened, out)),
+            common::PORT,
+        );
+        let body = send_ok(
+            &app,
+            post("/api/smear/stylize", json!({"clip": "Wave", "toml": toml})),
+        )
+        .await;
+        let (h, _) = pack::read_f32(&body, "body").unwrap();
+        let report = &h["report"];
+        let size = report["size"].as_f64().unwrap();
+        let objects = report["objects"].as_array().unwrap();
+        let mean = |key: &str| {
+            let v: Vec<f64> = objects.iter().filter_map(|o| o[key].as_f64()).collect();
+            v.iter().sum::<f64>() / v.len().max(1) as f64 / size
+        };
+        runs.push((
+            scale as f64,
+            size,
+            mean("elongation_mean"),
+            mean("lines_length_mean"),
+        ));
+    }
+    let (_, size, e, l) = runs[0];
+    assert!(e > 1e-4 && l > 1e-4, "{runs:?}");
+    for &(k, size_k, ek, lk) in &runs[1..] {
+        assert!(
+            (size_k / (size * k) - 1.0).abs() < 1e-4,
+            "size {size_k} at ×{k}"
+        );
+        assert!((ek / e - 1.0).abs() < 0.01, "×{k}: elongation {ek} vs {e}");
+        assert!((lk / l - 1.0).abs() < 0.01, "×{k}: line length {lk} vs {l}");
+    }
+}

@@ -14,6 +14,9 @@
 
 use std::path::{Path, PathBuf};
 
+mod scaled;
+pub use scaled::{glb_json, scaled_glb};
+
 /// The `assets/` folder at the workspace root.
 pub fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets")

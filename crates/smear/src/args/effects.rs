@@ -16,13 +16,18 @@ pub struct Elongate {
     /// Stylization preset S_E.
     #[arg(long, value_enum, default_value_t = ElongatePreset::default())]
     pub preset: ElongatePreset,
-    /// Maximum elongation β_max in frames; keyframes as FRAME:VALUE,... (e.g. 0:0,12:3).
+    /// Maximum elongation β_max: frames with `linear`; frames per (size unit per second)
+    /// with `speed` and `noise`, which multiply it by the speed (frames per scene unit per
+    /// frame with --speed-units scene). Keyframes as FRAME:VALUE,... (e.g. 0:0,12:3).
     #[arg(long, default_value_t = Param::Constant(crate::DEFAULT_BETA_MAX))]
     pub beta_max: Param,
-    /// Noise scale κ of the `noise` preset (keyframeable).
+    /// Noise scale κ of the `noise` preset: Voronoi cells per size unit (per scene unit with
+    /// --speed-units scene); keyframeable.
     #[arg(long, default_value_t = Param::Constant(crate::DEFAULT_KAPPA))]
     pub kappa: Param,
-    /// User expression for β (replaces the preset), e.g. "beta_max * speed * past(delta)".
+    /// User expression for β in frames (replaces the preset), e.g. "beta_max * speed *
+    /// past(delta)"; `speed`, `vx, vy, vz` in size units per second, `x, y, z` in size units
+    /// (scene units per frame and scene units with --speed-units scene).
     #[arg(long)]
     pub expr: Option<String>,
 }
@@ -178,15 +183,18 @@ pub struct Lines {
     /// Seed of every random choice (default: the tool's fixed seed; runs are reproducible).
     #[arg(long, value_name = "SEED")]
     pub seed: Option<u64>,
-    /// User expression for τ (replaces the linear one), e.g. "tau_max * speed * past(delta)".
+    /// User expression for τ in frames (replaces the linear one), e.g. "tau_max * speed *
+    /// past(delta)"; inputs in size units (per second) as for --expr of `elongate`.
     #[arg(long)]
     pub length_expr: Option<String>,
-    /// Tube radius in size units (one unit = the character's bounding-box diagonal; scene
-    /// units with --speed-units scene), default 0.002 × the body's diagonal; keyframeable.
+    /// Tube radius in size units (one unit = the character's rest-pose bounding-box
+    /// diagonal; scene units with --speed-units scene), default 0.002 × the body's diagonal;
+    /// keyframeable.
     #[arg(long, conflicts_with = "thickness_expr")]
     pub thickness: Option<Param>,
-    /// User expression for the tube radius along the line (`t` = 0 at the surface), e.g.
-    /// "0.01 * (1 - t)" for tapering lines.
+    /// User expression for the tube radius along the line in size units (scene units with
+    /// --speed-units scene; `t` = 0 at the surface), e.g. "0.01 * (1 - t)" for tapering
+    /// lines.
     #[arg(long)]
     pub thickness_expr: Option<String>,
     /// User expression for the opacity along the line (`t` = 0 at the surface), e.g. "1 - t".

@@ -136,14 +136,14 @@ pub struct EffectArgs {
 pub struct UnitArgs {
     /// Units of speeds (the `speed` input, --min-speed, thresholds) and lengths (--thickness,
     /// --ground, `x, y, z`, noise κ per length): `size` = the character's own size (one unit
-    /// = its bounding-box diagonal at the first frame, or --size-reference), speeds per
+    /// = its bounding-box diagonal at the rest pose, or --size-reference), speeds per
     /// second, so a style looks the same in centimetres and in metres; `scene` = scene units,
     /// speeds per frame (the paper's numbers). With --style: overrides the file's
     /// `speed_units`.
     #[arg(long, value_enum, value_name = "UNITS")]
     pub speed_units: Option<SpeedUnits>,
     /// One size unit: a length in scene units (e.g. 1.8) or the name of an object whose
-    /// bounding-box diagonal at the first frame it is. With --style: overrides the file's
+    /// bounding-box diagonal at the rest pose it is. With --style: overrides the file's
     /// `size_reference`.
     #[arg(long, value_name = "NODE|LENGTH")]
     pub size_reference: Option<SizeReference>,

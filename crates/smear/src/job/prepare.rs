@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use anim::{Aabb, Camera, MeshAnimation, SampledScene};
+use anim::{Camera, MeshAnimation, SampledScene};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
@@ -100,17 +100,8 @@ pub struct Prepared {
     targets: Vec<Target>,
     colliders: Vec<Collider>,
     report: PrepareReport,
-    /// The character's size: bounding-box diagonal of every object at the first frame.
+    /// The character's size: bounding-box diagonal of every object at its rest pose.
     size: f32,
-}
-
-/// Bounding-box diagonal of the first frame of every object of `scene` (0 without objects).
-fn first_frame_diagonal<'a>(animations: impl Iterator<Item = &'a MeshAnimation>) -> f32 {
-    animations
-        .filter(|a| a.frame_count() > 0)
-        .map(|a| Aabb::from_points(a.frame(0)))
-        .reduce(Aabb::union)
-        .map_or(0.0, |b| b.diagonal())
 }
 
 /// Takes the objects named in `names` out of `scene` as colliders.
@@ -235,7 +226,7 @@ pub fn prepare(mut scene: SampledScene, options: &PrepareOptions) -> Result<Prep
     let solve_seconds = start.elapsed().as_secs_f64();
     let objects = object_reports(&scene, |i| field.mode(i), &per_object);
     let causal = options.offsets.causal;
-    let size = first_frame_diagonal(scene.objects.iter().map(|o| &o.animation));
+    let size = scene.rest_diagonal();
     let weight_units = StyleUnits::size(size as f64, scene.fps as f64);
     let velocities = |anim: &MeshAnimation| {
         let (p, f, n) = (anim.positions(), anim.frame_count(), anim.vertex_count());
@@ -442,15 +433,15 @@ impl Prepared {
     }
 
     /// The character's size in scene units: the bounding-box diagonal of every object at
-    /// the first frame (colliders excluded) — one size unit of a style in
-    /// [`SpeedUnits::Size`] without a `size_reference`.
+    /// its rest pose ([`SampledScene::rest_diagonal`], colliders excluded) — one size unit
+    /// of a style in [`SpeedUnits::Size`] without a `size_reference`.
     pub fn size(&self) -> f32 {
         self.size
     }
 
     /// How a style's numbers convert into this scene's units: nothing in
     /// [`SpeedUnits::Scene`]; in [`SpeedUnits::Size`] one length unit is `reference` (a
-    /// length, or an object's bounding-box diagonal at the first frame) or
+    /// length, or an object's bounding-box diagonal at its rest pose) or
     /// [`Prepared::size`], and speeds are per second at the scene's frame rate.
     ///
     /// # Errors
@@ -473,7 +464,7 @@ impl Prepared {
                         available: available.join(", "),
                     });
                 };
-                first_frame_diagonal(std::iter::once(&o.animation))
+                o.rest_bounds.diagonal()
             }
         };
         Ok(StyleUnits::size(size as f64, self.report.fps as f64))

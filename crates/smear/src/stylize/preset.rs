@@ -31,7 +31,7 @@ pub const DEFAULT_COPIES: f32 = 1.0;
 #[serde(rename_all = "lowercase")]
 pub enum ElongatePreset {
     /// S_E(δ; β_max) = β_max·δ (SMEAR Eq. 10 example, Fig. 9b, 11b): the default, which
-    /// needs no scale-dependent β (speed is in scene units per frame).
+    /// needs no speed, so β is in frames in any units.
     #[default]
     Linear,
     /// S_E(δ; v, β_max) = β_max‖v‖δ (Fig. 11c): fast parts stretch, slow parts stay put.

@@ -271,7 +271,7 @@ pub struct ObjectStyle {
 /// Units (`docs/smear-units.md`): speeds (`speed`, `vx, vy, vz`, `threshold`,
 /// `lines.min_speed`) are in size units per second and lengths (`x, y, z`, noise κ per
 /// length, `lines.thickness`, `contact.ground`) in size units, one size unit being the
-/// character's bounding-box diagonal at the first frame (or [`Style::size_reference`]);
+/// character's bounding-box diagonal at its rest pose (or [`Style::size_reference`]);
 /// `speed_units = "scene"` reads them as the paper does, in scene units (per frame).
 /// Displacements β, τ and spacings stay in frames.
 ///
@@ -298,8 +298,8 @@ pub struct Style {
     #[serde(skip_serializing_if = "SpeedUnits::is_size")]
     pub speed_units: SpeedUnits,
     /// One size unit: a length in scene units (`1.8`) or an object whose bounding-box
-    /// diagonal at the first frame it is (`"Body"`). Default: the diagonal of every object
-    /// at the first frame. Ignored with `speed_units = "scene"`.
+    /// diagonal at its rest pose it is (`"Body"`). Default: the diagonal of every object
+    /// at the rest pose. Ignored with `speed_units = "scene"`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub size_reference: Option<SizeReference>,
     /// Painted weights ω (paper Fig. 15b): a weight group, a vertex attribute or a function

@@ -18,9 +18,9 @@ use super::stage::Stage;
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum SpeedUnits {
-    /// The character's own size: lengths in size units (one unit = the bounding-box
-    /// diagonal, see [`SizeReference`]), speeds in size units per second. The same style
-    /// looks the same on a character modelled in centimetres or in metres.
+    /// The character's own size: lengths in size units (one unit = the rest-pose
+    /// bounding-box diagonal, or --size-reference), speeds in size units per second. The
+    /// same style looks the same on a character modelled in centimetres or in metres.
     #[default]
     Size,
     /// The scene's units: lengths in scene units, speeds in scene units per frame (the
@@ -38,14 +38,14 @@ impl SpeedUnits {
 /// What one size unit is when a style is in [`SpeedUnits::Size`].
 ///
 /// TOML: `size_reference = 1.8` (a length in scene units) or `size_reference = "Body"` (the
-/// bounding-box diagonal of that object at the first frame). Without it: the bounding-box
-/// diagonal of every object of the scene at the first frame.
+/// bounding-box diagonal of that object at its rest pose). Without it: the bounding-box
+/// diagonal of every object of the scene at the rest pose (`anim::SampledScene::rest_diagonal`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(untagged)]
 pub enum SizeReference {
     /// A length in scene units (> 0).
     Length(f32),
-    /// An object (mesh) of the scene: its bounding-box diagonal at the first frame.
+    /// An object (mesh) of the scene: its bounding-box diagonal at its rest pose.
     Node(String),
 }
 

@@ -160,16 +160,14 @@ pub(crate) fn skinned_scene(
         weights,
     };
     let animation = MeshAnimation::new(mesh, 24.0, pos).unwrap();
+    let name = animation.mesh.name.clone();
     SampledScene {
         fps: 24.0,
         start_time: 0.0,
         frame_count: frames,
         objects: vec![MeshObject {
-            node: 0,
-            name: animation.mesh.name.clone(),
-            animation,
             skin: Some(skin),
-            parent_joint: None,
+            ..MeshObject::new(0, name, animation)
         }],
         skeleton,
         joint_nodes: (0..nj).collect(),
