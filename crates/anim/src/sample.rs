@@ -381,7 +381,17 @@ fn sample_object(
     // Zeroed by the allocator (fresh pages for a large cache, none touched here): the skinning
     // workers write every frame and so fault its pages in on all cores, instead of this
     // thread clearing the whole cache first.
-    let mut positions: Vec<Vec3> = bytemuck::allocation::zeroed_vec(poses.len() * nv);
+    // Within the point budget the allocation can still fail (a smaller machine, a process
+    // limit): said in one line instead of bytemuck's panic.
+    let mut positions: Vec<Vec3> =
+        bytemuck::allocation::try_zeroed_vec(poses.len() * nv).map_err(|()| {
+            AnimError::Invalid(format!(
+                "{} frames × {nv} vertices ({:.1} GB) could not be allocated (the memory of this \
+                 machine or process): lower --fps or pick a shorter clip",
+                poses.len(),
+                (poses.len() * nv * std::mem::size_of::<Vec3>()) as f64 / 1e9
+            ))
+        })?;
     // Each frame is checked for non-finite positions while it is still in cache, instead of
     // a second pass over the whole buffer in `MeshAnimation::new`.
     let finite = positions

@@ -452,3 +452,33 @@ fn a_gltf_buffer_outside_its_folder_is_refused() {
         );
     }
 }
+
+/// Keys at 0 and 4,000 s on CesiumMan: 96,001 frames × 3,273 vertices are within the point
+/// budget, but 3.8 GB do not fit a 3 GB address space. That allocation failing was the
+/// "panic in bytemuck" (exit 101); it is now one line naming the file and what to lower.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_clip_within_budget_that_does_not_fit_in_memory_is_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("walk.glb");
+    rekeyed_glb(&data("characters/CesiumMan.glb"), &[0.0, 4_000.0], &input);
+    let script = format!(
+        "ulimit -v 3000000 && exec '{}' convert '{}' '{}'",
+        env!("CARGO_BIN_EXE_toonkit"),
+        s(&input),
+        s(&dir.path().join("walk.pc2"))
+    );
+    let out = std::process::Command::new("sh")
+        .args(["-c", &script])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("walk.glb: 96001 frames × 3273 vertices (3.8 GB) could not be allocated"),
+        "{err}"
+    );
+    assert!(err.contains("lower --fps or pick a shorter clip"), "{err}");
+    assert_eq!(file_names(dir.path()), ["walk.glb"]);
+}

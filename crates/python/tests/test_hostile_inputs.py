@@ -107,11 +107,11 @@ def test_an_expression_nan_at_some_vertices_names_the_frame_and_the_vertex(wave,
     path.write_text('[elongate]\nfunction = { expr = "sqrt(x)" }\n')
     cli = cli_error("smear", asset(ROBOT), "--clip", "Wave", "--style", path, "-o", tmp_path / "o.glb")
     assert msg.split(": ", 1)[1] == cli.split(": ", 1)[1], (msg, cli)
-    # The stream reports the frame it was pushed.
+    # The stream reports the frame it was pushed (a ValueError, as its other bad inputs).
     s = toonkit.smear.stream(
         wave.triangles, wave.positions.shape[1], elongate={"expr": "sqrt(x)"}
     )
-    with pytest.raises(toonkit.ToonkitError) as e:
+    with pytest.raises(ValueError) as e:
         s.push(wave.positions[0])
     assert "is NaN or infinite at frame 0, vertex " in one_line(e)
     # Finite everywhere: works.
@@ -130,3 +130,22 @@ def test_saving_over_the_input_is_refused(tmp_path):
     assert "is the input" in one_line(e)
     assert robot.read_bytes() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["robot.glb"]
+
+
+@pytest.mark.parametrize("uri", ["/etc/hostname", "../x.bin", "file:///dev/zero", "/dev/zero"])
+def test_a_gltf_buffer_outside_its_folder_is_refused(tmp_path, uri):
+    path = tmp_path / "escape.gltf"
+    path.write_text(json.dumps({
+        "asset": {"version": "2.0"},
+        "buffers": [{"uri": uri, "byteLength": 36}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "min": [0, 0, 0], "max": [1, 1, 0]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0,
+    }))
+    with pytest.raises(toonkit.ToonkitError) as e:
+        toonkit.load(path)
+    msg = one_line(e)
+    assert uri in msg and "escape.gltf" in msg
+    assert msg == cli_error("info", path)

@@ -43,6 +43,22 @@ async fn an_export_over_the_opened_file_is_refused_and_keeps_every_byte() {
     );
     assert_eq!(std::fs::read(&robot).unwrap(), before);
     assert_eq!(common_names(dir.path()), ["robot.glb"], "no temporary left");
+    // Through a symlink in the output folder: the same file (device and inode).
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(&robot, dir.path().join("link.glb")).unwrap();
+        let (status, body) = send(
+            &app,
+            post(
+                "/api/smear/export",
+                json!({"clip": "Wave", "name": "link.glb", "toml": "[elongate]\n"}),
+            ),
+        )
+        .await;
+        assert_eq!(status, StatusCode::CONFLICT, "{}", error_of(&body));
+        assert!(error_of(&body).contains("is the input"));
+        assert_eq!(std::fs::read(&robot).unwrap(), before);
+    }
 }
 
 /// Sixteen exports of one name at the same time: every one is answered 200 (the temporary

@@ -97,7 +97,7 @@ pub struct Expression {
 /// The smallest (frame, vertex) at which an expression evaluated to NaN or an infinity,
 /// shared by the threads evaluating it. Keyed as `frame << 32 | vertex` and kept with
 /// `fetch_min`, so the place reported does not depend on the threads' order.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 struct FirstNonFinite(AtomicU64);
 
 impl FirstNonFinite {
