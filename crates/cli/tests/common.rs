@@ -164,18 +164,17 @@ pub(crate) fn rekeyed_glb(src: &Path, times: &[f32], dst: &Path) {
             as usize
     };
     let n = times.len() as u64;
+    // Values per key of every sampler, before any shared input accessor is rewritten.
+    let count = |g: &serde_json::Value, a: usize| g["accessors"][a]["count"].as_u64().unwrap();
     let mut samplers = Vec::new();
     for a in gltf["animations"].as_array().unwrap() {
         for s in a["samplers"].as_array().unwrap() {
-            samplers.push((
-                s["input"].as_u64().unwrap() as usize,
-                s["output"].as_u64().unwrap() as usize,
-            ));
+            let input = s["input"].as_u64().unwrap() as usize;
+            let output = s["output"].as_u64().unwrap() as usize;
+            samplers.push((input, output, count(&gltf, output) / count(&gltf, input)));
         }
     }
-    for &(input, output) in &samplers {
-        let keys = gltf["accessors"][input]["count"].as_u64().unwrap();
-        let per_key = gltf["accessors"][output]["count"].as_u64().unwrap() / keys;
+    for &(input, output, per_key) in &samplers {
         let at = offset(&gltf, input);
         for (k, t) in times.iter().enumerate() {
             bin[at + 4 * k..at + 4 * k + 4].copy_from_slice(&t.to_le_bytes());
