@@ -129,13 +129,7 @@ pub(crate) fn assert_readable(message: &str) {
 
 /// Every file name in `dir`, sorted (temporary files included: they start with '.').
 pub(crate) fn file_names(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .flatten()
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
+    testdata::file_names(dir)
 }
 
 /// A copy of the glTF `src` (`.glb`, or `.gltf` with buffers beside it) whose every animation

@@ -159,67 +159,56 @@ fn an_expression_nan_at_some_vertices_names_the_frame_and_the_vertex() {
     let input = data("characters/CesiumMan.glb");
     let vertex = first_vertex_left_of_the_origin();
     let out = dir.path().join("e.glb");
+    let (i, o) = (s(&input), s(&out));
     let want = format!("expression 'sqrt(x)' is NaN or infinite at frame 0, vertex {vertex}");
-    assert_bad_input(
-        &[
-            "smear",
-            "elongate",
-            s(&input),
-            "-o",
-            s(&out),
-            "--expr",
-            "sqrt(x)",
-        ],
-        &want,
+    refused(
+        &["smear", "elongate", i, "-o", o, "--expr", "sqrt(x)"],
+        &[&want, "CesiumMan.glb", "keep it finite"],
+        &input,
+        dir.path(),
+        &[],
     );
-    let err = String::from_utf8_lossy(
-        &toonkit(&[
-            "smear",
-            "elongate",
-            s(&input),
-            "-o",
-            s(&out),
-            "--expr",
-            "sqrt(x)",
-        ])
-        .stderr,
-    )
-    .into_owned();
-    assert!(err.contains("CesiumMan.glb"), "names the file: {err}");
-    assert!(err.contains("keep it finite"), "says the fix: {err}");
-    // The same through a style file, on the multiples' opacity and the lines' length (one
-    // motion line per seed: the index counts lines).
+    // The same through a style file, on the multiples' opacity and the lines' length (the
+    // index then counts motion lines).
     let style = dir.path().join("s.toml");
+    let styled = ["smear", i, "--style", s(&style), "-o", o];
     std::fs::write(
         &style,
         "[multiples]\nopacity = { expr = \"0.5 / step(x)\" }\n",
     )
     .unwrap();
-    assert_bad_input(
-        &["smear", s(&input), "--style", s(&style), "-o", s(&out)],
-        "expression '0.5 / step(x)' is NaN or infinite at frame ",
+    refused(
+        &styled,
+        &[
+            "expression '0.5 / step(x)' is NaN or infinite at frame ",
+            ", vertex ",
+        ],
+        &input,
+        dir.path(),
+        &["s.toml"],
     );
     std::fs::write(
         &style,
         "[lines]\ncount = 50\nlength = { expr = \"2 / step(x)\" }\n",
     )
     .unwrap();
-    assert_bad_input(
-        &["smear", s(&input), "--style", s(&style), "-o", s(&out)],
-        "expression '2 / step(x)' is NaN or infinite at frame ",
+    refused(
+        &styled,
+        &[
+            "expression '2 / step(x)' is NaN or infinite at frame ",
+            ", motion line ",
+        ],
+        &input,
+        dir.path(),
+        &["s.toml"],
     );
-    let err = String::from_utf8_lossy(
-        &toonkit(&["smear", s(&input), "--style", s(&style), "-o", s(&out)]).stderr,
-    )
-    .into_owned();
-    assert!(err.contains(", motion line "), "{err}");
     // Finite everywhere: works.
     ok(&[
         "smear",
         "elongate",
-        s(&input),
+        i,
         "-o",
-        s(&out),
+        o,
         "--expr",
         "sqrt(abs(x)) * delta",
     ]);
@@ -428,21 +417,7 @@ fn clumsy_inputs_get_one_line_with_the_fix() {
 fn a_gltf_buffer_outside_its_folder_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     for uri in ["/etc/hostname", "../x.bin", "file:///dev/zero", "/dev/zero"] {
-        let path = dir.path().join("escape.gltf");
-        std::fs::write(
-            &path,
-            serde_json::json!({
-                "asset": {"version": "2.0"},
-                "buffers": [{"uri": uri, "byteLength": 36}],
-                "bufferViews": [{"buffer": 0, "byteLength": 36}],
-                "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3,
-                    "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}],
-                "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
-                "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0
-            })
-            .to_string(),
-        )
-        .unwrap();
+        let path = testdata::gltf_with_buffer_uri(dir.path(), uri);
         refused(
             &["convert", s(&path), s(&dir.path().join("x.obj"))],
             &["escape.gltf", uri],

@@ -42,7 +42,11 @@ async fn an_export_over_the_opened_file_is_refused_and_keeps_every_byte() {
         "{error}"
     );
     assert_eq!(std::fs::read(&robot).unwrap(), before);
-    assert_eq!(common_names(dir.path()), ["robot.glb"], "no temporary left");
+    assert_eq!(
+        testdata::file_names(dir.path()),
+        ["robot.glb"],
+        "no temporary left"
+    );
     // Through a symlink in the output folder: the studio writes through no link at all.
     #[cfg(unix)]
     {
@@ -87,7 +91,11 @@ async fn sixteen_concurrent_exports_of_one_name_all_succeed() {
         let (status, body) = t.await.unwrap();
         assert_eq!(status, StatusCode::OK, "{}", String::from_utf8_lossy(&body));
     }
-    assert_eq!(common_names(&out), ["same.glb"], "no temporary left");
+    assert_eq!(
+        testdata::file_names(&out),
+        ["same.glb"],
+        "no temporary left"
+    );
     let scene = tkio::gltf::read(&out.join("same.glb")).unwrap();
     assert!(!scene.meshes.is_empty());
 }
@@ -98,35 +106,14 @@ async fn sixteen_concurrent_exports_of_one_name_all_succeed() {
 fn a_gltf_reading_outside_its_folder_is_not_opened() {
     let dir = tempfile::tempdir().unwrap();
     for uri in ["/etc/hostname", "../x.bin", "file:///dev/zero", "/dev/zero"] {
-        let path = dir.path().join("escape.gltf");
-        std::fs::write(
-            &path,
-            json!({
-                "asset": {"version": "2.0"},
-                "buffers": [{"uri": uri, "byteLength": 36}],
-                "bufferViews": [{"buffer": 0, "byteLength": 36}],
-                "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3,
-                    "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}],
-                "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
-                "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0
-            })
-            .to_string(),
-        )
-        .unwrap();
-        let error = OpenedFile::open(&path).err().expect("refused").to_string();
+        let path = testdata::gltf_with_buffer_uri(dir.path(), uri);
+        let Err(error) = OpenedFile::open(&path) else {
+            panic!("{uri}: opened")
+        };
+        let error = error.to_string();
         assert!(
             error.contains("escape.gltf") && error.contains(uri) && !error.contains('\n'),
             "{uri}: {error}"
         );
     }
-}
-
-fn common_names(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .flatten()
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
 }
