@@ -13,6 +13,11 @@ use thiserror::Error;
 /// Sampled positions, frames × vertices, of one job: 400 million points (4.8 GB of f32 xyz).
 pub const DEFAULT_MAX_POINTS: u64 = 400_000_000;
 
+/// Frames one clip may be sampled into (its length × `--fps`): 100,000 frames, over an hour
+/// at 24 fps. Every frame costs a pose, a flipbook entry and per-frame output records however
+/// small the mesh, so a clip keyed at 0 and 20,000 s is refused even on a triangle.
+pub const DEFAULT_MAX_FRAMES: u64 = 100_000;
+
 /// Temporal smoothing half-window N of SMEAR Eq. 2 (`--smooth`): a window wider than the
 /// longest clip only repeats its end frames, and its weights are allocated.
 pub const DEFAULT_MAX_SMOOTH: u64 = 100_000;

@@ -299,16 +299,16 @@ pub fn frame_count(duration: f32, fps: f32) -> usize {
     if !(duration.is_finite() && fps.is_finite() && duration > 0.0 && fps > 0.0) {
         return 1;
     }
+    // Exact for any f32 duration × fps (saturating far past every budget): callers check it
+    // against [`MAX_FRAMES`] before allocating, and the message states the true count.
     let n = (duration as f64 * fps as f64 + 1e-3).floor();
-    if n >= MAX_FRAMES as f64 {
-        return MAX_FRAMES + 1; // callers reject this; it never allocates
-    }
-    n as usize + 1
+    (n as usize).saturating_add(1)
 }
 
-/// The most frames a clip may be sampled into; longer requests are an error (lower the fps
-/// or pick a shorter clip) rather than an allocation that cannot succeed.
-pub const MAX_FRAMES: usize = 10_000_000;
+/// The most frames a clip may be sampled into ([`crate::budget::DEFAULT_MAX_FRAMES`]); longer
+/// requests are an error (lower the fps or pick a shorter clip) rather than an allocation
+/// that cannot succeed.
+pub const MAX_FRAMES: usize = crate::budget::DEFAULT_MAX_FRAMES as usize;
 
 #[cfg(test)]
 mod tests {
@@ -387,5 +387,7 @@ mod tests {
         assert_eq!(frame_count(2.0, 24.0), 49);
         assert_eq!(frame_count(0.0, 24.0), 1);
         assert_eq!(frame_count(59.966_667, 30.0), 1800);
+        assert_eq!(frame_count(20_000.0, 24.0), 480_001);
+        assert_eq!(frame_count(f32::MAX, f32::MAX), usize::MAX);
     }
 }

@@ -45,6 +45,10 @@ pub enum AnimError {
     /// The data is not usable for the requested operation.
     #[error("{0}")]
     Invalid(String),
+    /// A size derived from the input (frames sampled from a clip, frames × vertices) is over
+    /// its budget ([`crate::budget`]). Lower the frame rate or pick a shorter clip.
+    #[error(transparent)]
+    OverBudget(#[from] crate::OverBudget),
 }
 
 /// Result alias for this crate.

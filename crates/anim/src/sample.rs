@@ -234,15 +234,12 @@ fn sample_with(
             .sum::<usize>()
             .max(1),
     );
-    if frames > crate::MAX_FRAMES || cache_values > MAX_SAMPLED_VALUES {
-        return Err(AnimError::Invalid(format!(
-            "sampling {:.1} s at {fps} fps needs {frames} frames: frames × vertices = {} is over \
-             the limit of {} (lower --fps or pick a shorter clip)",
-            clip.map(|c| c.duration()).unwrap_or(0.0),
-            crate::human_number(cache_values as f64),
-            crate::human_number(MAX_SAMPLED_VALUES as f64),
-        )));
-    }
+    check_sampling(
+        clip.map_or(0.0, |c| c.duration()),
+        fps,
+        frames,
+        cache_values,
+    )?;
     let order = scene.topological_order();
     let nn = scene.nodes.len();
 
@@ -347,6 +344,28 @@ fn sample_with(
     })
 }
 
+/// The frame and point budgets of sampling `duration` seconds at `fps` into `frames` frames of
+/// `points` positions in all, checked before the poses are allocated.
+fn check_sampling(duration: f32, fps: f32, frames: usize, points: usize) -> Result<()> {
+    use crate::budget::{check_budget, DEFAULT_MAX_FRAMES};
+    let hint = format!("the clip lasts {duration:.1} s: lower --fps or pick a shorter clip");
+    check_budget(
+        &format!("frames at {fps} fps"),
+        frames as u64,
+        DEFAULT_MAX_FRAMES,
+        &hint,
+    )
+    .and_then(|()| {
+        check_budget(
+            "frames × vertices",
+            points as u64,
+            MAX_SAMPLED_VALUES as u64,
+            &hint,
+        )
+    })
+    .map_err(AnimError::OverBudget)
+}
+
 type Pose = (Vec<Mat4>, Vec<Vec<f32>>);
 
 fn sample_object(
@@ -396,7 +415,17 @@ fn sample_object(
     // Zeroed by the allocator (fresh pages for a large cache, none touched here): the skinning
     // workers write every frame and so fault its pages in on all cores, instead of this
     // thread clearing the whole cache first.
-    let mut positions: Vec<Vec3> = bytemuck::allocation::zeroed_vec(poses.len() * nv);
+    // Within the point budget the allocation can still fail (a smaller machine, a process
+    // limit): said in one line instead of bytemuck's panic.
+    let mut positions: Vec<Vec3> =
+        bytemuck::allocation::try_zeroed_vec(poses.len() * nv).map_err(|()| {
+            AnimError::Invalid(format!(
+                "{} frames × {nv} vertices ({:.1} GB) could not be allocated (the memory of this \
+                 machine or process): lower --fps or pick a shorter clip",
+                poses.len(),
+                (poses.len() * nv * std::mem::size_of::<Vec3>()) as f64 / 1e9
+            ))
+        })?;
     // Each frame is checked for non-finite positions while it is still in cache, instead of
     // a second pass over the whole buffer in `MeshAnimation::new`.
     let finite = positions

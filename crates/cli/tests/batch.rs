@@ -347,23 +347,41 @@ fn a_shot_writing_over_an_input_fails_and_the_input_is_kept() {
     let input = dir.path().join("walk.glb");
     std::fs::copy(data("characters/CesiumMan.glb"), &input).unwrap();
     let before = std::fs::read(&input).unwrap();
+    // Another shot's output names the input of `reader` (it would break that shot).
+    let robot = data("characters/RobotExpressive.glb");
+    let run = dir.path().join("run.glb");
+    std::fs::copy(data("characters/CesiumMan.glb"), &run).unwrap();
     let shots = vec![
         shot("own", "convert", &input, "0", &["walk.glb"]),
         shot("fine", "convert", &input, "0", &["walk.abc"]),
+        shot("across", "convert", &robot, "Wave", &["run.glb"]),
+        shot("reader", "convert", &run, "0", &["run.abc"]),
     ];
     let m = manifest(dir.path(), &shots);
     let (code, status, text) = run_statuses(&m, dir.path());
-    assert_eq!(code, Some(1), "one shot failed: {text}");
+    assert_eq!(
+        code,
+        Some(2),
+        "two shots failed (the exit code counts them): {text}"
+    );
     assert_eq!(
         status,
         [
             ("own".into(), "failed".into()),
-            ("fine".into(), "done".into())
+            ("fine".into(), "done".into()),
+            ("across".into(), "failed".into()),
+            ("reader".into(), "done".into())
         ],
         "{text}"
     );
     assert!(text.contains("is its own input"), "{text}");
+    assert!(text.contains("is the input of shot 'reader'"), "{text}");
+    assert!(text.contains("name another output"), "{text}");
     assert_eq!(std::fs::read(&input).unwrap(), before);
+    assert_eq!(
+        std::fs::read(&run).unwrap(),
+        std::fs::read(data("characters/CesiumMan.glb")).unwrap()
+    );
 }
 
 /// The stamp covers every file a shot read, not only the manifest's input: an edited

@@ -129,11 +129,84 @@ pub(crate) fn assert_readable(message: &str) {
 
 /// Every file name in `dir`, sorted (temporary files included: they start with '.').
 pub(crate) fn file_names(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .flatten()
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
+    testdata::file_names(dir)
+}
+
+/// A copy of the glTF `src` (`.glb`, or `.gltf` with buffers beside it) whose every animation
+/// sampler has the keys `times` (seconds), written as a `.glb` at `dst`: each sampler keeps
+/// its first `times.len()` output values (linear), so skins, node transforms and morph weights
+/// stay valid. A clip with one key at 20,000 s, or keys at 0 and 20,000 s, asks the samplers
+/// for what a hostile file would.
+pub(crate) fn rekeyed_glb(src: &Path, times: &[f32], dst: &Path) {
+    let bytes = std::fs::read(src).unwrap();
+    let (mut gltf, mut bin): (serde_json::Value, Vec<u8>) = if bytes.starts_with(b"glTF") {
+        let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+        let json = serde_json::from_slice(&bytes[20..20 + len]).unwrap();
+        (json, bytes[28 + len..].to_vec())
+    } else {
+        let json: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
+        let uri = json["buffers"][0]["uri"].as_str().unwrap();
+        let bin = std::fs::read(src.with_file_name(uri)).unwrap();
+        (json, bin)
+    };
+    assert_eq!(gltf["buffers"].as_array().unwrap().len(), 1, "one buffer");
+    gltf["buffers"][0] = serde_json::json!({"byteLength": bin.len()});
+    let offset = |g: &serde_json::Value, a: usize| {
+        let acc = &g["accessors"][a];
+        let view = &g["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
+        (view["byteOffset"].as_u64().unwrap_or(0) + acc["byteOffset"].as_u64().unwrap_or(0))
+            as usize
+    };
+    let n = times.len() as u64;
+    // Values per key of every sampler, before any shared input accessor is rewritten.
+    let count = |g: &serde_json::Value, a: usize| g["accessors"][a]["count"].as_u64().unwrap();
+    let mut samplers = Vec::new();
+    for a in gltf["animations"].as_array().unwrap() {
+        for s in a["samplers"].as_array().unwrap() {
+            let input = s["input"].as_u64().unwrap() as usize;
+            let output = s["output"].as_u64().unwrap() as usize;
+            samplers.push((input, output, count(&gltf, output) / count(&gltf, input)));
+        }
+    }
+    for &(input, output, per_key) in &samplers {
+        let at = offset(&gltf, input);
+        for (k, t) in times.iter().enumerate() {
+            bin[at + 4 * k..at + 4 * k + 4].copy_from_slice(&t.to_le_bytes());
+        }
+        let lo = times.iter().copied().fold(f32::INFINITY, f32::min);
+        let hi = times.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+        let acc = &mut gltf["accessors"][input];
+        acc["count"] = n.into();
+        acc["min"] = serde_json::json!([lo]);
+        acc["max"] = serde_json::json!([hi]);
+        let out = &mut gltf["accessors"][output];
+        out["count"] = (per_key * n).into();
+        if let Some(o) = out.as_object_mut() {
+            o.remove("min");
+            o.remove("max");
+        }
+    }
+    for a in gltf["animations"].as_array_mut().unwrap() {
+        for s in a["samplers"].as_array_mut().unwrap() {
+            s["interpolation"] = "LINEAR".into();
+        }
+    }
+    let mut json = serde_json::to_vec(&gltf).unwrap();
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+    let mut glb = Vec::new();
+    glb.extend_from_slice(b"glTF");
+    glb.extend_from_slice(&2u32.to_le_bytes());
+    glb.extend_from_slice(&((28 + json.len() + bin.len()) as u32).to_le_bytes());
+    glb.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    glb.extend_from_slice(b"JSON");
+    glb.extend_from_slice(&json);
+    glb.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    glb.extend_from_slice(b"BIN\0");
+    glb.extend_from_slice(&bin);
+    std::fs::write(dst, glb).unwrap();
 }

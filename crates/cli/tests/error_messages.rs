@@ -35,6 +35,12 @@ fn anim_errors() -> Vec<anim::AnimError> {
             available: "Walk, Run".into(),
         },
         E::Invalid("a clip needs at least one key".into()),
+        E::OverBudget(anim::OverBudget {
+            what: "frames at 24 fps".into(),
+            asked: 480_001,
+            limit: anim::budget::DEFAULT_MAX_FRAMES,
+            hint: "; the clip lasts 20000.0 s: lower --fps or pick a shorter clip".into(),
+        }),
     ]
 }
 
@@ -133,6 +139,12 @@ fn style_errors() -> Vec<smear::StyleError> {
         },
         E::ExprAndStages,
         E::Syntax("line 3, key 'elongate.stpe': unknown field".into()),
+        E::NotFinite {
+            expr: "sqrt(x)".into(),
+            frame: 12,
+            item: "vertex",
+            index: 3071,
+        },
     ];
     // Parameter: through the validation a user really hits, with extreme values.
     for (p, lo, hi) in [

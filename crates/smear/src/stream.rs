@@ -167,7 +167,9 @@ impl Stream {
     /// Pushes the positions of the next frame and returns its elongated in-between.
     ///
     /// # Errors
-    /// [`SmearError::InvalidParameter`] when `positions` does not have one point per vertex.
+    /// [`SmearError::InvalidParameter`] when `positions` does not have one point per vertex;
+    /// [`SmearError::Style`] ([`crate::StyleError::NotFinite`]) when the elongation expression
+    /// was NaN or infinite at a vertex of this frame (the frame is pushed all the same).
     ///
     /// # Performance
     /// O(vertices × (history + N)) memory moves, SMEAR Eq. 1 on two frames, and one S_E
@@ -253,11 +255,15 @@ impl Stream {
                         frame,
                         m: 0.0,
                         t: 0.0,
+                        vertex: i as u32,
                     };
                     *o = tr.displaced(now, i, function.eval(&x));
                 }
             });
         self.pushed += 1;
+        // The frame is pushed (the stream stays usable); an expression that was NaN or
+        // infinite at some vertex is reported with the frame and the vertex.
+        self.function.check_finite("vertex")?;
         Ok(&self.out)
     }
 }

@@ -75,7 +75,11 @@ impl OpenedFile {
 
     /// Samples `clip` (the first clip when `None`) at [`FPS`].
     pub fn sample(&self, clip: Option<&str>) -> ApiResult<SampledScene> {
-        let at = |e: anim::AnimError| ApiError::bad(format!("{}: {e}", self.label()));
+        // A clip over the sampling budget is a request too large (413), the rest bad (400).
+        let at = |e: anim::AnimError| {
+            let over = matches!(e, anim::AnimError::OverBudget(_));
+            ApiError::refused(format!("{}: {e}", self.label()), over)
+        };
         match &self.loaded {
             Loaded::Scene(scene) => {
                 let clip = match clip {

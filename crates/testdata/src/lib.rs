@@ -41,6 +41,35 @@ pub fn bytes(rel: &str) -> Vec<u8> {
     std::fs::read(&p).unwrap_or_else(|e| panic!("cannot read test asset {}: {e}", p.display()))
 }
 
+/// Every file name in `dir`, sorted (temporary files included: they start with '.'), to
+/// check what a job left behind.
+pub fn file_names(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("cannot list {}: {e}", dir.display()))
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// Writes `escape.gltf` into `dir`: one triangle whose 36-byte buffer is read from `uri` (a
+/// hostile file's absolute path, `../…`, `file:` URL or device), and returns its path.
+pub fn gltf_with_buffer_uri(dir: &Path, uri: &str) -> PathBuf {
+    let path = dir.join("escape.gltf");
+    let text = format!(
+        r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"uri":"{}","byteLength":36}}],
+        "bufferViews":[{{"buffer":0,"byteLength":36}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3",
+        "min":[0,0,0],"max":[1,1,0]}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+        "nodes":[{{"mesh":0}}],"scenes":[{{"nodes":[0]}}],"scene":0}}"#,
+        uri.replace('\\', "\\\\").replace('"', "\\\"")
+    );
+    std::fs::write(&path, text).unwrap_or_else(|e| panic!("cannot write {}: {e}", path.display()));
+    path
+}
+
 #[cfg(test)]
 mod tests {
     #[test]

@@ -330,6 +330,7 @@ impl<'a> EffectInputs<'a> {
             frame: f as f32,
             m: 0.0,
             t: 0.0,
+            vertex: i as u32,
         }
     }
 }

@@ -21,6 +21,9 @@ pub struct StyleInput {
     pub m: f32,
     /// Position along a motion line t ∈ [0, 1] (0 at the surface), 0 otherwise.
     pub t: f32,
+    /// Index of the vertex (or motion line) evaluated: where a user expression that is not
+    /// finite is reported.
+    pub vertex: u32,
 }
 
 /// A stylization function: maps the inputs at one vertex to a scalar (β for elongation,

@@ -278,6 +278,8 @@ pub fn stylize_frames(
 ) -> Result<Stylized> {
     let start = Instant::now();
     check_range(&frames, prepared.report().frames)?;
+    // Over budget is said first (a studio request naming --smooth 1e9 hears the limit).
+    style.offsets.check_budget()?;
     if style.offsets != prepared.options().offsets {
         return Err(SmearError::InvalidParameter {
             name: "style.offsets",
@@ -474,6 +476,9 @@ pub fn stylize_frames(
             });
         }
         report.seconds.lines += t.elapsed().as_secs_f64();
+        // A user expression that was NaN or infinite somewhere drew zeros there: an error
+        // naming it, the frame and the vertex, not a silently flat smear.
+        fx.check_finite()?;
         report.objects.push(stats);
         objects.push(parts);
     }

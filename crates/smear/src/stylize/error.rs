@@ -34,6 +34,23 @@ pub enum StyleError {
         /// What is wrong.
         problem: String,
     },
+    /// A user expression is NaN or infinite at some vertices (a division by zero, the log or
+    /// square root of a negative number there). Keep it finite over the inputs it reads, e.g.
+    /// `1 / max(x, 0.001)` or `log(max(speed, 0.001))`.
+    #[error(
+        "expression '{expr}' is NaN or infinite at frame {frame}, {item} {index} (a division \
+         by zero, or log/sqrt of a negative number): keep it finite there, e.g. max(..., 0.001)"
+    )]
+    NotFinite {
+        /// The expression text.
+        expr: String,
+        /// First frame where it is not finite.
+        frame: u32,
+        /// What `index` counts: `vertex` or `motion line`.
+        item: &'static str,
+        /// The vertex (or motion line) at that frame.
+        index: u32,
+    },
     /// A function gives both `expr` and `stages`. Give one of them.
     #[error("a stylization function takes either 'expr' or 'stages', not both")]
     ExprAndStages,

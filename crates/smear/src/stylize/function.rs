@@ -150,6 +150,20 @@ pub enum StyleFunction {
     Expr(Box<Expression>),
 }
 
+impl StyleFunction {
+    /// `Err` when this is a user expression that was NaN or infinite somewhere since the last
+    /// check, naming it with the frame and the `item` (`"vertex"`, `"motion line"`).
+    ///
+    /// # Errors
+    /// [`StyleError::NotFinite`].
+    pub fn check_finite(&self, item: &'static str) -> Result<(), StyleError> {
+        match self {
+            StyleFunction::Stages(_) => Ok(()),
+            StyleFunction::Expr(e) => e.check_finite(item),
+        }
+    }
+}
+
 impl Stylize for StyleFunction {
     #[inline]
     fn eval(&self, x: &StyleInput) -> f32 {
@@ -178,6 +192,7 @@ mod tests {
                     rest: Vec3::new(f * 0.013, (f * 0.7).sin(), 0.2),
                     frame: (k % 40) as f32,
                     m: [-2.0, -1.0, 1.0, 2.0][k % 4],
+                    vertex: k as u32,
                     t: (k % 11) as f32 / 10.0,
                 }
             })

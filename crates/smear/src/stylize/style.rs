@@ -563,6 +563,30 @@ pub struct CompiledLines {
     pub seed: u64,
 }
 
+impl CompiledEffects {
+    /// `Err` naming the first user expression of these effects that was NaN or infinite
+    /// since the last check, with the frame and the vertex (motion line for the lines'
+    /// functions). Called after the effects ran: the evaluations keep the geometry defined
+    /// and remember where.
+    ///
+    /// # Errors
+    /// [`StyleError::NotFinite`].
+    pub fn check_finite(&self) -> Result<(), StyleError> {
+        if let Some((f, _)) = &self.elongate {
+            f.check_finite("vertex")?;
+        }
+        if let Some((f, _)) = &self.multiples {
+            f.check_finite("vertex")?;
+        }
+        if let Some(l) = &self.lines {
+            for f in [&l.length, &l.thickness, &l.opacity] {
+                f.check_finite("motion line")?;
+            }
+        }
+        Ok(())
+    }
+}
+
 impl ObjectEffects<'_> {
     /// Compiles the functions of a style in scene units; `diagonal` is the object's
     /// bounding-box diagonal (default line thickness).

@@ -154,7 +154,9 @@ impl WeightSource {
                         name: "weights",
                         reason: e.to_string(),
                     })?;
-                Ok(function_weights(&f, obj.animation.frame(0)))
+                let weights = function_weights(&f, obj.animation.frame(0));
+                f.check_finite("vertex")?;
+                Ok(weights)
             }
         }
     }
@@ -181,13 +183,16 @@ impl std::fmt::Display for WeightSource {
     }
 }
 
-/// ω = f(rest position), clamped to [0, 1]; non-finite values read 0.
+/// ω = f(rest position), clamped to [0, 1]; non-finite values read 0 (and a user expression
+/// remembers where, for the caller's check).
 fn function_weights(f: &dyn Stylize, rest: &[Vec3]) -> Vec<f32> {
     rest.iter()
-        .map(|&p| {
+        .enumerate()
+        .map(|(i, &p)| {
             let w = f.eval(&StyleInput {
                 rest: p,
                 weight: 1.0,
+                vertex: i as u32,
                 ..Default::default()
             });
             if w.is_finite() {
