@@ -5,7 +5,8 @@
 # LTS (reusing caches.sh's target/caches-venv), 4.5.15 LTS and 5.0.1 (own venvs), each with
 # numpy<2 --
 # installs the zip with bpy.ops.extensions.package_install_files and runs
-# blender/tests/test_smear.py, test_stopmo.py and test_loa.py (one PASS/FAIL line per test,
+# blender/tests/test_smear.py, test_stopmo.py, test_loa.py, test_rigs.py and test_usd.py (USD
+# import of the debug toonkit's curves and velocities) (one PASS/FAIL line per test,
 # non-zero exit on a failure).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -41,7 +42,7 @@ for spec in "4.2.0:target/caches-venv" "4.5.15:target/blender-venv-4.5" \
     out="target/blender-out-$version"
     rm -rf "$out" "target/blender-user-$version"
     echo "== Blender $version"
-    for t in smear stopmo loa rigs; do
+    for t in smear stopmo loa rigs usd; do
         rm -rf "target/blender-user-$version"
         BLENDER_USER_RESOURCES="$ROOT/target/blender-user-$version" \
             "$dir/bin/python" "blender/tests/test_$t.py" "$zip" "$out/$t" || status=1

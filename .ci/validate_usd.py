@@ -16,7 +16,8 @@ Per layer:
    max(faceVertexIndices) + 1 <= len(points), sum(faceVertexCounts) == len(faceVertexIndices),
    every face count >= 3, UsdGeom.Mesh.ValidateTopology, finite points, an extent of two
    corners that contains every point, and vertex-interpolated primvars with one value per
-   point; `velocities` one per point and equal to the points' central difference per second.
+   point; `velocities` one per point, finite, and (fixed topology) equal to the points'
+   central difference per second.
    Every UsdGeom.BasisCurves likewise: linear, sum(curveVertexCounts) == len(points), every
    curve >= 2 points, widths and vertex primvars one per point, finite points in the extent.
 Tested with usd-core 24.11 (ComplianceChecker) and 26.11 (UsdValidation).
@@ -154,6 +155,16 @@ def check_velocities(geom, where):
         v = attr.Get(t) or []
         if len(v) != len(points):
             out.append(f"{where} @ {t}: {len(v)} velocities for {len(points)} points")
+        text = str(v).lower()
+        if "nan" in text or "inf" in text:
+            out.append(f"{where} @ {t}: non-finite velocity")
+    if geom.GetPrim().IsA(UsdGeom.Mesh) and \
+            UsdGeom.Mesh(geom).GetFaceVertexIndicesAttr().GetNumTimeSamples() > 0:
+        # A topology that changes per frame (a subdivided smear): point i is not the same
+        # vertex from frame to frame, so there is no central difference to compare with
+        # (the Rust tests compare such velocities with the point cache's at the input's
+        # vertices).
+        return out
     for t in times[1:-1]:
         before, after = geom.GetPointsAttr().Get(t - 1), geom.GetPointsAttr().Get(t + 1)
         v = attr.Get(t)

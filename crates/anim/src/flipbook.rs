@@ -3,6 +3,7 @@
 //! writes and `render` previews.
 
 use crate::{Curves, Mesh, MeshAnimation};
+use glam::Vec3;
 
 /// One part of a [`Flipbook`].
 // A flipbook has a handful of parts: the size of the inline point cache does not matter.
@@ -27,6 +28,10 @@ pub enum FlipbookPart {
         /// The same frames as curves when the meshes are tubes swept along them (motion
         /// lines): scene files that hold curves write these instead of the tubes.
         curves: Option<Vec<Curves>>,
+        /// Velocity of every vertex of every frame's mesh (units per frame, one per vertex of
+        /// that frame's mesh), for scene files that carry motion (USD `velocities`): a
+        /// subdivided smear's vertices move along the smear although their count changes.
+        velocities: Option<Vec<Vec<Vec3>>>,
     },
 }
 

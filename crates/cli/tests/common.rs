@@ -210,3 +210,37 @@ pub(crate) fn rekeyed_glb(src: &Path, times: &[f32], dst: &Path) {
     glb.extend_from_slice(&bin);
     std::fs::write(dst, glb).unwrap();
 }
+
+/// The `.timeSamples` of `decl` inside `text` (file order), as the text of each value; one
+/// entry for a static (default) value.
+pub(crate) fn samples<'a>(text: &'a str, decl: &str) -> Vec<&'a str> {
+    let head = format!("{decl}.timeSamples = {{\n");
+    if let Some(start) = text.find(&head) {
+        let body = &text[start + head.len()..];
+        let end = body.find("\n        }").unwrap();
+        return body[..end]
+            .lines()
+            .map(|l| l.split_once(": ").unwrap().1.trim_end_matches(','))
+            .collect();
+    }
+    let head = format!("{decl} = ");
+    let start = text.find(&head).unwrap_or_else(|| panic!("no {decl}")) + head.len();
+    vec![text[start..].lines().next().unwrap()]
+}
+
+/// Parses `[(x, y, z), ...]`.
+pub(crate) fn vec3s(v: &str) -> Vec<[f32; 3]> {
+    let inner = v.trim().trim_start_matches('[').trim_end_matches(']');
+    if inner.is_empty() {
+        return Vec::new();
+    }
+    inner
+        .trim_start_matches('(')
+        .trim_end_matches(')')
+        .split("), (")
+        .map(|t| {
+            let c: Vec<f32> = t.split(", ").map(|x| x.parse().unwrap()).collect();
+            [c[0], c[1], c[2]]
+        })
+        .collect()
+}

@@ -130,6 +130,15 @@ fn elongate_subdivides_grounds_and_refuses_point_caches() {
         "-o",
         s(&m),
     ]);
+    // Every copy its own prim with displayOpacity and velocities.
+    let text = std::fs::read_to_string(&m).unwrap();
+    let prims = usd_meshes(&text);
+    let names: Vec<&str> = prims.iter().map(|p| p.0).collect();
+    assert_eq!(prims.len(), 4, "the body and 3 copies: {names:?}");
+    for (name, p) in &prims[1..] {
+        assert!(p.contains("float[] primvars:displayOpacity"), "{name}");
+        assert!(p.contains("vector3f[] velocities"), "{name}");
+    }
     let bad = toonkit(&[
         "smear",
         "elongate",
@@ -150,6 +159,15 @@ fn lowest(path: &Path) -> f32 {
         .positions()
         .iter()
         .fold(f32::INFINITY, |m, p| m.min(p.y))
+}
+
+/// `toonkit smear elongate INPUT --beta-max 4 EXTRA… -o OUT`; returns `out`.
+fn elongate_drop(input: &Path, out: &Path, extra: &[&str]) -> PathBuf {
+    let mut args = vec!["smear", "elongate", s(input), "--beta-max", "4"];
+    args.extend_from_slice(extra);
+    args.extend(["-o", s(out)]);
+    ok(&args);
+    out.to_path_buf()
 }
 
 #[test]
@@ -181,14 +199,7 @@ fn elongate_stays_out_of_a_collider_file() {
     let obj = dir.path().join("platform.obj");
     std::fs::write(&obj, tkio::obj::write(&platform)).unwrap();
 
-    let run = |name: &str, extra: &[&str]| {
-        let out = dir.path().join(name);
-        let mut args = vec!["smear", "elongate", s(&input), "--beta-max", "4"];
-        args.extend_from_slice(extra);
-        args.extend(["-o", s(&out)]);
-        ok(&args);
-        out
-    };
+    let run = |name: &str, extra: &[&str]| elongate_drop(&input, &dir.path().join(name), extra);
     let free = run("free.pc2", &[]);
     assert!(lowest(&free) < -1e-2, "nothing crossed: {}", lowest(&free));
     let collided = run("collided.pc2", &["--collider", s(&obj)]);
@@ -360,4 +371,66 @@ fn subdivided_smear_and_converted_flipbook_as_obj_sequences_keep_each_frames_mes
         s(&copies),
     ]);
     assert_eq!(v["files"].as_array().unwrap().len(), 16, "{v}");
+}
+
+/// The `def Mesh` prims of a `.usda` layer: name and text (up to the next prim).
+fn usd_meshes(text: &str) -> Vec<(&str, &str)> {
+    text.split("def Mesh \"")
+        .skip(1)
+        .map(|p| (p.split('"').next().unwrap(), p))
+        .collect()
+}
+
+#[test]
+fn subdivided_smear_usd_velocities_agree_with_the_point_cache() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = write_drop(dir.path());
+    let run = |name: &str, extra: &[&str]| {
+        std::fs::read_to_string(elongate_drop(&input, &dir.path().join(name), extra)).unwrap()
+    };
+    let plain = run("plain.usda", &[]);
+    let sub = run("subdivided.usda", &["--subdivide", "2"]);
+    let (plain_p, plain_v) = (
+        samples(&plain, "point3f[] points"),
+        samples(&plain, "vector3f[] velocities"),
+    );
+    let (sub_p, sub_v) = (
+        samples(&sub, "point3f[] points"),
+        samples(&sub, "vector3f[] velocities"),
+    );
+    assert_eq!((sub_p.len(), sub_v.len()), (16, 16));
+    let mut grew = false;
+    for f in 0..16 {
+        let (pp, pv) = (vec3s(plain_p[f]), vec3s(plain_v[f]));
+        let (sp, sv) = (vec3s(sub_p[f]), vec3s(sub_v[f]));
+        let n = pp.len();
+        assert_eq!(sv.len(), sp.len(), "frame {f}: one velocity per point");
+        grew |= sp.len() > n;
+        let fastest = pv
+            .iter()
+            .map(|v| Vec3::from_array(*v).length())
+            .fold(0.0, f32::max);
+        for (k, v) in sv.iter().enumerate() {
+            let v = Vec3::from_array(*v);
+            if k < n {
+                // The input's vertices come first, where the point cache has them, moving
+                // as the point cache says.
+                assert!(Vec3::from_array(sp[k]).distance(Vec3::from_array(pp[k])) < 1e-4);
+                let want = Vec3::from_array(pv[k]);
+                assert!(
+                    v.distance(want) <= 1e-4 * (1.0 + want.length()),
+                    "frame {f} vertex {k}: {v} vs the point cache's {want}"
+                );
+            } else {
+                // New vertices move as a blend of their input vertices.
+                assert!(
+                    v.length() <= fastest * 1.0001 + 1e-6,
+                    "frame {f} vertex {k}: {v}"
+                );
+            }
+        }
+    }
+    assert!(grew, "nothing was subdivided");
+
+    keep_for_validation(dir.path(), "usd_subdivided");
 }

@@ -6,44 +6,10 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{data, json, keep_for_validation, read_pc2, s, toonkit};
+use common::{data, json, keep_for_validation, read_pc2, s, samples, toonkit, vec3s};
 
 fn robot() -> PathBuf {
     data("characters/RobotExpressive.glb")
-}
-
-/// The `.timeSamples` of `decl` inside `text` (file order), as the text of each value; one
-/// entry for a static (default) value.
-fn samples<'a>(text: &'a str, decl: &str) -> Vec<&'a str> {
-    let head = format!("{decl}.timeSamples = {{\n");
-    if let Some(start) = text.find(&head) {
-        let body = &text[start + head.len()..];
-        let end = body.find("\n        }").unwrap();
-        return body[..end]
-            .lines()
-            .map(|l| l.split_once(": ").unwrap().1.trim_end_matches(','))
-            .collect();
-    }
-    let head = format!("{decl} = ");
-    let start = text.find(&head).unwrap_or_else(|| panic!("no {decl}")) + head.len();
-    vec![text[start..].lines().next().unwrap()]
-}
-
-/// Parses `[(x, y, z), ...]`.
-fn vec3s(v: &str) -> Vec<[f32; 3]> {
-    let inner = v.trim().trim_start_matches('[').trim_end_matches(']');
-    if inner.is_empty() {
-        return Vec::new();
-    }
-    inner
-        .trim_start_matches('(')
-        .trim_end_matches(')')
-        .split("), (")
-        .map(|t| {
-            let c: Vec<f32> = t.split(", ").map(|x| x.parse().unwrap()).collect();
-            [c[0], c[1], c[2]]
-        })
-        .collect()
 }
 
 /// The text of the `def Mesh "name"` prim (up to the next prim).

@@ -151,25 +151,39 @@ pub(crate) fn flipbook_stage<'a>(
                 name,
                 meshes,
                 curves,
-            } => frames_prim(name, meshes, curves.as_deref(), holds_curves),
+                velocities,
+            } => frames_prim(
+                name,
+                meshes,
+                curves.as_deref(),
+                velocities.as_deref(),
+                holds_curves,
+            ),
         })
         .collect();
     UsdStage::new(book.fps, meshes)
 }
 
 /// Per-frame meshes as a prim: their curves when there are some for every frame and the
-/// format holds them, else the meshes.
+/// format holds them, else the meshes (with their vertices' velocities when every frame has
+/// them).
 fn frames_prim<'a>(
     name: &str,
     meshes: &'a [Mesh],
     curves: Option<&'a [Curves]>,
+    velocities: Option<&'a [Vec<Vec3>]>,
     holds_curves: &dyn Fn(&[&Curves]) -> bool,
 ) -> UsdMesh<'a> {
     let curves: Option<Vec<&Curves>> = curves
         .filter(|c| c.len() == meshes.len())
         .map(|c| c.iter().collect());
-    match curves {
-        Some(c) if holds_curves(&c) => UsdMesh::curves(name, c),
+    match (curves, velocities) {
+        (Some(c), _) if holds_curves(&c) => UsdMesh::curves(name, c),
+        (_, Some(v)) if v.len() == meshes.len() => UsdMesh::moving_frames(
+            name,
+            meshes.iter().collect(),
+            v.iter().map(Vec::as_slice).collect(),
+        ),
         _ => UsdMesh::frames(name, meshes.iter().collect()),
     }
 }
@@ -232,6 +246,6 @@ pub(crate) fn lines_stage<'a>(
     curves: Option<&'a [Curves]>,
     holds_curves: &dyn Fn(&[&Curves]) -> bool,
 ) -> UsdStage<'a> {
-    let lines = frames_prim("motion_lines", lines, curves, holds_curves);
+    let lines = frames_prim("motion_lines", lines, curves, None, holds_curves);
     UsdStage::new(body.fps, vec![UsdMesh::animation(body, None), lines])
 }

@@ -160,7 +160,19 @@ impl<'a> Source<'a> {
                 }
                 Faces::of(&animation.mesh).check(n, &what)?;
             }
-            UsdGeometry::Frames(meshes) => {
+            UsdGeometry::Frames { meshes, velocities } => {
+                if let Some(v) = velocities {
+                    let bad = (v.len() != meshes.len()).then_some(0).or_else(|| {
+                        (0..meshes.len()).find(|&f| v[f].len() != meshes[f].vertex_count())
+                    });
+                    if let Some(f) = bad {
+                        return Err(IoError::unsupported(format!(
+                            "{what} frame {}: velocities do not match the mesh's {} vertices",
+                            f + 1,
+                            meshes.get(f).map_or(0, |m| m.vertex_count())
+                        )));
+                    }
+                }
                 for (f, m) in meshes.iter().enumerate() {
                     let what = format!("{what} frame {}", f + 1);
                     Faces::of(m).check(m.vertex_count(), &what)?;
@@ -245,13 +257,17 @@ impl<'a> Source<'a> {
         (lo - Vec3::splat(half), hi + Vec3::splat(half))
     }
 
-    /// Whether the prim carries `velocities`: a point cache whose points move. (Per-frame
-    /// meshes and curves change their points' count or meaning from frame to frame.)
+    /// Whether the prim carries `velocities`: a point cache whose points move, or per-frame
+    /// meshes given with their velocities. (Otherwise per-frame meshes and curves change
+    /// their points' count or meaning from frame to frame: no difference to take.)
     pub(crate) fn has_velocities(&self) -> bool {
-        matches!(self.geometry, UsdGeometry::Animation { .. })
-            && self.frames > 1
-            && !self.points(0).is_empty()
-            && !self.points_static()
+        match self.geometry {
+            UsdGeometry::Animation { .. } => {
+                self.frames > 1 && !self.points(0).is_empty() && !self.points_static()
+            }
+            UsdGeometry::Frames { velocities, .. } => velocities.is_some(),
+            UsdGeometry::Curves(_) => false,
+        }
     }
 
     /// Velocity of every point at frame `f` in units per second, the derivative of the
@@ -259,7 +275,27 @@ impl<'a> Source<'a> {
     /// one-sided at the first and last frame (as SPEC's smear velocities), times the frame
     /// rate (USD's `velocities` are per second of time codes). So a renderer's motion blur
     /// sweeps each point along the path the frames show (a smear's in-betweens included).
+    ///
+    /// Per-frame meshes whose vertices change from frame to frame carry their own velocities
+    /// (units per frame, e.g. a subdivided smear's: the point cache's at the input's vertices,
+    /// blended inside the triangles), written per second; none for an absent frame.
     pub(crate) fn velocities(&self, f: usize) -> Vec<Vec3> {
+        if let UsdGeometry::Frames {
+            velocities: Some(v),
+            ..
+        } = self.geometry
+        {
+            if self.frame_mesh(f).is_none() {
+                return Vec::new();
+            }
+            return v[f]
+                .iter()
+                .map(|v| {
+                    let v = *v * self.fps;
+                    Vec3::new(finite(v.x), finite(v.y), finite(v.z))
+                })
+                .collect();
+        }
         let last = self.frames.saturating_sub(1);
         let (a, b) = (f.saturating_sub(1), (f + 1).min(last));
         let per_frame = if b > a { (b - a) as f32 } else { 1.0 };
@@ -277,7 +313,7 @@ impl<'a> Source<'a> {
     /// The mesh of frame `f` when the geometry is per-frame and the frame has a drawable one.
     pub(crate) fn frame_mesh(&self, f: usize) -> Option<&'a Mesh> {
         match self.geometry {
-            UsdGeometry::Frames(m) => m
+            UsdGeometry::Frames { meshes: m, .. } => m
                 .get(f)
                 .copied()
                 .filter(|m| m.vertex_count() > 0 && !m.triangles.is_empty()),
@@ -292,7 +328,7 @@ impl<'a> Source<'a> {
                 0 => &[],
                 _ => animation.frame(f),
             },
-            UsdGeometry::Frames(_) => self.frame_mesh(f).map_or(&[], |m| &m.positions),
+            UsdGeometry::Frames { .. } => self.frame_mesh(f).map_or(&[], |m| &m.positions),
             UsdGeometry::Curves(_) => self
                 .frame_curves(f)
                 .map_or(&HIDDEN_CURVE_POINTS, |c| &c.points),
@@ -303,7 +339,7 @@ impl<'a> Source<'a> {
     pub(crate) fn faces(&self, f: usize) -> Faces<'a> {
         match self.geometry {
             UsdGeometry::Animation { animation, .. } => Faces::of(&animation.mesh),
-            UsdGeometry::Frames(_) => self
+            UsdGeometry::Frames { .. } => self
                 .frame_mesh(f)
                 .map_or(Faces::Triangles(&[]), |m| Faces::of(m)),
             UsdGeometry::Curves(_) => Faces::Triangles(&[]),
@@ -317,7 +353,7 @@ impl<'a> Source<'a> {
                 let n = animation.vertex_count();
                 colors.map(|c| ColorsOf::Given(&c[f * n..(f + 1) * n]))
             }
-            UsdGeometry::Frames(meshes) => {
+            UsdGeometry::Frames { meshes, .. } => {
                 if !meshes.iter().any(|m| m.colors.is_some()) {
                     return None;
                 }
@@ -349,7 +385,7 @@ impl<'a> Source<'a> {
                     && has_faces
                     && colors.is_none_or(|c| c[f * n..(f + 1) * n].iter().any(|c| c[3] > 0.0))
             }
-            UsdGeometry::Frames(_) => self.frame_mesh(f).is_some(),
+            UsdGeometry::Frames { .. } => self.frame_mesh(f).is_some(),
             UsdGeometry::Curves(_) => self.frame_curves(f).is_some(),
         }
     }
@@ -402,7 +438,7 @@ impl<'a> Source<'a> {
                     .as_deref()
                     .filter(|u| u.len() == n && n > 0)
             }
-            UsdGeometry::Frames(_) | UsdGeometry::Curves(_) => None,
+            UsdGeometry::Frames { .. } | UsdGeometry::Curves(_) => None,
         }
     }
 

@@ -1,5 +1,6 @@
 //! The data model of a USD layer: a root `Xform` holding animated `Mesh` prims.
 
+use anim::glam::Vec3;
 use anim::{Curves, Mesh, MeshAnimation, DEFAULT_FPS};
 
 use crate::{IoError, Result};
@@ -26,9 +27,15 @@ pub enum UsdGeometry<'a> {
         colors: Option<&'a [[f32; 4]]>,
     },
     /// One mesh per frame, with its own topology and vertex colours ([`Mesh::colors`]):
-    /// motion lines. A frame with no mesh, no vertex or no triangle is absent (empty arrays,
-    /// `visibility` "invisible").
-    Frames(Vec<&'a Mesh>),
+    /// subdivided smears, tube motion lines. A frame with no mesh, no vertex or no triangle is
+    /// absent (empty arrays, `visibility` "invisible").
+    Frames {
+        /// The mesh of every frame.
+        meshes: Vec<&'a Mesh>,
+        /// Optional velocities of every frame's vertices in units per frame (one per vertex
+        /// of that frame's mesh), written as `velocities` per second.
+        velocities: Option<Vec<&'a [Vec3]>>,
+    },
     /// Linear curves per frame, written as a `BasisCurves` prim (width and colour per
     /// point): motion lines. A frame without a curve is absent (`visibility` "invisible").
     Curves(Vec<&'a Curves>),
@@ -39,7 +46,7 @@ impl UsdGeometry<'_> {
     pub fn frame_count(&self) -> usize {
         match self {
             UsdGeometry::Animation { animation, .. } => animation.frame_count(),
-            UsdGeometry::Frames(meshes) => meshes.len(),
+            UsdGeometry::Frames { meshes, .. } => meshes.len(),
             UsdGeometry::Curves(curves) => curves.len(),
         }
     }
@@ -76,7 +83,26 @@ impl<'a> UsdMesh<'a> {
     pub fn frames(name: impl Into<String>, meshes: Vec<&'a Mesh>) -> Self {
         UsdMesh {
             name: name.into(),
-            geometry: UsdGeometry::Frames(meshes),
+            geometry: UsdGeometry::Frames {
+                meshes,
+                velocities: None,
+            },
+        }
+    }
+
+    /// [`UsdMesh::frames`] whose vertices move: `velocities[f]` holds one velocity (units per
+    /// frame) per vertex of `meshes[f]`.
+    pub fn moving_frames(
+        name: impl Into<String>,
+        meshes: Vec<&'a Mesh>,
+        velocities: Vec<&'a [Vec3]>,
+    ) -> Self {
+        UsdMesh {
+            name: name.into(),
+            geometry: UsdGeometry::Frames {
+                meshes,
+                velocities: Some(velocities),
+            },
         }
     }
 }

@@ -11,10 +11,15 @@
 //! displaced parents. Attributes (normals, UVs, colours, scalar attributes, multiples'
 //! opacities) are blended with the same weights.
 //!
-//! An edge is split when either test holds (both measured against its rest length r):
+//! An edge is split when either test holds (r its rest length):
 //! * **stretch** — it is longer than `tolerance × r`;
 //! * **bend** — its midpoint on the smear is off the straight edge by more than
-//!   `BEND × (tolerance − 1) × r` ([`BEND`]). Where the parents' β differ, the smear of an edge
+//!   `BEND × (tolerance − 1) × r` ([`BEND`]), or by more than
+//!   `DEVIATION_SHARE × (tolerance − 1)` of the frame's 99th-percentile deviation before
+//!   subdivision ([`DEVIATION_SHARE`]; the first alone would leave the largest deviations of a
+//!   mesh of many small triangles, each a small fraction of its edge, untouched). A triangle
+//!   whose centroid on the smear is that far off the flat triangle splits all its edges
+//!   (SMEAR §4.1: β and the trajectories vary inside it). Where the parents' β differ, the smear of an edge
 //!   is the curve `u ↦ Q_u(h + β_u)` (`Q_u`, `β_u` blended along the edge): a leg swinging
 //!   through an arc is smeared along that arc although its edges barely stretch (a rigid
 //!   rotation keeps hip-to-foot lengths), so the stretch test alone leaves flat shards. A
@@ -43,6 +48,14 @@ pub const BEND: f32 = 0.05;
 
 /// Bends below this fraction of the rest length are rounding, never split (TOL = 1).
 const BEND_FLOOR: f32 = 1e-4;
+
+/// The deviation test's share: with `--subdivide TOL` an edge or triangle whose smear is off
+/// the flat one by more than `DEVIATION_SHARE × (TOL − 1)` of the frame's 99th-percentile
+/// deviation before subdivision is split (a quarter at TOL = 2). The bend test alone is
+/// relative to each edge's length, so a mesh of many small triangles, whose deviations are
+/// small fractions of their edges, would keep its largest deviations; this one refines the
+/// worst places of any mesh until they are a fraction of what they were.
+pub const DEVIATION_SHARE: f32 = 0.25;
 
 /// A vertex of the subdivided mesh: weights of up to three input vertices (unused slots 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -140,7 +153,8 @@ pub struct SubdivisionStats {
 /// * `alpha` — optional per-vertex opacities, blended into the output's colour alpha with
 ///   colour `rgb`.
 /// * `tolerance` — split edges longer than `tolerance ×` their rest length (e.g. 2), or
-///   whose smear bends away from them by more than [`BEND`]` × (tolerance − 1)` of it.
+///   whose smear bends away from them by more than [`BEND`]` × (tolerance − 1)` of it or
+///   [`DEVIATION_SHARE`]` × (tolerance − 1)` of the frame's 99th-percentile deviation.
 ///
 /// # Performance
 /// One trajectory evaluation per parent of every edge's midpoint, per round; hash map of
@@ -153,6 +167,42 @@ pub fn subdivide_frame(
     alpha: Option<(&[f32], [f32; 3])>,
     tolerance: f32,
 ) -> (Mesh, SubdivisionStats) {
+    let (out, _, stats) = subdivide(tr, mesh, h, beta, alpha, tolerance);
+    (out, stats)
+}
+
+/// [`subdivide_frame`] of a moving frame: also the velocity of every output vertex, the blend
+/// of `velocities` (one per input vertex, e.g. the central differences of the unsubdivided
+/// smear's frames) with the weights that place the vertex. The input's vertices keep their
+/// own velocity, so a renderer's motion blur of the subdivided smear agrees with the point
+/// cache's at every input vertex and is interpolated inside the triangles as the positions
+/// are.
+///
+/// # Panics
+/// When `velocities` has fewer values than `mesh` has vertices.
+pub fn subdivide_moving_frame(
+    tr: &Trajectories<'_>,
+    mesh: &Mesh,
+    h: usize,
+    beta: &[f32],
+    alpha: Option<(&[f32], [f32; 3])>,
+    tolerance: f32,
+    velocities: &[Vec3],
+) -> (Mesh, Vec<Vec3>, SubdivisionStats) {
+    let (out, blends, stats) = subdivide(tr, mesh, h, beta, alpha, tolerance);
+    let v = blends.iter().map(|b| b.lerp(velocities)).collect();
+    (out, v, stats)
+}
+
+/// [`subdivide_frame`], also returning every output vertex's blend of input vertices.
+fn subdivide(
+    tr: &Trajectories<'_>,
+    mesh: &Mesh,
+    h: usize,
+    beta: &[f32],
+    alpha: Option<(&[f32], [f32; 3])>,
+    tolerance: f32,
+) -> (Mesh, Vec<Blend>, SubdivisionStats) {
     let rest = tr.frame(h);
     let place = |b: &Blend| -> Vec3 {
         if b.count() == 1 {
@@ -195,6 +245,10 @@ pub fn subdivide_frame(
         }
     };
     let bend = (BEND * (tolerance - 1.0)).max(BEND_FLOOR);
+    let deviation =
+        DEVIATION_SHARE * (tolerance - 1.0).max(0.0) * initial_deviation(mesh, &pos, &place);
+    // Whether a deviation `d` of the smear from an element of rest length `r` is split.
+    let too_far = |d: f32, r: f32| d > (bend * r).min(deviation.max(BEND_FLOOR * r));
     let mut mids: HashMap<(u32, u32), u32> = HashMap::new();
     // Edges found short and straight: their ends never move, so they stay unsplit.
     let mut kept: HashSet<(u32, u32)> = HashSet::new();
@@ -216,7 +270,7 @@ pub fn subdivide_frame(
                     let nb = Blend::mid(&blends[key.0 as usize], &blends[key.1 as usize]);
                     let q = place(&nb);
                     let long = pa.distance(pb) > tolerance * r;
-                    let bent = q.distance(0.5 * (pa + pb)) > bend * r;
+                    let bent = too_far(q.distance(0.5 * (pa + pb)), r);
                     if long || bent {
                         mid = Some((nb, q));
                     }
@@ -248,7 +302,7 @@ pub fn subdivide_frame(
             let [u, v, w] = t.map(|v| &blends[v as usize]);
             let c = Blend::average(&[u, v, w]);
             let flat = t.iter().map(|&v| pos[v as usize]).sum::<Vec3>() / 3.0;
-            if r > 0.0 && place(&c).distance(flat) > bend * r {
+            if r > 0.0 && too_far(place(&c).distance(flat), r) {
                 for key in keys {
                     let nb = Blend::mid(&blends[key.0 as usize], &blends[key.1 as usize]);
                     let q = place(&nb);
@@ -340,7 +394,32 @@ pub fn subdivide_frame(
             0.0
         },
     };
-    (out, stats)
+    (out, blends, stats)
+}
+
+/// The 99th percentile of the unsubdivided frame's deviations from the smear: at every edge's
+/// midpoint and every triangle's centroid, the distance between the point on the smear and
+/// the point on the flat triangle through the smeared vertices `corners`.
+fn initial_deviation(mesh: &Mesh, corners: &[Vec3], place: &dyn Fn(&Blend) -> Vec3) -> f32 {
+    let mut d = Vec::with_capacity(mesh.triangles.len() * 4);
+    for t in &mesh.triangles {
+        let b = t.map(Blend::one);
+        for k in 0..3 {
+            let (u, v) = (t[k], t[(k + 1) % 3]);
+            if u < v {
+                let flat = 0.5 * (corners[u as usize] + corners[v as usize]);
+                d.push(place(&Blend::mid(&b[k], &b[(k + 1) % 3])).distance(flat));
+            }
+        }
+        let flat = t.iter().map(|&v| corners[v as usize]).sum::<Vec3>() / 3.0;
+        d.push(place(&Blend::average(&[&b[0], &b[1], &b[2]])).distance(flat));
+    }
+    d.retain(|x| x.is_finite());
+    if d.is_empty() {
+        return 0.0;
+    }
+    let k = ((d.len() - 1) as f32 * 0.99) as usize;
+    *d.select_nth_unstable_by(k, f32::total_cmp).1
 }
 
 /// Splits triangle `t` (its input triangle `orig`) at the midpoints `m` of its edges

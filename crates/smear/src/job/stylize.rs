@@ -6,6 +6,7 @@ use std::ops::Range;
 use std::time::Instant;
 
 use anim::{Aabb, Flipbook, FlipbookPart, MeshAnimation};
+use glam::Vec3;
 use serde::Serialize;
 
 use super::frames::{animation_at, check_range, elongate_range, lines_range, multiples_range};
@@ -208,12 +209,15 @@ fn subdivided_copy(
     rgb: [f32; 3],
     tol: f32,
     first: usize,
-) -> Result<Vec<anim::Mesh>> {
+) -> Result<(Vec<anim::Mesh>, Vec<Vec<Vec3>>)> {
     let tr = inputs.trajectories();
     let anim = &copy.animation;
     let (frames, n) = (anim.frame_count(), anim.vertex_count());
     let step = options.step.max(1);
+    // The copy's own motion: its vertices' central differences, blended into new vertices.
+    let moving = crate::vertex_velocities(anim);
     let mut meshes = Vec::with_capacity(frames);
+    let mut velocities = Vec::with_capacity(frames);
     for f in 0..frames {
         let h = crate::held_frame(first + f, step);
         let (past, future) = options.counts_at(h as f32);
@@ -229,10 +233,74 @@ fn subdivided_copy(
         };
         let beta = vec![b; n];
         let alpha = &copy.alpha[f * n..(f + 1) * n];
-        let (mesh, _) = crate::subdivide_frame(&tr, &anim.mesh, h, &beta, Some((alpha, rgb)), tol);
+        let v = &moving[f * n..(f + 1) * n];
+        let (mesh, v, _) =
+            crate::subdivide_moving_frame(&tr, &anim.mesh, h, &beta, Some((alpha, rgb)), tol, v);
         meshes.push(mesh);
+        velocities.push(v);
     }
-    Ok(meshes)
+    Ok((meshes, velocities))
+}
+
+/// The elongated body, adaptively subdivided per frame (issue #22).
+struct SubdividedBody<'a, 'i> {
+    inputs: &'a EffectInputs<'i>,
+    /// The elongation's stylization function.
+    f: &'a dyn Stylize,
+    /// Frames each drawing is held for.
+    step: usize,
+    /// Per clip frame: its squash, if any.
+    squash: &'a [Option<crate::Squash>],
+    ground: Option<f32>,
+    tol: f32,
+}
+
+impl SubdividedBody<'_, '_> {
+    /// Every frame of `frames`: its subdivided mesh and the velocities of its vertices (units
+    /// per frame: the central differences of the unsubdivided smear as a point cache writes
+    /// them, squash included, blended into the new vertices); the subdivision's figures go
+    /// into `stats`.
+    fn frames(
+        &self,
+        anim: &MeshAnimation,
+        body: &MeshAnimation,
+        range_squash: &[Option<crate::Squash>],
+        frames: &Range<usize>,
+        stats: &mut ObjectReport,
+    ) -> (Vec<anim::Mesh>, Vec<Vec<Vec3>>) {
+        let tr = self.inputs.trajectories();
+        let n = anim.vertex_count();
+        let mut written = body.clone();
+        squash_animation(&mut written, range_squash, self.ground);
+        let moving = crate::vertex_velocities(&written);
+        let mut beta = vec![0.0f32; n];
+        let mut meshes = Vec::with_capacity(frames.len());
+        let mut velocities = Vec::with_capacity(frames.len());
+        let (mut stretch, mut most, mut vertices, mut error) = (0.0f32, 0, 0, 0.0f32);
+        for (i, frame) in frames.clone().enumerate() {
+            let h = crate::held_frame(frame, self.step);
+            for (k, b) in beta.iter_mut().enumerate() {
+                *b = self.step as f32 * self.f.eval(&self.inputs.style_input(h, k));
+            }
+            let v = &moving[i * n..(i + 1) * n];
+            let (mut mesh, v, st) =
+                crate::subdivide_moving_frame(&tr, &anim.mesh, h, &beta, None, self.tol, v);
+            if let (Some(Some(sq)), Some(g)) = (self.squash.get(frame), self.ground) {
+                sq.apply(g, &mut mesh.positions);
+            }
+            stretch = stretch.max(st.max_stretch);
+            most = most.max(st.triangles);
+            vertices = vertices.max(st.vertices);
+            error = error.max(st.max_error);
+            meshes.push(mesh);
+            velocities.push(v);
+        }
+        stats.subdivision_max_stretch = Some(stretch);
+        stats.subdivision_max_triangles = Some(most);
+        stats.subdivision_max_vertices = Some(vertices);
+        stats.subdivision_max_error = Some(error);
+        (meshes, velocities)
+    }
 }
 
 /// Applies `style` to every object of `prepared`: per object, the elongated in-betweens (or
@@ -349,35 +417,22 @@ pub fn stylize_frames(
         let range_squash = squash.get(frames.clone()).unwrap_or(&[]);
         match (style.subdivide, &fx.elongate) {
             (Some(tol), Some((f, options))) => {
-                let tr = inputs.trajectories();
                 let step = options.step.max(1);
-                let mut beta = vec![0.0f32; n];
-                let mut meshes = Vec::with_capacity(frames.len());
-                let (mut stretch, mut most, mut vertices, mut error) = (0.0f32, 0, 0, 0.0f32);
-                for frame in frames.clone() {
-                    let h = crate::held_frame(frame, step);
-                    for (k, b) in beta.iter_mut().enumerate() {
-                        *b = step as f32 * f.eval(&inputs.style_input(h, k));
-                    }
-                    let (mut mesh, st) =
-                        crate::subdivide_frame(&tr, &anim.mesh, h, &beta, None, tol);
-                    if let (Some(Some(sq)), Some(g)) = (squash.get(frame), ground) {
-                        sq.apply(g, &mut mesh.positions);
-                    }
-                    stretch = stretch.max(st.max_stretch);
-                    most = most.max(st.triangles);
-                    vertices = vertices.max(st.vertices);
-                    error = error.max(st.max_error);
-                    meshes.push(mesh);
-                }
-                stats.subdivision_max_stretch = Some(stretch);
-                stats.subdivision_max_triangles = Some(most);
-                stats.subdivision_max_vertices = Some(vertices);
-                stats.subdivision_max_error = Some(error);
+                let sub = SubdividedBody {
+                    inputs: &inputs,
+                    f,
+                    step,
+                    squash: &squash,
+                    ground,
+                    tol,
+                };
+                let (meshes, velocities) =
+                    sub.frames(anim, &body, range_squash, &frames, &mut stats);
                 book.parts.push(FlipbookPart::Frames {
                     name: anim.mesh.name.clone(),
                     meshes,
                     curves: None,
+                    velocities: Some(velocities),
                 });
             }
             _ => {
@@ -409,12 +464,13 @@ pub fn stylize_frames(
                     total: c.alpha.len(),
                 });
                 if let Some(tol) = style.subdivide {
-                    let meshes =
+                    let (meshes, velocities) =
                         subdivided_copy(&inputs, options, &c, [r, g, b], tol, frames.start)?;
                     book.parts.push(FlipbookPart::Frames {
                         name: c.animation.mesh.name.clone(),
                         meshes,
                         curves: None,
+                        velocities: Some(velocities),
                     });
                     continue;
                 }
@@ -473,6 +529,7 @@ pub fn stylize_frames(
                 name: format!("{name}_lines"),
                 meshes,
                 curves: Some(curves),
+                velocities: None,
             });
         }
         report.seconds.lines += t.elapsed().as_secs_f64();

@@ -6,6 +6,7 @@
 //! (distance to its nearest triangle).
 
 use glam::Vec3;
+use rayon::prelude::*;
 use smear::Trajectories;
 
 /// Samples per input triangle: the points of a barycentric lattice of `LATTICE` steps
@@ -62,27 +63,34 @@ pub(crate) fn point_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
 }
 
 /// Distances from every point to the nearest triangle of a surface, through a uniform grid
-/// of the triangles' boxes (rings of cells searched outward until none can be nearer).
+/// of the triangles' boxes (about one triangle per cell; rings of cells searched outward
+/// until none can be nearer).
 pub(crate) fn surface_distances(
     points: &[Vec3],
     positions: &[Vec3],
     tris: &[[u32; 3]],
 ) -> Vec<f32> {
+    use glam::IVec3;
     let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
     for p in positions.iter().chain(points) {
         lo = lo.min(*p);
         hi = hi.max(*p);
     }
-    let cells = ((tris.len() as f32).cbrt().ceil() as usize).clamp(1, 64);
-    let size = ((hi - lo).max_element() / cells as f32).max(1e-6);
+    let span = (hi - lo).max(Vec3::splat(1e-6));
+    // Cubic cells of about one triangle each, at most 96 along an axis.
+    let volume = span.x * span.y * span.z;
+    let size = (volume / tris.len().max(1) as f32)
+        .cbrt()
+        .max(span.max_element() / 96.0);
+    let dims = (span / size).ceil().as_ivec3().max(IVec3::ONE);
     let cell = |p: Vec3| {
         ((p - lo) / size)
             .floor()
             .as_ivec3()
-            .clamp(glam::IVec3::ZERO, glam::IVec3::splat(cells as i32 - 1))
+            .clamp(IVec3::ZERO, dims - 1)
     };
-    let mut grid: Vec<Vec<u32>> = vec![Vec::new(); cells * cells * cells];
-    let index = |c: glam::IVec3| (c.x as usize * cells + c.y as usize) * cells + c.z as usize;
+    let index = |c: IVec3| ((c.x * dims.y + c.y) * dims.z + c.z) as usize;
+    let mut grid: Vec<Vec<u32>> = vec![Vec::new(); (dims.x * dims.y * dims.z) as usize];
     for (k, t) in tris.iter().enumerate() {
         let v = t.map(|i| positions[i as usize]);
         let (a, b) = (
@@ -92,31 +100,38 @@ pub(crate) fn surface_distances(
         for x in a.x..=b.x {
             for y in a.y..=b.y {
                 for z in a.z..=b.z {
-                    grid[index(glam::IVec3::new(x, y, z))].push(k as u32);
+                    grid[index(IVec3::new(x, y, z))].push(k as u32);
                 }
             }
         }
     }
+    let rings = dims.max_element();
     points
-        .iter()
+        .par_iter()
         .map(|&p| {
             let c = cell(p);
+            // Distance from p to the sides of its own cell: a triangle outside ring r − 1 is
+            // at least (r − 1)·size + margin away.
+            let corner = lo + c.as_vec3() * size;
+            let margin = (p - corner)
+                .min(corner + Vec3::splat(size) - p)
+                .min_element()
+                .max(0.0);
             let mut best = f32::INFINITY;
-            for r in 0..cells as i32 {
-                // Every triangle within distance r·size of p touches a cell of ring ≤ r.
-                if best <= r as f32 * size - size {
+            for r in 0..rings {
+                if r > 0 && best <= (r - 1) as f32 * size + margin {
                     break;
                 }
                 for x in c.x - r..=c.x + r {
                     for y in c.y - r..=c.y + r {
                         for z in c.z - r..=c.z + r {
-                            let on_ring =
-                                (x - c.x).abs().max((y - c.y).abs()).max((z - c.z).abs()) == r;
-                            let inside = [x, y, z].iter().all(|&u| u >= 0 && u < cells as i32);
+                            let u = IVec3::new(x, y, z);
+                            let on_ring = (u - c).abs().max_element() == r;
+                            let inside = u.cmpge(IVec3::ZERO).all() && u.cmplt(dims).all();
                             if !on_ring || !inside {
                                 continue;
                             }
-                            for &k in &grid[index(glam::IVec3::new(x, y, z))] {
+                            for &k in &grid[index(u)] {
                                 let [a, b, d] = tris[k as usize].map(|i| positions[i as usize]);
                                 best = best.min(point_triangle(p, a, b, d));
                             }
