@@ -64,6 +64,14 @@ class StopmoSettings(bpy.types.PropertyGroup):
         ("stl,3mf", "STL and 3MF", "Both")])
     plate_mm: FloatVectorProperty(name="Build plate (mm)", size=2, default=(120.0, 68.0),
                                   min=10.0, max=2000.0)
+    min_wall_mm: FloatProperty(
+        name="Min wall (mm)", default=0.0, min=0.0, max=10.0,
+        description="The printer's thinnest wall: thinner walls of a piece or mount are "
+                    "warned about; 0: the tool's default (0.8 mm)")
+    min_feature_mm: FloatProperty(
+        name="Min feature (mm)", default=0.0, min=0.0, max=10.0,
+        description="The printer's smallest free-standing feature (IDs, keys, plug pins); "
+                    "0: the tool's default (0.3 mm)")
     print_solids: BoolProperty(
         name="Printable solids", default=True,
         description="Build the STL solids; off, the pieces' surfaces, labels and errors only "
@@ -133,6 +141,9 @@ def options(s):
                                "height_mm": s.magnet_height_mm}
         if s.clearance_mm > 0.0:
             opts["clearance_mm"] = s.clearance_mm
+        for name in ("min_wall_mm", "min_feature_mm"):
+            if getattr(s, name) > 0.0:
+                opts[name] = getattr(s, name)
     return opts
 
 

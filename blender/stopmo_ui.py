@@ -103,7 +103,8 @@ class TOONKIT_PT_stopmo(bpy.types.Panel):
             row = col.row(align=True)
             row.prop(s, "magnet_diameter_mm", text="D")
             row.prop(s, "magnet_height_mm", text="H")
-        for name in ("clearance_mm", "print_format", "plate_mm", "directory"):
+        for name in ("clearance_mm", "print_format", "plate_mm", "min_wall_mm", "min_feature_mm",
+                     "directory"):
             col.prop(s, name)
         lay.operator("toonkit.stopmo_run", icon="MOD_BUILD")
         img = bpy.data.images.get("toonkit error curve")
