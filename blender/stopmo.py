@@ -44,6 +44,10 @@ class StopmoSettings(bpy.types.PropertyGroup):
     restarts: IntProperty(name="Restarts", default=4, min=1, max=100)
     seed: IntProperty(name="Seed", default=1, min=0)
     print_height_mm: FloatProperty(name="Print height (mm)", default=60.0, min=1.0)
+    thickness_mm: FloatProperty(
+        name="Wall (mm)", default=0.0, min=0.0, max=20.0,
+        description="Wall thickness of the pieces (a magnet pocket needs its depth plus 1 mm "
+                    "where a part hardly moves); 0: the tool's default (1.5 mm)")
     plugs: BoolProperty(name="Plugs", default=False,
                         description="Registration plugs between parts")
     magnets: BoolProperty(
@@ -134,6 +138,8 @@ def options(s):
     if s.plugs:
         opts["plugs"] = {}
     if s.print_solids:
+        if s.thickness_mm > 0.0:
+            opts["thickness_mm"] = s.thickness_mm
         opts["print_format"] = s.print_format
         opts["plate_mm"] = [float(v) for v in s.plate_mm]
         if s.magnets:

@@ -96,8 +96,8 @@ class TOONKIT_PT_stopmo(bpy.types.Panel):
         lay.prop(s, "count", text="")
         lay.prop(s, {"EACH": "pieces", "BUDGET": "budget", "MAX_ERROR": "max_error_mm"}[s.count])
         col = lay.column(align=True)
-        for name in ("lam", "restarts", "seed", "print_height_mm", "print_solids", "plugs",
-                     "magnets"):
+        for name in ("lam", "restarts", "seed", "print_height_mm", "print_solids", "thickness_mm",
+                     "plugs", "magnets"):
             col.prop(s, name)
         if s.magnets:
             row = col.row(align=True)
