@@ -44,6 +44,10 @@ class StopmoSettings(bpy.types.PropertyGroup):
     restarts: IntProperty(name="Restarts", default=4, min=1, max=100)
     seed: IntProperty(name="Seed", default=1, min=0)
     print_height_mm: FloatProperty(name="Print height (mm)", default=60.0, min=1.0)
+    thickness_mm: FloatProperty(
+        name="Wall (mm)", default=0.0, min=0.0, max=20.0,
+        description="Wall thickness of the pieces (a magnet pocket needs its depth plus 1 mm "
+                    "where a part hardly moves); 0: the tool's default (1.5 mm)")
     plugs: BoolProperty(name="Plugs", default=False,
                         description="Registration plugs between parts")
     magnets: BoolProperty(
@@ -64,6 +68,14 @@ class StopmoSettings(bpy.types.PropertyGroup):
         ("stl,3mf", "STL and 3MF", "Both")])
     plate_mm: FloatVectorProperty(name="Build plate (mm)", size=2, default=(120.0, 68.0),
                                   min=10.0, max=2000.0)
+    min_wall_mm: FloatProperty(
+        name="Min wall (mm)", default=0.0, min=0.0, max=10.0,
+        description="The printer's thinnest wall: thinner walls of a piece or mount are "
+                    "warned about; 0: the tool's default (0.8 mm)")
+    min_feature_mm: FloatProperty(
+        name="Min feature (mm)", default=0.0, min=0.0, max=10.0,
+        description="The printer's smallest free-standing feature (IDs, keys, plug pins); "
+                    "0: the tool's default (0.3 mm)")
     print_solids: BoolProperty(
         name="Printable solids", default=True,
         description="Build the STL solids; off, the pieces' surfaces, labels and errors only "
@@ -126,6 +138,8 @@ def options(s):
     if s.plugs:
         opts["plugs"] = {}
     if s.print_solids:
+        if s.thickness_mm > 0.0:
+            opts["thickness_mm"] = s.thickness_mm
         opts["print_format"] = s.print_format
         opts["plate_mm"] = [float(v) for v in s.plate_mm]
         if s.magnets:
@@ -133,6 +147,9 @@ def options(s):
                                "height_mm": s.magnet_height_mm}
         if s.clearance_mm > 0.0:
             opts["clearance_mm"] = s.clearance_mm
+        for name in ("min_wall_mm", "min_feature_mm"):
+            if getattr(s, name) > 0.0:
+                opts[name] = getattr(s, name)
     return opts
 
 

@@ -96,14 +96,15 @@ class TOONKIT_PT_stopmo(bpy.types.Panel):
         lay.prop(s, "count", text="")
         lay.prop(s, {"EACH": "pieces", "BUDGET": "budget", "MAX_ERROR": "max_error_mm"}[s.count])
         col = lay.column(align=True)
-        for name in ("lam", "restarts", "seed", "print_height_mm", "print_solids", "plugs",
-                     "magnets"):
+        for name in ("lam", "restarts", "seed", "print_height_mm", "print_solids", "thickness_mm",
+                     "plugs", "magnets"):
             col.prop(s, name)
         if s.magnets:
             row = col.row(align=True)
             row.prop(s, "magnet_diameter_mm", text="D")
             row.prop(s, "magnet_height_mm", text="H")
-        for name in ("clearance_mm", "print_format", "plate_mm", "directory"):
+        for name in ("clearance_mm", "print_format", "plate_mm", "min_wall_mm", "min_feature_mm",
+                     "directory"):
             col.prop(s, name)
         lay.operator("toonkit.stopmo_run", icon="MOD_BUILD")
         img = bpy.data.images.get("toonkit error curve")

@@ -4,6 +4,7 @@
 import { chromium } from 'playwright-core';
 import { mkdirSync, readFileSync } from 'node:fs';
 import { join } from 'node:path';
+import { inflateRawSync } from 'node:zlib';
 
 const url = process.argv[2];
 const shots = process.argv[3] || 'target/studio-shots';
@@ -14,6 +15,53 @@ const check = (name, ok, detail = '') => {
   console.log(`${ok ? 'ok  ' : 'FAIL'} ${name}${detail ? ': ' + detail : ''}`);
 };
 const median = (xs) => { const s = [...xs].sort((a, b) => a - b); return s[Math.floor(s.length / 2)]; };
+
+/** The entries of a zip (stored or deflated) by name, read through its central directory. */
+function unzip(buf) {
+  const entries = {};
+  let end = buf.length - 22;
+  while (end > 0 && buf.readUInt32LE(end) !== 0x06054b50) end--;
+  let at = buf.readUInt32LE(end + 16);
+  for (let i = buf.readUInt16LE(end + 10); i > 0; i--) {
+    const method = buf.readUInt16LE(at + 10), size = buf.readUInt32LE(at + 20);
+    const nameLen = buf.readUInt16LE(at + 28);
+    const name = buf.toString('utf8', at + 46, at + 46 + nameLen);
+    const local = buf.readUInt32LE(at + 42);
+    const start = local + 30 + buf.readUInt16LE(local + 26) + buf.readUInt16LE(local + 28);
+    const data = buf.subarray(start, start + size);
+    entries[name] = method === 8 ? inflateRawSync(data) : data;
+    at += 46 + nameLen + buf.readUInt16LE(at + 30) + buf.readUInt16LE(at + 32);
+  }
+  return entries;
+}
+
+/** The exported library as a print shop gets it: with the magnet and 3MF asked for in the
+ * panel, every piece has a pocket and a plate in report.json, each part's mount is a whole
+ * binary STL, and library.3mf holds one named object per piece in millimetres. */
+function exportedWithMagnets(folder, written) {
+  const report = JSON.parse(readFileSync(join(folder, 'report.json'), 'utf8'));
+  const p = report.printing || {};
+  const pieces = p.pieces || [];
+  check('the export carries the panel\'s magnet and print format', p.magnet && p.magnet.diameter_mm === 3 && p.magnet.height_mm === 2 && p.print_format === 'stl,3mf' && p.clearance_mm > 0, JSON.stringify({ magnet: p.magnet, format: p.print_format }));
+  check('every exported piece has a magnet pocket and a plate', pieces.length > 0 && pieces.every((q) => q.magnet && q.plate >= 1 && q.volume_mm3 > 0 && q.frames.length > 0) && (p.parts || []).every((q) => q.magnet_pocket), `${pieces.length} pieces`);
+  const mounts = (p.parts || []).map((q) => `stopmo_library/pieces/${q.name}_back.stl`);
+  const whole = mounts.every((m) => {
+    if (!written.includes(m)) return false;
+    const stl = readFileSync(join(folder, '..', m));
+    return stl.length === 84 + 50 * stl.readUInt32LE(80) && stl.readUInt32LE(80) > 0;
+  });
+  check('each part\'s mount with the matching pocket is exported', whole, mounts.join(', '));
+  let objects = [];
+  let unit = '';
+  if (written.includes('stopmo_library/library.3mf')) {
+    const model = unzip(readFileSync(join(folder, 'library.3mf')))['3D/3dmodel.model'];
+    const xml = model ? model.toString('utf8') : '';
+    unit = (xml.match(/<model[^>]*unit="([a-z]+)"/) || [])[1] || '';
+    objects = [...xml.matchAll(/<object [^>]*>/g)].map((m) => (m[0].match(/ name="([^"]+)"/) || [])[1]);
+  }
+  const ids = pieces.map((q) => q.id).sort();
+  check('library.3mf holds one object per piece, named by its ID, in millimetres', unit === 'millimeter' && JSON.stringify([...objects].sort()) === JSON.stringify(ids), `${unit}: ${objects.join(', ')} vs ${ids.join(', ')}`);
+}
 
 const browser = await chromium.launch({
   executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
@@ -304,6 +352,12 @@ try {
     check('the size-vs-error chart shows its points and labelled axes', points === 3 && labels.some((t) => t.includes('pieces')) && labels.some((t) => t.includes('(mm)')), `${points} points; ${await stopmoError()}`);
     console.log(`stopmo size curve (3 sizes, ${parts} parts): ${((Date.now() - tCurve) / 1000).toFixed(1)} s`);
     if (points > 0) {
+      // Printed as a studio mounts it: a 3×2 mm magnet in every piece (3.5 mm walls: a part
+      // that hardly moves is as thick as its wall, and the pocket needs 2.15 mm and 1 mm in
+      // front of it), STL and library.3mf.
+      await page.fill('#stopmo-magnets', '3x2');
+      await page.fill('#stopmo-thickness', '3.5');
+      await page.selectOption('#stopmo-format', 'stl,3mf');
       const tBuild = Date.now();
       await page.click('#stopmo-chart circle[data-pieces="2"]');
       await page.waitForFunction(() => window.studio.panels.stopmo.recon || !document.getElementById('error').hidden, null, { timeout: 600000 });
@@ -327,6 +381,8 @@ try {
       await page.waitForFunction(() => window.studio.panels.stopmo.exported || !document.getElementById('error').hidden, null, { timeout: 300000 });
       const written = await page.evaluate(() => { const e = window.studio.panels.stopmo.exported; return e ? e.written : []; });
       check('the library folder is exported', written.includes('stopmo_library/assembly.csv') && written.some((f) => f.endsWith('.stl')), `${written.length} files ${await stopmoError()}`);
+      const folder = await page.evaluate(() => (window.studio.panels.stopmo.exported || {}).folder);
+      if (folder) exportedWithMagnets(folder, written);
       await page.waitForTimeout(300);
       await page.screenshot({ path: join(shots, 'stopmo-library.png') });
       // Without printable solids: the same library, surfaces only, sooner.

@@ -80,6 +80,12 @@ def test_stopmo_run_matches_the_module():
     scene, obj = face()
     s = scene.toonkit_stopmo
     s.count, s.pieces, s.restarts, s.seed = "EACH", PIECES, 2, 1
+    # Printed as a studio mounts it: a 3x2 mm disc magnet (3.5 mm walls: where a part hardly
+    # moves it is as thick as its wall, and the pocket needs 2.15 mm and 1 mm in front of
+    # it), STL and library.3mf.
+    s.magnets, s.magnet_diameter_mm, s.magnet_height_mm = True, 3.0, 2.0
+    s.thickness_mm = 3.5
+    s.print_format = "stl,3mf"
     folder = os.path.join(OUT, "stopmo")
     r = bpy.ops.toonkit.stopmo_run(directory=folder)
     check(r == {"FINISHED"}, f"stopmo_run returned {r}")
@@ -92,6 +98,7 @@ def test_stopmo_run_matches_the_module():
                              parts=parts, **stopmo.options(s))
     same_as(folder, ref, os.path.join(OUT, "module"))
     shows_assembly(scene, folder, ref)
+    printed_with_magnets(folder)
     check(bpy.data.images.get("toonkit error curve") is not None or s.count == "EACH",
           "no size-vs-error image")
     # The job's warnings reach the user (the operator reports them) and stay with the result.
@@ -102,6 +109,36 @@ def test_stopmo_run_matches_the_module():
     check(any("cross the solid" in w for w in warnings) == any(
         p["shell"]["self_intersecting_triangles"] > 0 for p in ref.report["printing"]["parts"]),
         f"crossing warning vs report: {warnings}")
+
+
+def printed_with_magnets(folder):
+    """The panel's magnet and 3MF reached the files: report.json lists the magnet, a pocket
+    per part and every piece with a pocket and a plate; each part's mount is a whole binary
+    STL; library.3mf holds one object per piece, named by its ID, in millimetres."""
+    import struct
+    import xml.etree.ElementTree as ET
+    import zipfile
+
+    printing = json.load(open(os.path.join(folder, "report.json")))["printing"]
+    check(printing["magnet"] == {"diameter_mm": 3.0, "height_mm": 2.0},
+          f"magnet {printing['magnet']}")
+    check(printing["print_format"] == "stl,3mf", f"print format {printing['print_format']}")
+    pieces = printing["pieces"]
+    check(pieces and all(p["magnet"] and p["plate"] >= 1 and p["volume_mm3"] > 0
+                         for p in pieces), f"pieces {pieces}")
+    for part in printing["parts"]:
+        check(part["magnet_pocket"] is not None, f"part {part['name']}: no pocket")
+        with open(os.path.join(folder, "pieces", f"{part['name']}_back.stl"), "rb") as fh:
+            stl = fh.read()
+        n = struct.unpack_from("<I", stl, 80)[0]
+        check(n > 0 and len(stl) == 84 + 50 * n, f"mount {part['name']}: {len(stl)} bytes")
+    with zipfile.ZipFile(os.path.join(folder, "library.3mf")) as z:
+        model = ET.fromstring(z.read("3D/3dmodel.model"))
+    ns = {"m": model.tag[1:].split("}")[0]}
+    names = sorted(o.get("name") for o in model.iterfind("m:resources/m:object", ns))
+    check(model.get("unit") == "millimeter", f"unit {model.get('unit')}")
+    check(names == sorted(p["id"] for p in pieces), f"3MF objects {names}")
+    print(f"  magnets: {len(pieces)} pieces with pockets on {len(printing['plates'])} plate(s)")
 
 
 def shows_assembly(scene, folder, ref):

@@ -99,23 +99,31 @@ def test_solids_that_cross_as_built_are_regularized(face, tmp_path):
 
 
 def test_magnets_clearance_and_3mf_are_the_cli_flags(face, tmp_path):
-    """``magnets``, ``clearance_mm``, ``print_format`` and ``plate_mm`` are ``--magnets``,
-    ``--clearance``, ``--print-format`` and ``--plate``: the same pieces, pockets and plates."""
+    """``magnets``, ``clearance_mm``, ``print_format``, ``plate_mm``, ``min_wall_mm`` and
+    ``min_feature_mm`` are ``--magnets``, ``--clearance``, ``--print-format``, ``--plate``,
+    ``--min-wall`` and ``--min-feature``: the same pieces, pockets, plates and printability
+    (a printer that forms nothing under 0.5 mm warns about the IDs' 0.4 mm relief)."""
     cli = tmp_path / "cli"
     run_cli("stopmo", "run", asset(FACE), "-o", cli, "--fps", "2",
             "--part", "upper=point:0,10,13", "--part", "lower=point:0,-14,10",
             "--pieces", "2", "--restarts", "1", "--magnets", "3x2", "--clearance", "0.2",
-            "--print-format", "stl,3mf", "--plate", "80x60")
+            "--print-format", "stl,3mf", "--plate", "80x60", "--min-wall", "0.9",
+            "--min-feature", "0.5")
     lib = toonkit.stopmo.run(face, parts=PARTS, pieces=2, restarts=1, magnets="3x2",
-                             clearance_mm=0.2, print_format="stl,3mf", plate_mm=(80, 60))
+                             clearance_mm=0.2, print_format="stl,3mf", plate_mm=(80, 60),
+                             min_wall_mm=0.9, min_feature_mm=0.5)
     py = tmp_path / "py"
     lib.save(py)
     ours = json.loads((py / "report.json").read_text())["printing"]
     theirs = json.loads((cli / "report.json").read_text())["printing"]
     assert ours["magnet"] == {"diameter_mm": 3.0, "height_mm": 2.0}
     assert ours["clearance_mm"] == 0.2
-    for key in ("magnet", "clearance_mm", "plates", "pieces", "print_format"):
+    for key in ("magnet", "clearance_mm", "plates", "pieces", "print_format", "printability"):
         assert ours[key] == theirs[key], key
+    assert ours["printability"]["min_wall_mm"] == 0.9
+    assert ours["printability"]["min_feature_mm"] == 0.5
+    relief = [w for w in lib.report["warnings"] if "embossed ID relief" in w and "--no-ids" in w]
+    assert len(relief) == 2, lib.report["warnings"]
     assert [p["magnet_pocket"] for p in ours["parts"]] == [
         p["magnet_pocket"] for p in theirs["parts"]]
     assert all(p["magnet_pocket"]["cover_mm"] >= 1.0 for p in ours["parts"])

@@ -272,6 +272,15 @@ pub struct LibraryOptionsArgs {
     /// Build plate WIDTHxDEPTH in millimetres where library.3mf lays the pieces out.
     #[arg(long, value_name = "WxD", default_value = "120x68")]
     pub plate: String,
+    /// The printer's thinnest wall in millimetres: thinner walls of a piece or mount are
+    /// reported (a warning naming the pieces and the fix, report.json
+    /// "printing.printability"); magnet pockets keep at least this much material around.
+    #[arg(long, value_name = "MM", default_value_t = crate::DEFAULT_MIN_WALL_MM)]
+    pub min_wall: f64,
+    /// The printer's smallest free-standing feature in millimetres: smaller embossed IDs,
+    /// keys or plug pins are reported.
+    #[arg(long, value_name = "MM", default_value_t = crate::DEFAULT_MIN_FEATURE_MM)]
+    pub min_feature: f64,
     /// Printer resolution in millimetres: pieces that differ from a sibling by less are
     /// reported (a warning and report.json "printing.parts[].below_resolution").
     #[arg(long, value_name = "MM", default_value_t = crate::DEFAULT_RESOLUTION_MM)]
@@ -332,6 +341,14 @@ impl LibraryOptionsArgs {
             );
         };
         let plate_mm = parse_plate(&self.plate)?;
+        for (flag, v) in [
+            ("--min-wall", self.min_wall),
+            ("--min-feature", self.min_feature),
+        ] {
+            if !(v.is_finite() && (0.0..=10.0).contains(&v)) {
+                bail!("{flag} must be between 0 and 10 millimetres, got {v}");
+            }
+        }
         let saliency = match &self.saliency {
             Some(p) => Some(read_saliency(p)?),
             None => None,
@@ -371,6 +388,8 @@ impl LibraryOptionsArgs {
             clearance_mm: self.clearance,
             print_format,
             plate_mm,
+            min_wall_mm: self.min_wall,
+            min_feature_mm: self.min_feature,
             print: !self.no_print,
         })
     }

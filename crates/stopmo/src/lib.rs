@@ -114,3 +114,7 @@ pub use job::{
     PrintReport, PrintTime, Result, RunOptions, SegmentJobOptions, SegmentSummary, Segmented,
     SizeCurve, SizePoint, DEFAULT_PIECES, DEFAULT_RESOLUTION_MM,
 };
+pub use job::{
+    PrintabilityReport, SolidPrintability, Thin, ThinSpot, DEFAULT_MIN_FEATURE_MM,
+    DEFAULT_MIN_WALL_MM,
+};

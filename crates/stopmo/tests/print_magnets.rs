@@ -112,6 +112,140 @@ fn magnet_pockets_take_the_magnet_from_every_piece_and_the_3mf_holds_them_all() 
     }
     let bytes = held.library_3mf.as_ref().unwrap();
     assert_eq!(&bytes[..2], b"PK");
+    sheet_and_report_list_every_piece(&held);
+    // A normal setting (1.5 mm walls, a 3×2 mm magnet at 60 mm) is printable: every piece
+    // and mount is measured, nothing is under the printer's minimums and nothing warns.
+    let checked = &printing.printability;
+    assert_eq!(checked.min_wall_mm, stopmo::DEFAULT_MIN_WALL_MM);
+    assert_eq!(checked.min_feature_mm, stopmo::DEFAULT_MIN_FEATURE_MM);
+    assert_eq!(checked.solids.len(), held.pieces.len() + held.mounts.len());
+    for c in &checked.solids {
+        assert!(c.thinnest_wall_mm >= 0.8, "{c:?}");
+        assert_eq!(c.smallest_feature_mm.is_some(), !c.mount, "{c:?}");
+    }
+    assert!(
+        checked.under_minimum.is_empty(),
+        "{:?}",
+        checked.under_minimum
+    );
+    let thin: Vec<&String> = held
+        .report
+        .warnings
+        .iter()
+        .filter(|w| w.contains("printer's minimum"))
+        .collect();
+    assert!(thin.is_empty(), "{thin:?}");
+}
+
+/// `report.json` and `assembly.md` as written: every piece with its ID, part, frames used,
+/// volume, magnet and plate, as the job measured them.
+fn sheet_and_report_list_every_piece(held: &stopmo::LibraryResult) {
+    let files = held.files().unwrap();
+    let text = |name: &str| match &files.iter().find(|f| f.path == name).unwrap().data {
+        stopmo::FileData::Text(t) => t.clone(),
+        _ => panic!("{name} is not text"),
+    };
+    let report: serde_json::Value = serde_json::from_str(&text("report.json")).unwrap();
+    let sheet = text("assembly.md");
+    let listed = report["printing"]["pieces"].as_array().unwrap();
+    assert_eq!(listed.len(), held.pieces.len());
+    let labels = &held.library.parts;
+    for (entry, piece) in listed.iter().zip(&held.pieces) {
+        let solid = piece.solid.as_ref().unwrap();
+        assert_eq!(entry["id"], piece.id.as_str());
+        assert_eq!(entry["part"], labels[piece.part].name.as_str());
+        let label = stopmo::piece_label(piece.part, piece.index);
+        assert_eq!(entry["label"], label.as_str());
+        let frames: Vec<usize> = labels[piece.part]
+            .solution
+            .labels
+            .iter()
+            .enumerate()
+            .filter(|(_, &l)| l as usize == piece.index)
+            .map(|(f, _)| f)
+            .collect();
+        let written: Vec<usize> = entry["frames"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f.as_u64().unwrap() as usize)
+            .collect();
+        assert_eq!(written, frames, "{}", piece.id);
+        let v = entry["volume_mm3"].as_f64().unwrap();
+        assert!((v - volume(solid)).abs() <= 1e-6 * v, "{}: {v}", piece.id);
+        assert_eq!(entry["magnet"], true);
+        let plate = entry["plate"].as_u64().expect("a plate");
+        let on = report["printing"]["plates"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["plate"] == plate)
+            .unwrap();
+        assert!(on["pieces"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|x| x == piece.id.as_str()));
+        // The sheet's row: piece, ID, part, frames, volume, magnet, plate.
+        let row = format!(
+            "| {} | {label} | {} | {} | {v:.1} | yes | {plate} |",
+            piece.id,
+            labels[piece.part].name,
+            frames.len()
+        );
+        assert!(sheet.contains(&row), "{row} not in the sheet:\n{sheet}");
+    }
+}
+
+/// Walls and features under the printer's minimums warn, in `report.json` and on the
+/// assembly sheet, naming the part, the pieces and the fix: 0.5 mm walls against the
+/// default 0.8 mm, and a printer that forms nothing under 0.5 mm against the 0.4 mm relief
+/// of the embossed IDs.
+#[test]
+fn thin_walls_and_features_warn_naming_the_pieces_and_the_fix() {
+    let anim = common::face(0.5);
+    let mut opts = options(README, None);
+    opts.library.thickness_mm = 0.5;
+    opts.library.min_feature_mm = 0.5;
+    opts.library.print_format = PrintFormat::Stl;
+    let thin = stopmo::run(&anim, &opts).unwrap();
+    let checked = &thin.report.printing.as_ref().unwrap().printability;
+    assert_eq!(checked.solids.len(), thin.pieces.len());
+    for piece in &thin.pieces {
+        let c = checked.solids.iter().find(|c| c.id == piece.id).unwrap();
+        assert!(c.thinnest_wall_mm < 0.8, "{c:?}");
+        assert!(checked
+            .under_minimum
+            .iter()
+            .any(|t| t.id == piece.id && t.what == stopmo::Thin::FrontToBack));
+        assert!(checked
+            .under_minimum
+            .iter()
+            .any(|t| t.id == piece.id && t.what == stopmo::Thin::IdRelief && t.mm == 0.4));
+    }
+    let warned = |what: &str, fix: &str| -> Vec<&String> {
+        thin.report
+            .warnings
+            .iter()
+            .filter(|w| w.contains(what) && w.contains(fix) && w.contains("printer's minimum"))
+            .collect()
+    };
+    let walls = warned(
+        "wall between front and back",
+        "give --thickness 0.8 or more",
+    );
+    let ids = warned("embossed ID relief", "--no-ids");
+    assert_eq!(walls.len(), 2, "{:?}", thin.report.warnings);
+    assert_eq!(ids.len(), 2, "{:?}", thin.report.warnings);
+    for part in ["upper", "lower"] {
+        assert!(walls
+            .iter()
+            .any(|w| w.starts_with(&format!("part {part}:")) && w.contains(&format!("{part}_0"))));
+    }
+    let sheet = thin.assembly_markdown();
+    for w in walls.iter().chain(&ids) {
+        assert!(sheet.contains(w.as_str()), "{w} not on the sheet");
+    }
 }
 
 /// A cut the printing was not tuned on (the seam through the eyes: its solids cross as

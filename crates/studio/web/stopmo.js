@@ -238,6 +238,12 @@ export class StopmoPanel {
     if (clearance) opts.clearance_mm = Number(clearance);
     const plate = $('stopmo-plate').value.trim();
     if (plate) opts.plate_mm = plate.split(/x/i).map(Number);
+    const thickness = $('stopmo-thickness').value.trim();
+    if (thickness) opts.thickness_mm = Number(thickness);
+    const minWall = $('stopmo-min-wall').value.trim();
+    if (minWall) opts.min_wall_mm = Number(minWall);
+    const minFeature = $('stopmo-min-feature').value.trim();
+    if (minFeature) opts.min_feature_mm = Number(minFeature);
     return opts;
   }
 

@@ -105,8 +105,11 @@ def library(
     crate's ``LibraryJobOptions`` (``restarts``, ``seed``, ``method``, ``print_height_mm``,
     ``plugs``, ...); printing: ``magnets="3x2"`` (a disc magnet, mm: a pocket in every piece
     and the part's mount), ``clearance_mm`` (fits; default 3 x the printer resolution),
-    ``print_format="stl"|"3mf"|"stl,3mf"`` and ``plate_mm=(w, d)`` (``library.3mf``'s build
-    plates), as the CLI's ``--magnets``, ``--clearance``, ``--print-format``, ``--plate``. Returns a :class:`Library` with ``.labels`` ``(frames, parts)``,
+    ``print_format="stl"|"3mf"|"stl,3mf"``, ``plate_mm=(w, d)`` (``library.3mf``'s build
+    plates), ``min_wall_mm`` and ``min_feature_mm`` (the printer's minimums, default 0.8 and
+    0.3: thinner walls and features are warned about), as the CLI's ``--magnets``,
+    ``--clearance``, ``--print-format``, ``--plate``, ``--min-wall``, ``--min-feature``.
+    Returns a :class:`Library` with ``.labels`` ``(frames, parts)``,
     ``.pieces``, ``.assembly``, ``.report`` and ``.save(dir)`` (the CLI's layout).
     """
     opts = _library_options(pieces, options)

@@ -334,6 +334,8 @@ pub(super) fn finish(
                 clearance_mm: opts.clearance(),
                 plate_mm: opts.plate_mm,
                 print_format: opts.print_format,
+                min_wall_mm: opts.min_wall_mm,
+                min_feature_mm: opts.min_feature_mm,
             },
         )?
     } else {
@@ -438,6 +440,17 @@ fn check_print_options(opts: &LibraryJobOptions) -> Result<()> {
             "clearance_mm",
             format!("must be between 0 and 5 millimetres, got {c}"),
         ));
+    }
+    for (name, v) in [
+        ("min_wall_mm", opts.min_wall_mm),
+        ("min_feature_mm", opts.min_feature_mm),
+    ] {
+        if !(v.is_finite() && (0.0..=10.0).contains(&v)) {
+            return Err(Error::option_error(
+                name,
+                format!("the printer's minimum must be 0 to 10 millimetres, got {v}"),
+            ));
+        }
     }
     if !opts
         .plate_mm

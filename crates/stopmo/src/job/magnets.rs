@@ -28,11 +28,13 @@ impl MagnetPlan {
     pub(crate) fn new(m: &MagnetOptions, s: &PrintSettings<'_>) -> MagnetPlan {
         let c = s.clearance_mm;
         let depth = m.height_mm + c;
+        // The printer's minimum wall when it asks for more than the magnet's own.
+        let wall = MIN_MAGNET_WALL_MM.max(s.min_wall_mm);
         MagnetPlan {
             radius_mm: (m.diameter_mm / 2.0 + c) as f32,
             depth_mm: depth as f32,
-            wall_mm: MIN_MAGNET_WALL_MM as f32,
-            mount_mm: (depth + MIN_MAGNET_WALL_MM).max(s.thickness_mm) as f32,
+            wall_mm: wall as f32,
+            mount_mm: (depth + wall).max(s.thickness_mm) as f32,
         }
     }
 }
@@ -105,18 +107,13 @@ pub(crate) fn cut_mount(
         ));
     }
     if s.ids {
-        // The ID is raised on the back of every piece at the same place (the label's
-        // extent bounds a recess; the labels of one part have the same length).
-        let (centre, right, up) = shell.id_frame(id_keys);
-        let pixel = (s.print_height_mm * 0.02).clamp(0.3, 1.0) as f32;
-        let (w, h) = render::text_size("0-00", 1);
-        let half = Vec3::new(w as f32, h as f32, 0.0) * pixel / 2.0;
+        let r = id_recess(shell, id_keys, pocket, keys, s);
         cutters.push(cylinder(
-            centre,
-            right.cross(up),
-            half.truncate().length() + c,
+            r.centre,
+            r.axis,
+            r.radius_mm,
             margin,
-            DEFAULT_ID_RELIEF_MM as f32 + c,
+            r.depth_mm,
             DEFAULT_POCKET_SEGMENTS / 2,
         ));
     }
@@ -129,6 +126,103 @@ pub(crate) fn cut_mount(
         ));
     }
     Ok(cut.mesh)
+}
+
+/// The mount's recess for the ID raised on the back of every piece.
+pub(crate) struct IdRecess {
+    /// Centre on the back surface.
+    pub(crate) centre: Vec3,
+    /// Direction it is cut (into the mount).
+    pub(crate) axis: Vec3,
+    /// Radius: the label's half diagonal plus the clearance.
+    pub(crate) radius_mm: f32,
+    /// Depth: the ID's relief plus the clearance.
+    pub(crate) depth_mm: f32,
+}
+
+/// Where the ID sits on the back of every piece of the part: the same place in all of them
+/// (the label's extent bounds a recess; the labels of one part have the same length). A
+/// recess that would leave a sliver thinner than the printer's minimum wall beside the
+/// magnet pocket or a key socket is widened into it instead (a wider recess still fits).
+pub(crate) fn id_recess(
+    shell: &PartShell,
+    id_keys: &[Key],
+    pocket: &Pocket,
+    keys: &[Key],
+    s: &PrintSettings<'_>,
+) -> IdRecess {
+    let c = s.clearance_mm as f32;
+    let (centre, right, up) = shell.id_frame(id_keys);
+    let axis = right.cross(up);
+    let pixel = super::printability::id_pixel_mm(s.print_height_mm) as f32;
+    let (w, h) = render::text_size("0-00", 1);
+    let half = Vec3::new(w as f32, h as f32, 0.0) * pixel / 2.0;
+    let mut radius = half.truncate().length() + c;
+    // The other cuts, as [`cut_mount`] cuts them.
+    let others: Vec<Cut> = std::iter::once(Cut {
+        at: Vec3::from_array(pocket.center),
+        axis: Vec3::from_array(pocket.axis),
+        radius: pocket.radius_mm,
+    })
+    .chain(keys.iter().map(|k| Cut {
+        at: Vec3::from_array(k.center),
+        axis: Vec3::from_array(k.direction),
+        radius: k.radius_mm + c,
+    }))
+    .collect();
+    let min_wall = s.min_wall_mm as f32;
+    for _ in 0..others.len() {
+        let sliver = others
+            .iter()
+            .map(|o| {
+                let recess = Cut {
+                    at: centre,
+                    axis,
+                    radius,
+                };
+                recess.gap(o)
+            })
+            .filter(|&gap| gap > 0.0 && gap < min_wall)
+            .fold(0.0f32, f32::max);
+        if sliver == 0.0 {
+            break;
+        }
+        radius += sliver + 0.01;
+    }
+    IdRecess {
+        centre,
+        axis,
+        radius_mm: radius,
+        depth_mm: DEFAULT_ID_RELIEF_MM as f32 + c,
+    }
+}
+
+/// Distance of `p` from the axis through `at` along `axis`.
+pub(crate) fn lateral_distance(at: Vec3, axis: Vec3, p: Vec3) -> f32 {
+    let n = axis.normalize_or_zero();
+    let d = p - at;
+    (d - n * d.dot(n)).length()
+}
+
+/// A cylindrical cut into a mount (pocket, key socket, ID recess).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Cut {
+    /// Centre on the back surface.
+    pub(crate) at: Vec3,
+    /// Its axis.
+    pub(crate) axis: Vec3,
+    /// Its radius.
+    pub(crate) radius: f32,
+}
+
+impl Cut {
+    /// Material between two cuts (negative where they overlap): the nearer of the two centres'
+    /// distances from the other's axis, less both radii.
+    pub(crate) fn gap(&self, other: &Cut) -> f32 {
+        let apart = lateral_distance(self.at, self.axis, other.at)
+            .min(lateral_distance(other.at, other.axis, self.at));
+        apart - self.radius - other.radius
+    }
 }
 
 /// Several meshes as one (their shells side by side).

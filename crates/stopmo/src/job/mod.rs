@@ -10,6 +10,7 @@ mod options;
 mod piece;
 mod plates;
 mod print;
+mod printability;
 mod report;
 mod result;
 mod segment_job;
@@ -28,6 +29,10 @@ pub use options::{
 pub use plates::Plate;
 pub use print::{
     piece_label, PartPrintReport, Piece, PieceReport, PrintReport, PrintTime, DEFAULT_RESOLUTION_MM,
+};
+pub use printability::{
+    PrintabilityReport, SolidPrintability, Thin, ThinSpot, DEFAULT_MIN_FEATURE_MM,
+    DEFAULT_MIN_WALL_MM,
 };
 pub use report::{LibraryReport, OrderReport, PartReport, PlugReport};
 pub use result::LibraryResult;

@@ -11,6 +11,8 @@ use crate::library::{
 };
 use crate::segment::{PartSpec, SavedSegmentation, SegmentOptions};
 
+use super::printability::{DEFAULT_MIN_FEATURE_MM, DEFAULT_MIN_WALL_MM};
+
 /// Clearance of printed fits per millimetre of printer resolution: 0.15 mm at the default
 /// 0.05 mm, the tight fit a resin printer holds (±0.15 mm; ≥ 0.3 mm gives a loose fit).
 pub const CLEARANCE_PER_RESOLUTION: f64 = 3.0;
@@ -174,6 +176,13 @@ pub struct LibraryJobOptions {
     pub print_format: PrintFormat,
     /// Build plate width and depth (millimetres) where `library.3mf` lays the pieces out.
     pub plate_mm: [f64; 2],
+    /// The printer's thinnest wall (millimetres): thinner walls of a piece or mount are
+    /// reported (a warning and `printing.printability`), and magnet pockets keep at least
+    /// this much material around them.
+    pub min_wall_mm: f64,
+    /// The printer's smallest free-standing feature (millimetres): smaller IDs, keys or plug
+    /// pins are reported.
+    pub min_feature_mm: f64,
     /// Build the printable solids (`pieces/*.stl`, the back surfaces, keys, IDs and the
     /// report's `"printing"`). Off, the job stops at the pieces' surfaces, the labels and the
     /// errors — a quick look at a library size before printing it (on the face, the solids
@@ -201,6 +210,8 @@ impl Default for LibraryJobOptions {
             clearance_mm: None,
             print_format: PrintFormat::Stl,
             plate_mm: DEFAULT_PLATE_MM,
+            min_wall_mm: DEFAULT_MIN_WALL_MM,
+            min_feature_mm: DEFAULT_MIN_FEATURE_MM,
             print: true,
         }
     }
@@ -245,6 +256,10 @@ pub(crate) struct PrintSettings<'a> {
     pub(crate) plate_mm: [f64; 2],
     /// Files of the solids.
     pub(crate) print_format: PrintFormat,
+    /// The printer's thinnest wall (mm).
+    pub(crate) min_wall_mm: f64,
+    /// The printer's smallest free-standing feature (mm).
+    pub(crate) min_feature_mm: f64,
     /// Printed back surfaces by part name (see [`crate::LibraryJobOptions::backs`]).
     pub(crate) backs: &'a BTreeMap<String, Vec<Vec3>>,
 }

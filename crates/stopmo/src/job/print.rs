@@ -15,6 +15,7 @@ use super::magnets::{cut_mount, cut_piece_pocket, find_pocket, MagnetPlan};
 pub(crate) use super::options::PrintSettings;
 pub use super::options::DEFAULT_RESOLUTION_MM;
 pub use super::piece::Piece;
+use super::printability::{measure_part, printability, PartGeometry, PrintabilityReport};
 use crate::library::{
     add_plugs, build_shells, material, piece_id, regularize, self_intersecting_triangles, volume,
     Bitmap, Key, KeyOptions, Library, MagnetOptions, MaterialEstimate, PartShell, Pocket,
@@ -150,6 +151,9 @@ pub struct PrintReport {
     pub parts: Vec<PartPrintReport>,
     /// Per piece: ID, part, frames used, volume, magnet, plate.
     pub pieces: Vec<PieceReport>,
+    /// Thinnest wall and smallest feature of every piece and mount against the printer's
+    /// minimums.
+    pub printability: PrintabilityReport,
 }
 
 /// One piece as [`print_pieces`] made it.
@@ -199,6 +203,7 @@ pub(crate) fn print_pieces(
     let mut warnings = Vec::new();
     let mut pieces_out: Vec<Piece> = Vec::new();
     let mut mounts_out: Vec<Mesh> = Vec::new();
+    let mut measured = Vec::new();
     // One back surface per part, seam walls shared between the parts that meet.
     let averages: Vec<Vec<Vec3>> = anims
         .iter()
@@ -278,6 +283,18 @@ pub(crate) fn print_pieces(
         if let (Some(mount), Some(q)) = (mount, &pocket) {
             mounts_out.push(cut_mount(&shell, &mount, q, &keys, &id_keys, s)?);
         }
+        measured.push(measure_part(
+            &PartGeometry {
+                part: p,
+                name: &part.name,
+                shell: &shell,
+                pieces: &refs,
+                keys: &keys,
+                pocket: pocket.as_ref(),
+                id_keys: &id_keys,
+            },
+            s,
+        ));
         let made: Vec<Made> = (0..pieces_mm.len())
             .into_par_iter()
             .map(|k| -> Result<Made> {
@@ -442,6 +459,8 @@ pub(crate) fn print_pieces(
     }
     // The solids are measured where they are (a piece's solid is ~30k triangles).
     let solids: Vec<&Mesh> = pieces_out.iter().filter_map(|p| p.solid.as_ref()).collect();
+    let (checked, thin) = printability(measured, s);
+    warnings.extend(thin);
     let report = PrintReport {
         material: material(solids.iter().copied()),
         print_time: print_time(&solids, s.plate_mm),
@@ -454,6 +473,7 @@ pub(crate) fn print_pieces(
         plates: Vec::new(),
         parts: parts_report,
         pieces: piece_reports(lib, &pieces_out, s.magnet.is_some()),
+        printability: checked,
     };
     Ok(Printed {
         pieces: pieces_out,

@@ -111,21 +111,39 @@ impl LibraryResult {
                 plate.pieces.join(", ")
             );
         }
+        let checked = &p.printability;
         let _ = writeln!(
             md,
-            "\n| piece | ID | part | frames | volume (mm³) | magnet | plate |\n|---|---|---|---|---|---|---|"
+            "\nThe printer's minimums: walls {} mm, free-standing features {} mm.",
+            checked.min_wall_mm, checked.min_feature_mm
         );
+        let _ = writeln!(
+            md,
+            "\n| piece | ID | part | frames | volume (mm³) | magnet | plate | thinnest wall (mm) | smallest feature (mm) |\n|---|---|---|---|---|---|---|---|---|"
+        );
+        let fit = |id: &str| checked.solids.iter().find(|c| c.id == id);
         for q in &p.pieces {
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {} | {:.1} | {} | {} |",
+                "| {} | {} | {} | {} | {:.1} | {} | {} | {} | {} |",
                 q.id,
                 q.label,
                 q.part,
                 q.frames.len(),
                 q.volume_mm3,
                 if q.magnet { "yes" } else { "no" },
-                q.plate.map_or("–".to_string(), |k| k.to_string())
+                q.plate.map_or("–".to_string(), |k| k.to_string()),
+                fit(&q.id).map_or("–".into(), |c| format!("{:.2}", c.thinnest_wall_mm)),
+                fit(&q.id)
+                    .and_then(|c| c.smallest_feature_mm)
+                    .map_or("–".into(), |f| format!("{f:.2}"))
+            );
+        }
+        for c in checked.solids.iter().filter(|c| c.mount) {
+            let _ = writeln!(
+                md,
+                "\nMount pieces/{}.stl (part {}): thinnest wall {:.2} mm.",
+                c.id, c.part, c.thinnest_wall_mm
             );
         }
         for w in &self.report.warnings {

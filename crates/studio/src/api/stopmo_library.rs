@@ -58,6 +58,17 @@ pub(crate) struct BuildRequest {
     /// Build plate of `library.3mf` (millimetres).
     #[serde(default = "default_plate")]
     plate_mm: [f64; 2],
+    /// Wall thickness of the pieces in millimetres (default
+    /// `stopmo::library::DEFAULT_THICKNESS_MM`): a magnet pocket needs its depth and a wall.
+    #[serde(default)]
+    thickness_mm: Option<f64>,
+    /// The printer's thinnest wall in millimetres (default `stopmo::DEFAULT_MIN_WALL_MM`).
+    #[serde(default)]
+    min_wall_mm: Option<f64>,
+    /// The printer's smallest free-standing feature in millimetres (default
+    /// `stopmo::DEFAULT_MIN_FEATURE_MM`).
+    #[serde(default)]
+    min_feature_mm: Option<f64>,
 }
 
 fn default_plate() -> [f64; 2] {
@@ -135,7 +146,8 @@ pub(crate) async fn curve(
 }
 
 /// `POST /api/stopmo/build` (`{"pieces", "print"?, "magnets"?: "DxH", "clearance_mm"?,
-/// "print_format"?: "stl"|"3mf"|"stl,3mf", "plate_mm"?: [w, d]}`): `{"job": id}`; the result is
+/// "print_format"?: "stl"|"3mf"|"stl,3mf", "plate_mm"?: [w, d], "thickness_mm"?, "min_wall_mm"?,
+/// "min_feature_mm"?}`): `{"job": id}`; the result is
 /// `{"pieces", "parts", "frame_ids" (per frame, the piece id of every part), "errors_mm",
 /// "total_pieces", "printed", "warnings"}`.
 pub(crate) async fn build(
@@ -174,6 +186,11 @@ pub(crate) async fn build(
             clearance_mm: r.clearance_mm,
             print_format: r.print_format,
             plate_mm: r.plate_mm,
+            thickness_mm: r
+                .thickness_mm
+                .unwrap_or(stopmo::library::DEFAULT_THICKNESS_MM),
+            min_wall_mm: r.min_wall_mm.unwrap_or(stopmo::DEFAULT_MIN_WALL_MM),
+            min_feature_mm: r.min_feature_mm.unwrap_or(stopmo::DEFAULT_MIN_FEATURE_MM),
             ..LibraryJobOptions::default()
         };
         let result =
