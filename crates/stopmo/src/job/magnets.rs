@@ -154,7 +154,7 @@ pub(crate) fn id_recess(
     let c = s.clearance_mm as f32;
     let (centre, right, up) = shell.id_frame(id_keys);
     let axis = right.cross(up);
-    let pixel = super::printability::id_pixel_mm(s.print_height_mm) as f32;
+    let pixel = id_pixel_mm(s.print_height_mm) as f32;
     let (w, h) = render::text_size("0-00", 1);
     let half = Vec3::new(w as f32, h as f32, 0.0) * pixel / 2.0;
     let mut radius = half.truncate().length() + c;
@@ -235,4 +235,9 @@ fn concat(meshes: &[Mesh]) -> Mesh {
         triangles.extend(m.triangles.iter().map(|t| t.map(|i| i + base)));
     }
     Mesh::new("cutters", positions, triangles)
+}
+
+/// Width of one pixel of the embossed ID (mm): 2 % of the print height, 0.3–1 mm.
+pub(crate) fn id_pixel_mm(print_height_mm: f64) -> f64 {
+    (print_height_mm * 0.02).clamp(0.3, 1.0)
 }

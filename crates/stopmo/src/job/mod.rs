@@ -23,17 +23,14 @@ pub use files::{save_files, FileData, OutputFile};
 pub use library_job::{file_safe_name, library, run};
 pub use options::{
     default_clearance_mm, LibraryJobOptions, PieceCount, PrintFormat, RunOptions,
-    SegmentJobOptions, CLEARANCE_PER_RESOLUTION, DEFAULT_PIECES, DEFAULT_PLATE_MM,
-    MAX_DEFAULT_CLEARANCE_MM,
+    SegmentJobOptions, CLEARANCE_PER_RESOLUTION, DEFAULT_MIN_FEATURE_MM, DEFAULT_MIN_WALL_MM,
+    DEFAULT_PIECES, DEFAULT_PLATE_MM, MAX_DEFAULT_CLEARANCE_MM,
 };
 pub use plates::Plate;
 pub use print::{
     piece_label, PartPrintReport, Piece, PieceReport, PrintReport, PrintTime, DEFAULT_RESOLUTION_MM,
 };
-pub use printability::{
-    PrintabilityReport, SolidPrintability, Thin, ThinSpot, DEFAULT_MIN_FEATURE_MM,
-    DEFAULT_MIN_WALL_MM,
-};
+pub use printability::{PrintabilityReport, SolidPrintability, Thin, ThinSpot};
 pub use report::{LibraryReport, OrderReport, PartReport, PlugReport};
 pub use result::LibraryResult;
 pub use segment_job::{saved_segmentation, segment, PartSummary, SegmentSummary, Segmented};

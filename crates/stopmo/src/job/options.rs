@@ -11,8 +11,6 @@ use crate::library::{
 };
 use crate::segment::{PartSpec, SavedSegmentation, SegmentOptions};
 
-use super::printability::{DEFAULT_MIN_FEATURE_MM, DEFAULT_MIN_WALL_MM};
-
 /// Clearance of printed fits per millimetre of printer resolution: 0.15 mm at the default
 /// 0.05 mm, the tight fit a resin printer holds (±0.15 mm; ≥ 0.3 mm gives a loose fit).
 pub const CLEARANCE_PER_RESOLUTION: f64 = 3.0;
@@ -238,6 +236,13 @@ pub struct RunOptions {
 
 /// Printer resolution assumed when none is given (mm).
 pub const DEFAULT_RESOLUTION_MM: f64 = 0.05;
+
+/// Thinnest wall a resin or PolyJet printer holds (mm): 0.8–1 mm, the lower end.
+pub const DEFAULT_MIN_WALL_MM: f64 = 0.8;
+
+/// Smallest free-standing feature a resin or PolyJet printer forms (mm): 0.25–0.3 mm, the
+/// upper end.
+pub const DEFAULT_MIN_FEATURE_MM: f64 = 0.3;
 
 /// How the pieces are printed.
 pub(crate) struct PrintSettings<'a> {

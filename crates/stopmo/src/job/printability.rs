@@ -22,16 +22,9 @@ use glam::Vec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::magnets::{id_recess, lateral_distance as lateral, Cut, MagnetPlan};
+use super::magnets::{id_pixel_mm, id_recess, lateral_distance as lateral, Cut, MagnetPlan};
 use super::options::PrintSettings;
 use crate::library::{piece_id, Key, PartShell, Pocket, DEFAULT_ID_RELIEF_MM};
-
-/// Thinnest wall a resin or PolyJet printer holds (mm): 0.8–1 mm, the lower end.
-pub const DEFAULT_MIN_WALL_MM: f64 = 0.8;
-
-/// Smallest free-standing feature a resin or PolyJet printer forms (mm): 0.25–0.3 mm, the
-/// upper end.
-pub const DEFAULT_MIN_FEATURE_MM: f64 = 0.3;
 
 /// What a wall or feature measure is of.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
@@ -172,11 +165,6 @@ pub struct PrintabilityReport {
     pub solids: Vec<SolidPrintability>,
     /// Every wall and feature under the minimum.
     pub under_minimum: Vec<ThinSpot>,
-}
-
-/// Width of one pixel of the embossed ID (mm): 2 % of the print height, 0.3–1 mm.
-pub(crate) fn id_pixel_mm(print_height_mm: f64) -> f64 {
-    (print_height_mm * 0.02).clamp(0.3, 1.0)
 }
 
 /// What one solid was measured to be.
