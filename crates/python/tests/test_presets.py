@@ -6,6 +6,7 @@ every named preset on two characters."""
 from __future__ import annotations
 
 import inspect
+import re
 
 import numpy as np
 import pytest
@@ -79,10 +80,17 @@ def test_parameter_table_is_what_the_front_ends_default_to():
     for f in (toonkit.smear.offsets, toonkit.smear.prepare):
         assert inspect.signature(f).parameters["smooth"].default == table["smooth"]["default"]
     # The CLI's flag defaults.
-    help_text = " ".join(run_cli("smear", "elongate", "--help").stdout.split())
+    help_lines = run_cli("smear", "elongate", "--help").stdout.splitlines()
 
-    def shown(flag):  # the help of one flag: up to the next flag
-        return help_text.split(f"{flag} ", 1)[1].split(" --", 1)[0]
+    def shown(flag):  # the help of one flag: its line up to the next flag's line (a flag
+        # named inside a help text is on an indented continuation line, not a flag's line)
+        def is_flag_line(line):
+            return re.match(r"^ {1,6}(-\w, )?--[\w-]+", line) is not None
+        start = next(i for i, line in enumerate(help_lines)
+                     if is_flag_line(line) and re.search(rf"(^|[ ,]){flag}\b", line))
+        end = next((i for i in range(start + 1, len(help_lines)) if is_flag_line(help_lines[i])),
+                   len(help_lines))
+        return " ".join(" ".join(help_lines[start:end]).split())
 
     for flag, key in (("--beta-max", "beta_max"), ("--kappa", "kappa"), ("--smooth", "smooth")):
         assert f"[default: {table[key]['default']:g}]" in shown(flag), shown(flag)
