@@ -11,6 +11,7 @@
 //! * [`SpeedUnits`], [`SizeReference`], [`StyleUnits`]: a style's speeds and lengths are in
 //!   the character's own size by default (`docs/smear-units.md`).
 
+mod compiled;
 mod error;
 mod expr;
 mod function;
@@ -25,6 +26,7 @@ mod voronoi;
 mod warp;
 mod weights;
 
+pub use compiled::{CompiledEffects, CompiledLines};
 pub use error::StyleError;
 pub use expr::{Expression, StyleOps, EXPRESSION_INPUTS, MAX_EXPRESSION_VARIABLES};
 pub use function::{FunctionSpec, StyleFunction};
@@ -35,8 +37,8 @@ pub use preset::{
 };
 pub use stage::{apply_stages, Stage};
 pub use style::{
-    CompiledEffects, CompiledLines, ElongateStyle, LinesStyle, MultiplesStyle, ObjectEffects,
-    ObjectStyle, Style, DEFAULT_LINE_COUNT, DEFAULT_LINE_THICKNESS, DEFAULT_MULTIPLE_COLOR,
+    ElongateStyle, LinesStyle, MultiplesStyle, ObjectEffects, ObjectStyle, Style,
+    DEFAULT_LINE_COUNT, DEFAULT_LINE_THICKNESS, DEFAULT_MULTIPLE_COLOR,
 };
 pub use units::{SizeReference, SpeedUnits, StyleUnits};
 pub use voronoi::voronoi_f1;
