@@ -27,11 +27,12 @@ pub use options::{
     DEFAULT_PIECES, DEFAULT_PLATE_MM, MAX_DEFAULT_CLEARANCE_MM,
 };
 pub use plates::Plate;
-pub use print::{
-    piece_label, PartPrintReport, Piece, PieceReport, PrintReport, PrintTime, DEFAULT_RESOLUTION_MM,
-};
+pub use print::{piece_label, Piece, DEFAULT_RESOLUTION_MM};
 pub use printability::{PrintabilityReport, SolidPrintability, Thin, ThinSpot};
-pub use report::{LibraryReport, OrderReport, PartReport, PlugReport};
+pub use report::{
+    LibraryReport, OrderReport, PartPrintReport, PartReport, PieceReport, PlugReport, PrintReport,
+    PrintTime,
+};
 pub use result::LibraryResult;
 pub use segment_job::{saved_segmentation, segment, PartSummary, SegmentSummary, Segmented};
 pub use size_curve::{library_of, size_curve, SizeCurve, SizePoint};

@@ -8,18 +8,17 @@
 use anim::{Mesh, MeshAnimation};
 use glam::Vec3;
 use rayon::prelude::*;
-use serde::Serialize;
 
 use super::error::{Error, Result};
 use super::magnets::{cut_mount, cut_piece_pocket, find_pocket, MagnetPlan};
 pub(crate) use super::options::PrintSettings;
 pub use super::options::DEFAULT_RESOLUTION_MM;
 pub use super::piece::Piece;
-use super::printability::{measure_part, printability, PartGeometry, PrintabilityReport};
+use super::printability::{measure_part, printability, PartGeometry};
+use super::report::{PartPrintReport, PieceReport, PrintReport, PrintTime};
 use crate::library::{
     add_plugs, build_shells, material, piece_id, regularize, self_intersecting_triangles, volume,
-    Bitmap, Key, KeyOptions, Library, MagnetOptions, MaterialEstimate, PartShell, Pocket,
-    ShellInput, ShellOptions, ShellStats, DEFAULT_ID_RELIEF_MM,
+    Bitmap, Key, KeyOptions, Library, PartShell, ShellInput, ShellOptions, DEFAULT_ID_RELIEF_MM,
 };
 
 /// Resin layer height assumed by the print-time estimate (mm).
@@ -47,113 +46,6 @@ pub(crate) struct Printed {
     /// With magnets, every part's mount with the matching pocket and key sockets
     /// (`pieces/<part>_back.stl`).
     pub(crate) mounts: Vec<Mesh>,
-}
-
-/// One part in [`PrintReport`].
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct PartPrintReport {
-    /// Part name.
-    pub name: String,
-    /// Measurements of the part's shared back surface.
-    pub shell: ShellStats,
-    /// Registration keys on the back surface (empty without keys).
-    pub keys: Vec<Key>,
-    /// Pieces closer to a sibling than the printer resolution.
-    pub below_resolution: Vec<String>,
-    /// Smallest largest-vertex-distance between two pieces of the part (mm; `null` for one
-    /// piece).
-    pub min_sibling_distance_mm: f64,
-    /// Triangles of the pieces' animated surfaces (the library pieces alone, before the back
-    /// is added) that cross that same surface, summed over the pieces whose solid crosses:
-    /// where the input presses into itself inside one part (lips or lids on a face) or has
-    /// degenerate triangles. No back can undo these (the regularized solid merges the touching
-    /// surfaces); a seam between them (one in each part) or a mended input keeps them apart.
-    pub surface_self_intersecting_triangles: usize,
-    /// Triangles of the solids as built (front, back, walls, keys, ID) that cross the same
-    /// solid, summed over the pieces; those pieces were regularized
-    /// ([`regularize`](crate::library::regularize)) and `shell.self_intersecting_triangles`
-    /// counts what is left in the written solids.
-    pub built_self_intersecting_triangles: usize,
-    /// Pieces whose solid crossed itself as built and was regularized: the printed shape
-    /// differs from the animated surface where it crossed.
-    pub regularized_pieces: Vec<String>,
-    /// Volume of what regularizing dropped (mm³): chips of material apart from a piece and
-    /// sealed cavities inside it (filled).
-    pub dropped_volume_mm3: f64,
-    /// The magnet pocket every piece of the part has, and the mount has at the same place
-    /// (`null` without magnets).
-    pub magnet_pocket: Option<Pocket>,
-}
-
-/// The print-time estimate.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct PrintTime {
-    /// Estimated hours.
-    pub hours: f64,
-    /// Build plates needed.
-    pub plates: f64,
-    /// Layers per plate.
-    pub layers_per_plate: f64,
-    /// Layer height (mm).
-    pub layer_mm: f64,
-    /// Seconds per layer.
-    pub seconds_per_layer: f64,
-    /// Build plate (mm).
-    pub plate_mm: [f64; 2],
-    /// What the estimate assumes.
-    pub assumes: String,
-}
-
-/// One printed piece in [`PrintReport::pieces`]: what a print shop and an animator look up.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct PieceReport {
-    /// Identifier `<part>_<NN>` (file stem, 3MF object name).
-    pub id: String,
-    /// The ID embossed on its back (`P-NN`).
-    pub label: String,
-    /// Part name.
-    pub part: String,
-    /// Frames (0-based) the piece is on, in frame order.
-    pub frames: Vec<usize>,
-    /// Volume of its solid (mm³).
-    pub volume_mm3: f64,
-    /// Whether it has a magnet pocket (at its part's `magnet_pocket`).
-    pub magnet: bool,
-    /// Build plate of `library.3mf` it is on (1-based; `null` without a 3MF).
-    pub plate: Option<usize>,
-}
-
-/// `report.json` `"printing"`: material, print time, resolution check, keys and IDs.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct PrintReport {
-    /// Material of all solids.
-    pub material: MaterialEstimate,
-    /// Print-time estimate.
-    pub print_time: PrintTime,
-    /// Printer resolution checked against (mm).
-    pub resolution_mm: f64,
-    /// Whether registration keys were added.
-    pub keys: bool,
-    /// Whether IDs were embossed.
-    pub ids: bool,
-    /// Clearance of the fits (mm): magnet pockets are this much wider (radius) and deeper
-    /// than the magnet, the mount's key sockets and ID recess wider and deeper than the key
-    /// or ID; from `--clearance`, else 3 × the printer resolution.
-    pub clearance_mm: f64,
-    /// The disc magnet every piece holds (`null` without magnets).
-    pub magnet: Option<MagnetOptions>,
-    /// Files of the solids: `"stl"`, `"3mf"` or `"stl,3mf"`.
-    pub print_format: super::options::PrintFormat,
-    /// Build plates of `library.3mf` (empty without a 3MF): several plates are laid side by
-    /// side along x in its one build, each listed here with its origin and pieces.
-    pub plates: Vec<super::plates::Plate>,
-    /// Per part.
-    pub parts: Vec<PartPrintReport>,
-    /// Per piece: ID, part, frames used, volume, magnet, plate.
-    pub pieces: Vec<PieceReport>,
-    /// Thinnest wall and smallest feature of every piece and mount against the printer's
-    /// minimums.
-    pub printability: PrintabilityReport,
 }
 
 /// One piece as [`print_pieces`] made it.

@@ -2,8 +2,11 @@
 
 use serde::Serialize;
 
-use super::print::PrintReport;
-use crate::library::{ErrorSummary, Library, Method, Plug, ShootingOrder};
+use super::printability::PrintabilityReport;
+use crate::library::{
+    ErrorSummary, Key, Library, MagnetOptions, MaterialEstimate, Method, Plug, Pocket, ShellStats,
+    ShootingOrder,
+};
 
 /// One plug in the report (millimetres, print coordinates).
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -215,4 +218,111 @@ fn plug_report(p: &Plug, names: &[String]) -> PlugReport {
         length_mm: p.length_mm,
         seam_vertices: p.seam_vertices,
     }
+}
+
+/// One part in [`PrintReport`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PartPrintReport {
+    /// Part name.
+    pub name: String,
+    /// Measurements of the part's shared back surface.
+    pub shell: ShellStats,
+    /// Registration keys on the back surface (empty without keys).
+    pub keys: Vec<Key>,
+    /// Pieces closer to a sibling than the printer resolution.
+    pub below_resolution: Vec<String>,
+    /// Smallest largest-vertex-distance between two pieces of the part (mm; `null` for one
+    /// piece).
+    pub min_sibling_distance_mm: f64,
+    /// Triangles of the pieces' animated surfaces (the library pieces alone, before the back
+    /// is added) that cross that same surface, summed over the pieces whose solid crosses:
+    /// where the input presses into itself inside one part (lips or lids on a face) or has
+    /// degenerate triangles. No back can undo these (the regularized solid merges the touching
+    /// surfaces); a seam between them (one in each part) or a mended input keeps them apart.
+    pub surface_self_intersecting_triangles: usize,
+    /// Triangles of the solids as built (front, back, walls, keys, ID) that cross the same
+    /// solid, summed over the pieces; those pieces were regularized
+    /// ([`regularize`](crate::library::regularize)) and `shell.self_intersecting_triangles`
+    /// counts what is left in the written solids.
+    pub built_self_intersecting_triangles: usize,
+    /// Pieces whose solid crossed itself as built and was regularized: the printed shape
+    /// differs from the animated surface where it crossed.
+    pub regularized_pieces: Vec<String>,
+    /// Volume of what regularizing dropped (mm³): chips of material apart from a piece and
+    /// sealed cavities inside it (filled).
+    pub dropped_volume_mm3: f64,
+    /// The magnet pocket every piece of the part has, and the mount has at the same place
+    /// (`null` without magnets).
+    pub magnet_pocket: Option<Pocket>,
+}
+
+/// The print-time estimate.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PrintTime {
+    /// Estimated hours.
+    pub hours: f64,
+    /// Build plates needed.
+    pub plates: f64,
+    /// Layers per plate.
+    pub layers_per_plate: f64,
+    /// Layer height (mm).
+    pub layer_mm: f64,
+    /// Seconds per layer.
+    pub seconds_per_layer: f64,
+    /// Build plate (mm).
+    pub plate_mm: [f64; 2],
+    /// What the estimate assumes.
+    pub assumes: String,
+}
+
+/// One printed piece in [`PrintReport::pieces`]: what a print shop and an animator look up.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PieceReport {
+    /// Identifier `<part>_<NN>` (file stem, 3MF object name).
+    pub id: String,
+    /// The ID embossed on its back (`P-NN`).
+    pub label: String,
+    /// Part name.
+    pub part: String,
+    /// Frames (0-based) the piece is on, in frame order.
+    pub frames: Vec<usize>,
+    /// Volume of its solid (mm³).
+    pub volume_mm3: f64,
+    /// Whether it has a magnet pocket (at its part's `magnet_pocket`).
+    pub magnet: bool,
+    /// Build plate of `library.3mf` it is on (1-based; `null` without a 3MF).
+    pub plate: Option<usize>,
+}
+
+/// `report.json` `"printing"`: material, print time, resolution check, keys and IDs.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PrintReport {
+    /// Material of all solids.
+    pub material: MaterialEstimate,
+    /// Print-time estimate.
+    pub print_time: PrintTime,
+    /// Printer resolution checked against (mm).
+    pub resolution_mm: f64,
+    /// Whether registration keys were added.
+    pub keys: bool,
+    /// Whether IDs were embossed.
+    pub ids: bool,
+    /// Clearance of the fits (mm): magnet pockets are this much wider (radius) and deeper
+    /// than the magnet, the mount's key sockets and ID recess wider and deeper than the key
+    /// or ID; from `--clearance`, else 3 × the printer resolution.
+    pub clearance_mm: f64,
+    /// The disc magnet every piece holds (`null` without magnets).
+    pub magnet: Option<MagnetOptions>,
+    /// Files of the solids: `"stl"`, `"3mf"` or `"stl,3mf"`.
+    pub print_format: super::options::PrintFormat,
+    /// Build plates of `library.3mf` (empty without a 3MF): several plates are laid side by
+    /// side along x in its one build, each listed here with its origin and pieces.
+    pub plates: Vec<super::plates::Plate>,
+    /// Per part.
+    pub parts: Vec<PartPrintReport>,
+    /// Per piece: ID, part, frames used, volume, magnet, plate.
+    pub pieces: Vec<PieceReport>,
+    /// Thinnest wall and smallest feature of every piece and mount against the printer's
+    /// minimums.
+    pub printability: PrintabilityReport,
 }

@@ -46,7 +46,7 @@ impl PartShell {
     /// no place of the back fits.
     ///
     /// # Performance
-    /// Brute force over the shell vertices for [`CANDIDATES`] centres: ~10 M point tests for
+    /// Brute force over the shell vertices for `CANDIDATES` centres: ~10 M point tests for
     /// a 10k-vertex part of 16 pieces.
     pub fn magnet_pocket(
         &self,
