@@ -5,9 +5,10 @@
 # LTS (reusing caches.sh's target/caches-venv), 4.5.15 LTS and 5.0.1 (own venvs), each with
 # numpy<2 --
 # installs the zip with bpy.ops.extensions.package_install_files and runs
-# blender/tests/test_smear.py, test_stopmo.py, test_loa.py, test_rigs.py and test_usd.py (USD
-# import of the debug toonkit's curves and velocities) (one PASS/FAIL line per test,
-# non-zero exit on a failure).
+# blender/tests/test_smear.py, test_stopmo.py, test_loa.py, test_rigs.py, test_usd.py (USD
+# import of the debug toonkit's curves and velocities) and test_presets.py (every named smear
+# preset against the debug toonkit CLI) (one PASS/FAIL line per test, non-zero exit on a
+# failure).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT="$PWD"
@@ -34,6 +35,8 @@ status=0
 tube=target/blender-tube.glb
 target/debug/examples/write_tube "$tube" 40
 export TOONKIT_TUBE="$ROOT/$tube"
+# test_rigs.py compares the bake with the CLI of this tree (the build phase's debug toonkit).
+export TOONKIT_CLI="$ROOT/target/debug/toonkit"
 for spec in "4.2.0:target/caches-venv" "4.5.15:target/blender-venv-4.5" \
     "5.0.1:target/blender-venv-5.0"; do
     version=${spec%%:*}
@@ -42,7 +45,7 @@ for spec in "4.2.0:target/caches-venv" "4.5.15:target/blender-venv-4.5" \
     out="target/blender-out-$version"
     rm -rf "$out" "target/blender-user-$version"
     echo "== Blender $version"
-    for t in smear stopmo loa rigs usd; do
+    for t in smear stopmo loa rigs usd presets; do
         rm -rf "target/blender-user-$version"
         BLENDER_USER_RESOURCES="$ROOT/target/blender-user-$version" \
             "$dir/bin/python" "blender/tests/test_$t.py" "$zip" "$out/$t" || status=1

@@ -2,9 +2,10 @@
 # Issue 19: MeshLab's own self-intersection filter (pymeshlab from PyPI, ~12 s to install) on
 # every STL of the README's stopmo example (`stopmo run` on the face at 2 fps, 8 pieces per
 # part, with the debug build `cargo test --workspace` left behind), and of a cut whose solids
-# cross themselves as built and are regularized (the seam through both eyes): every solid must
+# cross themselves as built and are regularized (the seam through both eyes), and of an untuned
+# cut whose magnet pocket stands in a boss (one piece per part, 15 frames): every solid must
 # be watertight with 0 self-intersecting faces. The crate's tests check the same with an exact
-# integer test; this is the independent check. Both runs mount the pieces with magnets (a
+# integer test; this is the independent check. All runs mount the pieces with magnets (a
 # pocket cut by an exact boolean in every piece and mount), and the first writes library.3mf,
 # which lib3mf (the 3MF Consortium's reader, PyPI) must load as watertight millimetre meshes,
 # one per piece (.ci/threemf_check.py).
@@ -36,6 +37,21 @@ echo "meshlab: stopmo run (seam through the eyes) took $(( $(date +%s) - start )
 "$VENV/bin/python" -c 'import json, sys
 parts = json.load(open(sys.argv[1]))["printing"]["parts"]
 sys.exit(0 if any(p["regularized_pieces"] for p in parts) else "meshlab: nothing was regularized")' \
+    "$OUT/report.json"
+"$VENV/bin/python" .ci/meshlab_check.py "$OUT/pieces"
+rm -rf "$OUT"
+rm -rf "$OUT"
+# A cut none of the printing was tuned on, one piece per part at the default 1.5 mm back: the
+# upper part's back is too thin for the pocket, which stands in a boss on every piece (joined
+# by an exact union) and in a recess of the mount.
+start=$(date +%s)
+target/debug/toonkit stopmo run assets/face/ict-face-talk.glb -o "$OUT" --fps 0.5 \
+    --part upper=point:0,5,14 --part lower=point:0,-16,6 --pieces 1 --seed 11 --restarts 1 \
+    --magnets 3x2
+echo "meshlab: stopmo run (an untuned cut, magnets in a boss) took $(( $(date +%s) - start )) s"
+"$VENV/bin/python" -c 'import json, sys
+parts = json.load(open(sys.argv[1]))["printing"]["parts"]
+sys.exit(0 if any(p["magnet_pocket"]["boss"] for p in parts) else "meshlab: no pocket needed a boss")' \
     "$OUT/report.json"
 "$VENV/bin/python" .ci/meshlab_check.py "$OUT/pieces"
 rm -rf "$OUT"

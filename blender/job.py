@@ -60,10 +60,9 @@ def bake_blocker(context):
         picked = context.selected_objects
         what = (f"{picked[0].name} is a {picked[0].type.lower()}: " if picked else "")
         return what + "select at least one mesh object (or its armature)"
-    scene = context.scene
-    if scene.frame_end <= scene.frame_start:
-        return (f"the scene range {scene.frame_start}-{scene.frame_end} needs at least two "
-                "frames")
+    start, end, what = sample.bake_range(context.scene)
+    if end <= start:
+        return f"the {what} {start}-{end} needs at least two frames"
     return None
 
 
@@ -94,8 +93,7 @@ def _prepare(context, objects, settings):
         raise JobError(f"{names}: does not move over frames {s.frame_start}-"
                        f"{s.frame_start + len(s.positions) - 1}, nothing to smear; animate it "
                        "or set the scene range to where it moves")
-    positions, skin = (sample.to_camera(s) if s.camera is not None
-                       else (s.positions, s.skin))
+    positions, skin = sample.to_camera(s)
     try:
         scene = toonkit.Scene.from_arrays(positions, s.triangles, fps=s.fps, skin=skin,
                                           objects=s.objects, attributes=s.attributes,
@@ -106,65 +104,113 @@ def _prepare(context, objects, settings):
     return s, prepared
 
 
-def _stylize(s, prepared, settings):
+def _stylize(s, prepared, style, frames=None):
+    """`toonkit.smear.stylize` of the style dict `style`; `frames` = (start, end) clip frames
+    only."""
     toonkit = _toonkit()
     try:
-        return toonkit.smear.stylize(prepared, style.from_settings(settings, s.bones))
+        return toonkit.smear.stylize(prepared, style, frames=frames)
     except (toonkit.ToonkitError, ValueError, json.JSONDecodeError) as e:
         raise JobError(_one_line(e)) from e
 
 
-def _world(s, points):
-    return sample.from_camera(s.camera, points) if s.camera is not None else points
+def _settings_style(s, settings):
+    try:
+        return style.from_settings(settings, s.bones)
+    except (ValueError, json.JSONDecodeError) as e:
+        raise JobError(_one_line(e)) from e
 
 
 class _Pending:
-    """The frames of a live restyle still to write: (mesh name, positions, alpha) per result
-    object, written one frame at a time as the scene reaches it (docs/blender.md, "Speed")."""
+    """The frames of a live restyle not written yet (docs/blender.md, "Speed"): the style is
+    stylized and written one frame at a time as the scene reaches it (`smear::stylize_frames`
+    costs the frames asked for), or all at once before a save or a render."""
 
-    def __init__(self, start, writes):
-        self.start, self.writes = start, writes
-        self.frames = set(range(len(writes[0][1]))) if writes else set()
+    def __init__(self, style, frames):
+        self.style, self.frames = style, set(frames)
 
-    def write(self, frames):
-        import bpy
-
-        frames = [k for k in frames if k in self.frames]
-        for name, positions, alpha in self.writes if frames else ():
-            mesh = bpy.data.meshes.get(name)
-            if mesh is not None:
-                results.write_frames(mesh, self.start, positions, alpha, frames)
+    def write(self, scene, frames):
+        frames = sorted(k for k in frames if k in self.frames)
+        cached = _CACHE.get(scene.name)
+        if not frames or cached is None:
+            return
+        s, prepared = cached
+        look = _stylize(s, prepared, self.style, (frames[0], frames[-1] + 1))
+        _write(s, look, [k - frames[0] for k in frames])
         self.frames.difference_update(frames)
 
-    def write_current(self, scene):
-        n = len(self.writes[0][1]) if self.writes else 0
-        self.write([min(max(scene.frame_current - self.start, 0), n - 1)] if n else [])
+
+def _current(scene, s):
+    """The clip frame index of the scene's frame, clamped to the baked range."""
+    return min(max(scene.frame_current - s.frame_start, 0), len(s.positions) - 1)
 
 
 def write_pending(scene, frame_only=True):
-    """Writes the pending frames of `scene`'s last live restyle: the current frame, or all."""
+    """Writes the pending frames of `scene`'s last live restyle: the current frame, or all.
+    A failure (the style cannot be applied) drops the pending frames and says why in the
+    panel."""
     p = _PENDING.get(scene.name)
-    if p is None:
+    cached = _CACHE.get(scene.name)
+    if p is None or cached is None:
+        _PENDING.pop(scene.name, None)
         return
-    if frame_only:
-        p.write_current(scene)
-    else:
-        p.write(sorted(p.frames))
+    try:
+        p.write(scene, [_current(scene, cached[0])] if frame_only else sorted(p.frames))
+    except JobError as e:
+        p.frames.clear()
+        scene.toonkit_smear.last_error = str(e)
     if not p.frames:
         _PENDING.pop(scene.name, None)
 
 
-def _show(scene, s, look, lazy=False):
-    """Creates or updates the result objects of `look` (elongation, copies, lines). `lazy`
-    writes the current frame only and leaves the others pending (`write_pending`)."""
+def _targets(s, look):
+    """What `look` shows: per result object, its key (the body of a source, or the k-th
+    copy of a source), its world positions (frames, n, 3) and opacity (frames, n) or None."""
+    first = look.first_frame
+    elongated = look.elongated
+    camera = None if s.camera is None else s.camera[first:first + len(elongated)]
+
+    def world(points):
+        return sample.from_y_up(points) if camera is None else sample.from_camera(camera, points)
+
+    elongated = world(elongated)
+    out = [(("body", name), elongated[:, r.start:r.stop], None) for name, r in s.objects]
+    count = {}
+    for c in look.multiples:
+        source = s.names[c["object"]]
+        k = count.get(source, 0)
+        count[source] = k + 1
+        out.append((("multiple", source, k), world(c["positions"]), c["alpha"]))
+    return out
+
+
+def _result_meshes():
+    """The result objects' meshes by key (see `_targets`)."""
+    meshes = {("body", o[results.SOURCE]): o.data for o in results.owned("body")}
+    for o in results.owned("multiple"):
+        meshes[("multiple", o[results.SOURCE], int(o.get("toonkit_index", 0)))] = o.data
+    return meshes
+
+
+def _write(s, look, frames=None):
+    """Writes the frames `frames` of `look` (indices into its frames; all when None) to the
+    result meshes, as clip frames from `look.first_frame` on."""
+    meshes = _result_meshes()
+    start = s.frame_start + look.first_frame
+    for key, positions, alpha in _targets(s, look):
+        mesh = meshes.get(key)
+        if mesh is not None:
+            results.write_frames(mesh, start, positions, alpha, frames)
+
+
+def _show(scene, s, look):
+    """Creates or updates the result objects of `look` (elongation, copies, lines) and
+    writes its frames."""
     import bpy
 
-    _PENDING.pop(scene.name, None)
-    writes = []
     start, end = s.frame_start, s.frame_start + len(s.positions) - 1
-    elongated = _world(s, look.elongated)
     bodies = {o[results.SOURCE]: o for o in results.owned("body")}
-    for name, r in s.objects:
+    for name, _ in s.objects:
         body = bodies.get(name)
         if body is None:
             original = bpy.data.objects[name]
@@ -173,11 +219,10 @@ def _show(scene, s, look, lazy=False):
             mesh.name = f"{name} smear"
             body = results.make_body(scene, original, mesh, start, end)
             bodies[name] = body
-        writes.append((body.data, elongated[:, r.start:r.stop], None))
         results.set_range(body, start, end)
 
     wanted = {}
-    for i, c in enumerate(look.multiples):
+    for c in look.multiples:
         source = s.names[c["object"]]
         k = sum(1 for key in wanted if key[0] == source)
         wanted[(source, k)] = c
@@ -186,12 +231,11 @@ def _show(scene, s, look, lazy=False):
     for key, obj in copies.items():
         if key not in wanted:
             results.remove(obj)
-    for key, c in wanted.items():
+    for key in wanted:
         obj = copies.get(key)
         if obj is None:
             obj = results.make_copy(scene, bodies[key[0]], key[1], start, end)
             obj["toonkit_index"] = key[1]
-        writes.append((obj.data, _world(s, c["positions"]), c["alpha"]))
         results.set_range(obj, start, end)
 
     lines = {s.names[ln["object"]]: ln for ln in look.lines}
@@ -201,48 +245,55 @@ def _show(scene, s, look, lazy=False):
     have = {o[results.SOURCE]: o for o in results.owned("lines")}
     for source, ln in lines.items():
         obj = have.get(source) or results.make_lines(scene, source, start, end)
-        frames = ln["frames"]
-        if s.camera is not None:
-            frames = [dict(f, positions=sample.from_camera(s.camera[k:k + 1],
-                                                          f["positions"][None])[0])
-                      for k, f in enumerate(frames)]
+        frames = [dict(f, positions=sample.from_y_up(f["positions"]) if s.camera is None
+                       else sample.from_camera(s.camera[k:k + 1], f["positions"][None])[0])
+                  for k, f in enumerate(ln["frames"])]
         results.write_lines(obj.data, start, frames)
         results.set_range(obj, start, end)
-    _write(scene, start, writes, lazy)
+    _write(s, look)
 
 
-def _write(scene, start, writes, lazy):
-    """Writes every frame of `writes`, or (`lazy`) only the current frame of the result
-    meshes that already hold every frame, the rest pending."""
-    later = []
-    for mesh, positions, alpha in writes:
-        if lazy and mesh.attributes.get(f"tk_P{start}") is not None:
-            later.append((mesh.name, positions, alpha))
-        else:
-            results.write_frames(mesh, start, positions, alpha)
-    if later:
-        _PENDING[scene.name] = _Pending(start, later)
-        write_pending(scene)
+def _stylize_lazily(scene, s, prepared, wanted, lazy):
+    """`wanted` stylized: the whole clip, or (`lazy`) the frame on screen only, the others
+    left for `_show_lazily`. Motion lines, one mesh for all frames, are stylized whole.
+    Returns the look and whether it is the frame on screen only."""
+    lazy = lazy and "lines" not in wanted
+    k = _current(scene, s)
+    return _stylize(s, prepared, wanted, (k, k + 1) if lazy else None), lazy
+
+
+def _show_lazily(scene, s, look, wanted, lazy):
+    """Shows `look`; when it is the frame on screen only (`lazy`), every other frame is
+    stylized and written when the scene reaches it, before a save or a render, or once
+    Blender is idle (docs/blender.md, "Speed")."""
+    _PENDING.pop(scene.name, None)
+    _show(scene, s, look)
+    if lazy:
+        k = look.first_frame
+        _PENDING[scene.name] = _Pending(wanted, set(range(len(s.positions))) - {k})
+        _flush_when_idle()
 
 
 def bake(context, objects):
     """Samples, prepares and stylizes `objects`, then shows the result (replacing an earlier
-    bake). Nothing in the scene changes when this raises."""
+    bake): the frame on screen at once, the others as `_show_lazily` says. Nothing in the
+    scene changes when this raises."""
     scene, settings = context.scene, context.scene.toonkit_smear
     s, prepared = _prepare(context, objects, settings)
-    look = _stylize(s, prepared, settings)
+    wanted = _settings_style(s, settings)
+    look, lazy = _stylize_lazily(scene, s, prepared, wanted, True)
     if is_baked(scene):
         results.remove_all(scene)
     _CACHE[scene.name] = (s, prepared)
-    _show(scene, s, look)
+    _show_lazily(scene, s, look, wanted, lazy)
     settings.last_error = ""
     return look
 
 
 def restyle(scene, lazy=False):
     """Re-stylizes the baked result from the cached offsets; returns an error line or None.
-    `lazy` (a live slider) writes the current frame now and each other frame when the scene
-    reaches it."""
+    `lazy` (a live slider) stylizes and writes the current frame now, the others later
+    (`_show_lazily`)."""
     import bpy
 
     settings = scene.toonkit_smear
@@ -254,10 +305,39 @@ def restyle(scene, lazy=False):
             cached = _prepare(bpy.context, objs, settings)
             _CACHE[scene.name] = cached
         s, prepared = cached
-        _show(scene, s, _stylize(s, prepared, settings), lazy)
+        wanted = _settings_style(s, settings)
+        # A style that fails leaves the last good one, its pending frames included.
+        look, lazy = _stylize_lazily(scene, s, prepared, wanted, lazy)
+        _show_lazily(scene, s, look, wanted, lazy)
     except JobError as e:
         return str(e)
     return None
+
+
+#: Seconds without a restyle before the pending frames are written (a slider being dragged
+#: restyles only the frame on screen).
+IDLE_SECONDS = 0.3
+
+
+def _flush_when_idle():
+    """Writes every pending frame once Blender has been idle `IDLE_SECONDS` (a timer, set
+    again by each restyle: the interface shows the bake or the slider's frame first)."""
+    import bpy
+
+    cancel_flush()
+    bpy.app.timers.register(_flush, first_interval=IDLE_SECONDS)
+
+
+def cancel_flush():
+    import bpy
+
+    if bpy.app.timers.is_registered(_flush):
+        bpy.app.timers.unregister(_flush)
+
+
+def _flush():
+    write_all_pending()
+    return None  # once
 
 
 def timed_restyle(scene):
@@ -276,22 +356,36 @@ def write_all_pending():
 
 
 def after_undo():
-    """An undo may restore result meshes with some frames of a live restyle pending: those
-    scenes are restyled again in full, from the restored settings."""
+    """An undo restores result meshes as they were at its step, some frames perhaps written
+    from another style or not yet: every baked scene whose offsets are cached is restyled
+    from the restored settings (lazily: the frame on screen at once)."""
     import bpy
 
-    names = list(_PENDING)
     _PENDING.clear()
-    for name in names:
+    for name in list(_CACHE):
         scene = bpy.data.scenes.get(name)
         if scene is not None and is_baked(scene):
-            scene.toonkit_smear.last_error = restyle(scene) or ""
+            scene.toonkit_smear.last_error = restyle(scene, lazy=True) or ""
 
 
 def unbake(scene):
     _PENDING.pop(scene.name, None)
     results.remove_all(scene)
     _CACHE.pop(scene.name, None)
+
+
+def forget():
+    """Drops every cached bake and pending frame (another .blend is being opened: its results
+    sample their originals again at the first restyle)."""
+    cancel_flush()
+    _PENDING.clear()
+    _CACHE.clear()
+
+
+def pending_frames(scene):
+    """How many frames of `scene`'s last bake or live restyle are not written yet."""
+    p = _PENDING.get(scene.name)
+    return 0 if p is None else len(p.frames)
 
 
 def cached(scene):

@@ -6,7 +6,7 @@ from bpy.app.handlers import persistent
 from bpy.props import StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
-from . import job, style
+from . import job, sample, style
 
 
 class TOONKIT_OT_smear_bake(bpy.types.Operator):
@@ -34,8 +34,8 @@ class TOONKIT_OT_smear_bake(bpy.types.Operator):
             self.report({"ERROR"}, f"smear bake: {e}")
             return {"CANCELLED"}
         r = look.report
-        self.report({"INFO"}, f"smear: {len(r['objects'])} object(s), "
-                              f"{context.scene.frame_end - context.scene.frame_start + 1} frames")
+        start, end, _ = sample.bake_range(context.scene)
+        self.report({"INFO"}, f"smear: {len(r['objects'])} object(s), frames {start}-{end}")
         return {"FINISHED"}
 
 
@@ -136,8 +136,14 @@ def _undone(*args):
     job.after_undo()
 
 
+@persistent
+def _loading(*args):
+    job.forget()  # the next file's scenes may share these scene names
+
+
 HANDLERS = (("frame_change_pre", _frame_changed), ("save_pre", _write_all),
-            ("render_init", _write_all), ("undo_post", _undone), ("redo_post", _undone))
+            ("render_init", _write_all), ("undo_post", _undone), ("redo_post", _undone),
+            ("load_pre", _loading))
 
 
 def register():
@@ -148,6 +154,7 @@ def register():
 
 
 def unregister():
+    job.cancel_flush()
     job.write_all_pending()
     for name, handler in HANDLERS:
         handlers = getattr(bpy.app.handlers, name)

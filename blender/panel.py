@@ -6,7 +6,7 @@ from . import job, settings
 
 HOW_TO = (
     "1. Select the character's meshes (or its armature)",
-    "2. Bake: every frame of the scene range",
+    "2. Bake: every frame of the scene range (or the preview range)",
     "3. Drag a value: the smear updates",
     "4. Unbake removes every trace",
 )

@@ -143,12 +143,17 @@ def add_object(scene, name, mesh, role, source, start, end):
 
 
 def set_range(obj, start, end):
-    """The modifier's baked frame range."""
+    """The modifier's baked frame range (a restyle that keeps it tags nothing)."""
     mod = obj.modifiers[GROUP]
+    changed = False
     for item in mod.node_group.interface.items_tree:
         if getattr(item, "in_out", None) == "INPUT" and item.name in ("Start", "End"):
-            mod[item.identifier] = start if item.name == "Start" else end
-    obj.update_tag()
+            value = start if item.name == "Start" else end
+            if mod.get(item.identifier) != value:
+                mod[item.identifier] = value
+                changed = True
+    if changed:
+        obj.update_tag()
 
 
 def mesh_like(source_mesh, name):

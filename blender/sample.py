@@ -21,6 +21,7 @@ attributes (painted weights).
 """
 
 from dataclasses import dataclass, field
+from itertools import chain
 
 import numpy as np
 
@@ -106,15 +107,36 @@ def _evaluated(obj, depsgraph):
         ev.to_mesh_clear()
 
 
+def _triangles(ev):
+    """The loop triangles (t, 3) of the evaluated object `ev`'s mesh."""
+    mesh = ev.to_mesh()
+    try:
+        mesh.calc_loop_triangles()
+        tris = np.empty(len(mesh.loop_triangles) * 3, np.int32)
+        mesh.loop_triangles.foreach_get("vertices", tris)
+        return tris.reshape(-1, 3)
+    finally:
+        ev.to_mesh_clear()
+
+
 def _groups(obj, n):
-    """Every vertex group of `obj` as a dense (n,) weight array (one pass over the vertices)."""
+    """Every vertex group of `obj` as a dense (n,) weight array. Blender has no bulk read of
+    vertex weights: one pass over the vertices collects (group, vertex, weight) triples in
+    lists, and numpy scatters them at once."""
     names = {g.index: g.name for g in obj.vertex_groups}
-    out = {name: np.zeros(n, np.float32) for name in names.values()}
-    for v in obj.data.vertices:
+    dense = np.zeros((max(names, default=-1) + 1, n), np.float32)
+    group, vertex, weight = [], [], []
+    for i, v in enumerate(obj.data.vertices):
         for g in v.groups:
-            if g.group in names:
-                out[names[g.group]][v.index] = g.weight
-    return out
+            group.append(g.group)
+            vertex.append(i)
+            weight.append(g.weight)
+    if group:
+        group = np.array(group, np.int64)
+        known = group < len(dense)  # a weight of a group that no longer exists
+        dense[group[known], np.array(vertex, np.int64)[known]] = np.array(weight,
+                                                                         np.float32)[known]
+    return {name: dense[i] for i, name in names.items()}
 
 
 #: A vertex whose deforming weights sum to at most this stays at rest (the Armature modifier's
@@ -160,18 +182,29 @@ def _co(obj):
     return co.reshape(-1, 3)
 
 
-def _rest(obj):
-    """Rest vertices (object space) and triangles of `obj`'s own mesh."""
-    mesh = obj.data
-    co = _co(obj)
-    mesh.calc_loop_triangles()
-    tris = np.empty(len(mesh.loop_triangles) * 3, np.int32)
-    mesh.loop_triangles.foreach_get("vertices", tris)
-    return co, tris.reshape(-1, 3)
-
-
 def _matrix(m):
-    return np.array(m, np.float64)
+    """A mathutils 4x4 matrix as float64 numpy (fromiter: np.array walks its rows 5x
+    slower)."""
+    return np.fromiter(chain.from_iterable(m), np.float64, 16).reshape(4, 4)
+
+
+def affine_inverse(m):
+    """Inverses of affine 4x4 matrices (..., 4, 4) from the 3x3 part's cofactors: numpy's
+    LAPACK inverse wakes BLAS threads, which on a loaded machine took hundreds of
+    milliseconds for a clip's armature matrices. A singular matrix (a zero scale) inverts its
+    translation only."""
+    r = m[..., :3, :3]
+    cols = np.stack([np.cross(r[..., 1, :], r[..., 2, :]), np.cross(r[..., 2, :], r[..., 0, :]),
+                     np.cross(r[..., 0, :], r[..., 1, :])], axis=-1)
+    det = np.einsum("...i,...i->...", r[..., 0, :], cols[..., :, 0])
+    singular = det == 0.0
+    inv3 = np.where(singular[..., None, None], np.eye(3),
+                    cols / np.where(singular, 1.0, det)[..., None, None])
+    out = np.zeros(m.shape, np.float64)
+    out[..., :3, :3] = inv3
+    out[..., :3, 3] = -np.einsum("...ij,...j->...i", inv3, m[..., :3, 3])
+    out[..., 3, 3] = 1.0
+    return out
 
 
 def _rest_matrices(context, meshes):
@@ -222,10 +255,8 @@ class _Pose:
             a = self.armature_of[o.name]
             if a is not None and a not in self.armatures:
                 self.armatures.append(a)
-        self.rest = {}
+        self.rest = {o.name: _co(o) for o in objects}
         self.tris = {}
-        for o in objects:
-            self.rest[o.name], self.tris[o.name] = _rest(o)
         self.object_world = np.empty((frames, len(objects), 4, 4), np.float64)
         self.arm_world = np.empty((frames, len(self.armatures), 4, 4), np.float64)
         self.pose = [np.empty((frames, len(a.pose.bones) * 16), np.float32)
@@ -234,12 +265,12 @@ class _Pose:
         self.muted = []
 
     def first_frame(self, dg):
-        """The evaluated meshes' triangles (an n-gon's triangles follow its shape), then the
-        Armature modifiers off."""
+        """The evaluated meshes' triangles (a quad's diagonal and an n-gon's triangles follow
+        its shape), then the Armature modifiers off: Blender evaluates the pose, not these
+        meshes."""
         for o in self.objects:
-            self.tris[o.name] = _evaluated(o, dg)[1]
+            self.tris[o.name] = _triangles(o.evaluated_get(dg))
         self.mute()
-        dg.update()
 
     def mute(self):
         """Turns the Armature modifiers of the pose-only meshes off while sampling: Blender
@@ -305,10 +336,10 @@ class _Pose:
         frames = len(world)
         # foreach_get gives each 4x4 in Blender's column-major memory order.
         pose = self.pose[k].reshape(frames, -1, 4, 4).transpose(0, 1, 3, 2)[:, deform]
-        bind_inv = np.linalg.inv(np.stack([_matrix(bones[pose_names[i]].matrix_local)
+        bind_inv = affine_inverse(np.stack([_matrix(bones[pose_names[i]].matrix_local)
                                            for i in deform]))
         arm = self.arm_world[:, k]
-        to_arm = np.linalg.inv(arm) @ world
+        to_arm = affine_inverse(arm) @ world
         matrices = arm[:, None] @ pose.astype(np.float64) @ bind_inv[None] @ to_arm[:, None]
         groups = self.groups[o.name]
         n = len(self.rest[o.name])
@@ -325,8 +356,17 @@ class _Pose:
         return matrices, indices, weights
 
 
+def bake_range(scene):
+    """The frames a bake samples: the timeline's preview range when it is on (a range the
+    user sets without touching the scene's), else the scene range; (start, end, its name)."""
+    if scene.use_preview_range:
+        return scene.frame_preview_start, scene.frame_preview_end, "preview range"
+    return scene.frame_start, scene.frame_end, "scene range"
+
+
 def sample(context, objects, camera_relative=False, pose_only=True):
-    """Samples `objects` (meshes) over the scene range; restores the current frame.
+    """Samples `objects` (meshes) over the bake range (`bake_range`); restores the current
+    frame.
     `pose_only=False` evaluates every mesh (the reference the pose-only path is tested
     against)."""
     scene = context.scene
@@ -335,9 +375,9 @@ def sample(context, objects, camera_relative=False, pose_only=True):
         raise SampleError("select at least one mesh object")
     if camera_relative and scene.camera is None:
         raise SampleError("camera-relative speed needs a scene camera")
-    start, end = scene.frame_start, scene.frame_end
+    start, end, what = bake_range(scene)
     if end <= start:
-        raise SampleError(f"the scene range {start}-{end} needs at least two frames")
+        raise SampleError(f"the {what} {start}-{end} needs at least two frames")
     armature = _group_armature(meshes)
     joint_names, parents = _joint_order(armature) if armature else ([], [])
 
@@ -355,10 +395,10 @@ def sample(context, objects, camera_relative=False, pose_only=True):
         for k in range(frames):
             scene.frame_set(start + k)
             if k == 0:
+                if pose is not None:
+                    pose.first_frame(context.evaluated_depsgraph_get())
                 rest_matrices = _rest_matrices(context, meshes)
             dg = context.evaluated_depsgraph_get()
-            if k == 0 and pose is not None:
-                pose.first_frame(dg)  # the evaluated triangles, then the meshes off
             for o in evaluated:
                 p, t = _evaluated(o, dg)
                 if k == 0:
@@ -501,8 +541,16 @@ def _skin_and_attributes(result, meshes, counts, groups, armature, parents, matr
 
 
 def to_camera(sample):
-    """Positions and joint matrices in the camera's frame (SMEAR: camera space)."""
-    inv = np.linalg.inv(sample.camera)
+    """Positions and joint matrices in the frame the core works in: the camera's with
+    camera-relative speed (SMEAR: camera space), else the Y-up world (`to_y_up`)."""
+    if sample.camera is None:
+        skin = None
+        if sample.skin is not None:
+            skin = dict(sample.skin)
+            m = sample.skin["matrices"]
+            skin["matrices"] = m[..., [0, 2, 1, 3], :] * np.array([1, 1, -1, 1], m.dtype)[:, None]
+        return to_y_up(sample.positions), skin
+    inv = affine_inverse(sample.camera)
     p = sample.positions.astype(np.float64)
     p = np.einsum("fij,fvj->fvi", inv[:, :3, :3], p) + inv[:, None, :3, 3]
     skin = None
@@ -511,6 +559,20 @@ def to_camera(sample):
         skin["matrices"] = np.einsum("fij,fkjl->fkil", inv,
                                      sample.skin["matrices"].astype(np.float64)).astype(np.float32)
     return p.astype(np.float32), skin
+
+
+def to_y_up(points):
+    """Points (..., 3) of Blender's Z-up world in the Y-up world of glTF, USD and the CLI, turned
+    as the glTF exporter turns them: (x, y, z) -> (x, z, -y), a signed permutation (exact). The
+    core works there, so a style's position-dependent parts (the noise preset's Voronoi cells,
+    SMEAR Fig. 11d; an expression's rest position) fall on the character where the CLI puts
+    them on the exported file."""
+    return points[..., [0, 2, 1]] * np.array([1, 1, -1], points.dtype)
+
+
+def from_y_up(points):
+    """`to_y_up` undone: (x, y, z) -> (x, -z, y)."""
+    return points[..., [0, 2, 1]] * np.array([1, -1, 1], points.dtype)
 
 
 def from_camera(camera, points):

@@ -205,8 +205,9 @@ pub(crate) fn gltf_uri(data: &[u8]) {
 }
 
 /// Option sizes: eight little-endian u64 values read as `--smooth`, a motion-line count,
-/// samples, sides, frames, an image's width and height, and keystrokes. The budget checks
-/// never panic (products saturate), and a size they accept is within its limit.
+/// samples, sides, frames, an image's width and height, and keystrokes (and a job's memory
+/// estimate from them). The budget checks never panic (products saturate), and a size they
+/// accept is within its limit.
 pub(crate) fn sizes(data: &[u8]) {
     use anim::budget::{self, product};
     let mut v = [0u64; 8];
@@ -231,4 +232,12 @@ pub(crate) fn sizes(data: &[u8]) {
     let pixels = product(&[width, height, frames]);
     let _ = anim::check_budget("pixels", pixels, budget::DEFAULT_MAX_PIXELS, "");
     let _ = anim::check_budget("keystrokes", keys, budget::DEFAULT_MAX_KEYSTROKES, "");
+    // A job's memory: frames × vertices (width) × copies (count) and the lines' bytes.
+    let job = budget::JobMemory::new()
+        .positions("copies", frames as usize, width as usize, count)
+        .bytes("lines", lines);
+    match job.check("") {
+        Ok(()) => assert!(job.total() <= budget::max_job_bytes()),
+        Err(e) => assert!(e.to_string().contains("over the limit")),
+    }
 }

@@ -13,6 +13,14 @@ REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 ASSETS = os.path.join(REPO, "assets", "characters")
 
 
+def start():
+    """The command line's zip installed (`install`) and output folder made: (toonkit, OUT)."""
+    args = argv_after_dashes()
+    out = os.path.abspath(args[1]) if len(args) > 1 else tmpdir()
+    os.makedirs(out, exist_ok=True)
+    return install(os.path.abspath(args[0])), out
+
+
 def install(zip_path):
     """Installs and enables the extension zip as a user would (Install from Disk)."""
     import bpy

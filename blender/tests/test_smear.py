@@ -93,12 +93,33 @@ def expected(objs, style=None):
     diag = float(np.linalg.norm(np.ptp(positions[0], axis=0)))
     check(rel(positions, s.positions, diag) <= TOL, "the bake sampled other vertices")
     positions = s.positions
-    scene = toonkit.Scene.from_arrays(positions, s.triangles, fps=s.fps, skin=s.skin,
+    # The bake hands the core the Y-up world of glTF and the CLI (docs/blender.md, "Axes").
+    skin = s.skin and dict(s.skin, matrices=s.skin["matrices"][..., [0, 2, 1, 3], :]
+                           * np.array([1, 1, -1, 1], np.float32)[:, None])
+    scene = toonkit.Scene.from_arrays(y_up(positions), s.triangles, fps=s.fps, skin=skin,
                                       objects=s.objects, attributes=s.attributes, rest=s.rest)
     settings = bpy.context.scene.toonkit_smear
     prepared = toonkit.smear.prepare(scene, smooth=settings.smooth)
-    return positions, toonkit.smear.stylize(
-        prepared, style or style_mod.from_settings(settings, s.bones))
+    return positions, InWorld(toonkit.smear.stylize(
+        prepared, style or style_mod.from_settings(settings, s.bones)))
+
+
+def y_up(p):
+    """Blender's Z-up world as the glTF exporter turns it: (x, y, z) -> (x, z, -y)."""
+    return p[..., [0, 2, 1]] * np.array([1, 1, -1], p.dtype)
+
+
+def z_up(p):
+    return p[..., [0, 2, 1]] * np.array([1, -1, 1], p.dtype)
+
+
+class InWorld:
+    """The module's result turned back into Blender's world."""
+
+    def __init__(self, look):
+        self.elongated = z_up(look.elongated)
+        self.multiples = [dict(c, positions=z_up(c["positions"])) for c in look.multiples]
+        self.lines = look.lines
 
 
 def evaluated_with_originals(objs):

@@ -99,6 +99,7 @@ def test_stopmo_run_matches_the_module():
     same_as(folder, ref, os.path.join(OUT, "module"))
     shows_assembly(scene, folder, ref)
     printed_with_magnets(folder)
+    reconstruction_glb_plays(scene, folder)
     check(bpy.data.images.get("toonkit error curve") is not None or s.count == "EACH",
           "no size-vs-error image")
     # The job's warnings reach the user (the operator reports them) and stay with the result.
@@ -160,6 +161,40 @@ def shows_assembly(scene, folder, ref):
         check(set(np.unique(piece)) == set(int(i) for i in labels[k]),
               f"frame {f}: piece attribute {np.unique(piece)} vs labels {labels[k]}")
     return pieces, rows
+
+
+def reconstruction_glb_plays(scene, folder):
+    """reconstruction.glb (each part's pieces as morph targets, STEP weights) imports through
+    Blender's glTF importer and plays: at frame k every part shows the positions of
+    reconstruction.pc2's frame k (glTF axes there, Z up here), within the quantization."""
+    from bl_ext.user_default.toonkit import stopmo
+
+    frames = stopmo.read_pc2(os.path.join(folder, "reconstruction.pc2"))
+    before = set(bpy.data.objects)
+    bpy.ops.import_scene.gltf(filepath=os.path.join(folder, "reconstruction.glb"))
+    # Blender suffixes a name that is taken (".001").
+    new = {o.name.split(".")[0]: o for o in bpy.data.objects
+           if o not in before and o.type == "MESH"}
+    # One object per part, in report.json's part order (that of the .pc2's vertices).
+    names = [p["name"] for p in json.load(open(os.path.join(folder, "report.json")))["parts"]]
+    check(sorted(new) == sorted(names), f"reconstruction.glb imported {sorted(new)}")
+    parts = [new[n] for n in names]
+    keys = parts[0].data.shape_keys
+    check(keys is not None and keys.animation_data and keys.animation_data.action,
+          "reconstruction.glb: no shape-key animation")
+    first = int(keys.animation_data.action.frame_range[0])
+    diag = float(np.linalg.norm(frames[0].max(0) - frames[0].min(0)))
+    worst = 0.0
+    for k in range(len(frames)):
+        got = np.concatenate([world_positions(o, first + k) for o in parts])
+        got = got[:, [0, 2, 1]] * np.array([1.0, 1.0, -1.0], np.float32)  # Z up -> Y up
+        check(got.shape == frames[k].shape, f"{got.shape} imported vertices, pc2 {frames[k].shape}")
+        worst = max(worst, float(np.abs(got - frames[k]).max()))
+    check(worst <= 1e-4 * diag, f"reconstruction.glb vs pc2: {worst} (diagonal {diag})")
+    print(f"  reconstruction.glb: {len(frames)} frames play as reconstruction.pc2 "
+          f"(largest distance {worst:.2e} of a {diag:.1f} diagonal)")
+    for o in parts:
+        bpy.data.objects.remove(o)
 
 
 def test_stopmo_cursor_seeds():

@@ -10,9 +10,6 @@ use crate::{
     SkeletalAnimation, Skeleton, Skin, Transform, DEFAULT_FPS,
 };
 
-/// Upper bound on sampled positions (frames × vertices): the job's point budget.
-pub(crate) const MAX_SAMPLED_VALUES: usize = crate::budget::DEFAULT_MAX_POINTS as usize;
-
 /// What to sample.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SampleOptions {
@@ -117,7 +114,21 @@ impl SampledScene {
     }
 
     /// All objects merged into one cache (vertex order = object order).
+    ///
+    /// # Errors
+    /// [`AnimError::OverBudget`] when the samples, the merged copy and a file written from
+    /// it would be over [`crate::budget::DEFAULT_MAX_JOB_BYTES`]; those of
+    /// [`MeshAnimation::concat`].
     pub fn merged(&self, name: &str) -> Result<MeshAnimation> {
+        // The samples, the merged copy and the file a job writes it to, before the copy.
+        crate::budget::JobMemory::new()
+            .positions(
+                "copies of the clip (sampled, merged, written)",
+                self.frame_count,
+                self.vertex_count(),
+                3,
+            )
+            .check("lower --fps or pick a shorter clip")?;
         if self.objects.len() == 1 {
             let mut a = self.objects[0].animation.clone();
             a.mesh.name = name.to_string();
@@ -349,6 +360,7 @@ fn sample_with(
 fn check_sampling(duration: f32, fps: f32, frames: usize, points: usize) -> Result<()> {
     use crate::budget::{check_budget, DEFAULT_MAX_FRAMES};
     let hint = format!("the clip lasts {duration:.1} s: lower --fps or pick a shorter clip");
+    let points_hint = format!("{hint} (or raise {})", crate::budget::MAX_JOB_BYTES_ENV);
     check_budget(
         &format!("frames at {fps} fps"),
         frames as u64,
@@ -359,8 +371,8 @@ fn check_sampling(duration: f32, fps: f32, frames: usize, points: usize) -> Resu
         check_budget(
             "frames × vertices",
             points as u64,
-            MAX_SAMPLED_VALUES as u64,
-            &hint,
+            crate::budget::max_points(),
+            &points_hint,
         )
     })
     .map_err(AnimError::OverBudget)

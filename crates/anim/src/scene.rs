@@ -58,6 +58,9 @@ pub struct SkinDef {
     pub joints: Vec<usize>,
     /// Inverse bind matrix per slot.
     pub inverse_bind: Vec<Mat4>,
+    /// The skeleton root the file names (glTF `skin.skeleton`): the inverse bind matrices
+    /// are relative to it (to its parent when it is a joint). `None` when the file names none.
+    pub skeleton: Option<usize>,
 }
 
 /// A camera as stored in a scene.

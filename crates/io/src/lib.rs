@@ -16,6 +16,7 @@ mod atomic;
 mod error;
 mod inputs;
 mod save;
+mod shapes;
 
 pub mod abc;
 #[cfg(feature = "clap")]
@@ -39,6 +40,7 @@ pub use atomic::{
 pub use error::{describe_io, FilePath, IoError, Result};
 pub use inputs::{check_not_input, note_read, same_file, ReadScope};
 pub use save::{save, save_with, Layout, Output, SaveOptions};
+pub use shapes::ShapeAnimation;
 
 mod detect;
 mod flipbook;

@@ -187,19 +187,32 @@ pub(crate) fn decode_le_vec3(bytes: &[u8]) -> Option<Vec<Vec3>> {
 pub fn write(anim: &MeshAnimation) -> Vec<u8> {
     let positions = anim.positions();
     let mut out = Vec::with_capacity(HEADER_LEN + positions.len() * 12);
-    out.extend_from_slice(MAGIC);
-    out.extend_from_slice(&1i32.to_le_bytes());
-    out.extend_from_slice(&clamp_i32(anim.vertex_count()).to_le_bytes());
-    // In f64 and clamped: the product of two valid f32 can overflow f32.
-    let start = (anim.start_time as f64 * anim.fps as f64).clamp(f32::MIN as f64, f32::MAX as f64);
-    out.extend_from_slice(&(start as f32).to_le_bytes());
-    out.extend_from_slice(&1.0f32.to_le_bytes());
-    out.extend_from_slice(&clamp_i32(positions.len() / anim.vertex_count().max(1)).to_le_bytes());
+    out.extend_from_slice(&header_bytes(
+        anim.vertex_count(),
+        positions.len() / anim.vertex_count().max(1),
+        anim.start_time,
+        anim.fps,
+    ));
     for p in positions {
         for c in p.to_array() {
             out.extend_from_slice(&c.to_le_bytes());
         }
     }
+    out
+}
+
+/// The header of a cache of `frames` frames of `vertices` vertices starting at
+/// `start_time` seconds (one sample per frame).
+pub(crate) fn header_bytes(vertices: usize, frames: usize, start_time: f32, fps: f32) -> Vec<u8> {
+    let mut out = Vec::with_capacity(HEADER_LEN);
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&1i32.to_le_bytes());
+    out.extend_from_slice(&clamp_i32(vertices).to_le_bytes());
+    // In f64 and clamped: the product of two valid f32 can overflow f32.
+    let start = (start_time as f64 * fps as f64).clamp(f32::MIN as f64, f32::MAX as f64);
+    out.extend_from_slice(&(start as f32).to_le_bytes());
+    out.extend_from_slice(&1.0f32.to_le_bytes());
+    out.extend_from_slice(&clamp_i32(frames).to_le_bytes());
     out
 }
 

@@ -157,8 +157,6 @@
 
 pub mod animate;
 mod animation;
-#[cfg(feature = "clap")]
-pub mod args;
 mod chain;
 mod dynamics;
 mod error;

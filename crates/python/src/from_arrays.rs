@@ -125,6 +125,28 @@ fn split_objects(
             )));
         }
     }
+    let parent_of = |k: usize| {
+        object_parents
+            .and_then(|p| usize::try_from(p[k]).ok())
+            .filter(|&j| j < scene.skeleton.len())
+    };
+    if let [(name, _, _)] = objects {
+        // One object (a host's single mesh): the whole scene's, named, its frames moved
+        // rather than copied.
+        let mut animation = whole.animation;
+        animation.mesh.name.clone_from(name);
+        let skin = whole
+            .skin
+            .filter(|s| (0..vertices).any(|v| !s.weights.influences(v).0.is_empty()));
+        let parent_joint = parent_of(0);
+        scene.objects.push(anim::MeshObject {
+            skin,
+            parent_joint,
+            rest_bounds: Aabb::from_points(rest),
+            ..anim::MeshObject::new(0, name.clone(), animation)
+        });
+        return Ok(());
+    }
     let mut triangles: Vec<Vec<[u32; 3]>> = vec![Vec::new(); objects.len()];
     for (i, t) in whole.animation.mesh.triangles.iter().enumerate() {
         let k = objects.partition_point(|o| o.2 <= t[0] as usize);
@@ -162,9 +184,7 @@ fn split_objects(
                 weights: VertexWeights::from_influences(rows),
             })
         });
-        let parent_joint = object_parents
-            .and_then(|p| usize::try_from(p[k]).ok())
-            .filter(|&j| j < scene.skeleton.len());
+        let parent_joint = parent_of(k);
         scene.objects.push(anim::MeshObject {
             skin,
             parent_joint,

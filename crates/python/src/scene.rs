@@ -156,7 +156,7 @@ pub(crate) enum ClipArg {
 /// >>> scene.frame_count > 0
 /// True
 #[pyfunction]
-#[pyo3(signature = (path, clip=None, fps=24.0))]
+#[pyo3(signature = (path, clip=None, fps=anim::DEFAULT_FPS))]
 pub(crate) fn load(
     py: Python<'_>,
     path: PathBuf,
@@ -213,7 +213,7 @@ impl Scene {
     /// >>> t.positions.shape == s.positions.shape
     /// True
     #[staticmethod]
-    #[pyo3(signature = (positions, triangles, fps=24.0, skin=None, objects=None, attributes=None, rest=None))]
+    #[pyo3(signature = (positions, triangles, fps=anim::DEFAULT_FPS, skin=None, objects=None, attributes=None, rest=None))]
     fn from_arrays(
         py: Python<'_>,
         positions: crate::arrays::ArrayIn<'_, f32>,

@@ -160,22 +160,32 @@ fn read_style(
     Ok(style)
 }
 
-/// The native half of `toonkit.smear.stylize`.
+/// The native half of `toonkit.smear.stylize`; `frames` = `(start, end)` stylizes clip
+/// frames `start..end` only (`smear::stylize_frames`: a live restyle draws the frame on
+/// screen, the others when the scene reaches them).
 #[pyfunction(name = "smear_stylize")]
-#[pyo3(signature = (prepared, style_json=None, style_path=None, progress=None))]
+#[pyo3(signature = (prepared, style_json=None, style_path=None, progress=None, frames=None))]
 pub(crate) fn stylize(
     py: Python<'_>,
     prepared: &Bound<'_, Prepared>,
     style_json: Option<&str>,
     style_path: Option<PathBuf>,
     progress: Option<Py<PyAny>>,
+    frames: Option<(usize, usize)>,
 ) -> PyResult<Stylized> {
     let p = prepared.get();
     let style = read_style(style_json, style_path, &p.prepared.options().offsets)?;
+    let clip = p.prepared.report().frames;
+    let (start, end) = frames.unwrap_or((0, clip));
+    if start >= end || end > clip {
+        return Err(value_error(format!(
+            "frames ({start}, {end}): a non-empty range of the clip's {clip} frames"
+        )));
+    }
     report(py, progress.as_ref(), "stylize", 0.0)?;
     let shared = p.prepared.clone();
     let stylized = py
-        .detach(move || smear::stylize(&shared, &style))
+        .detach(move || smear::stylize_frames(&shared, &style, start..end))
         .map_err(|e| smear_error(&p.source, e))?;
     report(py, progress.as_ref(), "stylize", 1.0)?;
     Ok(Stylized {
@@ -252,10 +262,11 @@ impl Stylized {
             .collect();
         let frames = self.stylized.flipbook.frames;
         let vertices: usize = bodies.iter().map(|a| a.vertex_count()).sum();
+        // One copy into numpy's buffer, frame by frame (no array per frame).
         let mut data = Vec::with_capacity(frames * vertices * 3);
         for f in 0..frames {
             for a in &bodies {
-                data.extend(flat3(a.frame(f)));
+                data.extend_from_slice(bytemuck::cast_slice::<glam::Vec3, f32>(a.frame(f)));
             }
         }
         output(py, &[frames, vertices, 3], data)
@@ -316,6 +327,12 @@ impl Stylized {
             out.push(d);
         }
         Ok(out)
+    }
+
+    /// The clip frame of the first frame held (0 unless ``stylize`` was given ``frames``).
+    #[getter]
+    fn first_frame(&self) -> usize {
+        self.stylized.first_frame
     }
 
     /// What the style did, as JSON text (per-object elongation, copies, lines, timings).

@@ -53,6 +53,15 @@ def test_from_arrays_with_skin_gives_the_same_offsets(robot):
     np.testing.assert_allclose(
         toonkit.smear.offsets(scene, whole_body=True), toonkit.smear.offsets(robot, whole_body=True),
         atol=1e-6, rtol=0)
+    # One object covering every vertex (a host's single mesh) is the whole scene, named.
+    n = robot.positions.shape[1]
+    skin = {k: v for k, v in robot.skin.items() if k != "object_parents"}
+    one = toonkit.Scene.from_arrays(robot.positions, robot.triangles, fps=robot.fps,
+                                    skin=skin, objects=[("all", range(0, n))])
+    whole = toonkit.Scene.from_arrays(robot.positions, robot.triangles, fps=robot.fps,
+                                      skin=skin)
+    assert one.objects == [("all", range(0, n))]
+    np.testing.assert_array_equal(toonkit.smear.offsets(one), toonkit.smear.offsets(whole))
     # Without the skin the robot is one simple object (SMEAR Eq. 1): different offsets.
     simple = toonkit.Scene.from_arrays(robot.positions, robot.triangles, fps=robot.fps)
     assert np.abs(toonkit.smear.offsets(simple) - loaded).max() > 0.1
@@ -134,6 +143,24 @@ def test_restyling_reuses_the_offsets(prepared):
         # "object" indexes scene.objects: the copy has that object's vertices.
         name, r = prepared_objects(prepared)[c["object"]]
         assert v == len(r) and c["name"].startswith(name)
+
+
+def test_stylize_frames_equal_those_frames_of_the_clip(prepared):
+    style = {**STRETCH, "multiples": {"past": 1, "future": 1}}
+    whole = toonkit.smear.stylize(prepared, style)
+    frames = whole.elongated.shape[0]
+    assert whole.first_frame == 0
+    for start, end in ((0, 1), (7, 8), (3, 12), (frames - 1, frames)):
+        part = toonkit.smear.stylize(prepared, style, frames=(start, end))
+        assert part.first_frame == start
+        np.testing.assert_array_equal(part.elongated, whole.elongated[start:end])
+        assert len(part.multiples) == len(whole.multiples)
+        for a, b in zip(part.multiples, whole.multiples):
+            np.testing.assert_array_equal(a["positions"], b["positions"][start:end])
+            np.testing.assert_array_equal(a["alpha"], b["alpha"][start:end])
+    for bad in ((5, 5), (6, 2), (0, frames + 1)):
+        with pytest.raises(ValueError, match="frames"):
+            toonkit.smear.stylize(prepared, style, frames=bad)
 
 
 def prepared_objects(prepared):

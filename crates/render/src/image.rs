@@ -39,7 +39,9 @@ pub(crate) fn check_pixels(width: u32, height: u32, frames: usize) -> Result<()>
     anim::check_budget(
         "width × height × frames",
         asked,
-        anim::budget::DEFAULT_MAX_PIXELS,
+        // The job budget at the bytes a pixel costs ([`anim::budget::DEFAULT_MAX_PIXELS`]
+        // by default).
+        anim::budget::max_job_bytes() / anim::budget::PIXEL_BYTES,
         &format!("{frames} frames of {width}x{height}: ask for a smaller --size or fewer frames"),
     )?;
     Ok(())

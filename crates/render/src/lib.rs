@@ -40,8 +40,6 @@
 #![warn(missing_docs, unreachable_pub)]
 
 mod animation;
-#[cfg(feature = "clap")]
-pub mod args;
 pub mod chart;
 mod color;
 mod colormap;

@@ -33,6 +33,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         name: "chain".into(),
         joints: (0..nj).collect(),
         inverse_bind,
+        skeleton: None,
     });
     scene.meshes.push(SceneMesh {
         mesh,

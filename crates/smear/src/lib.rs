@@ -136,11 +136,11 @@ pub use effects::{
     attribute_weights, elongate, elongate_frame, eq12_opacity, group_weights, held_frame,
     motion_lines, motion_lines_frame, multiple_opacity, multiples, multiples_frame,
     overlap_spacing, sample_surface, squash_frames, subdivide_frame, subdivide_moving_frame,
-    surface_point_weights, ContactStyle, EffectInputs, ElongateOptions, LineFrame, LineOptions,
-    LineStyle, MultipleCopy, MultiplesOptions, Spacing, Squash, StyleInput, Stylize,
-    SubdivisionStats, Trajectories, BEND, DEFAULT_FRAME_STEP, DEFAULT_LINE_SAMPLES,
-    DEFAULT_LINE_SIDES, DEFAULT_SEED, DEFAULT_SPACING, DEFAULT_SQUASH_FRAMES, DEVIATION_SHARE,
-    MAX_SQUASH, MAX_SUBDIVISION_LEVELS,
+    surface_point_weights, trajectory_velocities, AroundFrame, ContactStyle, EffectInputs,
+    ElongateOptions, LineFrame, LineOptions, LineStyle, MultipleCopy, MultiplesOptions, Spacing,
+    Squash, StyleInput, Stylize, SubdivisionStats, Trajectories, BEND, DEFAULT_FRAME_STEP,
+    DEFAULT_LINE_SAMPLES, DEFAULT_LINE_SIDES, DEFAULT_SEED, DEFAULT_SPACING, DEFAULT_SQUASH_FRAMES,
+    DEVIATION_SHARE, MAX_SQUASH, MAX_SUBDIVISION_LEVELS,
 };
 pub use error::{Result, SmearError};
 pub use job::{

@@ -23,9 +23,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::plane::plane_frames;
 use crate::{
-    causal_smoothing_weights, Collider, FunctionSpec, Result, SmearError, StyleFunction,
-    StyleInput, Stylize, Trajectories, DEFAULT_SMOOTH, DEFAULT_STILL_TOLERANCE,
-    STILL_ROUNDING_FACTOR,
+    causal_smoothing_weights, Collider, FunctionSpec, Result, SmearError, SpeedUnits,
+    StyleFunction, StyleInput, StyleUnits, Stylize, Trajectories, DEFAULT_SMOOTH,
+    DEFAULT_STILL_TOLERANCE, STILL_ROUNDING_FACTOR,
 };
 
 /// Default number of past frames a [`Stream`] keeps for its trajectories.
@@ -44,10 +44,21 @@ pub struct StreamOptions {
     pub elongate: FunctionSpec,
     /// Past frames kept: β below −(history − 1) clamps to the oldest kept frame.
     pub history: usize,
-    /// A ground plane `y = ground` the result never goes below (collider meshes:
-    /// [`Stream::add_collider`]).
+    /// A ground plane `y = ground` (a length in `speed_units`) the result never goes below
+    /// (collider meshes: [`Stream::add_collider`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ground: Option<f32>,
+    /// What `elongate`'s speeds and lengths and `ground` are measured in, as in a style
+    /// (`docs/smear-units.md`): by default the character's size (speeds in sizes per second
+    /// at `fps`, lengths in sizes); `scene` keeps scene units per frame.
+    #[serde(skip_serializing_if = "SpeedUnits::is_size")]
+    pub speed_units: SpeedUnits,
+    /// One size unit in scene units (> 0). Without it: the bounding-box diagonal of the first
+    /// pushed frame — the stream's rest pose, as for arrays without a rest.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub size_reference: Option<f32>,
+    /// Frames per second of the pushed frames (size speeds are per second).
+    pub fps: f32,
 }
 
 impl Default for StreamOptions {
@@ -57,6 +68,9 @@ impl Default for StreamOptions {
             elongate: FunctionSpec::linear(1.0),
             history: DEFAULT_STREAM_HISTORY,
             ground: None,
+            speed_units: SpeedUnits::Size,
+            size_reference: None,
+            fps: anim::DEFAULT_FPS,
         }
     }
 }
@@ -84,6 +98,9 @@ impl Default for StreamOptions {
 pub struct Stream {
     triangles: Vec<[u32; 3]>,
     n: usize,
+    /// The elongation as given, compiled in the stream's units at the first push.
+    spec: FunctionSpec,
+    units: StreamUnits,
     function: StyleFunction,
     weights: Vec<f32>,
     ground: Option<f32>,
@@ -111,6 +128,7 @@ impl Stream {
     /// # Errors
     /// A style function that does not compile; `history` below 2.
     pub fn new(mesh: &Mesh, options: &StreamOptions) -> Result<Stream> {
+        let units = StreamUnits::new(options)?;
         let function = options
             .elongate
             .compile()
@@ -129,6 +147,8 @@ impl Stream {
         Ok(Stream {
             triangles: mesh.triangles.clone(),
             n,
+            spec: options.elongate.clone(),
+            units,
             function,
             weights: causal_smoothing_weights(options.smooth),
             ground: options.ground.filter(|g| g.is_finite()),
@@ -185,6 +205,7 @@ impl Stream {
         if self.pushed == 0 {
             self.rest = positions.to_vec();
             self.still = Some(still_tolerance(positions));
+            self.start(positions)?;
         }
         if self.kept == self.history {
             self.positions.copy_within(n.., 0);
@@ -265,6 +286,68 @@ impl Stream {
         // infinite at some vertex is reported with the frame and the vertex.
         self.function.check_finite("vertex")?;
         Ok(&self.out)
+    }
+
+    /// The first frame fixes the size unit: the elongation and the ground are compiled into
+    /// scene units once (`docs/smear-units.md`).
+    fn start(&mut self, first: &[Vec3]) -> Result<()> {
+        let Some(units) = self.units.resolve(first) else {
+            return Ok(());
+        };
+        self.function =
+            self.spec
+                .compile_in(&units, 1.0)
+                .map_err(|e| SmearError::InvalidParameter {
+                    name: "elongate",
+                    reason: e.to_string(),
+                })?;
+        self.ground = self.ground.map(|g| units.length_to_scene(g));
+        Ok(())
+    }
+}
+
+/// A stream's units before its first frame: scene units, or sizes per second at `fps` with
+/// the size given or to be measured on the first frame.
+#[derive(Debug, Clone, Copy)]
+enum StreamUnits {
+    Scene,
+    Size { size: Option<f32>, fps: f32 },
+}
+
+impl StreamUnits {
+    fn new(options: &StreamOptions) -> Result<StreamUnits> {
+        if options.speed_units == SpeedUnits::Scene {
+            return Ok(StreamUnits::Scene);
+        }
+        if !(options.fps.is_finite() && options.fps > 0.0) {
+            return Err(SmearError::InvalidParameter {
+                name: "fps",
+                reason: format!("give a frame rate > 0, got {}", options.fps),
+            });
+        }
+        if let Some(s) = options.size_reference {
+            if !(s.is_finite() && s > 0.0) {
+                return Err(SmearError::InvalidParameter {
+                    name: "size_reference",
+                    reason: format!("a size reference length must be > 0, got {s}"),
+                });
+            }
+        }
+        Ok(StreamUnits::Size {
+            size: options.size_reference,
+            fps: options.fps,
+        })
+    }
+
+    /// The conversion for a stream whose first frame is `first`; `None` in scene units.
+    fn resolve(&self, first: &[Vec3]) -> Option<StyleUnits> {
+        match *self {
+            StreamUnits::Scene => None,
+            StreamUnits::Size { size, fps } => {
+                let size = size.unwrap_or_else(|| anim::Aabb::from_points(first).diagonal());
+                Some(StyleUnits::size(size as f64, fps as f64))
+            }
+        }
     }
 }
 

@@ -275,11 +275,21 @@ pub struct LibraryOptionsArgs {
     /// The printer's thinnest wall in millimetres: thinner walls of a piece or mount are
     /// reported (a warning naming the pieces and the fix, report.json
     /// "printing.printability"); magnet pockets keep at least this much material around.
-    #[arg(long, value_name = "MM", default_value_t = crate::DEFAULT_MIN_WALL_MM)]
+    #[arg(
+        long,
+        value_name = "MM",
+        default_value_t = crate::DEFAULT_MIN_WALL_MM,
+        allow_negative_numbers = true
+    )]
     pub min_wall: f64,
     /// The printer's smallest free-standing feature in millimetres: smaller embossed IDs,
     /// keys or plug pins are reported.
-    #[arg(long, value_name = "MM", default_value_t = crate::DEFAULT_MIN_FEATURE_MM)]
+    #[arg(
+        long,
+        value_name = "MM",
+        default_value_t = crate::DEFAULT_MIN_FEATURE_MM,
+        allow_negative_numbers = true
+    )]
     pub min_feature: f64,
     /// Printer resolution in millimetres: pieces that differ from a sibling by less are
     /// reported (a warning and report.json "printing.parts[].below_resolution").

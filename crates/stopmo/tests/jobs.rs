@@ -63,7 +63,8 @@ fn segment_then_library_on_a_tube_gives_the_spec_layout() {
         assert_eq!(p.surface.vertex_count(), parts[p.part].vertex_count());
     }
     // The reconstruction shows each frame's piece.
-    for (part, recon) in lib.reconstruction.iter().enumerate() {
+    for part in 0..lib.reconstruction.len() {
+        let recon = lib.reconstruction_of(part).expect("a reconstruction");
         let sol = &lib.library.parts[part].solution;
         for f in [0, 17, 35] {
             assert_eq!(recon.frame(f), &sol.pieces[sol.labels[f] as usize][..]);
@@ -127,10 +128,10 @@ fn segment_then_library_on_a_tube_gives_the_spec_layout() {
         .unwrap()
         .data
     {
-        FileData::PointCache(a) => {
-            assert_eq!(a.frame_count(), 36);
+        FileData::Shapes { parts: shown, rest } => {
+            assert!(shown.iter().all(|s| s.shown.len() == 36));
             assert_eq!(
-                a.vertex_count(),
+                rest.vertex_count(),
                 parts.iter().map(|p| p.vertex_count()).sum::<usize>()
             );
         }

@@ -63,8 +63,8 @@ fn a_curve_point_builds_the_same_library_as_the_library_job_of_that_size() {
     assert_eq!(picked.pieces.len(), 6);
     assert_eq!(picked.frame_ids(), direct.frame_ids());
     assert_eq!(
-        picked.reconstruction[1].positions(),
-        direct.reconstruction[1].positions()
+        picked.reconstruction_of(1).unwrap().positions(),
+        direct.reconstruction_of(1).unwrap().positions()
     );
     let files: Vec<String> = picked
         .files()

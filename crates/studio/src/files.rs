@@ -9,7 +9,7 @@ use tkio::{LoadOptions, Loaded};
 use crate::error::{ApiError, ApiResult, StudioError};
 
 /// Frames per second the studio samples clips at (the CLI's default).
-pub const FPS: f32 = 24.0;
+pub const FPS: f32 = anim::DEFAULT_FPS;
 
 /// Longest file name accepted for an export.
 pub const MAX_NAME_LEN: usize = 200;
@@ -107,9 +107,45 @@ pub fn merged(label: &str, sampled: &SampledScene) -> ApiResult<MeshAnimation> {
     if sampled.objects.is_empty() {
         return Err(ApiError::bad(format!("{label}: the file has no mesh")));
     }
-    sampled
-        .merged(label)
-        .map_err(|e| ApiError::bad(format!("{label}: {e}")))
+    sampled.merged(label).map_err(|e| {
+        let over = matches!(e, anim::AnimError::OverBudget(_));
+        ApiError::refused(format!("{label}: {e}"), over)
+    })
+}
+
+/// A clip sampled once, with its objects merged: a scene of one object is its own merged
+/// cache (borrowed, not copied: a face of 1,440 frames is 160 MB), several are merged once.
+#[derive(Debug)]
+pub struct Clip {
+    /// The sampled clip.
+    pub sampled: SampledScene,
+    /// The objects merged, when there are several.
+    several: Option<MeshAnimation>,
+}
+
+impl Clip {
+    /// Merges the objects of `sampled` (a file without mesh is refused).
+    pub fn new(label: &str, sampled: SampledScene) -> ApiResult<Clip> {
+        let several = match sampled.objects.len() {
+            0 => return Err(ApiError::bad(format!("{label}: the file has no mesh"))),
+            1 => None,
+            _ => Some(merged(label, &sampled)?),
+        };
+        Ok(Clip { sampled, several })
+    }
+
+    /// Every object's vertices as one cache, in object order.
+    pub fn merged(&self) -> &MeshAnimation {
+        match &self.several {
+            Some(m) => m,
+            None => &self.sampled.objects[0].animation,
+        }
+    }
+
+    /// The merged positions as float32 coordinates (for [`crate::pack::Pack::shared`]).
+    pub fn coordinates(&self) -> &[f32] {
+        crate::pack::coordinates(self.merged().positions())
+    }
 }
 
 /// Makes (if needed) and canonicalizes the output folder.

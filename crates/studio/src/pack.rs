@@ -6,7 +6,15 @@
 //! `"buffers": [{"name", "type": "f32"|"u32", "offset", "count"}]` (offset in bytes from the
 //! start of the data, count in elements), so the page can view each one as a typed array
 //! without copying.
+//!
+//! The response body goes out as chunks (the header, then the buffers as written), so a
+//! clip of a few hundred megabytes is neither copied into one more buffer at the end nor,
+//! for buffers [`Pack::shared`] hands over, copied at all: the server's peak memory stays
+//! near what it holds anyway.
 
+use std::convert::Infallible;
+
+use axum::body::{Body, Bytes};
 use axum::http::header;
 use axum::response::{IntoResponse, Response};
 use serde_json::{json, Map, Value};
@@ -15,7 +23,12 @@ use serde_json::{json, Map, Value};
 #[derive(Debug, Default)]
 pub struct Pack {
     entries: Vec<Value>,
+    /// Finished chunks of the data, in order.
+    chunks: Vec<Bytes>,
+    /// The chunk being written.
     data: Vec<u8>,
+    /// Bytes in `chunks`.
+    written: usize,
 }
 
 impl Pack {
@@ -24,9 +37,14 @@ impl Pack {
         Pack::default()
     }
 
+    /// The offset of the next buffer from the start of the data.
+    fn offset(&self) -> usize {
+        self.written + self.data.len()
+    }
+
     /// Adds a float32 buffer.
     pub fn f32(&mut self, name: &str, values: impl IntoIterator<Item = f32>) -> &mut Pack {
-        let offset = self.data.len();
+        let offset = self.offset();
         let mut count = 0usize;
         for v in values {
             self.data.extend_from_slice(&v.to_le_bytes());
@@ -42,7 +60,11 @@ impl Pack {
         name: &str,
         slices: impl IntoIterator<Item = &'a [f32]>,
     ) -> &mut Pack {
-        let offset = self.data.len();
+        let offset = self.offset();
+        let slices: Vec<&[f32]> = slices.into_iter().collect();
+        // Reserved exactly: a growing buffer would hold its old and new block at once.
+        self.data
+            .reserve_exact(4 * slices.iter().map(|s| s.len()).sum::<usize>());
         let mut count = 0usize;
         for s in slices {
             if cfg!(target_endian = "little") {
@@ -55,9 +77,41 @@ impl Pack {
         self.entry(name, "f32", offset, count)
     }
 
+    /// Adds a float32 buffer without copying it: `owner` keeps the values alive until the
+    /// response is sent (e.g. a clip the server holds anyway, behind an `Arc`), `values`
+    /// reads them.
+    pub fn shared<T: Send + 'static>(
+        &mut self,
+        name: &str,
+        owner: T,
+        values: fn(&T) -> &[f32],
+    ) -> &mut Pack {
+        let offset = self.offset();
+        let count = values(&owner).len();
+        if cfg!(target_endian = "little") {
+            self.flush();
+            self.written += 4 * count;
+            self.chunks
+                .push(Bytes::from_owner(F32Bytes { owner, values }));
+        } else {
+            let v = values(&owner);
+            self.data.extend(v.iter().flat_map(|v| v.to_le_bytes()));
+        }
+        self.entry(name, "f32", offset, count)
+    }
+
+    /// Ends the chunk being written.
+    fn flush(&mut self) {
+        if !self.data.is_empty() {
+            let data = std::mem::take(&mut self.data);
+            self.written += data.len();
+            self.chunks.push(Bytes::from(data));
+        }
+    }
+
     /// Adds a uint32 buffer.
     pub fn u32(&mut self, name: &str, values: impl IntoIterator<Item = u32>) -> &mut Pack {
-        let offset = self.data.len();
+        let offset = self.offset();
         let mut count = 0usize;
         for v in values {
             self.data.extend_from_slice(&v.to_le_bytes());
@@ -73,8 +127,10 @@ impl Pack {
         self
     }
 
-    /// The bytes: `header` (a JSON object) gains `"buffers"`.
-    pub fn finish(self, header: Value) -> Vec<u8> {
+    /// The header chunk (length and JSON) and the data chunks: `header` (a JSON object) gains
+    /// `"buffers"`.
+    fn chunks(mut self, header: Value) -> Vec<Bytes> {
+        self.flush();
         let mut object = match header {
             Value::Object(m) => m,
             other => {
@@ -88,20 +144,45 @@ impl Pack {
         while !text.len().is_multiple_of(4) {
             text.push(b' ');
         }
-        let mut out = Vec::with_capacity(4 + text.len() + self.data.len());
-        out.extend_from_slice(&(text.len() as u32).to_le_bytes());
-        out.extend_from_slice(&text);
-        out.extend_from_slice(&self.data);
+        let mut head = Vec::with_capacity(4 + text.len());
+        head.extend_from_slice(&(text.len() as u32).to_le_bytes());
+        head.extend_from_slice(&text);
+        let mut out = Vec::with_capacity(1 + self.chunks.len());
+        out.push(Bytes::from(head));
+        out.extend(self.chunks);
         out
     }
 
-    /// The bytes as an `application/octet-stream` response.
+    /// The bytes in one buffer (tests and tools; a response sends the chunks as they are).
+    pub fn finish(self, header: Value) -> Vec<u8> {
+        self.chunks(header).concat()
+    }
+
+    /// The bytes as an `application/octet-stream` response, sent chunk by chunk.
     pub fn response(self, header: Value) -> Response {
+        let chunks = self.chunks(header);
+        let length: usize = chunks.iter().map(Bytes::len).sum();
+        let stream = futures_util::stream::iter(chunks.into_iter().map(Ok::<_, Infallible>));
         (
-            [(header::CONTENT_TYPE, "application/octet-stream")],
-            self.finish(header),
+            [
+                (header::CONTENT_TYPE, "application/octet-stream".to_string()),
+                (header::CONTENT_LENGTH, length.to_string()),
+            ],
+            Body::from_stream(stream),
         )
             .into_response()
+    }
+}
+
+/// A float32 buffer's bytes borrowed from the value that holds it ([`Pack::shared`]).
+struct F32Bytes<T> {
+    owner: T,
+    values: fn(&T) -> &[f32],
+}
+
+impl<T> AsRef<[u8]> for F32Bytes<T> {
+    fn as_ref(&self) -> &[u8] {
+        bytemuck::cast_slice((self.values)(&self.owner))
     }
 }
 
@@ -127,6 +208,23 @@ pub fn read_f32(bytes: &[u8], name: &str) -> Option<(Value, Vec<f32>)> {
     Some((header, values))
 }
 
+/// Reads a pack back: the named uint32 buffer (for tests and tools).
+pub fn read_u32(bytes: &[u8], name: &str) -> Option<Vec<u32>> {
+    let (header, data) = split(bytes)?;
+    let entry = header["buffers"]
+        .as_array()?
+        .iter()
+        .find(|b| b["name"] == name && b["type"] == "u32")?;
+    let offset = entry["offset"].as_u64()? as usize;
+    let count = entry["count"].as_u64()? as usize;
+    let raw = data.get(offset..offset + count * 4)?;
+    Some(
+        raw.chunks_exact(4)
+            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect(),
+    )
+}
+
 /// Splits a pack into its header and data.
 pub fn split(bytes: &[u8]) -> Option<(Value, &[u8])> {
     let len = u32::from_le_bytes(bytes.get(..4)?.try_into().ok()?) as usize;
@@ -143,10 +241,16 @@ mod tests {
         let mut p = Pack::new();
         p.u32("tri", [0, 1, 2]).f32("pos", [1.5, -2.0]);
         p.f32_slices("frames", [&[0.25f32, 3.0][..], &[-7.5][..]]);
+        let held = std::sync::Arc::new(vec![4.0f32, 5.0, 6.0]);
+        p.shared("held", held.clone(), |v| &v[..]);
+        p.u32("after", [9]);
         let bytes = p.finish(json!({"frames": 3}));
         let (header, pos) = read_f32(&bytes, "pos").unwrap();
         assert_eq!(pos, vec![1.5, -2.0]);
         assert_eq!(read_f32(&bytes, "frames").unwrap().1, vec![0.25, 3.0, -7.5]);
+        assert_eq!(read_f32(&bytes, "held").unwrap().1, *held);
+        assert_eq!(header["buffers"][3]["offset"], 32);
+        assert_eq!(header["buffers"][4]["offset"], 44);
         assert_eq!(header["frames"], 3);
         assert_eq!(header["buffers"][1]["offset"], 12);
         let len = u32::from_le_bytes(bytes[..4].try_into().unwrap()) as usize;

@@ -5,10 +5,8 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
-use anim::SampledScene;
-
 use crate::error::{ApiError, ApiResult};
-use crate::files::OpenedFile;
+use crate::files::{Clip, OpenedFile};
 use crate::jobs::Jobs;
 pub use crate::lock::lock;
 
@@ -30,9 +28,9 @@ pub struct LoaSession {
     pub scene: anim::Scene,
     /// The synthesized joint motion.
     pub motion: loa::animate::Motion,
-    /// The character's merged mesh per motion frame (f32, frames × vertices × 3), for the
-    /// page's second request (`GET /api/loa/motion`).
-    pub positions: Vec<f32>,
+    /// The character's meshes merged, every motion frame (`GET /api/loa/motion`), shared
+    /// with the answers that send it.
+    pub merged: Arc<anim::MeshAnimation>,
     /// Counts the animate requests: a page asking for the motion of an older one is refused.
     pub version: u64,
 }
@@ -58,7 +56,7 @@ pub struct Studio {
     pub files: Vec<OpenedFile>,
     /// The canonical output folder (the only place it writes).
     pub out_dir: PathBuf,
-    sampled: Mutex<HashMap<ClipKey, Arc<SampledScene>>>,
+    sampled: Mutex<HashMap<ClipKey, Arc<Clip>>>,
     prepared: Mutex<HashMap<ClipKey, Arc<smear::Prepared>>>,
     preparing: Mutex<()>,
     /// The last line of action.
@@ -94,16 +92,22 @@ impl Studio {
         })
     }
 
-    /// The clip `clip` of file `index`, sampled once.
-    pub fn sampled(&self, index: usize, clip: &str) -> ApiResult<Arc<SampledScene>> {
+    /// The clip `clip` of file `index`, sampled once (until [`Studio::forget_clip`]).
+    pub fn sampled(&self, index: usize, clip: &str) -> ApiResult<Arc<Clip>> {
         let key = (index, clip.to_string());
         if let Some(s) = lock(&self.sampled).get(&key) {
             return Ok(s.clone());
         }
         let file = self.file(index)?;
-        let s = Arc::new(file.sample(Some(clip))?);
+        let s = Arc::new(Clip::new(&file.label(), file.sample(Some(clip))?)?);
         lock(&self.sampled).insert(key, s.clone());
         Ok(s)
+    }
+
+    /// Drops the sampled clip from the cache (a request holding it keeps it until done): a
+    /// stopmo segmentation's parts hold the same frames, and a large clip is not kept twice.
+    pub fn forget_clip(&self, index: usize, clip: &str) {
+        lock(&self.sampled).remove(&(index, clip.to_string()));
     }
 
     /// The smear offsets of file `index`, clip `clip`: `smear::prepare` runs once per file
@@ -116,8 +120,11 @@ impl Studio {
         }
         let sampled = self.sampled(index, clip)?;
         let label = self.file(index)?.label();
-        let p = smear::prepare((*sampled).clone(), &smear::PrepareOptions::default())
-            .map_err(|e| ApiError::bad(format!("{label}: {e}")))?;
+        let p = smear::prepare(sampled.sampled.clone(), &smear::PrepareOptions::default())
+            .map_err(|e| {
+                let over = matches!(e, smear::SmearError::OverBudget(_));
+                ApiError::refused(format!("{label}: {e}"), over)
+            })?;
         let p = Arc::new(p);
         lock(&self.prepared).insert(key, p.clone());
         Ok(p)

@@ -426,6 +426,15 @@ async fn two_seeds_give_two_parts_on_a_worker_thread() {
     .await;
     assert_eq!(status, StatusCode::BAD_REQUEST);
     error_of(&body);
+    // A seed past the mesh is the request's error, before any job starts.
+    let past = json!({"file": 1, "seeds": [[top], [4_000_000_000u32]]});
+    let (status, body) = send(&app, post("/api/stopmo/segment", past)).await;
+    assert_eq!(status, StatusCode::BAD_REQUEST);
+    assert!(
+        error_of(&body).contains("triangle 4000000000 of part 2 is past the mesh's"),
+        "{}",
+        String::from_utf8_lossy(&body)
+    );
     let (status, _) = send(&app, post("/api/jobs/999/cancel", json!({}))).await;
     assert_eq!(status, StatusCode::NOT_FOUND);
 }

@@ -146,15 +146,34 @@ async fn segment_curve_build_reconstruct_and_export_the_library_folder() {
     assert_eq!(built["total_pieces"], 4);
     let frame_ids: Vec<Vec<String>> = serde_json::from_value(built["frame_ids"].clone()).unwrap();
 
-    // The reconstruction: every part merged, the assembly's piece on every frame.
+    // The reconstruction: every part merged, the assembly's piece on every frame — sent as
+    // the pieces and the piece of every frame, expanded here as the page does.
     let (status, recon) = c.call("GET", "/api/stopmo/reconstruction", None).await;
     assert_eq!(status, StatusCode::OK);
-    let (header, positions) = pack::read_f32(&recon, "positions").unwrap();
+    let (header, pieces) = pack::read_f32(&recon, "pieces").unwrap();
+    let labels = pack::read_u32(&recon, "labels").unwrap();
     let frames = header["frames"].as_u64().unwrap() as usize;
     let vertices = header["vertices"].as_u64().unwrap() as usize;
+    let part_vertices: Vec<usize> =
+        serde_json::from_value(header["part_vertices"].clone()).unwrap();
+    let part_pieces: Vec<usize> = serde_json::from_value(header["part_pieces"].clone()).unwrap();
     assert_eq!(header["frame_ids"], built["frame_ids"]);
     assert_eq!(frame_ids.len(), frames);
-    assert_eq!(positions.len(), frames * vertices * 3);
+    assert_eq!(part_vertices.iter().sum::<usize>(), vertices);
+    assert_eq!(part_pieces, [2, 2]);
+    let sizes = part_vertices.iter().zip(&part_pieces);
+    assert_eq!(pieces.len(), sizes.map(|(v, p)| v * p * 3).sum::<usize>());
+    assert_eq!(labels.len(), frames * part_vertices.len());
+    let mut positions = Vec::with_capacity(frames * vertices * 3);
+    for f in 0..frames {
+        let mut start = 0;
+        for (i, (&n, &p)) in part_vertices.iter().zip(&part_pieces).enumerate() {
+            let k = labels[f * part_vertices.len() + i] as usize;
+            assert!(k < p, "frame {f}: piece {k} of {p}");
+            positions.extend_from_slice(&pieces[start + k * n * 3..start + (k + 1) * n * 3]);
+            start += p * n * 3;
+        }
+    }
     // Two pieces per part: some frames show different pieces, and frames showing the same
     // pieces show the same geometry (a replacement face, not the animation).
     let frame = |f: usize| &positions[f * vertices * 3..(f + 1) * vertices * 3];

@@ -35,7 +35,6 @@ export class LoaPanel {
 
   deactivate() {
     this.active = false;
-    if (this.restCtl) { this.restCtl.abort(); this.restCtl = null; }
     this.overlay.classList.remove('drawing');
     this.ctx.clearRect(0, 0, this.overlay.width, this.overlay.height);
     this.studio.view.setActionCamera(null);
@@ -67,9 +66,7 @@ export class LoaPanel {
   onFrame(f) {
     const r = this.result;
     if (!r) return;
-    // Until the whole motion has arrived the view holds one frame: the one drawn on.
-    const whole = r.buffers.positions.length === r.header.motion.frames * r.header.motion.vertices * 3;
-    this.studio.view.setFrame(whole ? f - r.header.motion.first_frame : 0);
+    this.studio.view.setFrame(f - r.header.motion.first_frame);
   }
 
   point(e) {
@@ -168,48 +165,26 @@ export class LoaPanel {
         height: this.overlay.clientHeight,
         keystrokes: this.keys.map((k) => ({ frame: k.frame, points: k.points, stiffness: k.stiffness, damping: k.damping, bones: k.bones })),
         wobbles: this.wobbles,
-        frame: s.frame,
       };
-      if (this.restCtl) { this.restCtl.abort(); this.restCtl = null; }
-      // The line (all frames, small) and the character at the current frame first.
+      // One answer: the line (every frame) and the character's whole motion, as float32.
       const r = await getPack('/api/loa/animate', body);
       this.result = r;
       s.showError('');
       const h = r.header;
-      // The whole motion is asked for at once (the server keeps it since this answer).
-      this.loadRest(r, t0);
       s.view.setAnimation({ triangles: r.buffers.triangles, positions: r.buffers.positions, frames: h.motion.positions_frames, vertices: h.motion.vertices }, { frame: false });
       s.setTimeline(Math.max(TIMELINE, h.line.first_frame + h.line.frames + 12), 24);
       this.onFrame(s.frame);
       await s.view.rendered();
       const ms = performance.now() - t0;
-      s.stats.loa.push({ ms, server_ms: h.seconds.total * 1000, bytes: r.bytes });
-      $('loa-report').textContent = `line + character in ${ms.toFixed(0)} ms (line ${(h.seconds.line * 1000).toFixed(0)} ms, motion ${(h.seconds.animate * 1000).toFixed(0)} ms)\n` + loaSummary(h);
+      const stat = { ms, server_ms: h.seconds.total * 1000, bytes: r.bytes };
+      s.stats.loa.push(stat);
+      s.stats.loaAll.push(stat);
+      $('loa-report').textContent = loaSummary(h) + `\n\nredrawn in ${ms.toFixed(0)} ms: line ${(h.seconds.line * 1000).toFixed(0)} ms, motion ${(h.seconds.animate * 1000).toFixed(0)} ms on the server, ${(r.bytes / 1048576).toFixed(1)} MiB`;
     } catch (e) {
       s.showError(e.message);
     } finally {
       this.inflight = false;
       if (this.pending !== undefined && this.pending !== null) { const t = this.pending; this.pending = null; this.update(t); }
-    }
-  }
-
-  /** The character's motion at every frame of answer `r`, in the background (a newer stroke aborts it). */
-  async loadRest(r, t0) {
-    const s = this.studio, h = r.header;
-    const ctl = new AbortController();
-    this.restCtl = ctl;
-    try {
-      const m = await getPack(`/api/loa/motion?version=${h.version}`, undefined, ctl.signal);
-      if (this.result !== r) return;
-      r.buffers.positions = m.buffers.positions;
-      s.view.setAnimation({ triangles: r.buffers.triangles, positions: m.buffers.positions, frames: h.motion.frames, vertices: h.motion.vertices }, { frame: false });
-      this.onFrame(s.frame);
-      await s.view.rendered();
-      s.stats.loaAll.push({ ms: performance.now() - t0, bytes: m.bytes });
-    } catch (e) {
-      if (e.name !== 'AbortError' && this.result === r) s.showError(e.message);
-    } finally {
-      if (this.restCtl === ctl) this.restCtl = null;
     }
   }
 

@@ -64,13 +64,14 @@ export function smearSummary(report, frames, height) {
 export function loaSummary(h) {
   const r = h.report;
   const pct = (x) => `${(x * 100).toFixed(1)} %`;
+  const worst = r.line_distance_worst || { distance: 0, joint: '—', frame: 0 };
   const lines = [
     `line over ${count(h.line.frames, 'frame')} from ${count(h.line.keystroke_frames.length, 'keystroke')}; character ${count(h.motion.frames, 'frame')} at ${h.motion.fps} fps`,
-    `the body follows the line within ${pct(r.line_distance_mean)} of its length on average (worst frame ${pct(r.line_distance_max)})`,
+    `the body follows the line within ${pct(r.line_distance_mean)} of its length on average (95 % of the points within ${pct(r.line_distance_p95)}; farthest: ${worst.joint} at frame ${worst.frame}, ${pct(worst.distance)})`,
     `largest joint turn between two frames: ${(r.max_rotation_step * 180 / Math.PI).toFixed(1)}°; body height ${sig(r.height)} units`,
   ];
   const warnings = [...h.warnings];
-  if (r.line_distance_max > 0.25) warnings.push('the body is far from the line on some frames: draw the stroke closer to the character, or raise the keystroke\'s stiffness.');
+  if (worst.distance > 0.25) warnings.push('the body is far from the line on some frames: draw the stroke closer to the character, or raise the keystroke\'s stiffness.');
   if (r.max_rotation_step > Math.PI / 4) warnings.push('a joint turns more than 45° between two frames: space the keystrokes further apart or raise the damping.');
   return lines.concat(warnings.map((w) => `⚠ ${w}`)).join('\n');
 }

@@ -313,10 +313,12 @@ export class SmearPanel {
     try {
       const r = await rest;
       if (gen !== this.gen) return;
+      const fetched = performance.now();
       this.restCtl = null;
       this.apply(r);
+      const applied = performance.now();
       await s.view.rendered();
-      s.stats.smearAll.push({ ms: performance.now() - t0, server_ms: r.header.seconds * 1000, bytes: r.bytes });
+      s.stats.smearAll.push({ ms: performance.now() - t0, server_ms: r.header.seconds * 1000, bytes: r.bytes, frames: r.header.frames, fetch_ms: fetched - t0, apply_ms: applied - fetched, draw_ms: performance.now() - applied });
       $('smear-report').textContent += `\nall ${r.header.frames} frames in ${(performance.now() - t0).toFixed(0)} ms (server ${(r.header.seconds * 1000).toFixed(0)} ms, ${(r.bytes / 1048576).toFixed(1)} MiB)\n` + smearSummary(r.header.report, r.header.frames, this.anim.height);
     } catch (e) {
       if (e.name !== 'AbortError' && gen === this.gen) s.showError(e.message);

@@ -8,6 +8,9 @@ import { getJSON, getPack, postJSON } from './api.js';
 import { segmentSummary } from './report.js';
 
 const $ = (id) => document.getElementById(id);
+
+/** The jobs as the panel names them. */
+const JOB_NAMES = { 'stopmo.segment': 'segmentation', 'stopmo.curve': 'size curve', 'stopmo.build': 'library' };
 const COLORS = [[0.95, 0.55, 0.3], [0.35, 0.6, 0.95], [0.45, 0.85, 0.45], [0.9, 0.8, 0.3], [0.8, 0.45, 0.85], [0.4, 0.85, 0.85]];
 
 export class StopmoPanel {
@@ -78,7 +81,7 @@ export class StopmoPanel {
   }
 
   list() {
-    $('stopmo-seeds').textContent = this.seeds.map((s, i) => `part ${i + 1}: ${s.length ? 'triangles ' + s.join(', ') : 'no seed yet'}`).join('\n');
+    $('stopmo-seeds').textContent = this.seeds.map((s, i) => `part ${i + 1}: ${s.length ? `${s.length} seed${s.length === 1 ? '' : 's'} placed` : 'no seed yet — click the face'}`).join('\n');
   }
 
   /** Colours vertices by part (seam vertices dark) and marks seed triangles white. */
@@ -112,7 +115,8 @@ export class StopmoPanel {
       this.colour(this.labels);
       this.setSeams(r);
       $('stopmo-curve').disabled = false;
-      $('stopmo-report').textContent += '\n' + segmentSummary(r.summary, this.anim && this.anim.height);
+      this.segmentText = segmentSummary(r.summary, this.anim && this.anim.height);
+      $('stopmo-report').textContent += '\n' + this.segmentText;
     });
   }
 
@@ -134,7 +138,10 @@ export class StopmoPanel {
     try {
       const st = await getJSON(`/api/jobs/${id}`);
       $('stopmo-progress').value = st.progress;
-      $('stopmo-report').textContent = `job ${id} (${st.kind}): ${st.state}, ${st.stage} (${st.seconds.toFixed(1)} s)`;
+      const what = JOB_NAMES[st.kind] || st.kind;
+      const line = st.state === 'running' ? `${what}: ${st.stage}… ${st.seconds.toFixed(1)} s` : `${what} ${st.state === 'done' ? 'done' : st.state} in ${st.seconds.toFixed(1)} s`;
+      // The segmentation's summary stays in sight under the later jobs' progress.
+      $('stopmo-report').textContent = line + (this.segmentText && st.kind !== 'stopmo.segment' ? '\n' + this.segmentText : '');
       if (st.state === 'running') { setTimeout(() => this.poll(done), 200); return; }
       this.job = null;
       $('stopmo-cancel').disabled = true;
@@ -223,7 +230,7 @@ export class StopmoPanel {
       const { header, buffers } = await getPack('/api/stopmo/reconstruction');
       this.setReconstruction(header, buffers);
       this.built = r;
-      $('stopmo-built').textContent = `library of ${r.pieces} pieces per part (${r.total_pieces} in all${r.printed ? '' : ', surfaces only'}): mean error ${r.errors_mm.position_mean.toFixed(3)} mm, max ${r.errors_mm.position_max.toFixed(3)} mm` + (r.warnings.length ? '\n' + r.warnings.join('\n') : '');
+      $('stopmo-built').textContent = `library of ${r.pieces} pieces per part (${r.total_pieces} in all${r.printed ? '' : ', surfaces only'}): mean error ${r.errors_mm.position_mean.toFixed(3)} mm, max ${r.errors_mm.position_max.toFixed(3)} mm` + r.warnings.map((w) => `\n⚠ ${w}`).join('');
       $('stopmo-export').disabled = false;
     });
   }
@@ -267,7 +274,11 @@ export class StopmoPanel {
       view.controls.update();
       this.framed = true;
     }
-    this.recon = { mesh, header, positions: buffers.positions };
+    // Where each part's pieces start in `pieces` and its vertices in the merged mesh.
+    const starts = [], at = [];
+    let p0 = 0, v0 = 0;
+    header.part_vertices.forEach((n, i) => { starts.push(p0); at.push(v0); p0 += header.part_pieces[i] * n * 3; v0 += n * 3; });
+    this.recon = { mesh, header, pieces: buffers.pieces, labels: buffers.labels, starts, at };
     this.placeReconstruction();
   }
 
@@ -281,10 +292,14 @@ export class StopmoPanel {
 
   placeReconstruction() {
     if (!this.recon) return;
-    const { mesh, header, positions } = this.recon;
-    const f = Math.min(this.studio.frame, header.frames - 1), n = header.vertices * 3;
+    const { mesh, header, pieces, labels, starts, at } = this.recon;
+    const f = Math.min(this.studio.frame, header.frames - 1), parts = header.part_vertices.length;
     const pos = mesh.geometry.attributes.position;
-    pos.array.set(positions.subarray(f * n, (f + 1) * n));
+    // Each part shows its frame's piece (the library's labels): a copy of that piece.
+    header.part_vertices.forEach((n, i) => {
+      const k = labels[f * parts + i], from = starts[i] + k * n * 3;
+      pos.array.set(pieces.subarray(from, from + n * 3), at[i]);
+    });
     pos.needsUpdate = true;
     mesh.geometry.computeVertexNormals();
     this.ids = header.frame_ids[f];

@@ -4,7 +4,8 @@
 //! crate's; this command gives the runner the tool: each output's command line runs in this
 //! process, through the same parser and dispatcher as the `toonkit` binary, so every command
 //! and option of the tools works in a manifest. A failing shot is reported and the others go
-//! on; the exit code is the number of failed shots (capped at 100).
+//! on; the exit code is 2 when any shot failed (as for any bad input), and the report (`--json`)
+//! says which and why, per shot.
 
 use std::collections::HashMap;
 use std::io::IsTerminal;
@@ -26,6 +27,10 @@ use super::Context;
 
 /// Arguments of `toonkit batch`.
 #[derive(Debug, Args)]
+#[command(
+    after_help = "Exit code: 0 when every shot was made or skipped, 2 when any shot \
+failed (the others are still made; --json reports each shot's status and error)."
+)]
 pub(crate) struct BatchArgs {
     /// The manifest: `[[shot]]` tables with name, tool, input, clip, style, options, outputs.
     pub(crate) manifest: PathBuf,

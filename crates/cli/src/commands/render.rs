@@ -4,9 +4,9 @@
 
 use std::time::Instant;
 
+use crate::flags::render::{ColorArg, PreviewFlags};
 use anyhow::{anyhow, bail, Context as _, Result};
 use clap::Args;
-use render::args::{ColorArg, PreviewFlags};
 use render::ColorMap;
 use serde_json::json;
 

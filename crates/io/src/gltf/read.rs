@@ -147,6 +147,7 @@ fn convert(doc: &gltf::Document, buffers: &[&[u8]]) -> Result<Scene> {
             name: skin.name().unwrap_or_default().to_string(),
             joints,
             inverse_bind,
+            skeleton: skin.skeleton().map(|n| n.index()),
         });
     }
     for cam in doc.cameras() {

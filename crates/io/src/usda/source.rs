@@ -277,8 +277,9 @@ impl<'a> Source<'a> {
     /// sweeps each point along the path the frames show (a smear's in-betweens included).
     ///
     /// Per-frame meshes whose vertices change from frame to frame carry their own velocities
-    /// (units per frame, e.g. a subdivided smear's: the point cache's at the input's vertices,
-    /// blended inside the triangles), written per second; none for an absent frame.
+    /// (units per frame, e.g. a subdivided smear's: each vertex's own trajectory across the
+    /// in-betweens, as the point cache's at the input's vertices), written per second; none
+    /// for an absent frame.
     pub(crate) fn velocities(&self, f: usize) -> Vec<Vec3> {
         if let UsdGeometry::Frames {
             velocities: Some(v),

@@ -313,7 +313,12 @@ pub struct AnimateReport {
     pub line_distance_p95: f64,
     /// The single point farthest from the line, over every frame.
     pub line_distance_worst: WorstPoint,
-    /// Names of the measured points' joints (a leaf's tip is `NAME (tip)`), in joint order.
+    /// Names of the measured points' joints (a leaf's tip is `NAME (tip)`), in joint order:
+    /// every point of the bone sets' chains except the lower end of a branch connector —
+    /// where a chain turns from going up the skeleton to going down (the pelvis on a foot-to-
+    /// head chain), the joint below the turn (RobotExpressive's `UpperLegR`, the hip beside
+    /// the pelvis) hangs off the line by the pelvis's width and is neither constrained nor
+    /// measured.
     pub measured_joints: Vec<String>,
     /// Frames with no constrained point (no bone set in force there), left out of the
     /// distance figures.

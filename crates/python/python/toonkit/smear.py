@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import json
 import os
-from typing import Any, Callable, Iterable, Mapping, Optional, Union
+from typing import Any, Callable, Iterable, Mapping, Optional, Tuple, Union
 
 import numpy as np
 
@@ -188,6 +188,9 @@ def stream(
     elongate: Optional[Mapping[str, Any]] = None,
     history: int = 6,
     ground: Optional[float] = None,
+    fps: float = 24.0,
+    speed_units: str = "size",
+    size_reference: Optional[float] = None,
 ) -> Stream:
     """A streaming smear (past-only): ``s.push(positions)`` returns that frame's elongated
     in-between at once, from the frames pushed so far -- for games and live previews.
@@ -197,14 +200,26 @@ def stream(
     ``[elongate] function`` table (default ``{"stages": [{"op": "scale", "by": 1}]}``);
     ``history`` the past frames kept; ``ground`` a plane y = ground never crossed.
 
+    Units as in a style (docs/smear-units.md): with ``speed_units="size"`` (default) the
+    function's speeds are in character sizes per second at ``fps`` and its lengths (``x, y,
+    z``, noise, ``ground``) in sizes, one size being ``size_reference`` (scene units) or the
+    bounding-box diagonal of the first pushed frame; ``"scene"`` keeps scene units per frame.
+
     >>> s = toonkit.smear.stream(scene.triangles, scene.positions.shape[1])
     >>> out = s.push(scene.positions[0])
     """
-    options: dict = {"smooth": int(smooth), "history": int(history)}
+    options: dict = {
+        "smooth": int(smooth),
+        "history": int(history),
+        "fps": float(fps),
+        "speed_units": str(speed_units),
+    }
     if elongate is not None:
         options["elongate"] = dict(elongate)
     if ground is not None:
         options["ground"] = float(ground)
+    if size_reference is not None:
+        options["size_reference"] = float(size_reference)
     return _native.Stream(np.asarray(triangles), int(vertices), json.dumps(options))
 
 
@@ -212,6 +227,7 @@ def stylize(
     prepared: Prepared,
     style: Union[Mapping[str, Any], str, "os.PathLike[str]"],
     progress: Optional[Callable[[str, float], None]] = None,
+    frames: Optional[Tuple[int, int]] = None,
 ) -> Stylized:
     """Applies a style to prepared offsets (SMEAR Section 4 effects, Section 5 functions).
 
@@ -225,12 +241,18 @@ def stylize(
     per-vertex ``alpha``), ``.report`` and ``.save(path)`` (``.glb``, ``.usda``, ``.usdc``,
     ``.usdz`` or ``.abc``, as the CLI writes them). The GIL is released while computing.
 
+    ``frames=(start, end)`` stylizes clip frames ``start..end`` only (an interactive restyle
+    draws the frame on screen first): the result holds ``end - start`` frames, each equal to
+    that frame of the whole clip's, and ``.first_frame`` is ``start``.
+
     >>> look = toonkit.smear.stylize(prepared, {"multiples": {"past": 2, "future": 0}})
     >>> len(look.multiples)
     2
     """
+    if frames is not None:
+        frames = (int(frames[0]), int(frames[1]))
     if isinstance(style, Mapping):
-        return _native.smear_stylize(prepared, json.dumps(style), None, progress)
+        return _native.smear_stylize(prepared, json.dumps(style), None, progress, frames)
     if isinstance(style, (str, os.PathLike)):
-        return _native.smear_stylize(prepared, None, os.fspath(style), progress)
+        return _native.smear_stylize(prepared, None, os.fspath(style), progress, frames)
     raise TypeError(f"style must be a dict or a path, got {type(style).__name__}")

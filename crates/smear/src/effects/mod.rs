@@ -29,8 +29,8 @@ pub use multiples::{
 pub use seeds::{sample_surface, DEFAULT_SEED};
 pub use stylization::{StyleInput, Stylize};
 pub use subdivide::{
-    subdivide_frame, subdivide_moving_frame, SubdivisionStats, BEND, DEVIATION_SHARE,
-    MAX_SUBDIVISION_LEVELS,
+    subdivide_frame, subdivide_moving_frame, trajectory_velocities, AroundFrame, SubdivisionStats,
+    BEND, DEVIATION_SHARE, MAX_SUBDIVISION_LEVELS,
 };
 pub use trajectory::Trajectories;
 pub use weights::{attribute_weights, group_weights, surface_point_weights};

@@ -171,15 +171,15 @@ pub fn subdivide_frame(
     (out, stats)
 }
 
-/// [`subdivide_frame`] of a moving frame: also the velocity of every output vertex, the blend
-/// of `velocities` (one per input vertex, e.g. the central differences of the unsubdivided
-/// smear's frames) with the weights that place the vertex. The input's vertices keep their
-/// own velocity, so a renderer's motion blur of the subdivided smear agrees with the point
-/// cache's at every input vertex and is interpolated inside the triangles as the positions
-/// are.
-///
-/// # Panics
-/// When `velocities` has fewer values than `mesh` has vertices.
+/// A frame around a moving frame: its held frame and its elongation β per input vertex.
+pub type AroundFrame<'a> = (usize, &'a [f32]);
+
+/// [`subdivide_frame`] of a moving frame, with every output vertex also placed on the frames
+/// `around` it (`[before, after]`, `None` past an end of the clip): the same surface point —
+/// the same blend of input vertices — on those frames' in-betweens. Each vertex's velocity is
+/// then the derivative of its own trajectory ([`trajectory_velocities`]), consistent with the
+/// in-betweens it is placed on: a vertex placed on a curved smear moves with the curve, not
+/// as the average of its parents (whose velocity lies off the smear).
 pub fn subdivide_moving_frame(
     tr: &Trajectories<'_>,
     mesh: &Mesh,
@@ -187,11 +187,51 @@ pub fn subdivide_moving_frame(
     beta: &[f32],
     alpha: Option<(&[f32], [f32; 3])>,
     tolerance: f32,
-    velocities: &[Vec3],
-) -> (Mesh, Vec<Vec3>, SubdivisionStats) {
+    around: [Option<AroundFrame<'_>>; 2],
+) -> (Mesh, [Option<Vec<Vec3>>; 2], SubdivisionStats) {
     let (out, blends, stats) = subdivide(tr, mesh, h, beta, alpha, tolerance);
-    let v = blends.iter().map(|b| b.lerp(velocities)).collect();
-    (out, v, stats)
+    let placed = around.map(|a| {
+        a.map(|(h, beta)| {
+            blends
+                .iter()
+                .map(|b| place(tr, h, beta, b))
+                .collect::<Vec<Vec3>>()
+        })
+    });
+    (out, placed, stats)
+}
+
+/// Per-frame velocities (units per frame) of points at `current` that are at `around`
+/// (`[before, after]`) on the frames around: the central difference, one-sided at an end
+/// (zero when the clip has one frame) — as SPEC's velocities of a point cache.
+pub fn trajectory_velocities(current: &[Vec3], around: &[Option<Vec<Vec3>>; 2]) -> Vec<Vec3> {
+    let (before, after, span) = match around {
+        [Some(b), Some(a)] => (b.as_slice(), a.as_slice(), 2.0),
+        [Some(b), None] => (b.as_slice(), current, 1.0),
+        [None, Some(a)] => (current, a.as_slice(), 1.0),
+        [None, None] => (current, current, 1.0),
+    };
+    before
+        .iter()
+        .zip(after)
+        .map(|(b, a)| (*a - *b) / span)
+        .collect()
+}
+
+/// Where the surface point `b` (a blend of input vertices) lies on the in-between of held
+/// frame `h` elongated by `beta`: an input vertex on its own trajectory, a blend on the
+/// trajectory of its point (offset interpolated), lifted off the flat triangle as the smear.
+fn place(tr: &Trajectories<'_>, h: usize, beta: &[f32], b: &Blend) -> Vec3 {
+    if b.count() == 1 {
+        return tr.displaced(h, b.v[0] as usize, beta[b.v[0] as usize]);
+    }
+    let bb: f32 = b.support().map(|(v, w)| w * beta[v as usize]).sum();
+    let bb = if bb.is_finite() { bb } else { 0.0 };
+    let p: Vec3 = b
+        .support()
+        .map(|(v, w)| tr.seen_from(h, v as usize, h as f32 + bb) * w)
+        .sum();
+    tr.lifted(h, p)
 }
 
 /// [`subdivide_frame`], also returning every output vertex's blend of input vertices.
@@ -204,18 +244,7 @@ fn subdivide(
     tolerance: f32,
 ) -> (Mesh, Vec<Blend>, SubdivisionStats) {
     let rest = tr.frame(h);
-    let place = |b: &Blend| -> Vec3 {
-        if b.count() == 1 {
-            return tr.displaced(h, b.v[0] as usize, beta[b.v[0] as usize]);
-        }
-        let bb: f32 = b.support().map(|(v, w)| w * beta[v as usize]).sum();
-        let bb = if bb.is_finite() { bb } else { 0.0 };
-        let p: Vec3 = b
-            .support()
-            .map(|(v, w)| tr.seen_from(h, v as usize, h as f32 + bb) * w)
-            .sum();
-        tr.lifted(h, p)
-    };
+    let place = |b: &Blend| place(tr, h, beta, b);
     let mut blends: Vec<Blend> = (0..mesh.vertex_count() as u32).map(Blend::one).collect();
     let mut pos: Vec<Vec3> = blends.iter().map(place).collect();
     // Per triangle: its input triangle (for rest lengths).

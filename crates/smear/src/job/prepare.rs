@@ -169,6 +169,27 @@ pub struct SceneOffsets {
     pub report: PrepareReport,
 }
 
+/// Bytes per vertex and frame of the offsets a solve holds: raw and smoothed (f32).
+const OFFSET_BYTES: u64 = 8;
+
+/// Bytes per vertex and frame of a flipbook coloured by offset: position and RGBA (f32).
+const FLIPBOOK_VERTEX_BYTES: u64 = 12 + 16;
+
+/// Checks what a solve of `scene` will hold against [`anim::budget::DEFAULT_MAX_JOB_BYTES`]
+/// before it allocates: `position_copies` copies of the clip's positions, its offsets and
+/// `file_bytes` per vertex and frame of the file written.
+fn check_memory(scene: &SampledScene, position_copies: u64, file_bytes: u64) -> Result<()> {
+    let (frames, vertices) = (scene.frame_count, scene.vertex_count());
+    anim::budget::JobMemory::new()
+        .positions("copies of the clip", frames, vertices, position_copies)
+        .bytes(
+            "its offsets and their file",
+            anim::budget::product(&[frames as u64, vertices as u64, OFFSET_BYTES + file_bytes]),
+        )
+        .check("lower --fps or pick a shorter clip")?;
+    Ok(())
+}
+
 /// Solves the motion offsets of every object of `scene` (SMEAR Eqs. 1–9, smoothed by
 /// SMEAR Eq. 2) and merges them in object order — the whole `toonkit smear offsets` job.
 ///
@@ -179,6 +200,8 @@ pub struct SceneOffsets {
 /// One solve, parallel over frames; the only copy is the merge of several objects.
 pub fn offsets(scene: &SampledScene, options: &OffsetOptions) -> Result<SceneOffsets> {
     let start = Instant::now();
+    // The clip, its offsets and the file they are written to (at most a coloured flipbook).
+    check_memory(scene, 1, FLIPBOOK_VERTEX_BYTES)?;
     let field = SolvedField::new(scene, options)?;
     let revolving = revolving_objects(scene, &options.revolve)?;
     let modes: Vec<Option<OffsetMode>> = (0..field.object_count()).map(|i| field.mode(i)).collect();
@@ -218,6 +241,8 @@ pub fn offsets(scene: &SampledScene, options: &OffsetOptions) -> Result<SceneOff
 /// positions.
 pub fn prepare(mut scene: SampledScene, options: &PrepareOptions) -> Result<Prepared> {
     let start = Instant::now();
+    // The clip, its velocities, a merged copy and the offsets (stylizing adds its own).
+    check_memory(&scene, 2 + u64::from(options.merge.is_some()), 0)?;
     let colliders = take_colliders(&mut scene, &options.colliders)?;
     let camera = options.offsets.selected_camera(&scene.cameras)?.cloned();
     let field = SolvedField::new(&scene, &options.offsets)?;

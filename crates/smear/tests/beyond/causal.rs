@@ -2,7 +2,9 @@
 
 use anim::MeshAnimation;
 use glam::Vec3;
-use smear::{stylize, ContactStyle, MultiplesStyle, Param, Stream, StreamOptions, Style};
+use smear::{
+    stylize, ContactStyle, FunctionSpec, MultiplesStyle, Param, Stream, StreamOptions, Style,
+};
 
 use super::{elongation, legged, part_frames, prepared};
 
@@ -74,4 +76,57 @@ fn the_stream_matches_the_causal_mode() {
         }
     }
     assert!(stream.push(&[Vec3::ZERO]).is_err());
+}
+
+/// The stream's frames of `walk` scaled by `k`, divided back by `k`.
+fn streamed(walk: &MeshAnimation, k: f32, options: &StreamOptions) -> Vec<Vec3> {
+    let mut stream = Stream::new(&walk.mesh, options).unwrap();
+    let mut out = Vec::new();
+    for f in 0..walk.frame_count() {
+        let frame: Vec<Vec3> = walk.frame(f).iter().map(|p| *p * k).collect();
+        out.extend(stream.push(&frame).unwrap().iter().map(|p| *p / k));
+    }
+    out
+}
+
+#[test]
+fn the_stream_reads_speeds_in_the_characters_size() {
+    // docs/smear-units.md: by default the stream's speeds are in sizes per second (the first
+    // frame's bounding-box diagonal), so one function smears a walk in centimetres and in
+    // metres alike; in scene units per frame the same β converted by hand gives the same.
+    let walk = legged::gait(24, 0.35, 0.3);
+    let size = anim::Aabb::from_points(walk.frame(0)).diagonal();
+    let options = StreamOptions {
+        elongate: FunctionSpec::speed(0.5),
+        ..StreamOptions::default()
+    };
+    let base = streamed(&walk, 1.0, &options);
+    let moved = base
+        .iter()
+        .zip(walk.positions())
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0f32, f32::max);
+    assert!(
+        moved > 0.01 * size,
+        "the speed function smears nothing: {moved}"
+    );
+    for k in [0.01, 100.0] {
+        let scaled = streamed(&walk, k, &options);
+        for (a, b) in scaled.iter().zip(&base) {
+            assert!(a.distance(*b) <= 1e-4 * size, "×{k}: {a} vs {b}");
+        }
+    }
+    let scene = StreamOptions {
+        elongate: FunctionSpec::speed(0.5 * 24.0 / size),
+        speed_units: smear::SpeedUnits::Scene,
+        ..StreamOptions::default()
+    };
+    for (a, b) in streamed(&walk, 1.0, &scene).iter().zip(&base) {
+        assert!(a.distance(*b) <= 1e-5 * size, "scene units: {a} vs {b}");
+    }
+    let bad = StreamOptions {
+        size_reference: Some(-1.0),
+        ..StreamOptions::default()
+    };
+    assert!(Stream::new(&walk.mesh, &bad).is_err());
 }

@@ -286,3 +286,77 @@ fn subdivide_2_halves_the_p99_surface_error_of_cesium_man_walking() {
     let e = p99_surface_errors(&p, 3.0, 2.0, 4);
     report_and_check("CesiumMan walk (not tuned on)", &e);
 }
+
+/// A strip of quads at distance 3 from the y axis, tangent to its circle, turning steadily
+/// about that axis: every frame is the same shape rotated, so the subdivision splits it alike
+/// on every frame and output vertex k of one frame is the same surface point on the next.
+fn turning_strip(frames: usize) -> anim::MeshAnimation {
+    let (cols, rows) = (6u32, 2u32);
+    let mut base = Vec::new();
+    for j in 0..=rows {
+        for i in 0..=cols {
+            base.push(Vec3::new(-1.5 + 0.5 * i as f32, 0.3 * j as f32, 3.0));
+        }
+    }
+    let mut tris = Vec::new();
+    for j in 0..rows {
+        for i in 0..cols {
+            let a = j * (cols + 1) + i;
+            let (b, c) = (a + 1, a + cols + 1);
+            tris.extend([[a, b, c + 1], [a, c + 1, c]]);
+        }
+    }
+    let positions = (0..frames)
+        .flat_map(|f| {
+            let turn = glam::Quat::from_rotation_y(0.3 * f as f32);
+            base.iter().map(move |p| turn * *p).collect::<Vec<_>>()
+        })
+        .collect();
+    anim::MeshAnimation::new(
+        anim::Mesh::new("strip", base.clone(), tris),
+        24.0,
+        positions,
+    )
+    .unwrap()
+}
+
+#[test]
+fn subdivided_vertices_move_along_their_own_smeared_trajectory() {
+    // USD `velocities` of a subdivided smear: a new vertex sits on the curved smear, off the
+    // flat blend of its parents, so its velocity is the derivative of its own trajectory —
+    // the finite difference of its places on the frames around — not its parents' blend.
+    let strip = turning_strip(16);
+    let p = prepared(&strip, |_| {});
+    let style = Style {
+        subdivide: Some(2.0),
+        ..elongation(&p, 3.0)
+    };
+    let out = stylize(&p, &style).unwrap();
+    let FlipbookPart::Frames {
+        meshes, velocities, ..
+    } = &out.flipbook.parts[0]
+    else {
+        panic!("a subdivided body has one mesh per frame");
+    };
+    let velocities = velocities
+        .as_ref()
+        .expect("a moving body carries velocities");
+    let n = strip.vertex_count();
+    let mut compared = 0;
+    for f in 1..meshes.len() - 1 {
+        let same = |g: usize| meshes[g].triangles == meshes[f].triangles;
+        if !same(f - 1) || !same(f + 1) || meshes[f].vertex_count() == n {
+            continue;
+        }
+        for k in n..meshes[f].vertex_count() {
+            let fd = (meshes[f + 1].positions[k] - meshes[f - 1].positions[k]) * 0.5;
+            let v = velocities[f][k];
+            assert!(
+                v.distance(fd) <= 1e-4 * fd.length().max(1e-3),
+                "frame {f} new vertex {k}: velocity {v} vs its own motion {fd}"
+            );
+            compared += 1;
+        }
+    }
+    assert!(compared > 20, "only {compared} new vertices compared");
+}

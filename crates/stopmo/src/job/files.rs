@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anim::{Mesh, MeshAnimation};
 
-use super::error::Result;
+use super::error::{Error, Result};
 use super::result::LibraryResult;
 
 /// What one output file holds; the path's extension says which format it is written in.
@@ -22,6 +22,14 @@ pub enum FileData<'a> {
     Parts(Vec<&'a MeshAnimation>),
     /// One point cache (`.pc2`).
     PointCache(Cow<'a, MeshAnimation>),
+    /// Parts showing one of their pieces per frame (`.glb` with the pieces as morph
+    /// targets, or `.pc2` merged in part order and streamed, `rest` beside it as `.obj`).
+    Shapes {
+        /// The parts.
+        parts: Vec<tkio::ShapeAnimation<'a>>,
+        /// The merged rest mesh.
+        rest: Mesh,
+    },
     /// A rest mesh that is not borrowed from the result (`.obj`).
     OwnedMesh(Mesh),
 }
@@ -95,13 +103,22 @@ impl LibraryResult {
             "shooting_order.csv",
             FileData::Text(self.shooting_order_csv()),
         ));
+        let rest = self.merged_rest()?;
         out.push(file(
             "reconstruction.glb",
-            FileData::Parts(self.reconstruction.iter().collect()),
+            FileData::Shapes {
+                parts: self.shape_animations(),
+                rest: rest.clone(),
+            },
         ));
-        let merged = self.merged_reconstruction()?;
-        out.push(file("rest.obj", FileData::OwnedMesh(merged.mesh.clone())));
-        out.push(file("reconstruction.pc2", FileData::PointCache(merged)));
+        out.push(file("rest.obj", FileData::OwnedMesh(rest.clone())));
+        out.push(file(
+            "reconstruction.pc2",
+            FileData::Shapes {
+                parts: self.shape_animations(),
+                rest,
+            },
+        ));
         if let Some(csv) = self.error_curve_csv() {
             out.push(file("error_curve.csv", FileData::Text(csv)));
         }
@@ -125,10 +142,39 @@ impl LibraryResult {
     ///
     /// # Errors
     /// When the parts' frames differ (they never do for a library's own reconstruction).
-    pub fn merged_reconstruction(&self) -> Result<Cow<'_, MeshAnimation>> {
+    pub fn merged_reconstruction(&self) -> Result<MeshAnimation> {
+        let parts = (0..self.reconstruction.len())
+            .map(|i| {
+                self.reconstruction_of(i).ok_or_else(|| {
+                    Error::option_error("parts", format!("no reconstruction of part {i}"))
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(match parts.len() {
+            1 => parts.into_iter().next().expect("one part"),
+            _ => MeshAnimation::concat("reconstruction", &parts)?,
+        })
+    }
+
+    /// The rest mesh of [`LibraryResult::merged_reconstruction`] (`rest.obj`), without
+    /// expanding the frames.
+    ///
+    /// # Errors
+    /// As [`LibraryResult::merged_reconstruction`].
+    pub fn merged_rest(&self) -> Result<Mesh> {
         Ok(match self.reconstruction.as_slice() {
-            [one] => Cow::Borrowed(one),
-            all => Cow::Owned(MeshAnimation::concat("reconstruction", all)?),
+            [one] => one.mesh.clone(),
+            all => {
+                let stills: Vec<MeshAnimation> = all
+                    .iter()
+                    .map(|r| {
+                        let mut a = MeshAnimation::still(r.mesh.clone());
+                        a.fps = r.fps;
+                        a
+                    })
+                    .collect();
+                MeshAnimation::concat("reconstruction", &stills)?.mesh
+            }
         })
     }
 }
@@ -151,6 +197,7 @@ impl FileData<'_> {
                 layout: tkio::Layout::default(),
                 colors: None,
             },
+            FileData::Shapes { parts, rest } => tkio::Output::Shapes { parts, rest },
             FileData::Parts(parts) => {
                 layers = parts.iter().map(|a| (*a, None)).collect();
                 tkio::Output::Parts {

@@ -10,7 +10,7 @@ use super::options::{LibraryJobOptions, PieceCount, RunOptions};
 use super::plates::library_3mf;
 use super::print::{print_pieces, surface_pieces, PrintSettings};
 use super::report::{InputErrors, LibraryReport, ReportInputs};
-use super::result::LibraryResult;
+use super::result::{LibraryResult, Reconstruction};
 use super::segment_job::segment;
 use super::sheets::{assembly_sheets, catalogue_png};
 use crate::library::{
@@ -47,9 +47,32 @@ pub fn file_safe_name(name: &str) -> String {
 /// [`Error::option`]); the optimization's and fabrication's own errors
 /// ([`Error::Library`]).
 pub fn library(parts: &[MeshAnimation], opts: &LibraryJobOptions) -> Result<LibraryResult> {
+    let frames = parts.first().map_or(0, MeshAnimation::frame_count);
+    let vertices = parts.iter().map(MeshAnimation::vertex_count).sum();
+    check_memory(frames, vertices, LIBRARY_COPIES)?;
     let refs: Vec<&MeshAnimation> = parts.iter().collect();
     let names: Vec<String> = parts.iter().map(|a| a.mesh.name.clone()).collect();
     build(&refs, &names, opts, None)
+}
+
+/// Copies of a part's positions a library build holds: the parts, the solver's frame matrix
+/// and its subspace (f64, twice an f32 copy each), the reconstruction and its file.
+const LIBRARY_COPIES: u64 = 7;
+
+/// Checks what building a library of parts of `vertices` vertices in all will hold (`copies`
+/// copies of their `frames` frames) against [`anim::budget::DEFAULT_MAX_JOB_BYTES`] before
+/// the solver allocates.
+fn check_memory(frames: usize, vertices: usize, copies: u64) -> Result<()> {
+    anim::budget::JobMemory::new()
+        .positions(
+            "copies of the clip (parts, solver, reconstruction, written)",
+            frames,
+            vertices,
+            copies,
+        )
+        .check("lower --fps or pick a shorter clip")
+        .map_err(anim::AnimError::from)?;
+    Ok(())
 }
 
 /// Segments `anim`, then builds the library of its parts (named after the parts, made
@@ -72,6 +95,8 @@ pub fn run(anim: &MeshAnimation, opts: &RunOptions) -> Result<LibraryResult> {
             ));
         }
     }
+    // The input and its segmentation stay held while the library is built.
+    check_memory(anim.frame_count(), anim.vertex_count(), 2 + LIBRARY_COPIES)?;
     let segmented = segment(anim, &opts.segment)?;
     let names: Vec<String> = segmented
         .parts
@@ -350,15 +375,16 @@ pub(super) fn finish(
     let reconstruction = anims
         .iter()
         .zip(names)
-        .enumerate()
-        .map(|(i, (a, name))| {
-            let mut r = lib.reconstruction(i, a).ok_or_else(|| {
-                Error::option_error("parts", format!("no reconstruction of part '{name}'"))
-            })?;
-            r.mesh.name.clone_from(name);
-            Ok(r)
+        .map(|(a, name)| {
+            let mut mesh = a.mesh.clone();
+            mesh.name.clone_from(name);
+            Reconstruction {
+                mesh,
+                fps: a.fps,
+                start_time: a.start_time,
+            }
         })
-        .collect::<Result<Vec<_>>>()?;
+        .collect();
     let mut report = LibraryReport::new(
         &lib,
         ReportInputs {
@@ -377,6 +403,7 @@ pub(super) fn finish(
         },
     );
     report.total_seconds = start.elapsed().as_secs_f64();
+    report.peak_memory_mib = super::report::peak_memory_mib();
     Ok(LibraryResult {
         segmented: None,
         part_names: names.to_vec(),

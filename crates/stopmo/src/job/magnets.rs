@@ -8,8 +8,9 @@ use glam::Vec3;
 use super::error::{Error, Result};
 use super::options::PrintSettings;
 use crate::library::{
-    check_solid, cut_pocket, cylinder, exact_difference, Key, MagnetOptions, PartShell, Pocket,
-    DEFAULT_ID_RELIEF_MM, DEFAULT_POCKET_SEGMENTS, MIN_MAGNET_WALL_MM,
+    check_solid, cut_pocket, cylinder, exact_difference, regularize, self_intersecting_triangles,
+    turned_cylinder, Key, MagnetOptions, PartShell, Pocket, PocketSpec, DEFAULT_ID_RELIEF_MM,
+    DEFAULT_POCKET_SEGMENTS, MIN_MAGNET_WALL_MM,
 };
 
 /// Sizes of the pocket and mount for one magnet (millimetres).
@@ -20,8 +21,10 @@ pub(crate) struct MagnetPlan {
     pub(crate) depth_mm: f32,
     /// Material left around and in front of the pocket.
     pub(crate) wall_mm: f32,
-    /// Thickness of the mount: the pocket, the clearance and a wall behind it.
-    pub(crate) mount_mm: f32,
+    /// Clearance of every fit.
+    pub(crate) clearance_mm: f32,
+    /// Least thickness of the mount (`--thickness`).
+    pub(crate) thickness_mm: f32,
 }
 
 impl MagnetPlan {
@@ -34,8 +37,25 @@ impl MagnetPlan {
             radius_mm: (m.diameter_mm / 2.0 + c) as f32,
             depth_mm: depth as f32,
             wall_mm: wall as f32,
-            mount_mm: (depth + wall).max(s.thickness_mm) as f32,
+            clearance_mm: c as f32,
+            thickness_mm: s.thickness_mm as f32,
         }
+    }
+
+    /// What the pocket asks of the part's back.
+    pub(crate) fn spec(&self) -> PocketSpec {
+        PocketSpec {
+            radius_mm: self.radius_mm,
+            depth_mm: self.depth_mm,
+            wall_mm: self.wall_mm,
+            clearance_mm: self.clearance_mm,
+        }
+    }
+
+    /// Thickness of the mount for `pocket`: its cuts (a boss's recess and the magnet pocket
+    /// below it) and a wall behind them, at least `--thickness`.
+    pub(crate) fn mount_mm(&self, pocket: &Pocket) -> f32 {
+        (pocket.mount_depth_mm(self.clearance_mm) + self.wall_mm).max(self.thickness_mm)
     }
 }
 
@@ -48,36 +68,64 @@ pub(crate) fn find_pocket(
     part: &str,
 ) -> Result<Pocket> {
     shell
-        .magnet_pocket(
-            pieces,
-            plan.radius_mm,
-            plan.depth_mm,
-            plan.wall_mm,
-            keys,
-            None,
-        )
-        .ok_or_else(|| {
+        .magnet_pocket(pieces, &plan.spec(), keys, None)
+        .map_err(|miss| {
             Error::option_error(
                 "magnets",
                 format!(
-                    "part {part}: no place on the back fits a pocket of {:.2} mm diameter and {:.2} mm depth with {} mm of material around and in front of it in every piece; use a smaller magnet, a larger --print-height or a thicker --thickness",
+                    "part {part} is too small for the magnet: a pocket of {:.2} mm diameter and {:.2} mm depth in a boss with {} mm of material around it needs {:.1} mm from its centre to the part's edge, clear of the registration keys, and the widest place of the part's back has {:.1} mm; use a smaller magnet, a larger --print-height, or leave the keys off (--no-keys)",
                     2.0 * plan.radius_mm,
                     plan.depth_mm,
-                    plan.wall_mm
+                    plan.wall_mm,
+                    miss.needed_mm,
+                    miss.widest_mm
                 ),
             )
         })
 }
 
-/// `solid` with the pocket cut; the cutter starts `below_mm` behind the back (clear of the
-/// back's curvature and the ID's relief).
-pub(crate) fn cut_piece_pocket(solid: &Mesh, pocket: &Pocket, below_mm: f32) -> Result<Mesh> {
+/// `solid` with the pocket cut (and its boss joined) and the count of its self-intersecting
+/// triangles; the cutter starts `below_mm` behind the back (clear of the back's curvature
+/// and the ID's relief).
+pub(crate) fn cut_piece_pocket(
+    solid: &Mesh,
+    pocket: &Pocket,
+    below_mm: f32,
+) -> Result<(Mesh, usize)> {
     let cut = cut_pocket(solid, pocket, below_mm)?;
-    Ok(cut.mesh)
+    Ok(fewer_crossings(cut.mesh))
 }
 
-/// The part's mount with the pocket matching the pieces' (a second magnet sits there), a
-/// socket per key and a recess for the embossed ID, every fit widened by the clearance.
+/// Rounds of [`fewer_crossings`] at most.
+const ROUNDING_REPAIRS: usize = 3;
+
+/// An exact boolean's new vertices are rounded to `f32`; where that makes triangles cross
+/// (a boss's side meeting the embossed ID's steps or a seam wall at a grazing angle), the
+/// rounded solid is regularized again, kept while it crosses less. The solid and its count
+/// of crossing triangles (every triangle when the exact test cannot run).
+pub(crate) fn fewer_crossings(mut mesh: Mesh) -> (Mesh, usize) {
+    let count = |m: &Mesh| {
+        self_intersecting_triangles(&m.positions, &m.triangles)
+            .map_or(m.triangles.len(), |t| t.len())
+    };
+    let mut crossing = count(&mesh);
+    for _ in 0..ROUNDING_REPAIRS {
+        if crossing == 0 {
+            break;
+        }
+        let Ok(r) = regularize(&mesh) else { break };
+        let c = count(&r.mesh);
+        if c >= crossing {
+            break;
+        }
+        (mesh, crossing) = (r.mesh, c);
+    }
+    (mesh, crossing)
+}
+
+/// The part's mount with the pocket matching the pieces' (a second magnet sits there; below
+/// the recess that takes the pieces' boss where they have one), a socket per key and a
+/// recess for the embossed ID, every fit widened by the clearance.
 pub(crate) fn cut_mount(
     shell: &PartShell,
     mount: &Mesh,
@@ -88,14 +136,32 @@ pub(crate) fn cut_mount(
 ) -> Result<Mesh> {
     let c = s.clearance_mm as f32;
     let margin = s.thickness_mm as f32;
-    let mut cutters: Vec<Mesh> = vec![cylinder(
-        Vec3::from_array(pocket.center),
-        -Vec3::from_array(pocket.axis),
+    let into = -Vec3::from_array(pocket.axis);
+    let mut cutters: Vec<Mesh> = Vec::new();
+    let opening = match pocket.boss {
+        Some(b) => {
+            cutters.push(turned_cylinder(
+                Vec3::from_array(pocket.center),
+                into,
+                b.radius_mm + c,
+                margin,
+                b.height_mm + c,
+                DEFAULT_POCKET_SEGMENTS,
+                0.5,
+            ));
+            // The second magnet faces the first across the recess's clearance.
+            pocket.opening() + into * c
+        }
+        None => Vec3::from_array(pocket.center),
+    };
+    cutters.push(cylinder(
+        opening,
+        into,
         pocket.radius_mm,
         margin,
         pocket.depth_mm,
         DEFAULT_POCKET_SEGMENTS,
-    )];
+    ));
     for k in keys {
         cutters.push(cylinder(
             Vec3::from_array(k.center),
@@ -119,13 +185,14 @@ pub(crate) fn cut_mount(
     }
     let cutter = concat(&cutters);
     let cut = exact_difference(mount, Some(&cutter))?;
-    if !check_solid(&cut.mesh).is_closed_manifold() {
+    let (cut_mesh, _) = fewer_crossings(cut.mesh);
+    if !check_solid(&cut_mesh).is_closed_manifold() {
         return Err(Error::option_error(
             "magnets",
             format!("the mount {} is not closed after its pockets", mount.name),
         ));
     }
-    Ok(cut.mesh)
+    Ok(cut_mesh)
 }
 
 /// The mount's recess for the ID raised on the back of every piece.
@@ -162,7 +229,7 @@ pub(crate) fn id_recess(
     let others: Vec<Cut> = std::iter::once(Cut {
         at: Vec3::from_array(pocket.center),
         axis: Vec3::from_array(pocket.axis),
-        radius: pocket.radius_mm,
+        radius: pocket.mount_cut_radius_mm(c),
     })
     .chain(keys.iter().map(|k| Cut {
         at: Vec3::from_array(k.center),

@@ -33,6 +33,8 @@ pub use report::{
     LibraryReport, OrderReport, PartPrintReport, PartReport, PieceReport, PlugReport, PrintReport,
     PrintTime,
 };
-pub use result::LibraryResult;
-pub use segment_job::{saved_segmentation, segment, PartSummary, SegmentSummary, Segmented};
+pub use result::{LibraryResult, Reconstruction};
+pub use segment_job::{
+    check_segment_memory, saved_segmentation, segment, PartSummary, SegmentSummary, Segmented,
+};
 pub use size_curve::{library_of, size_curve, SizeCurve, SizePoint};

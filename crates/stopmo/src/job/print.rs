@@ -142,13 +142,9 @@ pub(crate) fn print_pieces(
         let part = &lib.parts[p];
         let a = anims[p];
         let seams = shell.shared_seams(&avg, &boundaries, p);
-        // The mount is the back as it is before keys and IDs (what the pieces seat on).
-        let mount = s.magnet.map(|m| {
-            shell.mount(
-                MagnetPlan::new(&m, s).mount_mm,
-                &format!("{}_back", part.name),
-            )
-        });
+        // The mount is the back as it is before keys and IDs (what the pieces seat on); how
+        // thick it is depends on the pocket found once the keys are placed.
+        let unkeyed = s.magnet.map(|_| shell.clone());
         let keys = if s.keys {
             shell.add_seam_keys(&KeyOptions::for_print_height(s.print_height_mm), &seams)?
         } else {
@@ -172,7 +168,11 @@ pub(crate) fn print_pieces(
             .cloned()
             .chain(pocket.map(|q| q.as_key()))
             .collect();
-        if let (Some(mount), Some(q)) = (mount, &pocket) {
+        if let (Some(unkeyed), Some(m), Some(q)) = (unkeyed, &s.magnet, &pocket) {
+            let mount = unkeyed.mount(
+                MagnetPlan::new(m, s).mount_mm(q),
+                &format!("{}_back", part.name),
+            );
             mounts_out.push(cut_mount(&shell, &mount, q, &keys, &id_keys, s)?);
         }
         measured.push(measure_part(
@@ -227,11 +227,7 @@ pub(crate) fn print_pieces(
                     _ => (solid, built, None),
                 };
                 let (solid, crossing) = match &pocket {
-                    Some(q) => {
-                        let cut = cut_piece_pocket(&solid, q, s.thickness_mm as f32)?;
-                        let c = count(&cut);
-                        (cut, c)
-                    }
+                    Some(q) => cut_piece_pocket(&solid, q, s.thickness_mm as f32)?,
                     None => (solid, crossing),
                 };
                 let solid = add_plugs(&solid, p, s.plugs, s.plug_segments);

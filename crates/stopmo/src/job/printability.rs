@@ -223,7 +223,7 @@ pub(crate) fn measure_part(g: &PartGeometry<'_>, s: &PrintSettings<'_>) -> PartM
         solids.push(Measured {
             id: format!("{}_back", g.name),
             mount: true,
-            walls: mount_walls(g, q, MagnetPlan::new(m, s).mount_mm, s),
+            walls: mount_walls(g, q, MagnetPlan::new(m, s).mount_mm(q), s),
             features: Vec::new(),
         });
     }
@@ -259,17 +259,19 @@ fn piece_walls(
 }
 
 /// Material in front of the pocket's floor in one piece: the front points over the pocket
-/// and a wall around it (as [`PartShell::magnet_pocket`] measures it over all pieces).
+/// and a wall around it (as [`PartShell::magnet_pocket`] measures it over all pieces; the
+/// floor is nearer the front by the boss's height where the pocket stands in a boss).
 fn pocket_cover(q: &Pocket, piece: &[Vec3], wall_mm: f32) -> f64 {
     let (c, n) = (Vec3::from_array(q.center), Vec3::from_array(q.axis));
     let reach = q.radius_mm + wall_mm;
+    let floor = q.floor_mm();
     piece
         .iter()
         .filter_map(|&p| {
             let d = p - c;
             let axial = d.dot(n);
             let lateral = (d - n * axial).length();
-            (lateral < reach && axial > -2.0 * (q.depth_mm + wall_mm)).then_some(axial - q.depth_mm)
+            (lateral < reach && axial > -2.0 * (q.depth_mm + wall_mm)).then_some(axial - floor)
         })
         .fold(f64::INFINITY, |a, b| a.min(f64::from(b)))
 }
@@ -306,18 +308,22 @@ fn mount_walls(
         .iter()
         .map(|&(a, _)| back[a as usize])
         .collect();
-    // Every cut, as the mount is cut.
+    // Every cut, as the mount is cut (a boss's recess the widest and deepest at the pocket).
     let mut cuts = vec![Cut {
         at: Vec3::from_array(q.center),
         axis: Vec3::from_array(q.axis),
-        radius: q.radius_mm,
+        radius: q.mount_cut_radius_mm(c),
     }];
     let mut walls = vec![(
         Thin::BehindMountPocket,
-        f64::from(mount_mm - q.depth_mm),
+        f64::from(mount_mm - q.mount_depth_mm(c)),
         Some(Vec3::from_array(q.center)),
     )];
-    walls.push((Thin::BesidePocket, f64::from(q.side_wall_mm), None));
+    walls.push((
+        Thin::BesidePocket,
+        f64::from(q.side_wall_mm - (q.mount_cut_radius_mm(c) - q.radius_mm)),
+        None,
+    ));
     for k in g.keys {
         let (at, axis) = (Vec3::from_array(k.center), Vec3::from_array(k.direction));
         let radius = k.radius_mm + c;

@@ -122,6 +122,22 @@ pub struct LibraryReport {
     pub seconds: f64,
     /// Wall time of the whole job in seconds.
     pub total_seconds: f64,
+    /// Peak resident memory of the process up to the end of the job, in MiB (the `VmHWM` of
+    /// `/proc/self/status`; `null` where the system does not tell).
+    pub peak_memory_mib: Option<f64>,
+}
+
+/// Peak resident memory of this process so far in MiB (`VmHWM`, Linux); `None` elsewhere.
+pub(crate) fn peak_memory_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let kb: f64 = status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()?;
+    Some(kb / 1024.0)
 }
 
 /// Inputs of [`LibraryReport::new`] beyond the library.
@@ -151,7 +167,7 @@ pub(crate) struct InputErrors {
 }
 
 impl LibraryReport {
-    /// The report of `lib` (`total_seconds` 0 until the job sets it).
+    /// The report of `lib` (`total_seconds` 0 and no peak memory until the job sets them).
     pub(crate) fn new(lib: &Library, x: ReportInputs<'_>) -> LibraryReport {
         LibraryReport {
             input: None,
@@ -195,6 +211,7 @@ impl LibraryReport {
             },
             seconds: lib.seconds,
             total_seconds: 0.0,
+            peak_memory_mib: None,
         }
     }
 

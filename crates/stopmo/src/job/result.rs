@@ -1,6 +1,6 @@
 //! What [`library`](crate::library()) and [`run`](crate::run()) return.
 
-use anim::MeshAnimation;
+use anim::{Mesh, MeshAnimation};
 
 use super::print::Piece;
 use super::report::LibraryReport;
@@ -33,8 +33,9 @@ pub struct LibraryResult {
     pub shooting_order: ShootingOrder,
     /// Plugs across the seams (empty unless asked for).
     pub plugs: Vec<Plug>,
-    /// The stop-motion reconstruction of every part (model units, input timing).
-    pub reconstruction: Vec<MeshAnimation>,
+    /// The stop-motion reconstruction of every part (model units, input timing), kept as
+    /// pieces and labels: [`LibraryResult::reconstruction_of`] expands one to every frame.
+    pub reconstruction: Vec<Reconstruction>,
     /// `catalogue.png`: every piece with its embossed ID.
     pub catalogue: Vec<u8>,
     /// `assembly_shotNN.png` per shot: (file name, PNG bytes).
@@ -43,7 +44,47 @@ pub struct LibraryResult {
     pub report: LibraryReport,
 }
 
+/// The stop-motion reconstruction of one part: frame `f` shows piece `labels[f]` of the
+/// part's library, on the input's topology and timing. Held this way (not expanded to every
+/// frame), a feature-length reconstruction costs no more memory than its pieces.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reconstruction {
+    /// The part's topology, attributes and rest positions, named after the part.
+    pub mesh: Mesh,
+    /// Frames per second of the input.
+    pub fps: f32,
+    /// Time of frame 0 in seconds.
+    pub start_time: f32,
+}
+
 impl LibraryResult {
+    /// The reconstruction of every part as shapes (its pieces) and the shape of each frame,
+    /// for [`tkio::Output::Shapes`].
+    pub fn shape_animations(&self) -> Vec<tkio::ShapeAnimation<'_>> {
+        self.reconstruction
+            .iter()
+            .zip(&self.library.parts)
+            .map(|(r, p)| tkio::ShapeAnimation {
+                mesh: &r.mesh,
+                shapes: &p.solution.pieces,
+                shown: &p.solution.labels,
+                fps: r.fps,
+                start_time: r.start_time,
+            })
+            .collect()
+    }
+
+    /// The reconstruction of part `part` expanded to every frame (model units, input timing);
+    /// `None` when there is no such part.
+    pub fn reconstruction_of(&self, part: usize) -> Option<MeshAnimation> {
+        let r = self.reconstruction.get(part)?;
+        // A one-frame source for the topology and timing.
+        let mut source = MeshAnimation::still(r.mesh.clone());
+        source.fps = r.fps;
+        source.start_time = r.start_time;
+        self.library.reconstruction(part, &source)
+    }
+
     /// Piece label of every frame, per part.
     pub fn labels(&self) -> Vec<&[u32]> {
         self.library

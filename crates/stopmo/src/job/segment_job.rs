@@ -55,14 +55,35 @@ pub struct SegmentSummary {
     pub homogenization: Option<HomogenizeStats>,
 }
 
+/// Checks what segmenting `anim` will hold — the input, its cut copy, the parts and the file
+/// they are written to — against [`anim::budget::DEFAULT_MAX_JOB_BYTES`]; [`segment`] does
+/// it first, a front end that runs [`segment`] in the background does it before starting.
+///
+/// # Errors
+/// [`Error::Anim`] ([`anim::AnimError::OverBudget`]) naming the copies and the limit.
+pub fn check_segment_memory(anim: &MeshAnimation) -> Result<()> {
+    anim::budget::JobMemory::new()
+        .positions(
+            "copies of the clip (input, cut, parts, written)",
+            anim.frame_count(),
+            anim.vertex_count(),
+            4,
+        )
+        .check("lower --fps or pick a shorter clip")
+        .map_err(anim::AnimError::from)?;
+    Ok(())
+}
+
 /// Segments `anim` into parts and homogenizes the seams (StopShop Sections 3.1–3.2): the
 /// whole job of `toonkit stopmo segment`.
 ///
 /// # Errors
-/// [`Error::Option`] (`parts`) when fewer than two parts are given, or the segmentation's
-/// own errors ([`Error::Segment`]).
+/// [`Error::Option`] (`parts`) when fewer than two parts are given, [`Error::Anim`] when
+/// the clip's copies would be over [`anim::budget::DEFAULT_MAX_JOB_BYTES`], or the
+/// segmentation's own errors ([`Error::Segment`]).
 pub fn segment(anim: &MeshAnimation, opts: &SegmentJobOptions) -> Result<Segmented> {
     let start = Instant::now();
+    check_segment_memory(anim)?;
     let segmentation = match &opts.reuse {
         Some(saved) => crate::segment::segment_reusing(anim, saved, &opts.segment)?,
         None => {

@@ -89,14 +89,19 @@ impl LibraryResult {
                 if let Some(q) = &part.magnet_pocket {
                     let _ = writeln!(
                         md,
-                        "- {}: pocket {:.2} mm wide, {:.2} mm deep at ({:.1}, {:.1}, {:.1}); {:.2} mm of material in front of it",
+                        "- {}: pocket {:.2} mm wide, {:.2} mm deep at ({:.1}, {:.1}, {:.1}); {:.2} mm of material in front of it{}",
                         part.name,
                         2.0 * q.radius_mm,
                         q.depth_mm,
                         q.center[0],
                         q.center[1],
                         q.center[2],
-                        q.cover_mm
+                        q.cover_mm,
+                        q.boss.map_or(String::new(), |b| format!(
+                            "; it stands in a boss {:.2} mm wide and {:.2} mm high on the back of every piece, which the mount's recess takes",
+                            2.0 * b.radius_mm,
+                            b.height_mm
+                        ))
                     );
                 }
             }

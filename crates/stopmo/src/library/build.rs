@@ -194,15 +194,17 @@ pub fn build_library(parts: &[PartInput<'_>], opts: &LibraryOptions) -> Result<L
         .collect();
     let solve_one = |i: usize, d: usize| -> Result<PartSolution> {
         let p = &problems[i];
+        // Evaluated once, after the pieces are final.
+        let reevaluate = confine || opts.method == Method::KMeans;
         let mut s = match opts.method {
             Method::Uniform => p.uniform(d, lambda)?,
-            _ => p.solve(d, &method_opts)?,
+            _ => p.solve_with(d, &method_opts, !reevaluate)?,
         };
         if confine {
             // The velocity term lets pieces leave the input's range; not where a part ends.
             p.confine_borders(&mut s, &borders[i]);
         }
-        if confine || opts.method == Method::KMeans {
+        if reevaluate {
             s.energy = evaluate(p, &s.pieces, &s.labels, lambda).0;
         }
         Ok(s)

@@ -14,9 +14,9 @@ use anim::Mesh;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use super::back_surface::Pocket;
+use super::back_surface::{Boss, Pocket};
 use super::error::{LibraryError, Result};
-use super::regularize::{exact_difference, Regularized};
+use super::regularize::{exact_boolean, Regularized};
 
 /// Thinnest material left around and in front of a magnet pocket (mm): resin and PolyJet
 /// printers hold walls of 0.8–1 mm.
@@ -75,7 +75,7 @@ impl MagnetOptions {
     pub fn parse(text: &str) -> Result<MagnetOptions> {
         let bad = || {
             LibraryError::InvalidParameter(format!(
-                "magnet '{text}': expected DIAMETERxHEIGHT in millimetres, e.g. 3x2"
+                "magnet '{text}': expected DIAMETERxHEIGHT in millimetres, each > 0 and <= 100 mm, e.g. 3x2"
             ))
         };
         let (d, h) = text.trim().split_once(['x', 'X']).ok_or_else(bad)?;
@@ -118,6 +118,21 @@ pub(crate) fn cylinder(
     above: f32,
     segments: usize,
 ) -> Mesh {
+    turned_cylinder(center, axis, radius, below, above, segments, 0.0)
+}
+
+/// [`cylinder`] with its polygon turned by `turn` of a side: a boss (or the mount's recess
+/// for it) is turned half a side against the pocket cut through it, so that no edge of one
+/// runs through an edge of the other (degenerate crossings, rounded to slivers).
+pub(crate) fn turned_cylinder(
+    center: Vec3,
+    axis: Vec3,
+    radius: f32,
+    below: f32,
+    above: f32,
+    segments: usize,
+    turn: f32,
+) -> Mesh {
     let n = segments.max(3);
     let axis = axis.normalize_or(Vec3::Z);
     let u = axis.any_orthonormal_vector();
@@ -127,7 +142,7 @@ pub(crate) fn cylinder(
     let mut positions = Vec::with_capacity(2 * n + 2);
     for base in [lo, hi] {
         for i in 0..n {
-            let t = std::f32::consts::TAU * i as f32 / n as f32;
+            let t = std::f32::consts::TAU * (i as f32 + turn) / n as f32;
             positions.push(base + (u * t.cos() + w * t.sin()) * r);
         }
     }
@@ -147,26 +162,43 @@ pub(crate) fn cylinder(
 }
 
 /// `solid` with the pocket cut: the cylinder from `below_mm` behind the opening (clear of the
-/// back surface around it) to the pocket's floor.
+/// back surface around it) to the pocket's floor; with its boss joined first where it has
+/// one.
 ///
 /// # Errors
-/// [`LibraryError::Regularization`] when the exact difference fails (the solid is not
-/// closed and orientable).
+/// [`LibraryError::Regularization`] when the exact boolean fails (the solid is not closed
+/// and orientable).
 pub(crate) fn cut_pocket(solid: &Mesh, pocket: &Pocket, below_mm: f32) -> Result<Regularized> {
+    let axis = Vec3::from_array(pocket.axis);
     let cutter = cylinder(
-        Vec3::from_array(pocket.center),
-        Vec3::from_array(pocket.axis),
+        pocket.opening(),
+        axis,
         pocket.radius_mm,
         below_mm,
         pocket.depth_mm,
         DEFAULT_POCKET_SEGMENTS,
     );
-    exact_difference(solid, Some(&cutter))
+    let boss = pocket.boss.map(|b| boss_solid(pocket, &b));
+    exact_boolean(solid, boss.as_ref(), Some(&cutter))
+}
+
+/// The boss as a closed cylinder: from its top behind the back to its base inside the piece.
+pub(crate) fn boss_solid(pocket: &Pocket, boss: &Boss) -> Mesh {
+    turned_cylinder(
+        Vec3::from_array(pocket.center),
+        Vec3::from_array(pocket.axis),
+        boss.radius_mm,
+        boss.height_mm,
+        boss.base_mm,
+        DEFAULT_POCKET_SEGMENTS,
+        0.5,
+    )
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::library::plugs::components;
     use crate::library::test_shapes::cuboid;
     use crate::library::{check_solid, self_intersecting_triangles, volume};
 
@@ -208,6 +240,7 @@ mod tests {
             depth_mm: 2.0,
             cover_mm: 3.0,
             side_wall_mm: 3.5,
+            boss: None,
         };
         let cut = cut_pocket(&block, &pocket, 0.5).unwrap();
         assert!(check_solid(&cut.mesh).is_closed_manifold());
@@ -224,5 +257,57 @@ mod tests {
         let removed = volume(&block) - volume(&cut.mesh);
         assert!(removed >= magnet.volume_mm3(), "{removed}");
         assert!(removed < magnet.volume_mm3() * 1.01, "{removed}");
+    }
+
+    /// A back too thin for the pocket (a 1.5 mm plate): the pocket stands in a boss joined to
+    /// the plate, one closed shell that crosses nowhere, and the boss adds its cylinder less
+    /// the pocket.
+    #[test]
+    fn pocket_in_a_boss_on_a_thin_plate_is_one_clean_shell() {
+        let (p, t) = cuboid(Vec3::ZERO, Vec3::new(12.0, 12.0, 1.5));
+        let plate = Mesh::new("plate", p, t);
+        let boss = Boss {
+            radius_mm: 2.6,
+            height_mm: 1.6,
+            base_mm: 0.8,
+        };
+        let pocket = Pocket {
+            center: [6.0, 6.0, 0.0],
+            axis: [0.0, 0.0, 1.0],
+            radius_mm: 1.6,
+            depth_mm: 2.1,
+            cover_mm: 1.0,
+            side_wall_mm: 4.4,
+            boss: Some(boss),
+        };
+        let cut = cut_pocket(&plate, &pocket, 1.5).unwrap();
+        assert!(check_solid(&cut.mesh).is_closed_manifold());
+        assert_eq!(components(&cut.mesh).len(), 1);
+        assert_eq!(
+            self_intersecting_triangles(&cut.mesh.positions, &cut.mesh.triangles)
+                .unwrap()
+                .len(),
+            0
+        );
+        let pi = std::f64::consts::PI;
+        let added = pi * 2.6f64.powi(2) * 1.6;
+        let taken = pi * 1.6f64.powi(2) * 2.1;
+        let expected = volume(&plate) + added - taken;
+        let v = volume(&cut.mesh);
+        assert!((v - expected).abs() < 0.01 * expected, "{v} vs {expected}");
+        // The pocket opens on the boss's top and its floor keeps a wall (1 mm) in front of
+        // it: 2.1 mm deep from 1.6 mm behind the back, 1.5 - 0.5 mm in front.
+        assert!((pocket.floor_mm() - 0.5).abs() < 1e-6);
+        let over_pocket = |q: &&Vec3| q.truncate().distance(glam::Vec2::new(6.0, 6.0)) < 1.7;
+        let floor = cut
+            .mesh
+            .positions
+            .iter()
+            .filter(over_pocket)
+            .map(|q| q.z)
+            .fold(f32::NEG_INFINITY, f32::max);
+        assert!((floor - 0.5).abs() < 1e-5, "floor at {floor}");
+        let top = cut.mesh.bbox().min.z;
+        assert!((top + 1.6).abs() < 1e-5, "top at {top}");
     }
 }

@@ -70,10 +70,11 @@ pub use assembly::{
     DEFAULT_TWO_OPT_PASSES,
 };
 pub use back_surface::{
-    build_shells, DirectionField, PartShell, Pocket, ShellInput, ShellOptions, ShellStats,
-    ThinnestWall, DEFAULT_BACK_SMOOTHING_ITERATIONS, DEFAULT_CAP_FRACTION,
-    DEFAULT_EDGE_RING_RADIUS_MM, DEFAULT_ENVELOPE_LATERAL, DEFAULT_ENVELOPE_REACH,
-    DEFAULT_NORMAL_SMOOTHING_MM, DEFAULT_REPAIR_ROUNDS, DEFAULT_RESOLVE_ROUNDS,
+    build_shells, Boss, DirectionField, PartShell, Pocket, PocketMiss, PocketSpec, ShellInput,
+    ShellOptions, ShellStats, ThinnestWall, DEFAULT_BACK_SMOOTHING_ITERATIONS,
+    DEFAULT_CAP_FRACTION, DEFAULT_EDGE_RING_RADIUS_MM, DEFAULT_ENVELOPE_LATERAL,
+    DEFAULT_ENVELOPE_REACH, DEFAULT_NORMAL_SMOOTHING_MM, DEFAULT_REPAIR_ROUNDS,
+    DEFAULT_RESOLVE_ROUNDS,
 };
 pub use borders::BORDER_RINGS;
 pub use build::{
@@ -86,7 +87,7 @@ pub use fabricate::{
 };
 pub use input_errors::compare_frames;
 pub use intersect::{intersecting_pairs, self_intersecting_triangles, MAX_EXACT_COORDINATE};
-pub(crate) use magnet::{cut_pocket, cylinder};
+pub(crate) use magnet::{cut_pocket, cylinder, turned_cylinder};
 pub use magnet::{MagnetOptions, DEFAULT_POCKET_SEGMENTS, MIN_MAGNET_WALL_MM};
 pub use metrics::{ErrorSummary, FrameErrors};
 pub use nearest::{closest_point_on_triangle, TriangleGrid};

@@ -73,7 +73,8 @@ impl<'a> PartProblem<'a> {
     /// [`LibraryError::BadFixedPiece`], [`LibraryError::BadCut`].
     ///
     /// # Performance
-    /// One centred f32 copy of the frames plus the reduction (see [`SubspaceOptions`]).
+    /// The reduction streams centred blocks of frames (see [`SubspaceOptions`]): no copy of
+    /// the animation is made.
     pub fn new(
         anim: &'a MeshAnimation,
         setup: &PartSetup,
@@ -138,19 +139,25 @@ impl<'a> PartProblem<'a> {
             .map(|c| weights.as_ref().map_or(1.0, |w| w[c / 3].sqrt()))
             .collect();
         let rows = n + setup.fixed.len();
-        let mut z = vec![0.0f32; rows * 3 * m];
-        z.par_chunks_mut(3 * m).enumerate().for_each(|(r, row)| {
-            for (c, out) in row.iter_mut().enumerate() {
-                let v = if r < n {
-                    f64::from(anim.frame(r)[c / 3][c % 3])
+        // Rows of Z streamed straight from the frames (no second copy of the animation).
+        let fill = |r0: usize, out: &mut [f32]| {
+            out.par_chunks_mut(3 * m).enumerate().for_each(|(i, row)| {
+                let r = r0 + i;
+                if r < n {
+                    let frame = anim.frame(r);
+                    for (c, o) in row.iter_mut().enumerate() {
+                        let v = f64::from(frame[c / 3][c % 3]);
+                        *o = ((v - mean[c]) * scale[c]) as f32;
+                    }
                 } else {
-                    fixed_rows[(r - n) * 3 * m + c]
-                };
-                *out = ((v - mean[c]) * scale[c]) as f32;
-            }
-        });
-        let sub = reduce(&z, rows, 3 * m, subspace, seed)?;
-        drop(z);
+                    let fixed = &fixed_rows[(r - n) * 3 * m..(r - n + 1) * 3 * m];
+                    for (c, o) in row.iter_mut().enumerate() {
+                        *o = ((fixed[c] - mean[c]) * scale[c]) as f32;
+                    }
+                }
+            });
+        };
+        let sub = reduce(&fill, rows, 3 * m, subspace, seed)?;
         let q = sub.dim;
         let row = |f: usize| &sub.coords[f * q..(f + 1) * q];
         let xx = (0..n).map(|f| row(f).iter().map(|v| v * v).sum()).collect();

@@ -71,11 +71,32 @@ pub fn regularize(solid: &Mesh) -> Result<Regularized> {
 /// # Errors
 /// As [`regularize`]; also when the cutter is not a closed, orientable solid.
 pub(crate) fn exact_difference(solid: &Mesh, cutter: Option<&Mesh>) -> Result<Regularized> {
+    exact_boolean(solid, None, cutter)
+}
+
+/// `solid` joined with `added` (a boss that holds a pocket), then minus `cutter`, by the
+/// exact arrangement of [`exact_difference`] (same result and errors; `added` must be a
+/// closed, orientable solid too).
+pub(crate) fn exact_boolean(
+    solid: &Mesh,
+    added: Option<&Mesh>,
+    cutter: Option<&Mesh>,
+) -> Result<Regularized> {
     let fail = |reason: String| LibraryError::Regularization {
         mesh: solid.name.clone(),
         reason,
     };
-    let material = manifold_of(solid).map_err(fail)?;
+    let mut material = manifold_of(solid).map_err(fail)?;
+    if let Some(a) = added {
+        let a = manifold_of(a).map_err(|r| fail(format!("the added solid: {r}")))?;
+        material = material.boolean_with_engine(&a, OpType::Add, BooleanEngine::Robust);
+        if material.status() != ManifoldError::NoError {
+            return Err(fail(format!(
+                "the exact union failed ({:?})",
+                material.status()
+            )));
+        }
+    }
     let cutter = match cutter {
         Some(c) => manifold_of(c).map_err(|r| fail(format!("the cutter: {r}")))?,
         None => {

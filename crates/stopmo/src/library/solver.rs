@@ -342,6 +342,17 @@ impl PartProblem<'_> {
     /// Per iteration: one `frames × dim × pieces` GEMM, an `O(frames · pieces²)` Viterbi sweep
     /// and an `O(frames · dim)` pass; then one streaming pass over the full frames.
     pub fn solve(&self, pieces: usize, opts: &SolveOptions) -> Result<PartSolution> {
+        self.solve_with(pieces, opts, true)
+    }
+
+    /// [`PartProblem::solve`]; without `evaluate` the energy is left NaN for a caller that
+    /// changes the pieces and evaluates them itself (one pass over the frames less).
+    pub(crate) fn solve_with(
+        &self,
+        pieces: usize,
+        opts: &SolveOptions,
+        evaluate_energy: bool,
+    ) -> Result<PartSolution> {
         opts.validate()?;
         let d = pieces;
         if d == 0 {
@@ -378,7 +389,11 @@ impl PartProblem<'_> {
         }
         let best = best.expect("restarts >= 1");
         let (pieces, labels) = finish(self, d, opts.lambda, best.labels)?;
-        let energy = evaluate(self, &pieces, &labels, opts.lambda).0;
+        let energy = if evaluate_energy {
+            evaluate(self, &pieces, &labels, opts.lambda).0
+        } else {
+            f64::NAN
+        };
         Ok(PartSolution {
             pieces,
             labels,

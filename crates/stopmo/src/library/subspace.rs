@@ -66,37 +66,74 @@ fn par() -> Par {
     }
 }
 
-/// Reduces the row-major `rows × cols` matrix `z`.
+/// Rows of `Z` on demand: `fill(r0, out)` writes rows `r0..r0 + out.len() / cols`,
+/// row-major, into `out`. The frames are centred and scaled as they are streamed, so the
+/// reduction never holds a second copy of them.
+pub(crate) type RowSource<'a> = &'a (dyn Fn(usize, &mut [f32]) + Sync);
+
+/// Bytes of one streamed block of rows (small in unit tests, so that they cross blocks).
+const BLOCK_BYTES: usize = if cfg!(test) { 4096 } else { 8 << 20 };
+
+/// Rows streamed per block: a few MiB of `f32` at face sizes.
+fn block_rows(cols: usize) -> usize {
+    (BLOCK_BYTES / (4 * cols.max(1))).clamp(8, 1024)
+}
+
+/// Calls `each(r0, block)` for consecutive row blocks of `Z` (one reused buffer).
+fn stream(z: RowSource<'_>, rows: usize, cols: usize, mut each: impl FnMut(usize, &[f32])) {
+    let step = block_rows(cols);
+    let mut buf = vec![0.0f32; step.min(rows) * cols];
+    let mut r0 = 0;
+    while r0 < rows {
+        let k = step.min(rows - r0);
+        let block = &mut buf[..k * cols];
+        z(r0, block);
+        each(r0, block);
+        r0 += k;
+    }
+}
+
+/// Reduces the row-major `rows × cols` matrix `Z`, streamed from `z`.
 ///
 /// # Performance
 /// Exact (a copy) when `cols ≤ max_rank`; a Gram eigendecomposition (`rows² · cols`) when
-/// `rows ≤ max_rank`; otherwise two f32 GEMMs of `rows × cols × rank` per sketch attempt.
+/// `rows ≤ max_rank`; otherwise two streamed passes of f32 GEMMs of `rows × cols × rank`
+/// per sketch attempt, holding one block of rows at a time.
 pub(crate) fn reduce(
-    z: &[f32],
+    z: RowSource<'_>,
     rows: usize,
     cols: usize,
     opts: &SubspaceOptions,
     seed: u64,
 ) -> Result<Subspace> {
-    let total: f64 = z.iter().map(|&v| f64::from(v) * f64::from(v)).sum();
     if cols <= opts.max_rank.max(1) {
-        let coords = z.iter().map(|&v| f64::from(v)).collect();
+        let mut coords = vec![0.0f64; rows * cols];
+        stream(z, rows, cols, |r0, block| {
+            coords[r0 * cols..r0 * cols + block.len()]
+                .iter_mut()
+                .zip(block)
+                .for_each(|(c, &v)| *c = f64::from(v));
+        });
         return Ok(Subspace {
             dim: cols,
             coords,
             captured: 1.0,
         });
     }
-    if total <= 0.0 {
-        return Ok(Subspace {
-            dim: 1,
-            coords: vec![0.0; rows],
-            captured: 1.0,
-        });
-    }
-    let zv = MatRef::from_row_major_slice(z, rows, cols);
+    let mut total = 0.0f64;
     if rows <= opts.max_rank {
-        let z64 = Mat::<f64>::from_fn(rows, cols, |i, j| f64::from(zv[(i, j)]));
+        let mut z64 = Mat::<f64>::zeros(rows, cols);
+        stream(z, rows, cols, |r0, block| {
+            for (i, row) in block.chunks_exact(cols).enumerate() {
+                for (j, &v) in row.iter().enumerate() {
+                    z64[(r0 + i, j)] = f64::from(v);
+                    total += f64::from(v) * f64::from(v);
+                }
+            }
+        });
+        if total <= 0.0 {
+            return Ok(zero(rows));
+        }
         let mut gram = Mat::<f64>::zeros(rows, rows);
         matmul(
             gram.as_mut(),
@@ -115,29 +152,46 @@ pub(crate) fn reduce(
     }
     let mut rng = SplitMix64::new(seed, 0x5u64);
     let mut rank = opts.initial_rank.clamp(1, opts.max_rank);
+    let mut first = true;
     loop {
         let omega = Mat::<f32>::from_fn(cols, rank, |_, _| rng.normal() as f32);
         let mut sketch = Mat::<f32>::zeros(rows, rank);
-        matmul(
-            sketch.as_mut(),
-            Accum::Replace,
-            zv,
-            omega.as_ref(),
-            1.0f32,
-            par(),
-        );
+        stream(z, rows, cols, |r0, block| {
+            let k = block.len() / cols;
+            if first {
+                total += block
+                    .iter()
+                    .map(|&v| f64::from(v) * f64::from(v))
+                    .sum::<f64>();
+            }
+            matmul(
+                sketch.as_mut().subrows_mut(r0, k),
+                Accum::Replace,
+                MatRef::from_row_major_slice(block, k, cols),
+                omega.as_ref(),
+                1.0f32,
+                par(),
+            );
+        });
+        first = false;
+        if total <= 0.0 {
+            return Ok(zero(rows));
+        }
         let s64 = Mat::<f64>::from_fn(rows, rank, |i, j| f64::from(sketch[(i, j)]));
         let q = s64.qr().compute_thin_Q();
         let q32 = Mat::<f32>::from_fn(rows, rank, |i, j| q[(i, j)] as f32);
         let mut b = Mat::<f32>::zeros(rank, cols);
-        matmul(
-            b.as_mut(),
-            Accum::Replace,
-            q32.transpose(),
-            zv,
-            1.0f32,
-            par(),
-        );
+        stream(z, rows, cols, |r0, block| {
+            let k = block.len() / cols;
+            matmul(
+                b.as_mut(),
+                Accum::Add,
+                q32.as_ref().subrows(r0, k).transpose(),
+                MatRef::from_row_major_slice(block, k, cols),
+                1.0f32,
+                par(),
+            );
+        });
         let b64 = Mat::<f64>::from_fn(rank, cols, |i, j| f64::from(b[(i, j)]));
         let mut bbt = Mat::<f64>::zeros(rank, rank);
         matmul(
@@ -159,6 +213,15 @@ pub(crate) fn reduce(
             });
         }
         rank = (rank * 2).min(opts.max_rank).min(rows);
+    }
+}
+
+/// The reduction of all-zero rows: one zero coordinate each.
+fn zero(rows: usize) -> Subspace {
+    Subspace {
+        dim: 1,
+        coords: vec![0.0; rows],
+        captured: 1.0,
     }
 }
 
@@ -213,6 +276,11 @@ mod tests {
         g
     }
 
+    /// `z` as a row source.
+    fn rows_of(z: &[f32], cols: usize) -> impl Fn(usize, &mut [f32]) + Sync + '_ {
+        move |r0, out: &mut [f32]| out.copy_from_slice(&z[r0 * cols..r0 * cols + out.len()])
+    }
+
     fn low_rank(rows: usize, cols: usize, rank: usize) -> Vec<f32> {
         let mut rng = SplitMix64::new(3, 0);
         let a: Vec<f64> = (0..rows * rank).map(|_| rng.normal()).collect();
@@ -235,7 +303,7 @@ mod tests {
             max_rank: 16,
             ..Default::default()
         };
-        let s = reduce(&z, rows, cols, &opts, 1).unwrap();
+        let s = reduce(&rows_of(&z, cols), rows, cols, &opts, 1).unwrap();
         let z64: Vec<f64> = z.iter().map(|&v| f64::from(v)).collect();
         let (g0, g1) = (gram(&z64, rows, cols), gram(&s.coords, rows, s.dim));
         let err = g0
@@ -255,7 +323,7 @@ mod tests {
             max_rank: 20,
             tolerance: 1e-6,
         };
-        let s = reduce(&z, rows, cols, &opts, 2).unwrap();
+        let s = reduce(&rows_of(&z, cols), rows, cols, &opts, 2).unwrap();
         assert!(s.captured > 1.0 - 1e-5, "captured {}", s.captured);
         assert!(s.dim <= 8, "dim {}", s.dim);
         let z64: Vec<f64> = z.iter().map(|&v| f64::from(v)).collect();

@@ -133,9 +133,9 @@ fn keystrokes_json(r: &AnimateRequest, fps: f64) -> Value {
 }
 
 /// `POST /api/loa/animate`: buffers `line` (f32, line frames × joints × 2, canvas pixels),
-/// `positions` (f32, motion frames × vertices × 3 — or only the motion frame
-/// `motion.positions_first` when the request names a `frame`), `triangles` (u32); `version`
-/// names the answer for `GET /api/loa/motion`.
+/// `positions` (f32, every motion frame × vertices × 3 in one answer — or only the motion
+/// frame `motion.positions_first` when the request names a `frame`), `triangles` (u32);
+/// `version` names the answer for `GET /api/loa/motion`.
 pub(crate) async fn animate(
     State(studio): State<Arc<Studio>>,
     request: Result<Bytes, BytesRejection>,
@@ -203,7 +203,10 @@ pub(crate) async fn animate(
                 meshes: Vec::new(),
             },
         )
-        .map_err(|e| ApiError::internal(format!("{label}: {e}")))?;
+        .map_err(|e| {
+            let over = matches!(e, anim::AnimError::OverBudget(_));
+            ApiError::refused(format!("{label}: {e}"), over)
+        })?;
         let m = merged(&label, &sampled)?;
         let animate_seconds = start.elapsed().as_secs_f64() - line_seconds;
 
@@ -217,16 +220,20 @@ pub(crate) async fn animate(
                 .flat_map(|f| f.chain.joints().into_iter().flat_map(|p| [p.x as f32, p.y as f32])),
         );
         pack.u32("triangles", m.mesh.triangles.iter().flatten().copied());
-        let positions = coordinates(m.positions()).to_vec();
-        let (motion_frames, n) = (m.frame_count(), m.vertex_count() * 3);
+        let m = Arc::new(m);
+        let motion_frames = m.frame_count();
         let shown = match r.frame {
             Some(f) => {
                 let k = (f - motion.first_frame).clamp(0, motion_frames.max(1) as i64 - 1) as usize;
-                k..(k + 1).min(motion_frames)
+                pack.f32_slices("positions", [coordinates(m.frame(k))]);
+                k..k + 1
             }
-            None => 0..motion_frames,
+            // The whole motion in this answer: sent from the session's copy, not another.
+            None => {
+                pack.shared("positions", m.clone(), |m| coordinates(m.positions()));
+                0..motion_frames
+            }
         };
-        pack.f32_slices("positions", [&positions[shown.start * n..shown.end * n]]);
         let mut session = lock(&studio.loa);
         let version = session.as_ref().map_or(1, |s| s.version + 1);
         let rep = &motion.report;
@@ -264,7 +271,7 @@ pub(crate) async fn animate(
             line,
             scene: out,
             motion,
-            positions,
+            merged: m,
             version,
         });
         Ok(pack.response(header))
@@ -290,7 +297,9 @@ pub(crate) async fn motion(
             )));
         }
         let mut pack = Pack::new();
-        pack.f32_slices("positions", [&s.positions[..]]);
+        pack.shared("positions", s.merged.clone(), |m| {
+            coordinates(m.positions())
+        });
         Ok(pack.response(json!({ "version": s.version })))
     })
     .await

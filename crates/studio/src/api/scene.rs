@@ -9,8 +9,7 @@ use serde::Deserialize;
 use serde_json::{json, Value};
 
 use crate::error::ApiResult;
-use crate::files::merged;
-use crate::pack::{coordinates, Pack};
+use crate::pack::Pack;
 use crate::state::Studio;
 
 /// A file index and clip name (query string).
@@ -52,21 +51,21 @@ pub(crate) async fn scene(
 ) -> ApiResult<Response> {
     super::blocking(move || {
         let label = studio.file(q.file)?.label();
-        let sampled = studio.sampled(q.file, &q.clip)?;
-        let m = merged(&label, &sampled)?;
-        Ok(animation_pack(
-            &m,
-            json!({"file": q.file, "clip": q.clip, "name": label}),
-        ))
+        let clip = studio.sampled(q.file, &q.clip)?;
+        let header = json!({"file": q.file, "clip": q.clip, "name": label});
+        // The positions go out from the cached clip itself, not from a copy.
+        let mut pack = Pack::new();
+        let m = clip.merged();
+        pack.u32("triangles", m.mesh.triangles.iter().flatten().copied());
+        let header = describe(m, header);
+        pack.shared("positions", clip.clone(), |c| c.coordinates());
+        Ok(pack.response(header))
     })
     .await
 }
 
-/// A merged animation as a pack: header gains frames, vertices, triangles, fps, bbox.
-pub(crate) fn animation_pack(m: &anim::MeshAnimation, mut header: Value) -> Response {
-    let mut pack = Pack::new();
-    pack.u32("triangles", m.mesh.triangles.iter().flatten().copied());
-    pack.f32_slices("positions", [coordinates(m.positions())]);
+/// `header` with the animation's frames, vertices, triangles, fps and bounding box.
+fn describe(m: &anim::MeshAnimation, mut header: Value) -> Value {
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     for p in m.positions() {
         for k in 0..3 {
@@ -81,5 +80,5 @@ pub(crate) fn animation_pack(m: &anim::MeshAnimation, mut header: Value) -> Resp
         h.insert("fps".into(), json!(m.fps));
         h.insert("bbox".into(), json!([lo, hi]));
     }
-    pack.response(header)
+    header
 }

@@ -18,7 +18,7 @@ use super::changes::pack_changes;
 use super::scene::ClipQuery;
 use super::{blocking, body};
 use crate::error::{ApiError, ApiResult};
-use crate::files::{merged, output_path};
+use crate::files::output_path;
 use crate::pack::{coordinates, Pack};
 use crate::state::Studio;
 
@@ -206,13 +206,12 @@ pub(crate) async fn stylize(
             .collect();
         let bodies = &bodies;
         let vertices: usize = bodies.iter().map(|a| a.vertex_count()).sum();
-        let input = if r.changes {
-            let sampled = studio.sampled(r.file, &r.clip)?;
-            Some(merged(&studio.file(r.file)?.label(), &sampled)?)
+        let clip = if r.changes {
+            Some(studio.sampled(r.file, &r.clip)?)
         } else {
             None
         };
-        match &input {
+        match clip.as_ref().map(|c| c.merged()) {
             Some(m) if m.vertex_count() == vertices => pack_changes(
                 &mut pack,
                 frames,

@@ -17,7 +17,6 @@ use stopmo::SegmentJobOptions;
 
 use super::body;
 use crate::error::{ApiError, ApiResult};
-use crate::files::merged;
 use crate::state::{lock, StopmoSession, Studio};
 
 /// Most parts a segmentation request may ask for.
@@ -53,32 +52,20 @@ pub(crate) async fn segment(
     if let Some(i) = r.seeds.iter().position(Vec::is_empty) {
         return Err(ApiError::bad(format!("seeds: part {} has no seed", i + 1)));
     }
+    // The clip is sampled and the seeds checked here, before the job starts: a clip over a
+    // budget or a seed past the mesh is the request's error (4xx), not a failed job.
     let label = studio.file(r.file)?.label();
+    let clip = {
+        let studio = studio.clone();
+        let (file, clip) = (r.file, r.clip.clone());
+        super::blocking(move || studio.sampled(file, &clip)).await?
+    };
+    stopmo::check_segment_memory(clip.merged())
+        .map_err(|e| ApiError::too_large(format!("{label}: {e}")))?;
+    let parts = part_specs(&r, clip.merged().mesh.triangles.len())?;
     let job_studio = studio.clone();
     let id = studio.jobs.start("stopmo.segment", move |progress| {
         let cancelled = |e: crate::jobs::Cancelled| e.to_string();
-        progress.stage("sampling", 0.05).map_err(cancelled)?;
-        let sampled = job_studio.sampled(r.file, &r.clip).map_err(|e| e.message)?;
-        let anim = merged(&label, &sampled).map_err(|e| e.message)?;
-        let triangles = anim.mesh.triangles.len() as u32;
-        let mut parts = Vec::new();
-        for (i, seeds) in r.seeds.iter().enumerate() {
-            if let Some(t) = seeds.iter().find(|&&t| t >= triangles) {
-                return Err(format!(
-                    "seeds: triangle {t} of part {} is past the mesh's {triangles}",
-                    i + 1
-                ));
-            }
-            let name = r
-                .names
-                .get(i)
-                .cloned()
-                .unwrap_or_else(|| format!("part{}", i + 1));
-            parts.push(PartSpec::new(
-                name,
-                seeds.iter().map(|&t| Seed::Triangle(t)).collect(),
-            ));
-        }
         let options = SegmentJobOptions {
             parts,
             ..Default::default()
@@ -86,7 +73,8 @@ pub(crate) async fn segment(
         progress
             .stage("graph cut and homogenization", 0.2)
             .map_err(cancelled)?;
-        let s = stopmo::segment(&anim, &options).map_err(|e| format!("{label}: {e}"))?;
+        let s = stopmo::segment(clip.merged(), &options).map_err(|e| format!("{label}: {e}"))?;
+        drop(clip);
         progress.stage("done", 1.0).map_err(cancelled)?;
         let (seam_vertices, seam_weights) = seam_lines(&s);
         let mut answer = json!({
@@ -99,10 +87,36 @@ pub(crate) async fn segment(
         });
         // The parts move into the session (the curve's input), not copied beside `s`.
         let version = job_studio.store_segmentation(s.parts.into_iter().map(|p| p.animation));
+        // The parts hold the clip's frames now; a new segmentation samples it again.
+        job_studio.forget_clip(r.file, &r.clip);
         answer["segmentation"] = json!(version);
         Ok(answer)
     });
     Ok(Json(json!({ "job": id })))
+}
+
+/// The parts of a segmentation request: each part's seed triangles (checked against the
+/// mesh's `triangles`) and its name.
+fn part_specs(r: &SegmentRequest, triangles: usize) -> ApiResult<Vec<PartSpec>> {
+    let mut parts = Vec::new();
+    for (i, seeds) in r.seeds.iter().enumerate() {
+        if let Some(t) = seeds.iter().find(|&&t| t as usize >= triangles) {
+            return Err(ApiError::bad(format!(
+                "seeds: triangle {t} of part {} is past the mesh's {triangles}",
+                i + 1
+            )));
+        }
+        let name = r
+            .names
+            .get(i)
+            .cloned()
+            .unwrap_or_else(|| format!("part{}", i + 1));
+        parts.push(PartSpec::new(
+            name,
+            seeds.iter().map(|&t| Seed::Triangle(t)).collect(),
+        ));
+    }
+    Ok(parts)
 }
 
 /// The seams as line segments over the input mesh: point `2i` and `2i + 1` bound segment

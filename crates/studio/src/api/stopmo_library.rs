@@ -15,10 +15,10 @@ use serde::Deserialize;
 use serde_json::{json, Value};
 use stopmo::{LibraryJobOptions, LibraryResult, SizeCurve};
 
-use super::scene::animation_pack;
 use super::{blocking, body};
 use crate::error::{ApiError, ApiResult};
 use crate::files::output_path;
+use crate::pack::{coordinates, Pack};
 use crate::state::{lock, Studio};
 
 /// Most sizes one curve request may solve.
@@ -225,19 +225,53 @@ fn built_of(studio: &Studio) -> ApiResult<Arc<LibraryResult>> {
         .ok_or_else(|| ApiError::conflict("stopmo: build a library from the curve first"))
 }
 
-/// `GET /api/stopmo/reconstruction`: the built library's reconstruction, every part merged
-/// in part order (model units, the clip's frames), as `/api/scene`'s pack; the header adds
-/// `parts` and `frame_ids`.
+/// `GET /api/stopmo/reconstruction`: the built library's reconstruction as its pieces and
+/// the piece of every frame (StopShop Section 5: each frame *is* one piece per part), not
+/// every frame expanded — a clip of 1,440 frames is a few pieces. Buffers `triangles` (u32,
+/// every part merged in part order), `pieces` (f32, part by part: its pieces × its vertices
+/// × 3, model units), `labels` (u32, frames × parts: the piece each part shows); the header
+/// has `parts`, `part_vertices`, `part_pieces`, `frame_ids`, `frames`, `vertices`, `bbox`.
 pub(crate) async fn reconstruction(State(studio): State<Arc<Studio>>) -> ApiResult<Response> {
     let built = built_of(&studio)?;
     blocking(move || {
-        let merged = built
-            .merged_reconstruction()
-            .map_err(|e| ApiError::internal(format!("reconstruction: {e}")))?;
-        Ok(animation_pack(
-            &merged,
-            json!({"parts": built.part_names, "frame_ids": built.frame_ids()}),
-        ))
+        let parts = &built.library.parts;
+        let meshes: Vec<&anim::Mesh> = built.reconstruction.iter().map(|r| &r.mesh).collect();
+        if meshes.len() != parts.len() {
+            return Err(ApiError::internal(
+                "reconstruction: parts and pieces disagree",
+            ));
+        }
+        let frames = parts.first().map_or(0, |p| p.solution.labels.len());
+        let mut pack = Pack::new();
+        let mut base = 0u32;
+        let mut triangles = Vec::new();
+        for m in &meshes {
+            triangles.extend(m.triangles.iter().flatten().map(|&v| v + base));
+            base += m.positions.len() as u32;
+        }
+        pack.u32("triangles", triangles);
+        let pieces = parts.iter().flat_map(|p| p.solution.pieces.iter());
+        pack.f32_slices("pieces", pieces.clone().map(|piece| coordinates(piece)));
+        pack.u32(
+            "labels",
+            (0..frames).flat_map(|f| parts.iter().map(move |p| p.solution.labels[f])),
+        );
+        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for q in pieces.flatten() {
+            for k in 0..3 {
+                lo[k] = lo[k].min(q[k]);
+                hi[k] = hi[k].max(q[k]);
+            }
+        }
+        Ok(pack.response(json!({
+            "parts": built.part_names,
+            "part_vertices": meshes.iter().map(|m| m.positions.len()).collect::<Vec<_>>(),
+            "part_pieces": parts.iter().map(|p| p.solution.pieces.len()).collect::<Vec<_>>(),
+            "frame_ids": built.frame_ids(),
+            "frames": frames,
+            "vertices": base,
+            "bbox": [lo, hi],
+        })))
     })
     .await
 }

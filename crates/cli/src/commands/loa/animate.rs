@@ -10,10 +10,10 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use crate::flags::loa::MotionFlags;
 use anyhow::{bail, Context as _, Result};
 use clap::Args;
 use loa::animate::{ActionCamera, Character};
-use loa::args::MotionFlags;
 use serde_json::json;
 
 use super::{read_keystrokes, warn, Context, LineFlags};

@@ -6,9 +6,9 @@ mod line;
 
 use std::path::Path;
 
+pub(crate) use crate::flags::loa::LineFlags;
 use anyhow::{Context as _, Result};
 use clap::{Args, Subcommand};
-pub(crate) use loa::args::LineFlags;
 
 use super::Context;
 

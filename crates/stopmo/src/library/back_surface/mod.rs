@@ -55,7 +55,7 @@ pub use options::{
     DEFAULT_ENVELOPE_REACH, DEFAULT_NORMAL_SMOOTHING_MM, DEFAULT_REPAIR_ROUNDS,
     DEFAULT_RESOLVE_ROUNDS,
 };
-pub use pocket::Pocket;
+pub use pocket::{Boss, Pocket, PocketMiss, PocketSpec};
 pub use seams::{build_shells, ShellInput};
 
 /// Largest sideways slide of a back boundary point per millimetre of wall depth.

@@ -1,4 +1,4 @@
-//! The command-line flags of a preview (cargo feature `clap`), declared next to
+//! The command-line flags of a preview, declared in the CLI beside the render crate's
 //! [`PreviewOptions`]: frame, onion skins, colouring, view, size, supersampling and the
 //! contact sheet of `toonkit render`.
 
@@ -6,11 +6,11 @@ use std::path::Path;
 
 use clap::{Args, ValueEnum};
 
-use crate::{parse_size, ColorMap, OutputFormat, PreviewOptions, ViewSpec};
+use ::render::{parse_size, ColorMap, OutputFormat, PreviewOptions, ViewSpec};
 
 /// What the surface colour shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
-pub enum ColorArg {
+pub(crate) enum ColorArg {
     /// The meshes' own vertex colours, or grey.
     #[default]
     None,
@@ -22,47 +22,47 @@ pub enum ColorArg {
 
 /// The preview flags of `toonkit render`.
 #[derive(Debug, Clone, Args)]
-pub struct PreviewFlags {
+pub(crate) struct PreviewFlags {
     /// Frame of a PNG (0-based; default: the first).
     #[arg(long, value_name = "N")]
-    pub frame: Option<usize>,
+    pub(crate) frame: Option<usize>,
     /// Onion skin: ghosts of this many neighbouring frames on each side.
     #[arg(long, default_value_t = 0)]
-    pub onion: usize,
+    pub(crate) onion: usize,
     /// Surface colouring.
     #[arg(long, value_enum, default_value_t = ColorArg::None)]
-    pub color: ColorArg,
+    pub(crate) color: ColorArg,
     /// View: front, back, side, top, three-quarter (orthographic, fitted to the whole
     /// motion), follow or follow:DIRECTION (same scale, tracking a travelling subject) or camera:NAME
     /// (a scene camera).
     #[arg(long, default_value = "three-quarter")]
-    pub view: String,
+    pub(crate) view: String,
     /// Image size, WxH.
     #[arg(long, default_value = "400x400")]
-    pub size: String,
+    pub(crate) size: String,
     /// Supersampling per axis (1 = none, up to 4).
     #[arg(long, default_value_t = 2)]
-    pub supersample: u32,
+    pub(crate) supersample: u32,
     /// Write a contact sheet (`.png`): frames 0, N, 2N, … on a grid, numbered.
     #[arg(long)]
-    pub sheet: bool,
+    pub(crate) sheet: bool,
     /// Frame stride N of the contact sheet (default: about 16 cells).
     #[arg(long, requires = "sheet")]
-    pub every: Option<usize>,
+    pub(crate) every: Option<usize>,
     /// Columns of the contact sheet (default: square-ish).
     #[arg(long, requires = "sheet", default_value_t = 0)]
-    pub columns: usize,
+    pub(crate) columns: usize,
 }
 
 /// The preview flags, checked before anything is read.
 #[derive(Debug, Clone, PartialEq)]
-pub struct CheckedPreview {
+pub(crate) struct CheckedPreview {
     /// PNG or GIF, from the output's extension.
-    pub format: OutputFormat,
+    pub(crate) format: OutputFormat,
     /// Where the preview looks from.
-    pub view: ViewSpec,
+    pub(crate) view: ViewSpec,
     /// Image width and height in pixels.
-    pub size: (u32, u32),
+    pub(crate) size: (u32, u32),
 }
 
 impl PreviewFlags {
@@ -71,7 +71,7 @@ impl PreviewFlags {
     /// # Errors
     /// One line naming the flag or the output: unknown extension, view or size, or a
     /// contact sheet that is not a `.png`.
-    pub fn check(&self, output: &Path) -> Result<CheckedPreview, String> {
+    pub(crate) fn check(&self, output: &Path) -> Result<CheckedPreview, String> {
         let Some(format) = OutputFormat::from_extension(output) else {
             return Err(format!(
                 "{}: unknown output extension (use .png or .gif)",
@@ -98,7 +98,7 @@ impl PreviewFlags {
     ///
     /// # Errors
     /// `--every 0`.
-    pub fn options<'a>(
+    pub(crate) fn options<'a>(
         &self,
         checked: CheckedPreview,
         clip_frames: usize,

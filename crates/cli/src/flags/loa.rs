@@ -1,16 +1,16 @@
-//! The command-line flags of the loa jobs (cargo feature `clap`), declared next to the
+//! The command-line flags of the loa jobs, declared in the CLI beside the loa crate's
 //! options they fill: [`LineFlags`] → [`LineOptions`] (`loa line` and `loa animate`) and
 //! [`MotionFlags`] → [`AnimateOptions`] (`loa animate`).
 
 use clap::{Args, ValueEnum};
 use glam::DVec3;
 
-use crate::animate::{AnimateOptions, ContactKey, InitialPose};
-use crate::{Keystrokes, LineOptions};
+use ::loa::animate::{AnimateOptions, ContactKey, InitialPose};
+use ::loa::{Keystrokes, LineOptions};
 
 /// A flag whose value cannot be used, in the user's terms (`--settle x: …`).
 #[derive(Debug, thiserror::Error)]
-pub enum FlagError {
+pub(crate) enum FlagError {
     /// A flag's value is wrong; the text names the flag.
     #[error("{0}")]
     Flag(String),
@@ -38,7 +38,7 @@ fn at<T, E: std::error::Error + Send + Sync + 'static>(
 
 /// Interpolation mode.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
-pub enum ModeArg {
+pub(crate) enum ModeArg {
     /// Elastic chain simulation re-targeted onto every keystroke (anticipation, follow-through).
     #[default]
     Physics,
@@ -48,34 +48,34 @@ pub enum ModeArg {
 
 /// Line options shared by `loa line` and `loa animate`.
 #[derive(Debug, Clone, Args)]
-pub struct LineFlags {
+pub(crate) struct LineFlags {
     /// Interpolation mode.
     #[arg(long, value_enum, default_value_t = ModeArg::Physics)]
-    pub mode: ModeArg,
+    pub(crate) mode: ModeArg,
     /// Frames per second (default: the keystrokes', else 24).
     #[arg(long, value_name = "FPS", allow_negative_numbers = true)]
-    pub fps: Option<f32>,
+    pub(crate) fps: Option<f32>,
     /// Integration sub-steps per frame.
-    #[arg(long, default_value_t = crate::DEFAULT_SUBSTEPS)]
-    pub substeps: u32,
+    #[arg(long, default_value_t = loa::DEFAULT_SUBSTEPS)]
+    pub(crate) substeps: u32,
     /// Frames simulated from each keystroke (`M`), or `gap` for the frame gap between keys.
     #[arg(long, default_value = "40")]
-    pub simulated_frames: String,
+    pub(crate) simulated_frames: String,
     /// Rigid elements per chain (even).
-    #[arg(long, default_value_t = crate::DEFAULT_ELEMENTS)]
-    pub elements: usize,
+    #[arg(long, default_value_t = loa::DEFAULT_ELEMENTS)]
+    pub(crate) elements: usize,
     /// Follow-through after the last keystroke, ending on it at rest: a frame count (0 = end
     /// on the last keystroke), or `key` for one key interval (the last one).
     #[arg(long, default_value = "key")]
-    pub settle: String,
+    pub(crate) settle: String,
     /// Drag-to-wobble `FRAME:S:DX,DY`: hit the line at frame FRAME, at arc-length position
     /// S (0..1), with impulse DX,DY (screen units per second). Repeatable.
     #[arg(long = "wobble", allow_hyphen_values = true)]
-    pub wobbles: Vec<String>,
+    pub(crate) wobbles: Vec<String>,
     /// Stroke smoothing before the fit: Gaussian σ as a fraction of the stroke's length
     /// (0 = fit the raw samples).
-    #[arg(long, default_value_t = crate::DEFAULT_STROKE_SMOOTHING)]
-    pub smoothing: f64,
+    #[arg(long, default_value_t = loa::DEFAULT_STROKE_SMOOTHING)]
+    pub(crate) smoothing: f64,
 }
 
 impl LineFlags {
@@ -83,16 +83,16 @@ impl LineFlags {
     ///
     /// # Errors
     /// A bad `--simulated-frames`, `--settle` or `--wobble`.
-    pub fn options(&self, keys: &Keystrokes) -> Result<LineOptions, FlagError> {
+    pub(crate) fn options(&self, keys: &Keystrokes) -> Result<LineOptions, FlagError> {
         let simulated_frames = match self.simulated_frames.trim() {
-            "gap" => crate::SimulatedFrames::FrameGap,
-            m => crate::SimulatedFrames::Fixed(at(m.parse(), || {
+            "gap" => loa::SimulatedFrames::FrameGap,
+            m => loa::SimulatedFrames::Fixed(at(m.parse(), || {
                 format!("--simulated-frames {m}: expected a frame count or \"gap\"")
             })?),
         };
         let settle = match self.settle.trim() {
-            "key" => crate::Settle::KeyInterval,
-            s => crate::Settle::Frames(at(s.parse(), || {
+            "key" => loa::Settle::KeyInterval,
+            s => loa::Settle::Frames(at(s.parse(), || {
                 format!("--settle {s}: expected a frame count or \"key\"")
             })?),
         };
@@ -103,16 +103,16 @@ impl LineFlags {
             .collect::<Result<_, _>>()?;
         Ok(LineOptions {
             mode: match self.mode {
-                ModeArg::Physics => crate::Mode::Physics,
-                ModeArg::Hermite => crate::Mode::Hermite,
+                ModeArg::Physics => loa::Mode::Physics,
+                ModeArg::Hermite => loa::Mode::Hermite,
             },
             elements: self.elements,
-            physics: crate::PhysicsOptions {
+            physics: loa::PhysicsOptions {
                 fps: self
                     .fps
                     .map(f64::from)
                     .or(keys.fps())
-                    .unwrap_or(crate::DEFAULT_FPS),
+                    .unwrap_or(loa::DEFAULT_FPS),
                 substeps: self.substeps,
                 simulated_frames,
                 settle,
@@ -128,29 +128,29 @@ impl LineFlags {
 /// The motion options of `loa animate`: bone sets, action plane, contacts, twists, the
 /// initial pose and the solver's iteration cap.
 #[derive(Debug, Clone, Args)]
-pub struct MotionFlags {
+pub(crate) struct MotionFlags {
     /// Bone set at a keystroke frame: a preset found by joint names (right-leg-spine-head,
     /// left-leg-spine-head, arm-spine, left-arm-spine, arms, legs, full-body, and for a raised
     /// arm right-leg-spine-arm, left-leg-spine-arm), one found from the hierarchy for any
     /// names (foot-head, spine-head) or comma-separated joint names, then `@FRAME`. Repeat for
     /// changing sets.
     #[arg(long = "bones")]
-    pub bones: Vec<String>,
+    pub(crate) bones: Vec<String>,
     /// Action-plane normal `x,y,z` (default: the view direction).
     #[arg(long, allow_hyphen_values = true)]
-    pub plane_normal: Option<String>,
+    pub(crate) plane_normal: Option<String>,
     /// Contact: `JOINT@FRAME` (hold where it is), `JOINT@FRAME:x,y,z`, or `JOINT@A..B`.
     #[arg(long = "contact")]
-    pub contacts: Vec<String>,
+    pub(crate) contacts: Vec<String>,
     /// Twist: `JOINT@FRAME:DEGREES` about the bone's own axis.
     #[arg(long = "twist", allow_hyphen_values = true)]
-    pub twists: Vec<String>,
+    pub(crate) twists: Vec<String>,
     /// Initial pose: `rest`, or `CLIP@FRAME` (a frame of one of the file's clips).
     #[arg(long, default_value = "rest")]
-    pub pose: String,
+    pub(crate) pose: String,
     /// Cap on solver iterations per stage.
-    #[arg(long, default_value_t = crate::animate::DEFAULT_MAX_ITERATIONS)]
-    pub iterations: usize,
+    #[arg(long, default_value_t = loa::animate::DEFAULT_MAX_ITERATIONS)]
+    pub(crate) iterations: usize,
 }
 
 impl MotionFlags {
@@ -158,7 +158,7 @@ impl MotionFlags {
     ///
     /// # Errors
     /// A bad `--bones`, `--contact`, `--twist` or `--plane-normal`.
-    pub fn options(&self) -> Result<AnimateOptions, FlagError> {
+    pub(crate) fn options(&self) -> Result<AnimateOptions, FlagError> {
         let bone_sets = self
             .bones
             .iter()
@@ -187,7 +187,7 @@ impl MotionFlags {
     ///
     /// # Errors
     /// Neither `rest` nor `CLIP@FRAME`.
-    pub fn pose(&self) -> Result<InitialPose, FlagError> {
+    pub(crate) fn pose(&self) -> Result<InitialPose, FlagError> {
         at(self.pose.parse(), || format!("--pose {}", self.pose))
     }
 }

@@ -6,14 +6,15 @@ use std::ops::Range;
 use std::time::Instant;
 
 use anim::{Aabb, Flipbook, FlipbookPart, MeshAnimation};
-use glam::Vec3;
 use serde::Serialize;
+
+mod subdivided;
+
+use subdivided::{subdivided_copy, SubdividedBody};
 
 use super::frames::{animation_at, check_range, elongate_range, lines_range, multiples_range};
 use super::prepare::Prepared;
-use crate::{
-    CompiledEffects, CompiledLines, EffectInputs, LineStyle, Result, SmearError, Style, Stylize,
-};
+use crate::{CompiledEffects, CompiledLines, EffectInputs, LineStyle, Result, SmearError, Style};
 
 /// One copy of the multiple in-betweens in a [`StylizeReport`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -199,110 +200,6 @@ fn squash_animation(
     }
 }
 
-/// One multiple in-between, adaptively subdivided per frame (issue #22): every vertex of
-/// copy m moves by β_m(f) = step · m · Δf(f) (Section 4.2); opacities are blended into the
-/// colours' alpha. The copy's frame 0 is clip frame `first`.
-fn subdivided_copy(
-    inputs: &EffectInputs<'_>,
-    options: &crate::MultiplesOptions,
-    copy: &crate::MultipleCopy,
-    rgb: [f32; 3],
-    tol: f32,
-    first: usize,
-) -> Result<(Vec<anim::Mesh>, Vec<Vec<Vec3>>)> {
-    let tr = inputs.trajectories();
-    let anim = &copy.animation;
-    let (frames, n) = (anim.frame_count(), anim.vertex_count());
-    let step = options.step.max(1);
-    // The copy's own motion: its vertices' central differences, blended into new vertices.
-    let moving = crate::vertex_velocities(anim);
-    let mut meshes = Vec::with_capacity(frames);
-    let mut velocities = Vec::with_capacity(frames);
-    for f in 0..frames {
-        let h = crate::held_frame(first + f, step);
-        let (past, future) = options.counts_at(h as f32);
-        let shown = if copy.m < 0 {
-            copy.m.unsigned_abs() as usize <= past
-        } else {
-            copy.m as usize <= future
-        };
-        let b = if shown {
-            step as f32 * copy.m as f32 * options.spacing_at(h as f32)?
-        } else {
-            0.0
-        };
-        let beta = vec![b; n];
-        let alpha = &copy.alpha[f * n..(f + 1) * n];
-        let v = &moving[f * n..(f + 1) * n];
-        let (mesh, v, _) =
-            crate::subdivide_moving_frame(&tr, &anim.mesh, h, &beta, Some((alpha, rgb)), tol, v);
-        meshes.push(mesh);
-        velocities.push(v);
-    }
-    Ok((meshes, velocities))
-}
-
-/// The elongated body, adaptively subdivided per frame (issue #22).
-struct SubdividedBody<'a, 'i> {
-    inputs: &'a EffectInputs<'i>,
-    /// The elongation's stylization function.
-    f: &'a dyn Stylize,
-    /// Frames each drawing is held for.
-    step: usize,
-    /// Per clip frame: its squash, if any.
-    squash: &'a [Option<crate::Squash>],
-    ground: Option<f32>,
-    tol: f32,
-}
-
-impl SubdividedBody<'_, '_> {
-    /// Every frame of `frames`: its subdivided mesh and the velocities of its vertices (units
-    /// per frame: the central differences of the unsubdivided smear as a point cache writes
-    /// them, squash included, blended into the new vertices); the subdivision's figures go
-    /// into `stats`.
-    fn frames(
-        &self,
-        anim: &MeshAnimation,
-        body: &MeshAnimation,
-        range_squash: &[Option<crate::Squash>],
-        frames: &Range<usize>,
-        stats: &mut ObjectReport,
-    ) -> (Vec<anim::Mesh>, Vec<Vec<Vec3>>) {
-        let tr = self.inputs.trajectories();
-        let n = anim.vertex_count();
-        let mut written = body.clone();
-        squash_animation(&mut written, range_squash, self.ground);
-        let moving = crate::vertex_velocities(&written);
-        let mut beta = vec![0.0f32; n];
-        let mut meshes = Vec::with_capacity(frames.len());
-        let mut velocities = Vec::with_capacity(frames.len());
-        let (mut stretch, mut most, mut vertices, mut error) = (0.0f32, 0, 0, 0.0f32);
-        for (i, frame) in frames.clone().enumerate() {
-            let h = crate::held_frame(frame, self.step);
-            for (k, b) in beta.iter_mut().enumerate() {
-                *b = self.step as f32 * self.f.eval(&self.inputs.style_input(h, k));
-            }
-            let v = &moving[i * n..(i + 1) * n];
-            let (mut mesh, v, st) =
-                crate::subdivide_moving_frame(&tr, &anim.mesh, h, &beta, None, self.tol, v);
-            if let (Some(Some(sq)), Some(g)) = (self.squash.get(frame), self.ground) {
-                sq.apply(g, &mut mesh.positions);
-            }
-            stretch = stretch.max(st.max_stretch);
-            most = most.max(st.triangles);
-            vertices = vertices.max(st.vertices);
-            error = error.max(st.max_error);
-            meshes.push(mesh);
-            velocities.push(v);
-        }
-        stats.subdivision_max_stretch = Some(stretch);
-        stats.subdivision_max_triangles = Some(most);
-        stats.subdivision_max_vertices = Some(vertices);
-        stats.subdivision_max_error = Some(error);
-        (meshes, velocities)
-    }
-}
-
 /// Applies `style` to every object of `prepared`: per object, the elongated in-betweens (or
 /// the input when the style has none), the multiple in-betweens as alpha-coloured copies and
 /// the motion lines as per-frame tube meshes.
@@ -338,7 +235,9 @@ pub fn stylize(prepared: &Prepared, style: &Style) -> Result<Stylized> {
 /// # Errors
 /// [`SmearError::OverBudget`] when the motion lines asked for (count, samples, sides, frames)
 /// exceed [`anim::budget::DEFAULT_MAX_LINE_VERTICES`] or their seeds' trajectories
-/// [`anim::budget::DEFAULT_MAX_POINTS`]; the errors of the effects.
+/// [`anim::budget::DEFAULT_MAX_POINTS`], or when the stylized meshes, multiples and lines
+/// with the prepared clip exceed [`anim::budget::DEFAULT_MAX_JOB_BYTES`]; the errors of the
+/// effects.
 pub fn stylize_frames(
     prepared: &Prepared,
     style: &Style,
@@ -361,6 +260,12 @@ pub fn stylize_frames(
     };
     let mut objects = Vec::with_capacity(prepared.object_count());
     let mut report = StylizeReport::default();
+    let mut memory = anim::budget::JobMemory::new().positions(
+        "copies of the prepared clip (positions, velocities)",
+        prepared.report().frames,
+        prepared.scene().vertex_count(),
+        2,
+    );
     let camera = prepared.camera();
     let merged = prepared.options().merge.is_some();
     // The style's units into the scene's, once (docs/smear-units.md).
@@ -376,6 +281,11 @@ pub fn stylize_frames(
         let name = prepared.name(i);
         let diagonal = Aabb::from_points(anim.frame(0)).diagonal();
         let fx: CompiledEffects = style.for_object(name).compile_in(diagonal, &units)?;
+        if let Some(l) = &fx.lines {
+            check_line_budget(l, prepared.report().frames, frames.len())?;
+        }
+        memory = object_memory(memory, &fx, frames.len(), anim.vertex_count());
+        memory.check(MEMORY_HINT)?;
         let weights = match &fx.weights {
             Some(w) => Some(prepared.resolve_weights_in(w, i, &units)?),
             None => prepared.weights(i).map(<[f32]>::to_vec),
@@ -426,8 +336,7 @@ pub fn stylize_frames(
                     ground,
                     tol,
                 };
-                let (meshes, velocities) =
-                    sub.frames(anim, &body, range_squash, &frames, &mut stats);
+                let (meshes, velocities) = sub.frames(anim, &frames, &mut stats);
                 book.parts.push(FlipbookPart::Frames {
                     name: anim.mesh.name.clone(),
                     meshes,
@@ -490,7 +399,6 @@ pub fn stylize_frames(
 
         let t = Instant::now();
         if let Some(l) = &fx.lines {
-            check_line_budget(l, prepared.report().frames, frames.len())?;
             let tris = &anim.mesh.triangles;
             let mut points = crate::sample_surface(anim.frame(0), tris, l.count, l.seed);
             if merged {
@@ -546,6 +454,55 @@ pub fn stylize_frames(
         report,
         first_frame: frames.start,
     })
+}
+
+/// What to lower when a stylization is over the job's memory budget.
+const MEMORY_HINT: &str =
+    "lower --fps, pick a shorter clip or ask for fewer multiples or motion lines";
+
+/// Bytes of one stylized vertex of one frame: its position and its RGBA colour (f32).
+const STYLIZED_VERTEX_BYTES: u64 = 12 + 16;
+
+/// Bytes of one motion-line vertex of one frame: position, normal and RGBA colour (f32).
+const LINE_VERTEX_BYTES: u64 = 12 + 12 + 16;
+
+/// `memory` and what stylizing `frames` frames of one object of `vertices` vertices with `fx`
+/// will hold: the body and each multiple, the motion lines, each twice (the flipbook and the
+/// file it is written to), checked against [`anim::budget::DEFAULT_MAX_JOB_BYTES`] before
+/// they are made.
+fn object_memory(
+    memory: anim::budget::JobMemory,
+    fx: &CompiledEffects,
+    frames: usize,
+    vertices: usize,
+) -> anim::budget::JobMemory {
+    use anim::budget::product;
+    let copies = 1 + fx.multiples.as_ref().map_or(0, |(_, o)| o.indices().len()) as u64;
+    let meshes = product(&[
+        frames as u64,
+        vertices as u64,
+        copies,
+        STYLIZED_VERTEX_BYTES,
+        2,
+    ]);
+    let memory = memory.bytes(
+        format!("{copies} stylized meshes and their file, {frames} frames × {vertices} vertices"),
+        meshes,
+    );
+    match &fx.lines {
+        Some(l) => {
+            let lines = product(&[
+                l.count as u64,
+                l.options.samples as u64,
+                l.options.sides as u64,
+                frames as u64,
+                LINE_VERTEX_BYTES,
+                2,
+            ]);
+            memory.bytes(format!("{} motion lines and their file", l.count), lines)
+        }
+        None => memory,
+    }
 }
 
 /// Motion lines (SMEAR Eq. 13) are checked against their budgets before their seeds are

@@ -6,9 +6,14 @@ use std::path::{Path, PathBuf};
 
 use anim::{Flipbook, Mesh, MeshAnimation};
 
+use crate::shapes::ShapeAnimation;
 use crate::usda::{UsdMesh, UsdStage};
 
 use crate::{write_atomic_all, Format, IoError, Result};
+
+mod sequence;
+
+use sequence::{write_frames, write_sequence};
 
 /// How an animation is laid out in the output file.
 ///
@@ -114,6 +119,16 @@ pub enum Output<'a> {
     Text(&'a str),
     /// Bytes written as is (an encoded PNG or GIF).
     Bytes(&'a [u8]),
+    /// Parts with the same frames, each showing one of a few shapes per frame (a stop-motion
+    /// replacement library), never expanded to every frame where the format allows: `.glb`
+    /// (one morph target per shape, STEP weights), `.pc2` (merged in part order, streamed to
+    /// disk; `rest` as a same-name `.obj` beside it); other formats get the expanded parts.
+    Shapes {
+        /// The parts.
+        parts: &'a [ShapeAnimation<'a>],
+        /// The merged rest mesh written beside a point cache.
+        rest: &'a Mesh,
+    },
 }
 
 /// How [`save_with`] writes.
@@ -278,6 +293,39 @@ pub fn save_with(path: &Path, output: &Output<'_>, options: SaveOptions) -> Resu
             layout,
             colors,
         } => write_animation(path, animation, layout, colors, glb, &mut put)?,
+        Output::Shapes { parts, rest } => {
+            crate::shapes::check_parts(parts).map_err(|e| e.at(path))?;
+            match output_format(path)? {
+                Format::Pc2 => {
+                    rest_mesh_of(path, rest, &mut put)?;
+                    // The cache streams to disk first; the rest mesh follows, all or nothing
+                    // for it.
+                    crate::shapes::write_pc2(path, parts)?;
+                }
+                Format::Glb => put(
+                    path,
+                    crate::gltf::write_glb_with(&crate::shapes::shapes_scene(parts), glb)
+                        .map_err(|e| e.at(path))?,
+                )?,
+                _ => {
+                    let expanded = parts
+                        .iter()
+                        .map(ShapeAnimation::expand)
+                        .collect::<Result<Vec<_>>>()
+                        .map_err(|e| e.at(path))?;
+                    let layers: Vec<(&MeshAnimation, Option<&[[f32; 4]]>)> =
+                        expanded.iter().map(|a| (a, None)).collect();
+                    return save_with(
+                        path,
+                        &Output::Parts {
+                            parts: &layers,
+                            layout: Layout::Morph,
+                        },
+                        options,
+                    );
+                }
+            }
+        }
     }
     write_atomic_all(&files)?;
     Ok(files.into_iter().map(|(p, _)| p).collect())
@@ -424,91 +472,6 @@ fn write_animation(
     }
 }
 
-/// Every frame as its own file, `name_0001.obj`, … (numbered from 1, as Blender's OBJ
-/// sequences are).
-fn write_sequence(
-    path: &Path,
-    format: Format,
-    anim: &MeshAnimation,
-    put: &mut dyn FnMut(&Path, Vec<u8>) -> Result<()>,
-) -> Result<()> {
-    let base = sequence_base(path);
-    match format {
-        #[cfg(feature = "obj")]
-        Format::Obj => {
-            for (p, text) in crate::obj::write_sequence(anim, &base) {
-                put(&p, text.into_bytes())?;
-            }
-        }
-        _ => {
-            let stem = base.file_name().map(|s| s.to_string_lossy().into_owned());
-            let stem = stem.unwrap_or_else(|| "frame".into());
-            for f in 0..anim.frame_count() {
-                let p = base.with_file_name(format!("{stem}_{:04}.{}", f + 1, format.extension()));
-                write_animation(
-                    &p,
-                    &MeshAnimation::still(anim.mesh_at(f)),
-                    Layout::Flipbook,
-                    None,
-                    crate::gltf::GlbOptions::default(),
-                    put,
-                )?;
-            }
-        }
-    }
-    Ok(())
-}
-
-/// A flipbook in a one-frame format (`.obj`, `.stl`): one file per frame holding that
-/// frame's own meshes (their topology may change from frame to frame), `name_0001.obj`, …;
-/// a one-frame flipbook is the named file itself. OBJ keeps each mesh as its own `o`
-/// object; STL holds one solid, so the meshes are joined.
-fn write_frames(
-    path: &Path,
-    frames: usize,
-    frame: &dyn Fn(usize) -> Vec<Mesh>,
-    put: &mut dyn FnMut(&Path, Vec<u8>) -> Result<()>,
-) -> Result<()> {
-    let format = output_format(path)?;
-    let base = sequence_base(path);
-    let stem = base.file_name().map(|s| s.to_string_lossy().into_owned());
-    let stem = stem.unwrap_or_else(|| "frame".into());
-    for f in 0..frames {
-        let p = if frames == 1 {
-            path.to_path_buf()
-        } else {
-            base.with_file_name(format!("{stem}_{:04}.{}", f + 1, format.extension()))
-        };
-        let meshes = frame(f);
-        let bytes = match format {
-            #[cfg(feature = "obj")]
-            Format::Obj => crate::obj::write_objects(&meshes).into_bytes(),
-            #[cfg(feature = "stl")]
-            Format::Stl => crate::stl::write_binary(&joined(&meshes)),
-            _ => {
-                return Err(
-                    IoError::unsupported("this build of toonkit cannot write that format").at(&p),
-                )
-            }
-        };
-        put(&p, bytes)?;
-    }
-    Ok(())
-}
-
-/// Meshes joined into one (positions and triangles only), for formats with one solid.
-#[cfg(feature = "stl")]
-fn joined(meshes: &[Mesh]) -> Mesh {
-    let mut positions = Vec::new();
-    let mut triangles = Vec::new();
-    for m in meshes {
-        let first = positions.len() as u32;
-        positions.extend_from_slice(&m.positions);
-        triangles.extend(m.triangles.iter().map(|t| t.map(|i| i + first)));
-    }
-    Mesh::new("frame", positions, triangles)
-}
-
 /// The rest mesh of a PC2/MDD cache, as a same-name `.obj` beside it.
 #[cfg(feature = "obj")]
 fn rest_mesh(
@@ -516,10 +479,25 @@ fn rest_mesh(
     anim: &MeshAnimation,
     put: &mut dyn FnMut(&Path, Vec<u8>) -> Result<()>,
 ) -> Result<()> {
+    rest_mesh_of(path, &anim.mesh, put)
+}
+
+/// `mesh` as the same-name `.obj` beside the point cache `path`.
+#[cfg(feature = "obj")]
+fn rest_mesh_of(
+    path: &Path,
+    mesh: &Mesh,
+    put: &mut dyn FnMut(&Path, Vec<u8>) -> Result<()>,
+) -> Result<()> {
     put(
         &path.with_extension("obj"),
-        crate::obj::write(&anim.mesh).into_bytes(),
+        crate::obj::write(mesh).into_bytes(),
     )
+}
+
+#[cfg(not(feature = "obj"))]
+fn rest_mesh_of(_: &Path, _: &Mesh, _: &mut dyn FnMut(&Path, Vec<u8>) -> Result<()>) -> Result<()> {
+    Ok(())
 }
 
 #[cfg(not(feature = "obj"))]
@@ -531,20 +509,9 @@ fn rest_mesh(
     Ok(())
 }
 
-/// `out/walk.obj` or `out/walk_0001.obj` → `out/walk` (frames are numbered from there).
-fn sequence_base(path: &Path) -> PathBuf {
-    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("frame");
-    let trimmed = stem.trim_end_matches(|c: char| c.is_ascii_digit());
-    let trimmed = if trimmed.len() < stem.len() {
-        trimmed.trim_end_matches('_')
-    } else {
-        stem
-    };
-    path.with_file_name(trimmed)
-}
-
 #[cfg(test)]
 mod tests {
+    use super::sequence::sequence_base;
     use super::*;
 
     #[test]

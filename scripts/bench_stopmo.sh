@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Whole-process stopmo benchmark at feature-film scale (see crates/stopmo/benches/scale.rs):
+# builds the release CLI, writes the seeded inputs from the bundled face once, then runs
+# each case with every binary given (interleaved, so a shared machine's load hits all alike)
+# and prints wall, user and system CPU seconds and peak resident memory.
+#
+#   scripts/bench_stopmo.sh [--toonkit OTHER_BINARY]... [--repeat K] [--cases face20,table1,print20]
+#
+# Needs /usr/bin/time (Debian package `time`).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo build --release -p toonkit-cli
+exec cargo bench -p toonkit-stopmo --bench scale -- \
+    --out "$PWD/target/stopmo-scale" --toonkit "$PWD/target/release/toonkit" "$@"
