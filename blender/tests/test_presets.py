@@ -4,11 +4,24 @@
     python blender/tests/test_presets.py dist/toonkit-<version>-<platform>.zip [OUT_DIR]
 
 For the bundled CesiumMan and the benchmark tube, the panel's presets with one β max and κ are
-baked once and restyled (`smear_update`), and every frame's evaluated result is compared with
-`toonkit smear elongate FILE --preset P --beta-max B --kappa K` of the CLI built from the same
-tree (`$TOONKIT_CLI`, else `target/debug/toonkit`): within 1 % of the bounding-box diagonal
-(Blender samples its own evaluated meshes; the CLI samples the file). The panel's defaults are
-the CLI's (`toonkit smear elongate --help`).
+baked once and restyled (`smear_update`), and every frame's evaluated result is
+compared with `toonkit smear elongate FILE --preset P --beta-max B --kappa K` of the CLI built
+from the same tree (`$TOONKIT_CLI`, else `target/debug/toonkit`): within 1 % of the
+bounding-box diagonal (Blender samples its own evaluated meshes; the CLI samples the file,
+which crates/python/tests/test_gltf_spec.py checks against an independent reading of the glTF).
+The panel's defaults are the CLI's (`toonkit smear elongate --help`).
+
+RobotExpressive is not among them yet. What Blender samples of it is the file only when the
+importer's "Bone Dir" is Temperance (or Fortune): with the default ("Blender") the importer
+shortens every bone by the armature's scale (100 here) but still pulls the parts parented to a
+bone back by the unshortened length, so the robot's arms, shoulders, legs, feet, torso and head
+sit 0.57-0.65 units (6.7-7.8 % of its 8.438 size) from where the file puts them, in every frame
+and at rest, and its size is 8.132 (docs/blender.md, "Importing glTF characters");
+`test_the_robots_bone_parented_parts_follow_the_bone_heuristic` measures both imports. Even
+imported with Temperance, where every sampled vertex and the size agree with the core's within
+1e-6, the offsets Blender's bake solves differ from the CLI's (by up to 0.74 on the face part
+Head_3, up to 0.04 elsewhere; the linear preset's smear by 40 % of the diagonal). Why is
+not established (one candidate: the importer's triangles, 3,234 against the file's 3,237).
 """
 
 import json
@@ -53,12 +66,12 @@ def read_pc2(path):
     return np.frombuffer(data, "<f4", offset=32).reshape(frames, points, 3)
 
 
-def character(path, clip=None):
-    """Imports `file`, puts `clip` (an action name prefix) on its objects and selects its
-    meshes (without the importer's bone shape); returns the meshes and the action's first
-    frame."""
+def character(path, clip=None, bone_heuristic="BLENDER"):
+    """Imports `file` with the importer's `bone_heuristic` ("Bone Dir"), puts `clip` (an
+    action name prefix) on its objects and selects its meshes (without the importer's bone
+    shape); returns the meshes and the action's first frame."""
     empty_scene()
-    bpy.ops.import_scene.gltf(filepath=path)
+    bpy.ops.import_scene.gltf(filepath=path, bone_heuristic=bone_heuristic)
     for o in bpy.data.objects:
         ad = o.animation_data or (o.data.shape_keys.animation_data
                                   if o.type == "MESH" and o.data.shape_keys else None)
@@ -113,10 +126,10 @@ def align(meshes, first, file_positions, diag):
     return range(start, start + n), index
 
 
-def agree(path, clip, name):
+def agree(path, clip, name, bone_heuristic="BLENDER"):
     """Every preset on one character: Blender's bake and restyles against the CLI's caches."""
     args = [path, *(["--clip", clip] if clip else [])]
-    meshes, first = character(path, clip)
+    meshes, first = character(path, clip, bone_heuristic)
     loaded = toonkit.load(args[0], clip=clip)  # the file's sampling, only to align frames
     diag = float(np.linalg.norm(np.ptp(loaded.positions[0], axis=0)))
     frames, index = align(meshes, first, loaded.positions, diag)
@@ -153,6 +166,61 @@ def agree(path, clip, name):
 
 def test_every_preset_on_cesium_man_as_the_cli():
     agree(os.path.join(ASSETS, "CesiumMan.glb"), None, "cesium_man")
+
+
+def test_the_robots_bone_parented_parts_follow_the_bone_heuristic():
+    """What the extension samples of RobotExpressive (every frame of Dance, and the rest pose
+    its size unit is measured on) against the core's sampling of the file, part by part, for
+    both bone heuristics: Temperance gives the file's geometry; the default ("Blender") moves
+    every part parented to a bone along that bone by 99 % of the length the importer picked
+    for it (the bone is drawn 100× shorter, the armature's scale), and leaves the skinned
+    hands where the file puts them (docs/blender.md, "Importing glTF characters")."""
+    from bl_ext.user_default.toonkit import sample
+
+    path = os.path.join(ASSETS, "RobotExpressive.glb")
+    loaded = toonkit.load(path)
+    diag = float(np.linalg.norm(np.ptp(loaded.positions[0], axis=0)))
+    frames = index = None
+    REPORT["robot_import"] = measured = {}
+    for heuristic in ("TEMPERANCE", "BLENDER"):
+        meshes, first = character(path, None, heuristic)
+        if index is None:  # the Temperance import is the file's: it gives the vertex order
+            frames, index = align(meshes, first, loaded.positions, diag)
+        scene = bpy.context.scene
+        scene.frame_start, scene.frame_end = frames.start, frames.stop - 1
+        s = sample.sample(bpy.context, meshes)
+        want = loaded.positions[:, index] @ GLTF_TO_BLENDER.T
+        size = float(np.linalg.norm(np.ptp(s.rest, axis=0)))
+        parts = {}
+        for name, r in zip(s.names, s.ranges):
+            offset = s.positions[:, r.start:r.stop].astype(np.float64) - want[:, r.start:r.stop]
+            d = np.linalg.norm(offset, axis=2)
+            # How far the part is from a rigid translation of the file's (per frame).
+            spread = float(np.abs(offset - offset.mean(axis=1, keepdims=True)).max())
+            parts[name] = {"max": float(d.max()), "mean": float(d.mean()), "spread": spread}
+        measured[heuristic] = {"size": size, "core_size": loaded.size, "parts": parts}
+        worst = max(p["max"] for p in parts.values())
+        print(f"robot imported with bone heuristic {heuristic}: size {size:.4f} (core "
+              f"{loaded.size:.4f}); worst part {worst:.3g} units ({100 * worst / loaded.size:.2f}"
+              " % of the size); per part max/mean: " + ", ".join(
+                  f"{n} {p['max']:.3g}/{p['mean']:.3g}" for n, p in sorted(parts.items())),
+              flush=True)
+        skinned = {o.name for o in meshes if sample.armature_of(o) is not None}
+        on_bones = {o.name for o in meshes if sample._bone_parent(o)[0] is not None}
+        check(skinned and on_bones, f"skinned {skinned}, on bones {on_bones}")
+        for name, p in parts.items():
+            if heuristic == "TEMPERANCE" or name in skinned:
+                check(p["max"] <= 1e-5 * diag, f"{heuristic}: {name} is {p['max']:.2e} from "
+                                               "the file")
+            elif name in on_bones:
+                check(p["max"] > 0.05 * diag and p["spread"] <= 1e-5 * diag,
+                      f"{heuristic}: {name} is not the documented offset along its bone: {p}")
+        if heuristic == "TEMPERANCE":
+            check(abs(size - loaded.size) <= 1e-5 * loaded.size,
+                  f"Temperance: rest size {size:.6f} vs the core's {loaded.size:.6f}")
+        else:
+            check(size < 0.98 * loaded.size, f"Blender heuristic: rest size {size:.4f} vs the "
+                                             f"core's {loaded.size:.4f}")
 
 
 def test_every_preset_on_the_benchmark_tube_as_the_cli():
@@ -195,6 +263,7 @@ if __name__ == "__main__":
     code = run([
         test_the_panel_defaults_are_the_clis,
         test_every_preset_on_cesium_man_as_the_cli,
+        test_the_robots_bone_parented_parts_follow_the_bone_heuristic,
         test_every_preset_on_the_benchmark_tube_as_the_cli,
     ])
     with open(os.path.join(OUT, "report.json"), "w") as f:
