@@ -83,7 +83,13 @@ def character(path, clip=None, bone_heuristic="BLENDER"):
 
 
 def frames_of(objs, frames):
-    return np.stack([np.concatenate([world_positions(o, f) for o in objs]) for f in frames])
+    """The world positions of `objs` at each of `frames` (one frame change per frame: the
+    robot has 20 objects)."""
+    out = []
+    for f in frames:
+        bpy.context.scene.frame_set(f)
+        out.append(np.concatenate([world_positions(o) for o in objs]))
+    return np.stack(out)
 
 
 def nearest(a, b):
