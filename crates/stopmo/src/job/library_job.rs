@@ -55,9 +55,11 @@ pub fn library(parts: &[MeshAnimation], opts: &LibraryJobOptions) -> Result<Libr
     build(&refs, &names, opts, None)
 }
 
-/// Copies of a part's positions a library build holds: the parts, the solver's frame matrix
-/// and its subspace (f64, twice an f32 copy each), the reconstruction and its file.
-const LIBRARY_COPIES: u64 = 7;
+/// Copies of a part's positions a library build holds: the parts, and at most the solver's
+/// reduced coordinates (f64, twice an f32 copy, when a part is too small to be sketched).
+/// The frames are streamed into the sketch, the reconstruction is kept and written as pieces
+/// and labels (`reconstruction.pc2` streams frame by frame).
+const LIBRARY_COPIES: u64 = 3;
 
 /// Checks what building a library of parts of `vertices` vertices in all will hold (`copies`
 /// copies of their `frames` frames) against [`anim::budget::DEFAULT_MAX_JOB_BYTES`] before
@@ -65,7 +67,7 @@ const LIBRARY_COPIES: u64 = 7;
 fn check_memory(frames: usize, vertices: usize, copies: u64) -> Result<()> {
     anim::budget::JobMemory::new()
         .positions(
-            "copies of the clip (parts, solver, reconstruction, written)",
+            "copies of the clip (parts, solver)",
             frames,
             vertices,
             copies,

@@ -192,7 +192,9 @@ pub fn build_library(parts: &[PartInput<'_>], opts: &LibraryOptions) -> Result<L
             }
         })
         .collect();
-    let solve_one = |i: usize, d: usize| -> Result<PartSolution> {
+    // The solution and, when its energy was evaluated here, its per-frame errors (kept, so
+    // that a given size passes over the frames once for both).
+    let solve_full = |i: usize, d: usize| -> Result<(PartSolution, Option<FrameErrors>)> {
         let p = &problems[i];
         // Evaluated once, after the pieces are final.
         let reevaluate = confine || opts.method == Method::KMeans;
@@ -204,14 +206,18 @@ pub fn build_library(parts: &[PartInput<'_>], opts: &LibraryOptions) -> Result<L
             // The velocity term lets pieces leave the input's range; not where a part ends.
             p.confine_borders(&mut s, &borders[i]);
         }
-        if reevaluate {
-            s.energy = evaluate(p, &s.pieces, &s.labels, lambda).0;
-        }
-        Ok(s)
+        let errors = reevaluate.then(|| {
+            let (energy, errors) = evaluate(p, &s.pieces, &s.labels, lambda);
+            s.energy = energy;
+            errors
+        });
+        Ok((s, errors))
     };
-    let solved: Vec<(PartSolution, Vec<CurvePoint>)> = match &opts.size {
+    let solve_one = |i: usize, d: usize| solve_full(i, d).map(|(s, _)| s);
+    let given = |(s, e): (PartSolution, Option<FrameErrors>)| (s, Vec::new(), e);
+    let solved: Vec<(PartSolution, Vec<CurvePoint>, Option<FrameErrors>)> = match &opts.size {
         LibrarySize::Pieces(d) => (0..problems.len())
-            .map(|i| solve_one(i, *d).map(|s| (s, Vec::new())))
+            .map(|i| solve_full(i, *d).map(given))
             .collect::<Result<_>>()?,
         LibrarySize::PerPart(ds) => {
             if ds.len() != problems.len() {
@@ -222,21 +228,28 @@ pub fn build_library(parts: &[PartInput<'_>], opts: &LibraryOptions) -> Result<L
                 )));
             }
             (0..problems.len())
-                .map(|i| solve_one(i, ds[i]).map(|s| (s, Vec::new())))
+                .map(|i| solve_full(i, ds[i]).map(given))
                 .collect::<Result<_>>()?
         }
         LibrarySize::MaxError(e) => (0..problems.len())
-            .map(|i| max_error_search(&problems[i], *e, lambda, &|d| solve_one(i, d)))
+            .map(|i| {
+                max_error_search(&problems[i], *e, lambda, &|d| solve_one(i, d))
+                    .map(|(s, c)| (s, c, None))
+            })
             .collect::<Result<_>>()?,
-        LibrarySize::Budget(b) => budget_search(&problems, *b, lambda, &solve_one)?,
+        LibrarySize::Budget(b) => budget_search(&problems, *b, lambda, &solve_one)?
+            .into_iter()
+            .map(|(s, c)| (s, c, None))
+            .collect(),
     };
     let anims: Vec<&MeshAnimation> = parts.iter().map(|p| p.animation).collect();
     let mm = print_scale(&anims, opts.print_height_mm);
     let results: Vec<PartResult> = solved
         .into_par_iter()
         .zip(problems.par_iter())
-        .map(|((solution, curve), p)| {
-            let (_, errors) = evaluate(p, &solution.pieces, &solution.labels, lambda);
+        .map(|((solution, curve, errors), p)| {
+            let errors =
+                errors.unwrap_or_else(|| evaluate(p, &solution.pieces, &solution.labels, lambda).1);
             PartResult {
                 name: p.name.clone(),
                 errors_mm: errors.summary(mm),

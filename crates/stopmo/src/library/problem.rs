@@ -43,6 +43,9 @@ pub struct PartProblem<'a> {
     pub(crate) dxx: Vec<f64>,
 }
 
+/// Columns (coordinates) per parallel block of the mean frame: 32 KiB of `f64`.
+const MEAN_BLOCK: usize = 4096;
+
 /// Splits `0..n` at the cuts.
 pub(crate) fn chains(n: usize, cuts: &[usize]) -> Result<Vec<Range<usize>>> {
     let mut c: Vec<usize> = cuts.to_vec();
@@ -126,15 +129,21 @@ impl<'a> PartProblem<'a> {
         let chains = chains(n, &setup.cuts)?;
 
         // Centred, saliency-scaled rows Z = [X; R_fixed] (x̄ = mean frame).
+        // Parallel over column blocks, each summed over the frames in order (the same sums
+        // as one sequential pass).
         let mut mean = vec![0.0f64; 3 * m];
-        for f in anim.frames() {
-            for (acc, p) in mean.chunks_exact_mut(3).zip(f) {
-                acc[0] += f64::from(p.x);
-                acc[1] += f64::from(p.y);
-                acc[2] += f64::from(p.z);
-            }
-        }
-        mean.iter_mut().for_each(|v| *v /= n as f64);
+        mean.par_chunks_mut(MEAN_BLOCK)
+            .enumerate()
+            .for_each(|(b, acc)| {
+                let (c0, w) = (b * MEAN_BLOCK, acc.len());
+                for f in anim.frames() {
+                    let x: &[f32] = bytemuck::cast_slice(f);
+                    for (a, &v) in acc.iter_mut().zip(&x[c0..c0 + w]) {
+                        *a += f64::from(v);
+                    }
+                }
+                acc.iter_mut().for_each(|v| *v /= n as f64);
+            });
         let scale: Vec<f64> = (0..3 * m)
             .map(|c| weights.as_ref().map_or(1.0, |w| w[c / 3].sqrt()))
             .collect();
@@ -144,10 +153,9 @@ impl<'a> PartProblem<'a> {
             out.par_chunks_mut(3 * m).enumerate().for_each(|(i, row)| {
                 let r = r0 + i;
                 if r < n {
-                    let frame = anim.frame(r);
-                    for (c, o) in row.iter_mut().enumerate() {
-                        let v = f64::from(frame[c / 3][c % 3]);
-                        *o = ((v - mean[c]) * scale[c]) as f32;
+                    let frame: &[f32] = bytemuck::cast_slice(anim.frame(r));
+                    for (((o, &v), &mu), &s) in row.iter_mut().zip(frame).zip(&mean).zip(&scale) {
+                        *o = ((f64::from(v) - mu) * s) as f32;
                     }
                 } else {
                     let fixed = &fixed_rows[(r - n) * 3 * m..(r - n + 1) * 3 * m];
