@@ -105,10 +105,10 @@ pub mod segment;
 
 pub use job::{
     check_segment_memory, file_safe_name, library, library_of, piece_label, run, save_files,
-    saved_segmentation, segment, size_curve, Error, FileData, LibraryJobOptions, LibraryReport,
-    LibraryResult, OrderReport, OutputFile, PartPrintReport, PartReport, PartSummary, Piece,
-    PieceCount, PlugReport, PrintReport, PrintTime, Reconstruction, Result, RunOptions,
-    SegmentJobOptions, SegmentSummary, Segmented, SizeCurve, SizePoint, DEFAULT_PIECES,
+    saved_segmentation, segment, segment_owned, size_curve, Error, FileData, LibraryJobOptions,
+    LibraryReport, LibraryResult, OrderReport, OutputFile, PartPrintReport, PartReport,
+    PartSummary, Piece, PieceCount, PlugReport, PrintReport, PrintTime, Reconstruction, Result,
+    RunOptions, SegmentJobOptions, SegmentSummary, Segmented, SizeCurve, SizePoint, DEFAULT_PIECES,
     DEFAULT_RESOLUTION_MM,
 };
 pub use job::{

@@ -286,6 +286,49 @@ fn face_run_equals_segment_then_library_and_searches_a_size() {
     );
 }
 
+/// A clip handed over to the job (its frames grown into the cut's in place) segments exactly
+/// as a borrowed one: the same cut animation, parts and reports, bit for bit, with fresh seeds
+/// and when reusing a saved cut.
+#[test]
+fn face_handed_over_segments_bit_for_bit_as_borrowed() {
+    let anim = common::face(1.0);
+    let opts = SegmentJobOptions {
+        parts: vec![
+            PartSpec::new("upper", vec![Seed::Point(Vec3::new(0.0, 10.0, 13.0))]),
+            PartSpec::new("lower", vec![Seed::Point(Vec3::new(0.0, -14.0, 10.0))]),
+        ],
+        ..Default::default()
+    };
+    let borrowed = stopmo::segment(&anim, &opts).unwrap();
+    let reuse = SegmentJobOptions {
+        reuse: Some(borrowed.saved.clone()),
+        ..Default::default()
+    };
+    for (opts, expected) in [
+        (&opts, borrowed.clone()),
+        (&reuse, stopmo::segment(&anim, &reuse).unwrap()),
+    ] {
+        let owned = stopmo::segment_owned(anim.clone(), opts).unwrap();
+        let (a, b) = (
+            &owned.segmentation.animation,
+            &expected.segmentation.animation,
+        );
+        assert!(
+            a.vertex_count() > anim.vertex_count(),
+            "the cut adds vertices"
+        );
+        assert_eq!(a.positions(), b.positions());
+        assert_eq!(a.mesh.positions, b.mesh.positions);
+        assert_eq!(a.mesh.normals, b.mesh.normals);
+        assert_eq!(owned.report_json(), expected.report_json());
+        assert_eq!(owned.parts.len(), expected.parts.len());
+        for (p, q) in owned.parts.iter().zip(&expected.parts) {
+            assert_eq!(p.vertices, q.vertices);
+            assert_eq!(p.animation.positions(), q.animation.positions());
+        }
+    }
+}
+
 /// A part whose own animated surface presses through itself (as lips can at a mouth corner
 /// inside one part): the report counts it apart from the back's crossings, the warning
 /// says what to do, and the written solids are regularized.

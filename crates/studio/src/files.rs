@@ -142,6 +142,18 @@ impl Clip {
         }
     }
 
+    /// The merged animation handed over (a job that keeps only what it makes from the clip):
+    /// moved out when no one else holds the clip, copied otherwise.
+    pub fn into_merged(clip: std::sync::Arc<Clip>) -> MeshAnimation {
+        match std::sync::Arc::try_unwrap(clip) {
+            Ok(Clip {
+                several: Some(m), ..
+            }) => m,
+            Ok(Clip { mut sampled, .. }) => sampled.objects.swap_remove(0).animation,
+            Err(shared) => shared.merged().clone(),
+        }
+    }
+
     /// The merged positions as float32 coordinates (for [`crate::pack::Pack::shared`]).
     pub fn coordinates(&self) -> &[f32] {
         crate::pack::coordinates(self.merged().positions())

@@ -35,6 +35,7 @@ pub use report::{
 };
 pub use result::{LibraryResult, Reconstruction};
 pub use segment_job::{
-    check_segment_memory, saved_segmentation, segment, PartSummary, SegmentSummary, Segmented,
+    check_segment_memory, saved_segmentation, segment, segment_owned, PartSummary, SegmentSummary,
+    Segmented,
 };
 pub use size_curve::{library_of, size_curve, SizeCurve, SizePoint};

@@ -1,6 +1,7 @@
 //! The segmentation job: seeds or automatic parts → [`Segmentation`] → one animation per
 //! part, with the report of SPEC "Output layouts" and the Fig. 5 figure.
 
+use std::borrow::Cow;
 use std::time::Instant;
 
 use anim::MeshAnimation;
@@ -82,13 +83,28 @@ pub fn check_segment_memory(anim: &MeshAnimation) -> Result<()> {
 /// the clip's copies would be over [`anim::budget::DEFAULT_MAX_JOB_BYTES`], or the
 /// segmentation's own errors ([`Error::Segment`]).
 pub fn segment(anim: &MeshAnimation, opts: &SegmentJobOptions) -> Result<Segmented> {
+    segment_input(Cow::Borrowed(anim), opts)
+}
+
+/// [`segment`] of an animation handed over: the same result, but the input's frames become
+/// the cut animation's instead of being copied, so the clip is held once less at the peak
+/// (a front end that keeps only the parts gives its clip away).
+///
+/// # Errors
+/// As [`segment`].
+pub fn segment_owned(anim: MeshAnimation, opts: &SegmentJobOptions) -> Result<Segmented> {
+    segment_input(Cow::Owned(anim), opts)
+}
+
+fn segment_input(anim: Cow<'_, MeshAnimation>, opts: &SegmentJobOptions) -> Result<Segmented> {
     let start = Instant::now();
-    check_segment_memory(anim)?;
+    check_segment_memory(&anim)?;
+    let (input_vertices, input_triangles) = (anim.vertex_count(), anim.mesh.triangle_count());
     let segmentation = match &opts.reuse {
-        Some(saved) => crate::segment::segment_reusing(anim, saved, &opts.segment)?,
+        Some(saved) => crate::segment::reuse_input(anim, saved, &opts.segment)?,
         None => {
             let parts = match opts.auto_parts {
-                Some(n) => crate::segment::auto_parts(anim, n)?,
+                Some(n) => crate::segment::auto_parts(&anim, n)?,
                 None => opts.parts.clone(),
             };
             if parts.len() < 2 {
@@ -97,11 +113,11 @@ pub fn segment(anim: &MeshAnimation, opts: &SegmentJobOptions) -> Result<Segment
                     "give at least two parts, each with a seed (or auto_parts = N)",
                 ));
             }
-            crate::segment::segment(anim, &parts, &opts.segment)?
+            crate::segment::segment_input(anim, &parts, &opts.segment)?
         }
     };
     segmentation.check_parts()?;
-    let saved = segmentation.saved(anim.vertex_count(), anim.mesh.triangle_count());
+    let saved = segmentation.saved(input_vertices, input_triangles);
     let parts = segmentation.parts()?;
     let figure = if opts.figure {
         Some(render::encode_png(&super::figure::parts_figure(

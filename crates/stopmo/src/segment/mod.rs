@@ -80,11 +80,13 @@ pub use cut::{CutMesh, VertexSource, DEFAULT_SNAP};
 pub use error::{Result, SegmentError};
 pub use homogenize::{HomogenizeStats, Homogenizer, DEFAULT_CHUNK_FRAMES};
 pub use laplacian::DEFAULT_MAX_COT;
+pub(crate) use pipeline::segment_input;
 pub use pipeline::{
     auto_parts, homogenize, segment, segment_with, Part, SegmentOptions, SegmentReport,
     Segmentation,
 };
 pub use problem::{SegmentationProblem, DEFAULT_GAMMA};
+pub(crate) use reuse::reuse_input;
 pub use reuse::{segment_reusing, SavedSegmentation};
 pub use seeds::{
     auto_seeds, resolve_seeds, PartSpec, Seed, DEFAULT_AUTO_CENTERING_ITERATIONS,

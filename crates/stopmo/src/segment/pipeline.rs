@@ -1,6 +1,8 @@
 //! The segmentation pipeline: seeds → graph cut (StopShop Eqs. 1–3) → smooth boundaries → cut mesh →
 //! seam homogenization (StopShop Eqs. 4–9) → per-part animations.
 
+use std::borrow::Cow;
+
 use anim::{Mesh, MeshAnimation};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -229,10 +231,20 @@ pub fn segment(
     parts: &[PartSpec],
     options: &SegmentOptions,
 ) -> Result<Segmentation> {
+    segment_input(Cow::Borrowed(anim), parts, options)
+}
+
+/// [`segment`] on an input that is borrowed or handed over: an owned input's frames become
+/// the cut animation's (grown in place), so the input and its cut are never held at once.
+pub(crate) fn segment_input(
+    anim: Cow<'_, MeshAnimation>,
+    parts: &[PartSpec],
+    options: &SegmentOptions,
+) -> Result<Segmentation> {
     check_options(options)?;
-    let problem = SegmentationProblem::new(anim, options.weld_epsilon)?;
-    let seeds = resolve_seeds(anim, &problem, parts)?;
-    segment_with(
+    let problem = SegmentationProblem::new(&anim, options.weld_epsilon)?;
+    let seeds = resolve_seeds(&anim, &problem, parts)?;
+    cut_input(
         anim,
         &problem,
         parts.iter().map(|p| p.name.clone()).collect(),
@@ -267,6 +279,17 @@ fn check_options(o: &SegmentOptions) -> Result<()> {
 /// seeds or γ values without recomputing StopShop Eq. 3).
 pub fn segment_with(
     anim: &MeshAnimation,
+    problem: &SegmentationProblem,
+    part_names: Vec<String>,
+    seeds: Vec<Vec<u32>>,
+    options: &SegmentOptions,
+) -> Result<Segmentation> {
+    cut_input(Cow::Borrowed(anim), problem, part_names, seeds, options)
+}
+
+/// [`segment_with`] on a borrowed or handed-over input (see [`segment_input`]).
+fn cut_input(
+    anim: Cow<'_, MeshAnimation>,
     problem: &SegmentationProblem,
     part_names: Vec<String>,
     seeds: Vec<Vec<u32>>,
@@ -340,10 +363,11 @@ pub(super) struct Labels {
     pub gamma: f64,
 }
 
-/// Evaluates the cut on `anim`, finds the seam and homogenizes it towards `reference` (the
-/// average positions of the cut vertices on the clip that defined the cut).
+/// Evaluates the cut on `anim` (an owned input becomes the cut animation in place), finds the
+/// seam and homogenizes it towards `reference` (the average positions of the cut vertices on
+/// the clip that defined the cut).
 pub(super) fn finish(
-    anim: &MeshAnimation,
+    anim: Cow<'_, MeshAnimation>,
     cut: CutMesh,
     labels: Labels,
     reference: Vec<Vec3>,
@@ -427,8 +451,10 @@ fn representatives(class: &[u32], count: usize) -> Vec<u32> {
     rep
 }
 
-/// Evaluates the cut mesh's vertices in every frame and interpolates the attributes.
-fn build_cut_animation(anim: &MeshAnimation, cut: &CutMesh) -> Result<MeshAnimation> {
+/// Evaluates the cut mesh's vertices in every frame and interpolates the attributes. An owned
+/// input's position buffer is grown into the cut's (its vertices come first, in input
+/// order), not copied: the same numbers without a second copy of the clip.
+fn build_cut_animation(anim: Cow<'_, MeshAnimation>, cut: &CutMesh) -> Result<MeshAnimation> {
     let src = &anim.mesh;
     let mut mesh = Mesh::new(
         src.name.clone(),
@@ -480,20 +506,60 @@ fn build_cut_animation(anim: &MeshAnimation, cut: &CutMesh) -> Result<MeshAnimat
             })
             .collect()
     });
-    let n = cut.sources.len();
-    let mut positions = vec![Vec3::ZERO; n * anim.frame_count()];
-    positions
-        .par_chunks_mut(n.max(1))
-        .zip(anim.positions().par_chunks(anim.vertex_count().max(1)))
-        .for_each(|(out, x)| {
-            for (o, s) in out.iter_mut().zip(&cut.sources) {
-                *o = s.eval(x);
-            }
-        });
-    let mut out = MeshAnimation::new(mesh, anim.fps, positions)
+    let (fps, start_time) = (anim.fps, anim.start_time);
+    let positions = match anim {
+        Cow::Owned(input) if input_first(cut, input.vertex_count()) => {
+            let (m, frames) = (input.vertex_count(), input.frame_count());
+            grow_frames(input.into_parts().1, m, frames, cut)
+        }
+        anim => {
+            let n = cut.sources.len();
+            let mut positions = vec![Vec3::ZERO; n * anim.frame_count()];
+            positions
+                .par_chunks_mut(n.max(1))
+                .zip(anim.positions().par_chunks(anim.vertex_count().max(1)))
+                .for_each(|(out, x)| {
+                    for (o, s) in out.iter_mut().zip(&cut.sources) {
+                        *o = s.eval(x);
+                    }
+                });
+            positions
+        }
+    };
+    let mut out = MeshAnimation::new(mesh, fps, positions)
         .map_err(|e| SegmentError::Invalid(e.to_string()))?;
-    out.start_time = anim.start_time;
+    out.start_time = start_time;
     Ok(out)
+}
+
+/// Whether the cut's first `m` vertices are the input's `m` vertices in order (what
+/// [`cut_mesh`] makes), so that a frame of the input is the start of the cut's frame.
+fn input_first(cut: &CutMesh, m: usize) -> bool {
+    m > 0
+        && cut.sources.len() >= m
+        && cut.sources[..m]
+            .iter()
+            .enumerate()
+            .all(|(i, s)| matches!(s, VertexSource::Original(j) if *j as usize == i))
+}
+
+/// The input's frame-major positions (`frames × m`) grown in place into the cut's
+/// (`frames × n`, [`input_first`]): frames move from the last to the first (each one's new
+/// place only covers itself and frames already moved), then the new vertices of the frame
+/// are evaluated from its input vertices.
+fn grow_frames(mut positions: Vec<Vec3>, m: usize, frames: usize, cut: &CutMesh) -> Vec<Vec3> {
+    let n = cut.sources.len();
+    positions.truncate(frames * m);
+    positions.reserve_exact(frames * (n - m));
+    positions.resize(frames * n, Vec3::ZERO);
+    for f in (0..frames).rev() {
+        positions.copy_within(f * m..(f + 1) * m, f * n);
+        let (x, new) = positions[f * n..(f + 1) * n].split_at_mut(m);
+        for (o, s) in new.iter_mut().zip(&cut.sources[m..]) {
+            *o = s.eval(x);
+        }
+    }
+    positions
 }
 
 /// Homogenizes the seams of an animation whose triangles already carry part labels

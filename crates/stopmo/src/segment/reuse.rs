@@ -6,6 +6,8 @@
 //! and the targets — and applying them to another clip gives seam vertices at exactly the same
 //! positions in every frame of every clip.
 
+use std::borrow::Cow;
+
 use anim::MeshAnimation;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -61,6 +63,16 @@ impl Segmentation {
 /// factorization.
 pub fn segment_reusing(
     anim: &MeshAnimation,
+    saved: &SavedSegmentation,
+    options: &SegmentOptions,
+) -> Result<Segmentation> {
+    reuse_input(Cow::Borrowed(anim), saved, options)
+}
+
+/// [`segment_reusing`] on an input that is borrowed or handed over (an owned input's frames
+/// become the cut animation's).
+pub(crate) fn reuse_input(
+    anim: Cow<'_, MeshAnimation>,
     saved: &SavedSegmentation,
     options: &SegmentOptions,
 ) -> Result<Segmentation> {

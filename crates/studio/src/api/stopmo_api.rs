@@ -73,8 +73,11 @@ pub(crate) async fn segment(
         progress
             .stage("graph cut and homogenization", 0.2)
             .map_err(cancelled)?;
-        let s = stopmo::segment(clip.merged(), &options).map_err(|e| format!("{label}: {e}"))?;
-        drop(clip);
+        // The parts will hold the clip's frames: the cached clip is handed to the job (a new
+        // segmentation samples it again), whose cut grows in its buffer instead of copying it.
+        job_studio.forget_clip(r.file, &r.clip);
+        let input = crate::files::Clip::into_merged(clip);
+        let s = stopmo::segment_owned(input, &options).map_err(|e| format!("{label}: {e}"))?;
         progress.stage("done", 1.0).map_err(cancelled)?;
         let (seam_vertices, seam_weights) = seam_lines(&s);
         let mut answer = json!({
@@ -87,8 +90,6 @@ pub(crate) async fn segment(
         });
         // The parts move into the session (the curve's input), not copied beside `s`.
         let version = job_studio.store_segmentation(s.parts.into_iter().map(|p| p.animation));
-        // The parts hold the clip's frames now; a new segmentation samples it again.
-        job_studio.forget_clip(r.file, &r.clip);
         answer["segmentation"] = json!(version);
         Ok(answer)
     });
