@@ -83,6 +83,9 @@ def main():
     ap.add_argument("--concurrent", type=int, default=8)
     ap.add_argument("--lines", type=int, default=20000,
                     help="motion lines of each concurrent request (under the budget)")
+    ap.add_argument("--skip", action="append", default=[],
+                    help="leave out the refusals whose name holds this text")
+    ap.add_argument("--no-concurrent", action="store_true")
     ap.add_argument("--job-bytes", default="",
                     help="TOONKIT_MAX_JOB_BYTES for the studio (default: half the limit)")
     a = ap.parse_args()
@@ -116,6 +119,8 @@ def main():
         print("| request | body bytes | HTTP | RSS before (MiB) | peak (MiB) | next request |")
         print("|---|---:|---:|---:|---:|---:|")
         for what, method, path, body in refusals:
+            if any(k in what for k in a.skip):
+                continue
             data = body if isinstance(body, bytes) else json.dumps(body).encode()
             reset_peak(pid)
             before = status_mib(pid, "VmRSS:")
@@ -125,6 +130,8 @@ def main():
             print(f"| {what} | {len(data)} | {status} | {before:.0f} | {peak:.0f} | {nxt} |")
             print(f"|  ↳ {error_of(payload)[:150]} | | | | | |")
 
+        if a.no_concurrent:
+            return
         # Requests each under the budget, at once: the pool admits what fits, 503 for the rest.
         heavy = json.dumps(style(f"[elongate]\n[lines]\ncount = {a.lines}\n")).encode()
         reset_peak(pid)

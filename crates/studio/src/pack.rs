@@ -184,7 +184,7 @@ impl Pack {
         let length: usize = chunks.iter().map(Bytes::len).sum();
         // The stream owns what was kept: dropped with the body, once sent or abandoned.
         let stream = futures_util::stream::iter(chunks.into_iter().map(move |c| {
-            let _ = &kept;
+            let _kept = &kept;
             Ok::<_, Infallible>(c)
         }));
         (

@@ -48,6 +48,21 @@ fn stylize() -> axum::http::Request<axum::body::Body> {
     post("/api/smear/stylize", json!({"clip": CLIP, "toml": STYLE}))
 }
 
+/// `n` stylize requests sent at once (each on its own task); their answers.
+async fn at_once(app: &Router, n: usize) -> Vec<(StatusCode, Vec<u8>)> {
+    let tasks: Vec<_> = (0..n)
+        .map(|_| {
+            let app = app.clone();
+            tokio::spawn(async move { send(&app, stylize()).await })
+        })
+        .collect();
+    let mut answers = Vec::new();
+    for t in tasks {
+        answers.push(t.await.unwrap());
+    }
+    answers
+}
+
 fn assert_busy(status: StatusCode, body: &[u8]) {
     assert_eq!(
         status,
@@ -69,14 +84,9 @@ async fn concurrent_requests_over_the_pool_get_503_for_the_excess_and_the_next_s
     // Room for one request, not two; no wait, so the excess is refused at once.
     let pool = MemoryPool::new(estimate * 3 / 2, Duration::ZERO);
     let app = app(studio, &pool);
-    let answers = futures_util::future::join_all((0..8).map(|_| {
-        let app = app.clone();
-        tokio::spawn(async move { send(&app, stylize()).await })
-    }))
-    .await;
+    let answers = at_once(&app, 8).await;
     let (mut ok, mut busy) = (0, 0);
-    for a in answers {
-        let (status, body) = a.unwrap();
+    for (status, body) in answers {
         if status == StatusCode::OK {
             ok += 1;
         } else {
@@ -153,13 +163,8 @@ async fn requests_that_fit_one_after_another_wait_for_each_other_within_the_wait
     // Room for one at a time, and a wait longer than three requests take.
     let pool = MemoryPool::new(estimate, Duration::from_secs(120));
     let app = app(studio, &pool);
-    let answers = futures_util::future::join_all((0..3).map(|_| {
-        let app = app.clone();
-        tokio::spawn(async move { send(&app, stylize()).await })
-    }))
-    .await;
-    for a in answers {
-        let (status, body) = a.unwrap();
+    let answers = at_once(&app, 3).await;
+    for (status, body) in answers {
         assert_eq!(status, StatusCode::OK, "{}", String::from_utf8_lossy(&body));
     }
     assert_eq!(pool.reserved(), 0);

@@ -490,9 +490,9 @@ fn compiled(
     units: &crate::StyleUnits,
 ) -> Result<CompiledEffects> {
     let diagonal = Aabb::from_points(prepared.animation(i).frame(0)).diagonal();
-    style
+    Ok(style
         .for_object(prepared.name(i))
-        .compile_in(diagonal, units)
+        .compile_in(diagonal, units)?)
 }
 
 /// What to lower when a stylization is over the job's memory budget.
