@@ -195,6 +195,15 @@ impl JobMemory {
     /// # Errors
     /// [`OverBudget`].
     pub fn check(&self, hint: &str) -> Result<(), OverBudget> {
+        self.check_within(max_job_bytes(), hint)
+    }
+
+    /// `Ok` when the estimate is within `limit` bytes (a share of the job budget, e.g. what a
+    /// server has left for one more job), else [`OverBudget`] as [`JobMemory::check`] says it.
+    ///
+    /// # Errors
+    /// [`OverBudget`].
+    pub fn check_within(&self, limit: u64, hint: &str) -> Result<(), OverBudget> {
         let hint = if hint.is_empty() {
             format!("or raise {MAX_JOB_BYTES_ENV}")
         } else {
@@ -203,7 +212,7 @@ impl JobMemory {
         check_budget(
             &format!("memory of the job ({}) in bytes", self.parts.join(" + ")),
             self.bytes,
-            max_job_bytes(),
+            limit,
             &hint,
         )
     }

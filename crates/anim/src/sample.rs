@@ -113,6 +113,18 @@ impl SampledScene {
         }
     }
 
+    /// What a clip of `frames` frames × `vertices` vertices holds once sampled and merged
+    /// ([`SampledScene::merged`] checks it): the samples, the merged copy and the file a job
+    /// writes it to. A server reserves it before sampling a clip of that size.
+    pub fn merged_memory(frames: usize, vertices: usize) -> crate::budget::JobMemory {
+        crate::budget::JobMemory::new().positions(
+            "copies of the clip (sampled, merged, written)",
+            frames,
+            vertices,
+            3,
+        )
+    }
+
     /// All objects merged into one cache (vertex order = object order).
     ///
     /// # Errors
@@ -120,14 +132,7 @@ impl SampledScene {
     /// it would be over [`crate::budget::DEFAULT_MAX_JOB_BYTES`]; those of
     /// [`MeshAnimation::concat`].
     pub fn merged(&self, name: &str) -> Result<MeshAnimation> {
-        // The samples, the merged copy and the file a job writes it to, before the copy.
-        crate::budget::JobMemory::new()
-            .positions(
-                "copies of the clip (sampled, merged, written)",
-                self.frame_count,
-                self.vertex_count(),
-                3,
-            )
+        SampledScene::merged_memory(self.frame_count, self.vertex_count())
             .check("lower --fps or pick a shorter clip")?;
         if self.objects.len() == 1 {
             let mut a = self.objects[0].animation.clone();

@@ -234,7 +234,7 @@ fn refused(args: &[&str], needles: &[&str], input: &Path, dir: &Path, keep: &[&s
 
 /// Options whose sizes are over their budgets: refused before allocating, naming the option
 /// and the limit (`--smooth 1e9`, `--count 1e7`, a GIF of 8192², keystrokes nested 20,000
-/// deep in an SVG, 10,000 keystrokes).
+/// deep in an SVG, 10,000 keystrokes, keystrokes 500,000 frames apart).
 #[test]
 fn options_over_their_budgets_name_the_option_and_the_limit() {
     let dir = tempfile::tempdir().unwrap();
@@ -330,6 +330,28 @@ fn options_over_their_budgets_name_the_option_and_the_limit() {
         &keys,
         dir.path(),
         &["deep.svg", "keys.json", "walk.glb"],
+    );
+    // Two keystrokes 500,000 frames apart: every frame between them would be a pose.
+    let far = dir.path().join("far.json");
+    let stroke = [[10.0, 10.0], [20.0, 40.0], [30.0, 80.0]];
+    std::fs::write(
+        &far,
+        serde_json::json!({ "keystrokes": [
+            {"frame": 0, "points": stroke},
+            {"frame": 500_000i64, "points": stroke},
+        ] })
+        .to_string(),
+    )
+    .unwrap();
+    refused(
+        &["loa", "line", s(&far), "-o", &o("line.json")],
+        &[
+            "far.json",
+            "line frames (first keystroke to last, then the settle frames) = 1000001 is over the limit of 100000",
+        ],
+        &far,
+        dir.path(),
+        &["deep.svg", "far.json", "keys.json", "walk.glb"],
     );
 }
 

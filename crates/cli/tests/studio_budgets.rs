@@ -226,6 +226,16 @@ fn over_budget_requests_are_refused_and_the_studio_stays_up_under_a_memory_limit
             "keystrokes = 10000 is over the limit of 1000",
         ),
         post(
+            "2 keystrokes 500,000 frames apart",
+            "/api/loa/animate",
+            serde_json::json!({"keystrokes": [
+                {"frame": 0, "points": [[10.0, 10.0], [20.0, 40.0], [30.0, 80.0]]},
+                {"frame": 500_000i64, "points": [[10.0, 10.0], [20.0, 40.0], [30.0, 80.0]]},
+            ], "width": 800, "height": 600}),
+            413,
+            "line frames (first keystroke to last, then the settle frames) = 1000001 is over the limit",
+        ),
+        post(
             "a 1.2 MB expression",
             "/api/smear/stylize",
             style(format!(

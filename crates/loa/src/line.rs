@@ -75,6 +75,27 @@ pub struct Line {
     pub warnings: Vec<String>,
 }
 
+/// Every frame from the first keystroke to the last, then the settle frames, is a pose of
+/// the line (and of the character that follows it): keystrokes at frames 0 and 10^9 are
+/// refused before the poses are made, however few they are.
+fn check_line_frames(keys: &Keystrokes, options: &LineOptions) -> Result<(), LoaError> {
+    let frames = keys.frames();
+    let span = match (frames.first(), frames.last()) {
+        (Some(&a), Some(&b)) => {
+            u64::try_from(i128::from(b) - i128::from(a) + 1).unwrap_or(u64::MAX)
+        }
+        _ => 0,
+    };
+    let settle = u64::from(options.physics.settle.frames(&frames));
+    anim::check_budget(
+        "line frames (first keystroke to last, then the settle frames)",
+        span.saturating_add(settle),
+        anim::budget::DEFAULT_MAX_FRAMES,
+        "put the keystrokes' frames closer together, lower the settle frames or split the shot",
+    )?;
+    Ok(())
+}
+
 /// The whole 2D job: prepares the keystrokes (orientation, smoothing), fits them (LoA
 /// Eq. 1), interpolates them with the chosen mode (physics: LoA Section 3.2 and LoA Eq. 2),
 /// adds the settle frames and applies the wobbles.
@@ -88,8 +109,10 @@ pub struct Line {
 ///
 /// # Errors
 /// Invalid options (fps, sub-steps, element count, wobble frame) or a keystroke the fit
-/// rejects.
+/// rejects; [`LoaError::OverBudget`] when the keystrokes and the settle frames span more
+/// than [`anim::budget::DEFAULT_MAX_FRAMES`] frames.
 pub fn line(keys: &Keystrokes, options: &LineOptions) -> Result<Line, LoaError> {
+    check_line_frames(keys, options)?;
     let (prepared, reversed) = prepare(keys, options)?;
     let poses = fit_keystrokes(&prepared, options.elements)?;
     let (mut animation, retargets) = match options.mode {

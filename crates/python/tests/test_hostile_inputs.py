@@ -94,6 +94,12 @@ def test_sizes_over_their_budgets(wave, tmp_path):
     with pytest.raises(ValueError) as e:
         toonkit.loa.line(keys)
     assert "keystrokes = 10000 is over the limit of 1000" in one_line(e)
+    # Two keystrokes 500,000 frames apart: every frame between them would be a pose.
+    stroke = [[10.0, 10.0], [20.0, 40.0], [30.0, 80.0]]
+    far = [{"frame": 0, "points": stroke}, {"frame": 500_000, "points": stroke}]
+    with pytest.raises(ValueError) as e:
+        toonkit.loa.line(far)
+    assert "line frames (first keystroke to last, then the settle frames) = 1000001 is over the limit of 100000" in one_line(e)
 
 
 def test_an_expression_nan_at_some_vertices_names_the_frame_and_the_vertex(wave, tmp_path):

@@ -144,9 +144,9 @@ pub use effects::{
 };
 pub use error::{Result, SmearError};
 pub use job::{
-    offsets, prepare, stylize, stylize_frames, CopyReport, ObjectOffsets, ObjectParts,
-    ObjectReport, PrepareOptions, PrepareReport, Prepared, SceneOffsets, StylizeReport,
-    StylizeTimings, Stylized,
+    offsets, prepare, stylize, stylize_frames, stylize_memory, CopyReport, ObjectOffsets,
+    ObjectParts, ObjectReport, PrepareOptions, PrepareReport, Prepared, SceneOffsets,
+    StylizeReport, StylizeTimings, Stylized,
 };
 pub use offsets::MotionOffsets;
 pub use options::{

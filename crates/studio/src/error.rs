@@ -78,6 +78,15 @@ impl ApiError {
         }
     }
 
+    /// 503: the jobs running now hold the memory this one needs (the studio's memory pool);
+    /// the same request succeeds once they finish.
+    pub fn busy(message: impl Into<String>) -> ApiError {
+        ApiError {
+            status: StatusCode::SERVICE_UNAVAILABLE,
+            message: message.into(),
+        }
+    }
+
     /// A job's refusal: 413 when the request asked for more than a budget allows
     /// (`over_budget`, [`anim::budget`]), else 400.
     pub fn refused(message: impl Into<String>, over_budget: bool) -> ApiError {

@@ -15,7 +15,9 @@
 //! local server (DNS rebinding, [`guard`]), reads only the files it was opened with (the API
 //! names them by index, never by path), writes only inside its output folder
 //! ([`files::output_path`]), limits request bodies ([`MAX_BODY_BYTES`]) and answers every bad
-//! request with a JSON error (`{"error": "..."}`).
+//! request with a JSON error (`{"error": "..."}`). Requests running at once share one memory
+//! pool the size of the job budget ([`memory`]): a request that does not fit waits briefly,
+//! then is answered 503.
 //!
 //! ```no_run
 //! let options = studio::ServeOptions {
@@ -34,6 +36,7 @@ pub mod files;
 pub mod guard;
 pub mod jobs;
 mod lock;
+pub mod memory;
 pub mod pack;
 pub mod server;
 pub mod state;

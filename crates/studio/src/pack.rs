@@ -29,6 +29,18 @@ pub struct Pack {
     data: Vec<u8>,
     /// Bytes in `chunks`.
     written: usize,
+    /// Values dropped once the response is sent ([`Pack::keep`]).
+    kept: Kept,
+}
+
+/// What a response keeps until it is sent (a memory reservation).
+#[derive(Default)]
+struct Kept(Vec<Box<dyn std::any::Any + Send>>);
+
+impl std::fmt::Debug for Kept {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Kept({})", self.0.len())
+    }
 }
 
 impl Pack {
@@ -100,6 +112,13 @@ impl Pack {
         self.entry(name, "f32", offset, count)
     }
 
+    /// Keeps `value` until the response is sent or dropped (the memory reservation of the
+    /// job whose results the buffers copy).
+    pub fn keep<T: Send + 'static>(&mut self, value: T) -> &mut Pack {
+        self.kept.0.push(Box::new(value));
+        self
+    }
+
     /// Ends the chunk being written.
     fn flush(&mut self) {
         if !self.data.is_empty() {
@@ -159,10 +178,15 @@ impl Pack {
     }
 
     /// The bytes as an `application/octet-stream` response, sent chunk by chunk.
-    pub fn response(self, header: Value) -> Response {
+    pub fn response(mut self, header: Value) -> Response {
+        let kept = std::mem::take(&mut self.kept);
         let chunks = self.chunks(header);
         let length: usize = chunks.iter().map(Bytes::len).sum();
-        let stream = futures_util::stream::iter(chunks.into_iter().map(Ok::<_, Infallible>));
+        // The stream owns what was kept: dropped with the body, once sent or abandoned.
+        let stream = futures_util::stream::iter(chunks.into_iter().map(move |c| {
+            let _kept = &kept;
+            Ok::<_, Infallible>(c)
+        }));
         (
             [
                 (header::CONTENT_TYPE, "application/octet-stream".to_string()),

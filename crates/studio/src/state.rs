@@ -9,6 +9,7 @@ use crate::error::{ApiError, ApiResult};
 use crate::files::{Clip, OpenedFile};
 use crate::jobs::Jobs;
 pub use crate::lock::lock;
+use crate::memory::{MemoryPool, Reservation};
 
 /// A file index and clip name.
 pub type ClipKey = (usize, String);
@@ -65,6 +66,8 @@ pub struct Studio {
     pub stopmo: Mutex<Option<StopmoSession>>,
     /// Long jobs (stopmo).
     pub jobs: Jobs,
+    /// The memory the requests running at once share ([`Studio::reserve`]).
+    pub memory: Arc<MemoryPool>,
 }
 
 impl Studio {
@@ -79,7 +82,29 @@ impl Studio {
             loa: Mutex::default(),
             stopmo: Mutex::default(),
             jobs: Jobs::default(),
+            memory: MemoryPool::job_budget(),
         }
+    }
+
+    /// The studio with `pool` as its memory pool instead of one the size of the job budget
+    /// (a test's small pool, a server sharing its machine).
+    pub fn with_memory_pool(mut self, pool: Arc<MemoryPool>) -> Studio {
+        self.memory = pool;
+        self
+    }
+
+    /// Reserves the memory a job of file `index` estimates before it starts: held until the
+    /// [`Reservation`] is dropped.
+    ///
+    /// # Errors
+    /// 413 when `memory` is over the whole pool, 503 when the jobs running now leave no room
+    /// for it ([`MemoryPool::reserve`]).
+    pub fn reserve(
+        &self,
+        index: usize,
+        memory: &anim::budget::JobMemory,
+    ) -> ApiResult<Reservation> {
+        self.memory.reserve(&self.file(index)?.label(), memory)
     }
 
     /// The opened file at `index`.

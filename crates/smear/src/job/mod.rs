@@ -10,6 +10,6 @@ pub use prepare::{
     offsets, prepare, ObjectOffsets, PrepareOptions, PrepareReport, Prepared, SceneOffsets,
 };
 pub use stylize::{
-    stylize, stylize_frames, CopyReport, ObjectParts, ObjectReport, StylizeReport, StylizeTimings,
-    Stylized,
+    stylize, stylize_frames, stylize_memory, CopyReport, ObjectParts, ObjectReport, StylizeReport,
+    StylizeTimings, Stylized,
 };

@@ -47,9 +47,9 @@ pub fn file_safe_name(name: &str) -> String {
 /// [`Error::option`]); the optimization's and fabrication's own errors
 /// ([`Error::Library`]).
 pub fn library(parts: &[MeshAnimation], opts: &LibraryJobOptions) -> Result<LibraryResult> {
-    let frames = parts.first().map_or(0, MeshAnimation::frame_count);
-    let vertices = parts.iter().map(MeshAnimation::vertex_count).sum();
-    check_memory(frames, vertices, LIBRARY_COPIES)?;
+    library_memory(parts)
+        .check(MEMORY_HINT)
+        .map_err(anim::AnimError::from)?;
     let refs: Vec<&MeshAnimation> = parts.iter().collect();
     let names: Vec<String> = parts.iter().map(|a| a.mesh.name.clone()).collect();
     build(&refs, &names, opts, None)
@@ -61,18 +61,33 @@ pub fn library(parts: &[MeshAnimation], opts: &LibraryJobOptions) -> Result<Libr
 /// and labels (`reconstruction.pc2` streams frame by frame).
 const LIBRARY_COPIES: u64 = 3;
 
+/// What to lower when a library job is over the memory budget.
+const MEMORY_HINT: &str = "lower --fps or pick a shorter clip";
+
+/// What building a library of `parts` will hold ([`library`] checks it before the solver
+/// allocates; a server reserves it): [`LIBRARY_COPIES`] copies of the parts' frames.
+pub fn library_memory(parts: &[MeshAnimation]) -> anim::budget::JobMemory {
+    let frames = parts.first().map_or(0, MeshAnimation::frame_count);
+    let vertices = parts.iter().map(MeshAnimation::vertex_count).sum();
+    memory(frames, vertices, LIBRARY_COPIES)
+}
+
+/// `copies` copies of `frames` frames of parts of `vertices` vertices in all.
+fn memory(frames: usize, vertices: usize, copies: u64) -> anim::budget::JobMemory {
+    anim::budget::JobMemory::new().positions(
+        "copies of the clip (parts, solver)",
+        frames,
+        vertices,
+        copies,
+    )
+}
+
 /// Checks what building a library of parts of `vertices` vertices in all will hold (`copies`
 /// copies of their `frames` frames) against [`anim::budget::DEFAULT_MAX_JOB_BYTES`] before
 /// the solver allocates.
 fn check_memory(frames: usize, vertices: usize, copies: u64) -> Result<()> {
-    anim::budget::JobMemory::new()
-        .positions(
-            "copies of the clip (parts, solver)",
-            frames,
-            vertices,
-            copies,
-        )
-        .check("lower --fps or pick a shorter clip")
+    memory(frames, vertices, copies)
+        .check(MEMORY_HINT)
         .map_err(anim::AnimError::from)?;
     Ok(())
 }

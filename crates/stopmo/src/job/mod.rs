@@ -20,7 +20,7 @@ mod text;
 
 pub use error::{Error, Result};
 pub use files::{save_files, FileData, OutputFile};
-pub use library_job::{file_safe_name, library, run};
+pub use library_job::{file_safe_name, library, library_memory, run};
 pub use options::{
     default_clearance_mm, LibraryJobOptions, PieceCount, PrintFormat, RunOptions,
     SegmentJobOptions, CLEARANCE_PER_RESOLUTION, DEFAULT_MIN_FEATURE_MM, DEFAULT_MIN_WALL_MM,
@@ -35,7 +35,7 @@ pub use report::{
 };
 pub use result::{LibraryResult, Reconstruction};
 pub use segment_job::{
-    check_segment_memory, saved_segmentation, segment, segment_owned, PartSummary, SegmentSummary,
-    Segmented,
+    check_segment_memory, saved_segmentation, segment, segment_memory, segment_owned, PartSummary,
+    SegmentSummary, Segmented,
 };
 pub use size_curve::{library_of, size_curve, SizeCurve, SizePoint};

@@ -56,6 +56,17 @@ pub struct SegmentSummary {
     pub homogenization: Option<HomogenizeStats>,
 }
 
+/// What segmenting `anim` will hold: the input, its cut copy, the parts and the file they
+/// are written to ([`check_segment_memory`] checks it; a server reserves it).
+pub fn segment_memory(anim: &MeshAnimation) -> anim::budget::JobMemory {
+    anim::budget::JobMemory::new().positions(
+        "copies of the clip (input, cut, parts, written)",
+        anim.frame_count(),
+        anim.vertex_count(),
+        4,
+    )
+}
+
 /// Checks what segmenting `anim` will hold — the input, its cut copy, the parts and the file
 /// they are written to — against [`anim::budget::DEFAULT_MAX_JOB_BYTES`]; [`segment`] does
 /// it first, a front end that runs [`segment`] in the background does it before starting.
@@ -63,13 +74,7 @@ pub struct SegmentSummary {
 /// # Errors
 /// [`Error::Anim`] ([`anim::AnimError::OverBudget`]) naming the copies and the limit.
 pub fn check_segment_memory(anim: &MeshAnimation) -> Result<()> {
-    anim::budget::JobMemory::new()
-        .positions(
-            "copies of the clip (input, cut, parts, written)",
-            anim.frame_count(),
-            anim.vertex_count(),
-            4,
-        )
+    segment_memory(anim)
         .check("lower --fps or pick a shorter clip")
         .map_err(anim::AnimError::from)?;
     Ok(())

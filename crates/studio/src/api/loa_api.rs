@@ -162,6 +162,16 @@ pub(crate) async fn animate(
         let line_seconds = start.elapsed().as_secs_f64();
 
         let (c, label) = character(&studio, r.file, fps)?;
+        // The motion is sampled over the line's frames on every vertex the file's meshes
+        // have (as `anim::sample` counts them): reserved before the solve and the sampling.
+        let vertices = studio
+            .file(r.file)?
+            .scene()
+            .map_or(0, |s| s.meshes.iter().map(|m| m.mesh.vertex_count()).sum());
+        let held = studio.reserve(
+            r.file,
+            &anim::SampledScene::merged_memory(line.animation.frames.len(), vertices),
+        )?;
         let cam = camera(&c);
         let mut bone_sets = Vec::new();
         for k in &r.keystrokes {
@@ -213,6 +223,7 @@ pub(crate) async fn animate(
         let frames = &line.animation.frames;
         let joints = frames.first().map_or(0, |f| f.chain.joints().len());
         let mut pack = Pack::new();
+        pack.keep(held);
         pack.f32(
             "line",
             frames

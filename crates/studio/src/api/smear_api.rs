@@ -19,6 +19,7 @@ use super::scene::ClipQuery;
 use super::{blocking, body};
 use crate::error::{ApiError, ApiResult};
 use crate::files::output_path;
+use crate::memory::Reservation;
 use crate::pack::{coordinates, Pack};
 use crate::state::Studio;
 
@@ -165,8 +166,13 @@ fn read_style(r: &StyleRequest, prepared: &OffsetOptions) -> ApiResult<Style> {
     Ok(style)
 }
 
-/// The style of `r` applied to its frames (`all` = every frame, as exports write).
-fn stylized(studio: &Studio, r: &StyleRequest, all: bool) -> ApiResult<(Style, smear::Stylized)> {
+/// The style of `r` applied to its frames (`all` = every frame, as exports write), with the
+/// memory its job reserved (held while its results are sent or written).
+fn stylized(
+    studio: &Studio,
+    r: &StyleRequest,
+    all: bool,
+) -> ApiResult<(Style, smear::Stylized, Reservation)> {
     let p = studio.prepared(r.file, &r.clip)?;
     let style = read_style(r, &p.options().offsets)?;
     let label = studio.file(r.file)?.label();
@@ -174,11 +180,14 @@ fn stylized(studio: &Studio, r: &StyleRequest, all: bool) -> ApiResult<(Style, s
         Some([start, end]) if !all => start..end,
         _ => 0..p.report().frames,
     };
-    let s = smear::stylize_frames(&p, &style, frames).map_err(|e| {
+    let refused = |e: smear::SmearError| {
         let over = matches!(e, smear::SmearError::OverBudget(_));
         ApiError::refused(format!("{label}: {e}"), over)
-    })?;
-    Ok((style, s))
+    };
+    let memory = smear::stylize_memory(&p, &style, frames.clone()).map_err(refused)?;
+    let held = studio.reserve(r.file, &memory)?;
+    let s = smear::stylize_frames(&p, &style, frames).map_err(refused)?;
+    Ok((style, s, held))
 }
 
 /// `POST /api/smear/stylize`: the header's `first_frame` and `frames` say which clip frames
@@ -195,9 +204,10 @@ pub(crate) async fn stylize(
     let r: StyleRequest = body(request)?;
     blocking(move || {
         let start = Instant::now();
-        let (style, s) = stylized(&studio, &r, false)?;
+        let (style, s, held) = stylized(&studio, &r, false)?;
         let toml = style.to_toml_string().unwrap_or_default();
         let mut pack = Pack::new();
+        pack.keep(held);
         let frames = s.flipbook.frames;
         let bodies: Vec<&anim::MeshAnimation> = s
             .objects
@@ -328,7 +338,7 @@ pub(crate) async fn export(
                     "{name}: a styled smear is written as .glb, .usda, .usdc, .usdz or .abc (a style as .toml)"
                 )));
             }
-            let (_, s) = stylized(&studio, &r, true)?;
+            let (_, s, _held) = stylized(&studio, &r, true)?;
             tkio::save(&path, &tkio::Output::Flipbook(&s.flipbook)).map_err(io)?;
         }
         Ok(Json(json!({ "written": path.display().to_string() })))

@@ -55,13 +55,19 @@ pub(crate) async fn segment(
     // The clip is sampled and the seeds checked here, before the job starts: a clip over a
     // budget or a seed past the mesh is the request's error (4xx), not a failed job.
     let label = studio.file(r.file)?.label();
-    let clip = {
+    let (clip, held) = {
         let studio = studio.clone();
-        let (file, clip) = (r.file, r.clip.clone());
-        super::blocking(move || studio.sampled(file, &clip)).await?
+        let (file, clip, label) = (r.file, r.clip.clone(), label.clone());
+        super::blocking(move || {
+            let clip = studio.sampled(file, &clip)?;
+            stopmo::check_segment_memory(clip.merged())
+                .map_err(|e| ApiError::too_large(format!("{label}: {e}")))?;
+            // Held by the job until it ends (done, failed, cancelled or panicked).
+            let held = studio.reserve(file, &stopmo::segment_memory(clip.merged()))?;
+            Ok((clip, held))
+        })
+        .await?
     };
-    stopmo::check_segment_memory(clip.merged())
-        .map_err(|e| ApiError::too_large(format!("{label}: {e}")))?;
     let parts = part_specs(&r, clip.merged().mesh.triangles.len())?;
     let job_studio = studio.clone();
     let id = studio.jobs.start("stopmo.segment", move |progress| {
@@ -73,6 +79,7 @@ pub(crate) async fn segment(
         progress
             .stage("graph cut and homogenization", 0.2)
             .map_err(cancelled)?;
+        let _held = held;
         // The parts will hold the clip's frames: the cached clip is handed to the job (a new
         // segmentation samples it again), whose cut grows in its buffer instead of copying it.
         job_studio.forget_clip(r.file, &r.clip);

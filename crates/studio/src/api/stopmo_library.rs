@@ -18,6 +18,7 @@ use stopmo::{LibraryJobOptions, LibraryResult, SizeCurve};
 use super::{blocking, body};
 use crate::error::{ApiError, ApiResult};
 use crate::files::output_path;
+use crate::memory::Reservation;
 use crate::pack::{coordinates, Pack};
 use crate::state::{lock, Studio};
 
@@ -119,8 +120,10 @@ pub(crate) async fn curve(
             "sizes: {d} pieces per part is more than the clip's {frames} frames"
         )));
     }
+    let held = reserve_library(&studio, &parts).await?;
     let job_studio = studio.clone();
     let id = studio.jobs.start("stopmo.curve", move |progress| {
+        let _held = held;
         let mut on_point = |done: usize, total: usize| {
             let stage = format!("library size {} of {total}", (done + 1).min(total));
             progress
@@ -173,8 +176,10 @@ pub(crate) async fn build(
             sizes.join(", ")
         )));
     }
+    let held = reserve_library(&studio, &parts).await?;
     let job_studio = studio.clone();
     let id = studio.jobs.start("stopmo.build", move |progress| {
+        let _held = held;
         let cancelled = |e: crate::jobs::Cancelled| e.to_string();
         progress
             .stage("pieces, assembly and reconstruction", 0.1)
@@ -215,6 +220,16 @@ pub(crate) async fn build(
         Ok(answer)
     });
     Ok(Json(json!({ "job": id })))
+}
+
+/// Reserves what a library job of `parts` holds ([`stopmo::library_memory`]) for the job,
+/// waiting on the blocking pool.
+async fn reserve_library(
+    studio: &Arc<Studio>,
+    parts: &Arc<Vec<anim::MeshAnimation>>,
+) -> ApiResult<Reservation> {
+    let (pool, parts) = (studio.memory.clone(), parts.clone());
+    blocking(move || pool.reserve("stopmo library", &stopmo::library_memory(&parts))).await
 }
 
 /// The built library, or a conflict error telling what to do.

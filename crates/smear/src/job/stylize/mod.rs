@@ -244,15 +244,7 @@ pub fn stylize_frames(
     frames: Range<usize>,
 ) -> Result<Stylized> {
     let start = Instant::now();
-    check_range(&frames, prepared.report().frames)?;
-    // Over budget is said first (a studio request naming --smooth 1e9 hears the limit).
-    style.offsets.check_budget()?;
-    if style.offsets != prepared.options().offsets {
-        return Err(SmearError::InvalidParameter {
-            name: "style.offsets",
-            reason: "differ from the options the scene was prepared with; prepare it again".into(),
-        });
-    }
+    stylize_memory(prepared, style, frames.clone())?;
     let mut book = Flipbook {
         fps: prepared.report().fps,
         frames: frames.len(),
@@ -260,15 +252,8 @@ pub fn stylize_frames(
     };
     let mut objects = Vec::with_capacity(prepared.object_count());
     let mut report = StylizeReport::default();
-    let mut memory = anim::budget::JobMemory::new().positions(
-        "copies of the prepared clip (positions, velocities)",
-        prepared.report().frames,
-        prepared.scene().vertex_count(),
-        2,
-    );
     let camera = prepared.camera();
     let merged = prepared.options().merge.is_some();
-    // The style's units into the scene's, once (docs/smear-units.md).
     let units = prepared.units(style.speed_units, style.size_reference.as_ref())?;
     report.speed_units = style.speed_units;
     report.size = units.length;
@@ -279,13 +264,7 @@ pub fn stylize_frames(
     for i in 0..prepared.object_count() {
         let anim = prepared.animation(i);
         let name = prepared.name(i);
-        let diagonal = Aabb::from_points(anim.frame(0)).diagonal();
-        let fx: CompiledEffects = style.for_object(name).compile_in(diagonal, &units)?;
-        if let Some(l) = &fx.lines {
-            check_line_budget(l, prepared.report().frames, frames.len())?;
-        }
-        memory = object_memory(memory, &fx, frames.len(), anim.vertex_count());
-        memory.check(MEMORY_HINT)?;
+        let fx = compiled(prepared, style, i, &units)?;
         let weights = match &fx.weights {
             Some(w) => Some(prepared.resolve_weights_in(w, i, &units)?),
             None => prepared.weights(i).map(<[f32]>::to_vec),
@@ -454,6 +433,66 @@ pub fn stylize_frames(
         report,
         first_frame: frames.start,
     })
+}
+
+/// What [`stylize_frames`] will hold for `frames` of `prepared` styled by `style` — the
+/// prepared clip, each object's stylized meshes, multiples and motion lines, each with the
+/// file it is written to — checked against the job budget before anything is made (a server
+/// reserves it before stylizing).
+///
+/// # Errors
+/// As [`stylize_frames`] before it allocates: [`SmearError::OverBudget`] when the smoothing,
+/// the motion lines or the estimate are over their budgets (said in that order, so a request
+/// naming `--smooth 1e9` hears the limit); a range past the clip; offsets that differ from the
+/// prepared ones; style functions that do not compile.
+pub fn stylize_memory(
+    prepared: &Prepared,
+    style: &Style,
+    frames: Range<usize>,
+) -> Result<anim::budget::JobMemory> {
+    check_range(&frames, prepared.report().frames)?;
+    style.offsets.check_budget()?;
+    if style.offsets != prepared.options().offsets {
+        return Err(SmearError::InvalidParameter {
+            name: "style.offsets",
+            reason: "differ from the options the scene was prepared with; prepare it again".into(),
+        });
+    }
+    let mut memory = anim::budget::JobMemory::new().positions(
+        "copies of the prepared clip (positions, velocities)",
+        prepared.report().frames,
+        prepared.scene().vertex_count(),
+        2,
+    );
+    // The style's units into the scene's, once (docs/smear-units.md).
+    let units = prepared.units(style.speed_units, style.size_reference.as_ref())?;
+    for i in 0..prepared.object_count() {
+        let fx = compiled(prepared, style, i, &units)?;
+        if let Some(l) = &fx.lines {
+            check_line_budget(l, prepared.report().frames, frames.len())?;
+        }
+        memory = object_memory(
+            memory,
+            &fx,
+            frames.len(),
+            prepared.animation(i).vertex_count(),
+        );
+        memory.check(MEMORY_HINT)?;
+    }
+    Ok(memory)
+}
+
+/// The effects of `style` for object `i` of `prepared`, compiled in the scene's units.
+fn compiled(
+    prepared: &Prepared,
+    style: &Style,
+    i: usize,
+    units: &crate::StyleUnits,
+) -> Result<CompiledEffects> {
+    let diagonal = Aabb::from_points(prepared.animation(i).frame(0)).diagonal();
+    Ok(style
+        .for_object(prepared.name(i))
+        .compile_in(diagonal, units)?)
 }
 
 /// What to lower when a stylization is over the job's memory budget.
