@@ -8,11 +8,6 @@ mod flags;
 mod output;
 mod progress;
 
-/// The shared input flags and the load → sample steps they drive.
-use tkio::args as input;
-/// The shared layout and seed flags.
-use tkio::args as shared;
-
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
@@ -39,23 +34,23 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Describe a file: meshes, vertices, triangles, joints, morph targets, clips, bounds.
-    Info(shared::Deferred<commands::info::InfoArgs>),
+    Info(flags::Deferred<commands::info::InfoArgs>),
     /// Convert any readable animation into any writable one.
-    Convert(shared::Deferred<commands::convert::ConvertArgs>),
+    Convert(flags::Deferred<commands::convert::ConvertArgs>),
     /// Run the tools on the bundled sample and write the results.
-    Demo(shared::Deferred<commands::demo::DemoArgs>),
+    Demo(flags::Deferred<commands::demo::DemoArgs>),
     /// Dynamic lines of action: sketched keystrokes → animated line (Guay et al. 2015).
-    Loa(shared::Deferred<commands::loa::LoaArgs>),
+    Loa(flags::Deferred<commands::loa::LoaArgs>),
     /// Preview an animation as PNG (one frame, onion skins) or GIF, coloured by motion offsets.
-    Render(shared::Deferred<commands::render::RenderArgs>),
+    Render(flags::Deferred<commands::render::RenderArgs>),
     /// Smear frames: motion offsets (Basset et al. 2024).
-    Smear(shared::Deferred<Box<commands::smear::SmearArgs>>),
+    Smear(flags::Deferred<Box<commands::smear::SmearArgs>>),
     /// Replacement libraries for 3D-printed stop-motion (StopShop).
-    Stopmo(shared::Deferred<Box<commands::stopmo::StopmoArgs>>),
+    Stopmo(flags::Deferred<Box<commands::stopmo::StopmoArgs>>),
     /// A local web page to tune smears, sketch lines of action and segment faces (127.0.0.1).
-    Studio(shared::Deferred<commands::studio::StudioArgs>),
+    Studio(flags::Deferred<commands::studio::StudioArgs>),
     /// Many shots from a manifest: in parallel here, or as an Open Job Description farm job.
-    Batch(shared::Deferred<commands::batch::BatchArgs>),
+    Batch(flags::Deferred<commands::batch::BatchArgs>),
 }
 
 /// Runs `toonkit ARGS…` in this process, quietly (no summary, no spinner): the demo's steps

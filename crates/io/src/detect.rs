@@ -38,13 +38,32 @@ pub enum Format {
 }
 
 impl Format {
-    /// Whether the format holds a whole scene of several meshes whose topology may change per
-    /// frame (a stylized smear, motion lines): `.glb`, `.usda`, `.usdc`, `.usdz`, `.abc`.
+    /// The formats that hold a whole scene of several meshes whose topology may change per
+    /// frame (a stylized smear, motion lines), in the order messages list them.
+    pub const SCENES: [Format; 5] = [
+        Format::Glb,
+        Format::Usda,
+        Format::Usdc,
+        Format::Usdz,
+        Format::Abc,
+    ];
+
+    /// Whether the format is one of [`Format::SCENES`].
     pub fn holds_scenes(self) -> bool {
-        matches!(
-            self,
-            Format::Glb | Format::Usda | Format::Usdc | Format::Usdz | Format::Abc
-        )
+        Format::SCENES.contains(&self)
+    }
+
+    /// The extensions of `formats` as a message lists them: ".glb, .usda or .abc".
+    pub fn list(formats: &[Format]) -> String {
+        let dotted: Vec<String> = formats
+            .iter()
+            .map(|f| format!(".{}", f.extension()))
+            .collect();
+        match dotted.split_last() {
+            None => String::new(),
+            Some((last, [])) => last.clone(),
+            Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+        }
     }
 
     /// Whether a file of the format holds one frame only (`.obj`, `.stl`): several frames are
@@ -296,4 +315,27 @@ fn rest_mesh(_: &Path, _: &LoadOptions) -> Result<Mesh> {
     Err(IoError::unsupported(
         "point caches need the \"obj\" feature for their rest mesh",
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Messages list the formats in the words users type (every scene format once, the
+    /// extension that names it), so the CLI's refusals take their lists from here.
+    #[test]
+    fn format_lists_read_as_messages_and_name_formats_by_their_extension() {
+        assert_eq!(
+            Format::list(&Format::SCENES),
+            ".glb, .usda, .usdc, .usdz or .abc"
+        );
+        assert_eq!(Format::list(&[Format::Obj]), ".obj");
+        assert_eq!(Format::list(&[]), "");
+        for f in Format::SCENES {
+            let path = PathBuf::from(format!("out.{}", f.extension()));
+            assert_eq!(Format::from_extension(&path), Some(f));
+            assert!(f.holds_scenes());
+        }
+        assert!(!Format::Obj.holds_scenes());
+    }
 }

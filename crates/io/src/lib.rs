@@ -19,8 +19,6 @@ mod save;
 mod shapes;
 
 pub mod abc;
-#[cfg(feature = "clap")]
-pub mod args;
 pub mod bvh;
 pub mod info;
 pub mod mdd;
@@ -28,6 +26,7 @@ pub mod npy;
 #[cfg(feature = "obj")]
 pub mod obj;
 pub mod pc2;
+pub mod sampling;
 #[cfg(feature = "stl")]
 pub mod stl;
 pub mod threemf;
@@ -51,3 +50,4 @@ pub mod fbx;
 pub mod gltf;
 
 pub use detect::{detect, load, load_with_notes, Format, LoadOptions, Loaded};
+pub use sampling::{open, OpenError, OpenOptions};

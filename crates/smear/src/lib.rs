@@ -111,8 +111,6 @@
 
 #![warn(missing_docs, unreachable_pub)]
 
-#[cfg(feature = "clap")]
-pub mod args;
 mod collider;
 mod effects;
 mod error;

@@ -96,9 +96,6 @@
 
 #![warn(missing_docs, unreachable_pub)]
 
-#[cfg(feature = "clap")]
-pub mod args;
-
 mod job;
 pub mod library;
 pub mod segment;
@@ -113,7 +110,8 @@ pub use job::{
 };
 pub use job::{
     default_clearance_mm, PieceReport, Plate, PrintFormat, CLEARANCE_PER_RESOLUTION,
-    DEFAULT_PLATE_MM, MAX_DEFAULT_CLEARANCE_MM,
+    CLEARANCE_RANGE_MM, DEFAULT_PLATE_MM, MAX_DEFAULT_CLEARANCE_MM, PLATE_SIDE_RANGE_MM,
+    PRINTER_MINIMUM_RANGE_MM,
 };
 pub use job::{
     PrintabilityReport, SolidPrintability, Thin, ThinSpot, DEFAULT_MIN_FEATURE_MM,

@@ -113,7 +113,7 @@ impl InProcess {
     fn new(json: bool) -> InProcess {
         let show = !json && std::io::stderr().is_terminal();
         InProcess {
-            parser: tkio::args::built(crate::Cli::command()),
+            parser: crate::flags::built(crate::Cli::command()),
             multi: show.then(MultiProgress::new),
             bars: Mutex::default(),
         }

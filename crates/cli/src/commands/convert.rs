@@ -11,9 +11,8 @@ use serde_json::json;
 use tkio::{Format, Loaded};
 
 use super::Context;
-use crate::input::{self, InputArgs};
+use crate::flags::io::{InputArgs, LayoutArgs};
 use crate::output;
-use crate::shared::{self, LayoutArgs};
 
 /// Arguments of `toonkit convert`.
 #[derive(Debug, Args)]
@@ -31,7 +30,7 @@ pub(crate) struct ConvertArgs {
 /// Runs `toonkit convert`.
 pub(crate) fn run(ctx: &Context, args: ConvertArgs) -> Result<()> {
     let start = Instant::now();
-    let loaded = input::load(&args.input, &args.input_args)?;
+    let loaded = tkio::sampling::load(&args.input, &args.input_args.options())?;
     let spinner = crate::progress::spinner("converting", ctx.json);
     // A skeleton without mesh (BVH) to glTF: keep the joint hierarchy and its clip.
     if let Loaded::Scene(scene) = &loaded {
@@ -52,7 +51,7 @@ pub(crate) fn run(ctx: &Context, args: ConvertArgs) -> Result<()> {
             return Ok(());
         }
     }
-    let sampled = input::sample(&args.input, &loaded, &args.input_args)?;
+    let sampled = tkio::sampling::sample(&args.input, &loaded, &args.input_args.options())?;
     let layout = args.layout.layout();
     let one_frame_files = Format::from_extension(&args.output).is_some_and(Format::holds_one_frame);
     if layout == tkio::Layout::Sequence && one_frame_files && sampled.objects.len() > 1 {
@@ -60,7 +59,7 @@ pub(crate) fn run(ctx: &Context, args: ConvertArgs) -> Result<()> {
         // frame shows, so hidden objects are left out and the vertex count may change.
         return write_frames(ctx, &args, sampled, start, &spinner);
     }
-    let merged = input::merged(&args.input, &sampled)?;
+    let merged = tkio::sampling::merged(&args.input, &sampled)?;
     let written = output::write_animation(&args.output, &merged, layout, None, ctx.save)?;
     spinner.finish_and_clear();
     let summary = json!({
@@ -74,8 +73,8 @@ pub(crate) fn run(ctx: &Context, args: ConvertArgs) -> Result<()> {
     ctx.report(&summary, || {
         format!(
             "wrote {} ({} × {} vertices at {} fps)",
-            shared::files(&written),
-            shared::frames_written(layout, merged.frame_count()),
+            output::files(&written),
+            output::frames_written(layout, merged.frame_count()),
             merged.vertex_count(),
             merged.fps
         )
@@ -120,7 +119,7 @@ fn write_frames(
     ctx.report(&summary, || {
         format!(
             "wrote {} ({} frames, each file the objects its frame shows)",
-            shared::files(&written),
+            output::files(&written),
             book.frames
         )
     });

@@ -47,7 +47,7 @@ pub(crate) fn run(ctx: &Context, args: DemoArgs) -> Result<()> {
         tkio::write_atomic(&inputs.join(name), bytes)?;
     }
     let clip = args.clip.as_deref().unwrap_or(DEMO_CLIP);
-    let fps = crate::input::check_fps(args.fps.unwrap_or(anim::DEFAULT_FPS))?;
+    let fps = tkio::sampling::check_fps(args.fps.unwrap_or(anim::DEFAULT_FPS))?;
     let steps = steps(out, clip, fps);
     let mut timings = Vec::with_capacity(steps.len());
     for (i, step) in steps.iter().enumerate() {

@@ -6,7 +6,7 @@ use anyhow::Result;
 use clap::Args;
 
 use super::Context;
-use crate::input::{self, InputArgs};
+use crate::flags::io::InputArgs;
 
 /// Arguments of `toonkit info`.
 #[derive(Debug, Args)]
@@ -19,8 +19,9 @@ pub(crate) struct InfoArgs {
 
 /// Runs `toonkit info`.
 pub(crate) fn run(ctx: &Context, args: InfoArgs) -> Result<()> {
-    let (loaded, notes) = input::load_with_notes(&args.file, &args.input)?;
-    let fps = args.input.fps();
+    let input = args.input.options();
+    let (loaded, notes) = tkio::sampling::load_with_notes(&args.file, &input)?;
+    let fps = input.fps();
     let summary = tkio::info::summary(&loaded, fps, &notes)?;
     ctx.report(&summary, || {
         tkio::info::summary_text(&args.file, &summary, fps)

@@ -11,7 +11,7 @@ use render::ColorMap;
 use serde_json::json;
 
 use super::Context;
-use crate::input::{self, InputArgs};
+use crate::flags::io::InputArgs;
 
 /// Arguments of `toonkit render`.
 #[derive(Debug, Args)]
@@ -33,7 +33,7 @@ pub(crate) fn run(ctx: &Context, args: RenderArgs) -> Result<()> {
     // Check every option before reading or computing anything.
     let checked = args.preview.check(&args.output).map_err(|e| anyhow!(e))?;
     let (width, height) = checked.size;
-    let sampled = input::open(&args.input, &args.input_args)?;
+    let sampled = tkio::open(&args.input, &args.input_args.options())?;
     if sampled.objects.is_empty() {
         bail!("{}: the file has no mesh to render", args.input.display());
     }

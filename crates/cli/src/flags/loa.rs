@@ -8,22 +8,7 @@ use glam::DVec3;
 use ::loa::animate::{AnimateOptions, ContactKey, InitialPose};
 use ::loa::{Keystrokes, LineOptions};
 
-/// A flag whose value cannot be used, in the user's terms (`--settle x: …`).
-#[derive(Debug, thiserror::Error)]
-pub(crate) enum FlagError {
-    /// A flag's value is wrong; the text names the flag.
-    #[error("{0}")]
-    Flag(String),
-    /// A flag and value (`at`) and what is wrong with it.
-    #[error("{at}")]
-    At {
-        /// The flag and its value.
-        at: String,
-        /// What is wrong.
-        #[source]
-        source: Box<dyn std::error::Error + Send + Sync>,
-    },
-}
+use super::FlagError;
 
 /// `result`, its error named by the flag and value `at`.
 fn at<T, E: std::error::Error + Send + Sync + 'static>(

@@ -27,7 +27,6 @@ pub const DEFAULT_COPIES: f32 = 1.0;
 
 /// A named preset of the elongation S_E (SMEAR Section 5.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
-#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum ElongatePreset {
     /// S_E(δ; β_max) = β_max·δ (SMEAR Eq. 10 example, Fig. 9b, 11b): the default, which

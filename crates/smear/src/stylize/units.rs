@@ -15,7 +15,6 @@ use super::stage::Stage;
 /// What a style's speeds (`speed`, `vx, vy, vz`, `threshold`, `lines.min_speed`) and
 /// lengths (`x, y, z`, noise κ, `lines.thickness`, `contact.ground`) are measured in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum SpeedUnits {
     /// The character's own size: lengths in size units (one unit = the rest-pose

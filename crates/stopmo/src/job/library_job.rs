@@ -6,7 +6,10 @@ use std::time::Instant;
 use anim::MeshAnimation;
 
 use super::error::{Error, Result};
-use super::options::{LibraryJobOptions, PieceCount, RunOptions};
+use super::options::{
+    LibraryJobOptions, PieceCount, RunOptions, CLEARANCE_RANGE_MM, PLATE_SIDE_RANGE_MM,
+    PRINTER_MINIMUM_RANGE_MM,
+};
 use super::plates::library_3mf;
 use super::print::{print_pieces, surface_pieces, PrintSettings};
 use super::report::{InputErrors, LibraryReport, ReportInputs};
@@ -479,32 +482,44 @@ fn check_print_options(opts: &LibraryJobOptions) -> Result<()> {
             .map_err(|e| Error::option_error("magnets", e.to_string()))?;
     }
     let c = opts.clearance();
-    if !(c.is_finite() && (0.0..=5.0).contains(&c)) {
+    let r = CLEARANCE_RANGE_MM;
+    if !(c.is_finite() && r.contains(&c)) {
         return Err(Error::option_error(
             "clearance_mm",
-            format!("must be between 0 and 5 millimetres, got {c}"),
+            format!(
+                "must be between {} and {} millimetres, got {c}",
+                r.start(),
+                r.end()
+            ),
         ));
     }
     for (name, v) in [
         ("min_wall_mm", opts.min_wall_mm),
         ("min_feature_mm", opts.min_feature_mm),
     ] {
-        if !(v.is_finite() && (0.0..=10.0).contains(&v)) {
+        let r = PRINTER_MINIMUM_RANGE_MM;
+        if !(v.is_finite() && r.contains(&v)) {
             return Err(Error::option_error(
                 name,
-                format!("the printer's minimum must be 0 to 10 millimetres, got {v}"),
+                format!(
+                    "the printer's minimum must be {} to {} millimetres, got {v}",
+                    r.start(),
+                    r.end()
+                ),
             ));
         }
     }
     if !opts
         .plate_mm
         .iter()
-        .all(|v| v.is_finite() && (10.0..=2000.0).contains(v))
+        .all(|v| v.is_finite() && PLATE_SIDE_RANGE_MM.contains(v))
     {
         return Err(Error::option_error(
             "plate_mm",
             format!(
-                "the build plate must be 10 to 2000 millimetres each way, got {:?}",
+                "the build plate must be {} to {} millimetres each way, got {:?}",
+                PLATE_SIDE_RANGE_MM.start(),
+                PLATE_SIDE_RANGE_MM.end(),
                 opts.plate_mm
             ),
         ));

@@ -23,8 +23,9 @@ pub use files::{save_files, FileData, OutputFile};
 pub use library_job::{file_safe_name, library, library_memory, run};
 pub use options::{
     default_clearance_mm, LibraryJobOptions, PieceCount, PrintFormat, RunOptions,
-    SegmentJobOptions, CLEARANCE_PER_RESOLUTION, DEFAULT_MIN_FEATURE_MM, DEFAULT_MIN_WALL_MM,
-    DEFAULT_PIECES, DEFAULT_PLATE_MM, MAX_DEFAULT_CLEARANCE_MM,
+    SegmentJobOptions, CLEARANCE_PER_RESOLUTION, CLEARANCE_RANGE_MM, DEFAULT_MIN_FEATURE_MM,
+    DEFAULT_MIN_WALL_MM, DEFAULT_PIECES, DEFAULT_PLATE_MM, MAX_DEFAULT_CLEARANCE_MM,
+    PLATE_SIDE_RANGE_MM, PRINTER_MINIMUM_RANGE_MM,
 };
 pub use plates::Plate;
 pub use print::{piece_label, Piece, DEFAULT_RESOLUTION_MM};

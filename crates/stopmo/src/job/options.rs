@@ -2,6 +2,7 @@
 //! a TOML/JSON file, Python keyword arguments or a web form. Every field has a default.
 
 use std::collections::BTreeMap;
+use std::ops::RangeInclusive;
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -29,6 +30,15 @@ pub fn default_clearance_mm(resolution_mm: f64) -> f64 {
         0.1
     }
 }
+
+/// Clearances of printed fits a printer can use (mm): beyond 5 mm a fit holds nothing.
+pub const CLEARANCE_RANGE_MM: RangeInclusive<f64> = 0.0..=5.0;
+
+/// The printer minimums (thinnest wall, smallest feature) a printer can have (mm).
+pub const PRINTER_MINIMUM_RANGE_MM: RangeInclusive<f64> = 0.0..=10.0;
+
+/// Each side of a build plate (mm), from a toy printer to a large-format one.
+pub const PLATE_SIDE_RANGE_MM: RangeInclusive<f64> = 10.0..=2000.0;
 
 /// Build plate of a small resin printer (mm): where `library.3mf` lays the pieces out and
 /// what the print-time estimate assumes when no plate is given.

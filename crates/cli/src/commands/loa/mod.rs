@@ -23,9 +23,9 @@ pub(crate) struct LoaArgs {
 #[derive(Debug, Subcommand)]
 pub(crate) enum LoaCommand {
     /// Interpolate sketched keystrokes into a dynamic line of action (Guay et al. 2015, §3).
-    Line(tkio::args::Deferred<line::LineArgs>),
+    Line(crate::flags::Deferred<line::LineArgs>),
     /// Synthesize 3D character motion that follows the dynamic line (Guay et al. 2015, §4).
-    Animate(tkio::args::Deferred<Box<animate::AnimateArgs>>),
+    Animate(crate::flags::Deferred<Box<animate::AnimateArgs>>),
 }
 
 /// Runs `toonkit loa …`.

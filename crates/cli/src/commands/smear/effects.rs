@@ -27,13 +27,13 @@ use anim::{FlipbookPart, MeshAnimation};
 use anyhow::{bail, Context as _, Result};
 use clap::Args;
 use serde_json::json;
-use smear::args::{Elongate, Lines, Multiples};
 use smear::{Param, Prepared, Spacing, Style, Stylized};
 use tkio::{Format, Output};
 
 use super::{at_input, prepare, Context, EffectArgs, EffectIo};
+use crate::flags::io::LayoutArgs;
+use crate::flags::smear::{Elongate, Lines, Multiples};
 use crate::output;
-use crate::shared::{self, LayoutArgs};
 
 /// Arguments of `toonkit smear elongate`.
 #[derive(Debug, Args)]
@@ -75,16 +75,16 @@ pub(crate) struct LinesArgs {
 }
 
 /// Refuses an output that cannot hold a mesh that changes per frame (`why` says what
-/// changes it): scene files (`.glb`, `.usda`, `.usdc`, `.usdz`, `.abc`) can, and so can an
+/// changes it): scene files ([`Format::SCENES`]) can, and so can an
 /// OBJ/STL sequence (one file per frame, each with its frame's own mesh).
 fn require_frames(output: &std::path::Path, layout: &LayoutArgs, why: &str) -> Result<()> {
     let format = Format::from_extension(output);
     if format.is_some_and(Format::holds_one_frame) {
         if layout.layout() != tkio::Layout::Sequence {
             bail!(
-                "{}: {why}: write one file per frame with --layout sequence, or a .glb, .usda, \
-                 .usdc, .usdz or .abc",
-                output.display()
+                "{}: {why}: write one file per frame with --layout sequence, or a {}",
+                output.display(),
+                Format::list(&Format::SCENES)
             );
         }
         return Ok(());
@@ -96,8 +96,11 @@ fn require_frames(output: &std::path::Path, layout: &LayoutArgs, why: &str) -> R
             layout.layout().name()
         );
     }
-    let why = format!("{why}, which only scene files hold: write .glb, .usda, .usdc, .usdz or .abc, or an .obj/.stl sequence (--layout sequence)");
-    Ok(shared::require_scenes(output, &why)?)
+    let why = format!(
+        "{why}, which only scene files hold: write {}, or an .obj/.stl sequence (--layout sequence)",
+        Format::list(&Format::SCENES)
+    );
+    crate::output::require_scenes(output, &why)
 }
 
 /// Runs the style on the prepared input, naming the input in errors.
@@ -153,8 +156,8 @@ pub(crate) fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
     ctx.report(&summary, || {
         format!(
             "wrote {} ({} × {} vertices, elongated in-betweens)",
-            shared::files(&written),
-            shared::frames_written(layout, body.frame_count()),
+            output::files(&written),
+            output::frames_written(layout, body.frame_count()),
             body.vertex_count()
         )
     });
@@ -218,7 +221,7 @@ pub(crate) fn multiples(ctx: &Context, args: MultiplesArgs) -> Result<()> {
     ctx.report(&summary, || {
         format!(
             "wrote {} ({} frames, {} copies spaced {:.3} frames)",
-            shared::files(&written),
+            output::files(&written),
             body.frame_count(),
             copies_json.len(),
             plan.spacing
@@ -272,7 +275,7 @@ pub(crate) fn lines(ctx: &Context, args: LinesArgs) -> Result<()> {
     ctx.report(&summary, || {
         format!(
             "wrote {} ({} frames, {} seeds, up to {} lines per frame)",
-            shared::files(&written),
+            output::files(&written),
             meshes.len(),
             seed_total,
             per_frame.iter().max().unwrap_or(&0)

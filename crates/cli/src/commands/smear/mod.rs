@@ -8,13 +8,14 @@ mod style;
 
 use std::path::{Path, PathBuf};
 
+pub(crate) use crate::flags::smear::{EffectArgs, OffsetArgs};
 use anyhow::{bail, Result};
 use clap::{Args, Subcommand};
-pub(crate) use smear::args::{EffectArgs, OffsetArgs};
 use smear::{PrepareOptions, Prepared};
 
 use super::Context;
-use crate::input::{self, Deferred, InputArgs};
+use crate::flags::io::InputArgs;
+use crate::flags::Deferred;
 
 /// Arguments of `toonkit smear`: a subcommand, or `IN --style STYLE.toml -o OUT.glb`.
 #[derive(Debug, Args)]
@@ -70,19 +71,19 @@ pub(crate) struct EffectIo {
 fn prepare(io: &EffectIo, a: &EffectArgs) -> Result<Prepared> {
     let path = io.input.as_path();
     a.check_step()?;
-    let sampled = input::open(path, &io.input_args)?;
+    let sampled = tkio::open(path, &io.input_args.options())?;
     if sampled.objects.is_empty() {
         bail!("{}: the file has no mesh", path.display());
     }
     let options = PrepareOptions {
         offsets: a.offsets.options(&sampled),
         weights: a.weight_source(),
-        merge: Some(input::merged_name(path)),
+        merge: Some(tkio::sampling::merged_name(path)),
         colliders: a.collider_object.clone(),
     };
     let mut prepared = smear::prepare(sampled, &options).map_err(at_input(path))?;
     for file in &a.collider {
-        let scene = input::open(file, &InputArgs::default())?;
+        let scene = tkio::open(file, &tkio::OpenOptions::default())?;
         prepared.add_colliders(&scene).map_err(at_input(file))?;
     }
     Ok(prepared)

@@ -15,7 +15,7 @@ use serde_json::json;
 use tkio::{Format, Output};
 
 use super::{at_input, Context, OffsetArgs};
-use crate::input::{self, InputArgs};
+use crate::flags::io::InputArgs;
 use crate::output;
 
 /// Arguments of `toonkit smear offsets`.
@@ -42,7 +42,7 @@ pub(crate) fn run(ctx: &Context, args: OffsetsArgs) -> Result<()> {
             args.output.display()
         );
     }
-    let sampled = input::open(&args.input, &args.input_args)?;
+    let sampled = tkio::open(&args.input, &args.input_args.options())?;
     if sampled.objects.is_empty() {
         bail!("{}: the file has no mesh", args.input.display());
     }
@@ -62,7 +62,7 @@ pub(crate) fn run(ctx: &Context, args: OffsetsArgs) -> Result<()> {
             },
         )?;
     } else {
-        let anim = input::merged(&args.input, &sampled)?;
+        let anim = tkio::sampling::merged(&args.input, &sampled)?;
         let colors = render::offset_colors(merged.values());
         output::write_animation(
             &args.output,

@@ -17,7 +17,7 @@ use smear::{PrepareOptions, Style};
 use tkio::{Format, Output};
 
 use super::Context;
-use crate::input::{self, InputArgs};
+use crate::flags::io::InputArgs;
 
 /// The top-level form of `toonkit smear` (no subcommand).
 #[derive(Debug, Args)]
@@ -34,7 +34,7 @@ pub(crate) struct StyleArgs {
     #[arg(long)]
     pub(crate) gif: Option<PathBuf>,
     #[command(flatten)]
-    pub(crate) units: smear::args::UnitArgs,
+    pub(crate) units: crate::flags::smear::UnitArgs,
     #[command(flatten)]
     pub(crate) input_args: InputArgs,
 }
@@ -62,13 +62,14 @@ pub(crate) fn run(ctx: &Context, args: StyleArgs) -> Result<()> {
     };
     if !Format::from_extension(output).is_some_and(Format::holds_scenes) {
         bail!(
-            "{}: a styled smear is written as .glb, .usda, .usdc, .usdz or .abc",
-            output.display()
+            "{}: a styled smear is written as {}",
+            output.display(),
+            Format::list(&Format::SCENES)
         );
     }
     let mut style = read_style(style_path)?;
     args.units.apply(&mut style);
-    let sampled = input::open(input_path, &args.input_args)?;
+    let sampled = tkio::open(input_path, &args.input_args.options())?;
     if sampled.objects.is_empty() {
         bail!("{}: the file has no mesh", input_path.display());
     }

@@ -10,7 +10,7 @@ use clap::Args;
 
 use super::{warn, LibraryOptionsArgs};
 use crate::commands::Context;
-use crate::input::{self, InputArgs};
+use crate::flags::io::InputArgs;
 
 /// Arguments of `toonkit stopmo library`.
 #[derive(Debug, Args)]
@@ -30,7 +30,7 @@ pub(crate) struct LibraryArgs {
 /// The parts of the input: one per mesh object, named after it (file-safe; the file stem
 /// for an unnamed object).
 fn parts(path: &Path, args: &InputArgs) -> Result<Vec<MeshAnimation>> {
-    let sampled = input::open(path, args)?;
+    let sampled = tkio::open(path, &args.options())?;
     if sampled.objects.is_empty() {
         bail!("{}: the file has no mesh", path.display());
     }

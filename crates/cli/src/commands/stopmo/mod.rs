@@ -4,15 +4,15 @@
 //! `library` builds the replacement library; `run` chains both. Each command parses its
 //! arguments into the `stopmo` crate's options, loads with `tkio`, makes one `stopmo` call,
 //! writes the result's files with `tkio::save` and prints a summary. The option flags the
-//! commands share are the `stopmo` crate's ([`stopmo::args`]).
+//! commands share are declared in [`crate::flags::stopmo`].
 
 mod library;
 mod run;
 mod segment;
 
+pub(crate) use crate::flags::stopmo::{LibraryOptionsArgs, SegmentOptionsArgs};
 use anyhow::Result;
 use clap::{Args, Subcommand};
-pub(crate) use stopmo::args::{LibraryOptionsArgs, SegmentOptionsArgs};
 
 use super::Context;
 
@@ -28,13 +28,13 @@ pub(crate) struct StopmoArgs {
 pub(crate) enum StopmoCommand {
     /// Cut the animation into parts along low-motion seams and make the seams identical in
     /// every frame (StopShop Sections 3.1–3.2).
-    Segment(tkio::args::Deferred<segment::SegmentArgs>),
+    Segment(crate::flags::Deferred<segment::SegmentArgs>),
     /// Build a replacement library of printable pieces per part, the assembly sheet and a
     /// shooting order (StopShop Sections 3.3–3.4, 5).
-    Library(tkio::args::Deferred<library::LibraryArgs>),
+    Library(crate::flags::Deferred<library::LibraryArgs>),
     /// Segment, then build the library of every part: `segment` and `library` in one go,
     /// writing DIR/segmentation.glb, DIR/segmentation.json and the library layout in DIR.
-    Run(tkio::args::Deferred<run::RunArgs>),
+    Run(crate::flags::Deferred<run::RunArgs>),
 }
 
 /// Runs `toonkit stopmo …`.

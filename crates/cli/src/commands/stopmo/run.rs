@@ -14,7 +14,7 @@ use serde_json::json;
 
 use super::{warn, LibraryOptionsArgs, SegmentOptionsArgs};
 use crate::commands::Context;
-use crate::input::{self, InputArgs};
+use crate::flags::io::InputArgs;
 
 /// Arguments of `toonkit stopmo run`.
 #[derive(Debug, Args)]
@@ -59,7 +59,10 @@ pub(super) fn run(ctx: &Context, args: RunArgs) -> Result<()> {
         segment,
         library: args.library.options(&names)?,
     };
-    let anim = input::merged(&args.input, &input::open(&args.input, &args.input_args)?)?;
+    let anim = tkio::sampling::merged(
+        &args.input,
+        &tkio::open(&args.input, &args.input_args.options())?,
+    )?;
     let spinner = crate::progress::spinner("segmenting and optimizing", ctx.json);
     let mut result = stopmo::run(&anim, &options).map_err(|e| match e {
         stopmo::Error::Segment(_) => {

@@ -9,8 +9,7 @@ use serde_json::json;
 
 use super::SegmentOptionsArgs;
 use crate::commands::Context;
-use crate::input::{self, InputArgs};
-use crate::shared::LayoutArgs;
+use crate::flags::io::{InputArgs, LayoutArgs};
 
 /// Arguments of `toonkit stopmo segment`.
 #[derive(Debug, Args)]
@@ -47,7 +46,10 @@ pub(super) fn segment(ctx: &Context, args: SegmentArgs) -> Result<()> {
         );
     }
     let options = args.segment.options(args.render.is_some())?;
-    let anim = input::merged(&args.input, &input::open(&args.input, &args.input_args)?)?;
+    let anim = tkio::sampling::merged(
+        &args.input,
+        &tkio::open(&args.input, &args.input_args.options())?,
+    )?;
     let spinner = crate::progress::spinner("segmenting", ctx.json);
     let seg = stopmo::segment(&anim, &options).with_context(|| args.input.display().to_string())?;
     let layers: Vec<(&anim::MeshAnimation, Option<&[[f32; 4]]>)> = seg

@@ -2,34 +2,66 @@
 //! the [`Style`] each describes. Expressions are those of `smear::Expression` with the
 //! effect's maximum bound as a parameter (`beta_max`, `m_max`, `tau_max`).
 
-use clap::Args;
+use clap::{Args, ValueEnum};
 
 use super::{check, EffectArgs, FlagError};
-use crate::{
+use ::smear::{
     ElongatePreset, ElongateStyle, FunctionSpec, LineOptions, LinesStyle, MultiplesOptions,
     MultiplesStyle, Param, Prepared, Spacing, Stage, Style,
 };
 
+/// `--preset`: the names and docs of [`ElongatePreset`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum PresetArg {
+    /// S_E(δ; β_max) = β_max·δ (SMEAR Eq. 10 example, Fig. 9b, 11b): the default, which
+    /// needs no speed, so β is in frames in any units.
+    Linear,
+    /// S_E(δ; v, β_max) = β_max‖v‖δ (Fig. 11c): fast parts stretch, slow parts stay put.
+    Speed,
+    /// S_E(δ⁻; v, κ, β_max) = β_max‖v‖F1(p(0), κ)δ⁻ (Fig. 11d): a ragged trailing smear.
+    Noise,
+}
+
+impl From<ElongatePreset> for PresetArg {
+    fn from(p: ElongatePreset) -> PresetArg {
+        match p {
+            ElongatePreset::Linear => PresetArg::Linear,
+            ElongatePreset::Speed => PresetArg::Speed,
+            ElongatePreset::Noise => PresetArg::Noise,
+        }
+    }
+}
+
+impl From<PresetArg> for ElongatePreset {
+    fn from(p: PresetArg) -> ElongatePreset {
+        match p {
+            PresetArg::Linear => ElongatePreset::Linear,
+            PresetArg::Speed => ElongatePreset::Speed,
+            PresetArg::Noise => ElongatePreset::Noise,
+        }
+    }
+}
+
 /// Flags of the elongated in-betweens (SMEAR Eq. 10).
 #[derive(Debug, Clone, Args)]
-pub struct Elongate {
+pub(crate) struct Elongate {
     /// Stylization preset S_E.
-    #[arg(long, value_enum, default_value_t = ElongatePreset::default())]
-    pub preset: ElongatePreset,
+    #[arg(long, value_enum, default_value_t = PresetArg::from(ElongatePreset::default()))]
+    pub(crate) preset: PresetArg,
     /// Maximum elongation β_max: frames with `linear`; frames per (size unit per second)
     /// with `speed` and `noise`, which multiply it by the speed (frames per scene unit per
     /// frame with --speed-units scene). Keyframes as FRAME:VALUE,... (e.g. 0:0,12:3).
-    #[arg(long, default_value_t = Param::Constant(crate::DEFAULT_BETA_MAX))]
-    pub beta_max: Param,
+    #[arg(long, default_value_t = Param::Constant(::smear::DEFAULT_BETA_MAX))]
+    pub(crate) beta_max: Param,
     /// Noise scale κ of the `noise` preset: Voronoi cells per size unit (per scene unit with
     /// --speed-units scene); keyframeable.
-    #[arg(long, default_value_t = Param::Constant(crate::DEFAULT_KAPPA))]
-    pub kappa: Param,
+    #[arg(long, default_value_t = Param::Constant(::smear::DEFAULT_KAPPA))]
+    pub(crate) kappa: Param,
     /// User expression for β in frames (replaces the preset), e.g. "beta_max * speed *
     /// past(delta)"; `speed`, `vx, vy, vz` in size units per second, `x, y, z` in size units
     /// (scene units per frame and scene units with --speed-units scene).
     #[arg(long)]
-    pub expr: Option<String>,
+    pub(crate) expr: Option<String>,
 }
 
 impl Elongate {
@@ -37,11 +69,11 @@ impl Elongate {
     ///
     /// # Errors
     /// A function that does not compile, naming its flag.
-    pub fn function(&self, effect: &EffectArgs) -> Result<FunctionSpec, FlagError> {
+    pub(crate) fn function(&self, effect: &EffectArgs) -> Result<FunctionSpec, FlagError> {
         let spec = match &self.expr {
             Some(e) => FunctionSpec::expr(e, &[("beta_max", self.beta_max.clone())]),
             None => effect.weighted(
-                self.preset
+                ElongatePreset::from(self.preset)
                     .function(self.beta_max.clone(), self.kappa.clone()),
             ),
         };
@@ -57,7 +89,11 @@ impl Elongate {
     ///
     /// # Errors
     /// As [`Elongate::function`] and [`EffectArgs::shaping`].
-    pub fn style(&self, effect: &EffectArgs, prepared: &Prepared) -> Result<Style, FlagError> {
+    pub(crate) fn style(
+        &self,
+        effect: &EffectArgs,
+        prepared: &Prepared,
+    ) -> Result<Style, FlagError> {
         Ok(Style {
             elongate: Some(ElongateStyle {
                 enabled: true,
@@ -71,39 +107,39 @@ impl Elongate {
 
 /// Flags of the multiple in-betweens (SMEAR Eqs. 11–12).
 #[derive(Debug, Clone, Args)]
-pub struct Multiples {
+pub(crate) struct Multiples {
     /// Copies in the past, m_p; keyframes (FRAME:VALUE,...) fade copies in and out.
-    #[arg(long, default_value_t = Param::Constant(crate::DEFAULT_COPIES))]
-    pub past: Param,
+    #[arg(long, default_value_t = Param::Constant(::smear::DEFAULT_COPIES))]
+    pub(crate) past: Param,
     /// Copies in the future, m_n; keyframeable.
-    #[arg(long, default_value_t = Param::Constant(crate::DEFAULT_COPIES))]
-    pub future: Param,
+    #[arg(long, default_value_t = Param::Constant(::smear::DEFAULT_COPIES))]
+    pub(crate) future: Param,
     /// Temporal spacing Δf between copies, in frames; keyframes as FRAME:VALUE,...
     #[arg(long, conflicts_with = "overlap")]
-    pub spacing: Option<Param>,
+    pub(crate) spacing: Option<Param>,
     /// Copies overlapping between consecutive frames, N∩: Δf = 1/(m_p + m_n + 1 − N∩);
     /// keyframeable.
     #[arg(long)]
-    pub overlap: Option<Param>,
+    pub(crate) overlap: Option<Param>,
     /// m_max of SMEAR Eq. 12 (default: max(m_p, m_n); keyframeable).
     #[arg(long)]
-    pub m_max: Option<Param>,
+    pub(crate) m_max: Option<Param>,
     /// User expression for the opacity (replaces SMEAR Eq. 12), e.g. "step(delta * m)".
     #[arg(long)]
-    pub opacity_expr: Option<String>,
+    pub(crate) opacity_expr: Option<String>,
 }
 
 /// What the multiples flags resolve to before the input is read.
 #[derive(Debug, Clone)]
-pub struct MultiplesPlan {
+pub(crate) struct MultiplesPlan {
     /// Copies, spacing and step.
-    pub options: MultiplesOptions,
+    pub(crate) options: MultiplesOptions,
     /// Spacing Δf at frame 0.
-    pub spacing: f32,
+    pub(crate) spacing: f32,
     /// m_max of SMEAR Eq. 12.
-    pub m_max: Param,
+    pub(crate) m_max: Param,
     /// The opacity function (SMEAR Eq. 12 or the user's).
-    pub opacity: FunctionSpec,
+    pub(crate) opacity: FunctionSpec,
 }
 
 impl Multiples {
@@ -111,11 +147,11 @@ impl Multiples {
     ///
     /// # Errors
     /// No copy at all, a bad spacing, or an opacity expression that does not compile.
-    pub fn plan(&self, effect: &EffectArgs) -> Result<MultiplesPlan, FlagError> {
+    pub(crate) fn plan(&self, effect: &EffectArgs) -> Result<MultiplesPlan, FlagError> {
         let spacing = match (self.spacing.clone(), self.overlap.clone()) {
             (_, Some(n)) => Spacing::Overlap(n),
             (Some(df), None) => Spacing::Frames(df),
-            (None, None) => Spacing::Frames(crate::DEFAULT_SPACING.into()),
+            (None, None) => Spacing::Frames(::smear::DEFAULT_SPACING.into()),
         };
         let options = MultiplesOptions {
             past: self.past.clone(),
@@ -148,7 +184,7 @@ impl Multiples {
     ///
     /// # Errors
     /// As [`EffectArgs::shaping`].
-    pub fn style(
+    pub(crate) fn style(
         &self,
         effect: &EffectArgs,
         plan: &MultiplesPlan,
@@ -172,65 +208,65 @@ impl Multiples {
 
 /// Flags of the motion lines (SMEAR Eq. 13).
 #[derive(Debug, Clone, Args)]
-pub struct Lines {
+pub(crate) struct Lines {
     /// Number of lines K (random surface points, area-weighted). Keyframes (FRAME:VALUE,...)
     /// sample as many seeds as the largest key and draw a fixed random subset per frame.
-    #[arg(long, default_value_t = Param::Constant(crate::DEFAULT_LINE_COUNT as f32))]
-    pub count: Param,
+    #[arg(long, default_value_t = Param::Constant(::smear::DEFAULT_LINE_COUNT as f32))]
+    pub(crate) count: Param,
     /// Maximum length τ_max in frames: S_L(δ; τ_max) = τ_max·δ (SMEAR Eq. 13); keyframeable.
-    #[arg(long, default_value_t = Param::Constant(crate::DEFAULT_LINE_LENGTH))]
-    pub length_max: Param,
+    #[arg(long, default_value_t = Param::Constant(::smear::DEFAULT_LINE_LENGTH))]
+    pub(crate) length_max: Param,
     /// Seed of every random choice (default: the tool's fixed seed; runs are reproducible).
     #[arg(long, value_name = "SEED")]
-    pub seed: Option<u64>,
+    pub(crate) seed: Option<u64>,
     /// User expression for τ in frames (replaces the linear one), e.g. "tau_max * speed *
     /// past(delta)"; inputs in size units (per second) as for --expr of `elongate`.
     #[arg(long)]
-    pub length_expr: Option<String>,
+    pub(crate) length_expr: Option<String>,
     /// Tube radius in size units (one unit = the character's rest-pose bounding-box
     /// diagonal; scene units with --speed-units scene), default 0.002 × the body's diagonal;
     /// keyframeable.
     #[arg(long, conflicts_with = "thickness_expr")]
-    pub thickness: Option<Param>,
+    pub(crate) thickness: Option<Param>,
     /// User expression for the tube radius along the line in size units (scene units with
     /// --speed-units scene; `t` = 0 at the surface), e.g. "0.01 * (1 - t)" for tapering
     /// lines.
     #[arg(long)]
-    pub thickness_expr: Option<String>,
+    pub(crate) thickness_expr: Option<String>,
     /// User expression for the opacity along the line (`t` = 0 at the surface), e.g. "1 - t".
     #[arg(long)]
-    pub opacity_expr: Option<String>,
+    pub(crate) opacity_expr: Option<String>,
     /// Gap between surface and line, in frames along the trajectory; keyframeable.
     #[arg(long, default_value = "0")]
-    pub gap: Param,
+    pub(crate) gap: Param,
     /// Seeds slower than this draw no line, in size units per second (one unit = the
     /// character's bounding-box diagonal; scene units per frame with --speed-units scene);
     /// keyframeable.
     #[arg(long, default_value = "0")]
-    pub min_speed: Param,
+    pub(crate) min_speed: Param,
     /// Line colour, linear R,G,B in [0, 1] (default near-black).
     #[arg(long, value_delimiter = ',')]
-    pub color: Vec<f32>,
+    pub(crate) color: Vec<f32>,
     /// Only trace the past (τ clamped to ≤ 0).
     #[arg(long)]
-    pub past_only: bool,
+    pub(crate) past_only: bool,
     /// Sides of each tube.
-    #[arg(long, default_value_t = crate::DEFAULT_LINE_SIDES)]
-    pub sides: usize,
+    #[arg(long, default_value_t = ::smear::DEFAULT_LINE_SIDES)]
+    pub(crate) sides: usize,
     /// Rings along each line.
-    #[arg(long, default_value_t = crate::DEFAULT_LINE_SAMPLES)]
-    pub samples: usize,
+    #[arg(long, default_value_t = ::smear::DEFAULT_LINE_SAMPLES)]
+    pub(crate) samples: usize,
 }
 
 /// What the lines flags resolve to before the input is read.
 #[derive(Debug, Clone)]
-pub struct LinesPlan {
+pub(crate) struct LinesPlan {
     /// S_L, the length function.
-    pub length: FunctionSpec,
+    pub(crate) length: FunctionSpec,
     /// The opacity along a line.
-    pub opacity: FunctionSpec,
+    pub(crate) opacity: FunctionSpec,
     /// The line colour.
-    pub color: [Param; 3],
+    pub(crate) color: [Param; 3],
 }
 
 impl Lines {
@@ -239,7 +275,7 @@ impl Lines {
     /// # Errors
     /// A non-positive thickness, a function that does not compile, a count out of range or
     /// a colour that is not three numbers.
-    pub fn plan(&self, effect: &EffectArgs) -> Result<LinesPlan, FlagError> {
+    pub(crate) fn plan(&self, effect: &EffectArgs) -> Result<LinesPlan, FlagError> {
         let flag = |s: String| Err(FlagError::Flag(s));
         if let Some(t) = &self.thickness {
             if t.validate("--thickness", (0.0, true), (f32::MAX, false))
@@ -292,13 +328,20 @@ impl Lines {
     ///
     /// # Errors
     /// An unknown `--size-reference` object.
-    pub fn radius(&self, effect: &EffectArgs, prepared: &Prepared) -> Result<Param, FlagError> {
+    pub(crate) fn radius(
+        &self,
+        effect: &EffectArgs,
+        prepared: &Prepared,
+    ) -> Result<Param, FlagError> {
         let u = &effect.units;
-        let units = prepared.units(u.speed_units.unwrap_or_default(), u.size_reference.as_ref())?;
+        let units = prepared.units(
+            u.speed_units().unwrap_or_default(),
+            u.size_reference.as_ref(),
+        )?;
         Ok(match &self.thickness {
             Some(t) => units.length_param_to_scene(t),
             None => Param::Constant(
-                crate::DEFAULT_LINE_THICKNESS * prepared.animation(0).bbox().diagonal(),
+                ::smear::DEFAULT_LINE_THICKNESS * prepared.animation(0).bbox().diagonal(),
             ),
         })
     }
@@ -307,7 +350,7 @@ impl Lines {
     ///
     /// # Errors
     /// A thickness function that does not compile, or as [`EffectArgs::shaping`].
-    pub fn style(
+    pub(crate) fn style(
         &self,
         effect: &EffectArgs,
         plan: &LinesPlan,
@@ -319,10 +362,10 @@ impl Lines {
             (None, Some(t)) => Some(FunctionSpec::stages(vec![Stage::Set { value: t.clone() }])),
             // In scene units the body's default radius as given before units existed (bit
             // for bit); in size units the style's default, the same fraction of the body.
-            (None, None) if effect.units.speed_units == Some(crate::SpeedUnits::Scene) => {
+            (None, None) if effect.units.speed_units() == Some(::smear::SpeedUnits::Scene) => {
                 Some(FunctionSpec::stages(vec![Stage::Set {
                     value: Param::Constant(
-                        crate::DEFAULT_LINE_THICKNESS * prepared.animation(0).bbox().diagonal(),
+                        ::smear::DEFAULT_LINE_THICKNESS * prepared.animation(0).bbox().diagonal(),
                     ),
                 }]))
             }
@@ -339,7 +382,7 @@ impl Lines {
             lines: Some(LinesStyle {
                 enabled: true,
                 count: self.count.clone(),
-                seed: self.seed.unwrap_or(crate::DEFAULT_SEED),
+                seed: self.seed.unwrap_or(::smear::DEFAULT_SEED),
                 gap: self.gap.clone(),
                 min_speed: self.min_speed.clone(),
                 past_only: self.past_only,

@@ -8,54 +8,19 @@ use clap::{ArgMatches, Args, Command, FromArgMatches};
 /// invoked (clap's [`Command::defer`]).
 ///
 /// The derive API defines every flag of every subcommand before it parses anything: for the
-/// `toonkit` command tree that was ~0.7 ms of a 16 ms `toonkit smear offsets` run (issue
-/// #14). Wrapping a subcommand variant's arguments in `Deferred` keeps the variant's name and
-/// summary in `--help` and defines its flags when clap descends into it; parsing, help and
-/// errors are unchanged.
-///
-/// # Examples
-/// ```
-/// use clap::{Args, Parser, Subcommand};
-/// use tkio::args::Deferred;
-///
-/// #[derive(Parser)]
-/// struct Cli {
-///     #[command(subcommand)]
-///     command: Tool,
-/// }
-///
-/// #[derive(Subcommand)]
-/// enum Tool {
-///     /// Says hello.
-///     Hello(Deferred<HelloArgs>),
-/// }
-///
-/// #[derive(Args)]
-/// struct HelloArgs {
-///     #[arg(long)]
-///     name: String,
-/// }
-///
-/// let cli = Cli::parse_from(["tool", "hello", "--name", "Ada"]);
-/// let Tool::Hello(args) = cli.command;
-/// assert_eq!(args.name, "Ada");
-/// ```
+/// `toonkit` command tree that was ~0.7 ms of a 16 ms `toonkit smear offsets` run. Wrapping a
+/// subcommand variant's arguments in `Deferred` keeps the variant's name and summary in
+/// `--help` and defines its flags when clap descends into it; parsing, help and errors are
+/// unchanged (`deferred_subcommands_parse_like_eager_ones` below).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub struct Deferred<T>(pub T);
+pub(crate) struct Deferred<T>(pub(crate) T);
 
 /// `command` with every deferred subcommand's flags defined ([`Command::build`]), for code
 /// that reads the parser rather than parsing with it (e.g. looking up a subcommand's
 /// arguments).
-pub fn built(mut command: Command) -> Command {
+pub(crate) fn built(mut command: Command) -> Command {
     command.build();
     command
-}
-
-impl<T> Deferred<T> {
-    /// The arguments.
-    pub fn into_inner(self) -> T {
-        self.0
-    }
 }
 
 impl<T> Deref for Deferred<T> {

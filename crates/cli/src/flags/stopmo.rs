@@ -1,4 +1,4 @@
-//! The command-line flags of the stopmo jobs (cargo feature `clap`), declared next to the
+//! The command-line flags of the stopmo jobs, declared in the CLI beside the stopmo crate's
 //! options they fill: [`SegmentOptionsArgs`] → [`SegmentJobOptions`] (`stopmo segment` and
 //! `stopmo run`), [`LibraryOptionsArgs`] → [`LibraryJobOptions`] (`stopmo library` and
 //! `stopmo run`), with the files the flags name (`--segmentation`, `--saliency`, `--fixed`)
@@ -10,33 +10,15 @@ use std::path::{Path, PathBuf};
 use clap::{Args, ValueEnum};
 use glam::Vec3;
 
-use crate::library::{
+use ::stopmo::library::{
     Method, PlugOptions, SolveOptions, DEFAULT_LAMBDA, DEFAULT_PLUG_CLEARANCE_MM,
     DEFAULT_PLUG_LENGTH_MM, DEFAULT_PLUG_RADIUS_MM, DEFAULT_PRINT_HEIGHT_MM, DEFAULT_RESTARTS,
     DEFAULT_SEED, DEFAULT_THICKNESS_MM,
 };
-use crate::segment::{PartSpec, Seed, SegmentOptions, DEFAULT_GAMMA};
-use crate::{LibraryJobOptions, PieceCount, SegmentJobOptions};
+use ::stopmo::segment::{PartSpec, Seed, SegmentOptions, DEFAULT_GAMMA};
+use ::stopmo::{LibraryJobOptions, PieceCount, SegmentJobOptions};
 
-/// A flag whose value or file cannot be used, in the user's terms (`--part X: …`).
-#[derive(Debug, thiserror::Error)]
-pub enum FlagError {
-    /// A flag's value is wrong; the text names the flag.
-    #[error("{0}")]
-    Flag(String),
-    /// A flag or file (`at`) and what is wrong with it.
-    #[error("{at}")]
-    At {
-        /// The flag and value, or the file.
-        at: String,
-        /// What is wrong.
-        #[source]
-        source: Box<dyn std::error::Error + Send + Sync>,
-    },
-    /// A file a flag names cannot be read.
-    #[error(transparent)]
-    Io(#[from] tkio::IoError),
-}
+use super::FlagError;
 
 type Result<T, E = FlagError> = std::result::Result<T, E>;
 
@@ -68,29 +50,29 @@ impl<T> At<T> for Option<T> {
 
 /// Segmentation options shared by `stopmo segment` and `stopmo run`.
 #[derive(Debug, Args)]
-pub struct SegmentOptionsArgs {
+pub(crate) struct SegmentOptionsArgs {
     /// A part and its seed: `NAME=tri:ID` (triangle id) or `NAME=point:X,Y,Z` (snapped to the
     /// nearest triangle). Repeat for each part; repeat a name for several seeds.
     #[arg(long = "part", value_name = "NAME=SEED")]
-    pub parts: Vec<String>,
+    pub(crate) parts: Vec<String>,
     /// Choose N parts automatically (farthest seeds on per-triangle motion statistics).
     #[arg(long, conflicts_with = "parts")]
-    pub auto_parts: Option<usize>,
+    pub(crate) auto_parts: Option<usize>,
     /// Weight γ of the seam term (StopShop Eq. 1), after scaling the model to a unit box;
     /// ~1000 makes the cut independent of the exact seed placement (Fig. 4), much more
     /// collapses it.
     #[arg(long, default_value_t = DEFAULT_GAMMA)]
-    pub gamma: f64,
+    pub(crate) gamma: f64,
     /// Laplacian smoothing iterations of the part boundaries (0: cut along mesh edges).
     #[arg(long = "smooth-iters")]
-    pub smooth_iters: Option<usize>,
+    pub(crate) smooth_iters: Option<usize>,
     /// Keep the seams as they move (skip Section 3.2).
     #[arg(long)]
-    pub no_homogenize: bool,
+    pub(crate) no_homogenize: bool,
     /// Reuse the cut and seam targets of an earlier segmentation of the same mesh (its
     /// `segmentation.json`, or the `.glb` next to it): parts of both clips assemble together.
     #[arg(long, value_name = "SEG.json|SEG.glb", conflicts_with_all = ["parts", "auto_parts"])]
-    pub segmentation: Option<PathBuf>,
+    pub(crate) segmentation: Option<PathBuf>,
 }
 
 impl SegmentOptionsArgs {
@@ -98,7 +80,7 @@ impl SegmentOptionsArgs {
     ///
     /// # Errors
     /// A bad `--part` or an unreadable `--segmentation` file.
-    pub fn options(&self, figure: bool) -> Result<SegmentJobOptions> {
+    pub(crate) fn options(&self, figure: bool) -> Result<SegmentJobOptions> {
         let mut segment = SegmentOptions {
             gamma: self.gamma,
             homogenize: !self.no_homogenize,
@@ -123,7 +105,7 @@ impl SegmentOptionsArgs {
 
 /// Reads `--segmentation`: a `segmentation.json` (a `.glb` stands for the `.json` of the same
 /// name next to it, as `stopmo run` writes them).
-fn read_saved(path: &Path) -> Result<crate::segment::SavedSegmentation> {
+fn read_saved(path: &Path) -> Result<::stopmo::segment::SavedSegmentation> {
     let json = if path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
@@ -134,7 +116,7 @@ fn read_saved(path: &Path) -> Result<crate::segment::SavedSegmentation> {
     };
     let bytes =
         tkio::read_file(&json).with_context(|| format!("--segmentation {}", path.display()))?;
-    crate::saved_segmentation(&String::from_utf8_lossy(&bytes))
+    ::stopmo::saved_segmentation(&String::from_utf8_lossy(&bytes))
         .with_context(|| format!("--segmentation {}", json.display()))
 }
 
@@ -174,7 +156,7 @@ fn parse_parts(specs: &[String]) -> Result<Vec<PartSpec>> {
 
 /// Which algorithm picks the pieces.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
-pub enum MethodArg {
+pub(crate) enum MethodArg {
     /// Positions and velocities (StopShop Eq. 10, λ from --lambda).
     #[default]
     Stopshop,
@@ -196,119 +178,119 @@ impl From<MethodArg> for Method {
 
 /// Library options shared by `stopmo library` and `stopmo run`.
 #[derive(Debug, Args)]
-pub struct LibraryOptionsArgs {
+pub(crate) struct LibraryOptionsArgs {
     /// Pieces per part: `20` for every part, or `upper=20,lower=30`.
     #[arg(long, value_name = "N|PART=N,...", conflicts_with_all = ["max_error", "budget"])]
-    pub pieces: Option<String>,
+    pub(crate) pieces: Option<String>,
     /// Smallest library per part whose worst frame's mean position error is at most this many
     /// millimetres (at --print-height).
     #[arg(long, value_name = "MM", conflicts_with = "budget")]
-    pub max_error: Option<f64>,
+    pub(crate) max_error: Option<f64>,
     /// Total number of pieces over all parts, allocated greedily.
     #[arg(long, value_name = "PIECES")]
-    pub budget: Option<usize>,
+    pub(crate) budget: Option<usize>,
     /// Velocity weight λ of StopShop Eq. 10.
     #[arg(long, default_value_t = DEFAULT_LAMBDA)]
-    pub lambda: f64,
+    pub(crate) lambda: f64,
     /// Random restarts (run in parallel, the best is kept).
     #[arg(long, default_value_t = DEFAULT_RESTARTS)]
-    pub restarts: usize,
+    pub(crate) restarts: usize,
     /// Seed of every random choice (default: the tool's fixed seed; runs are reproducible).
     #[arg(long, value_name = "SEED")]
-    pub seed: Option<u64>,
+    pub(crate) seed: Option<u64>,
     /// Per-vertex saliency weights: float32 `.npy` of shape (vertices,) or (1, vertices), in
     /// the merged vertex order of the input (parts one after the other; for `stopmo run`, the
     /// input mesh's own vertex order, checked before anything is written).
     #[arg(long, value_name = "FILE.npy")]
-    pub saliency: Option<PathBuf>,
+    pub(crate) saliency: Option<PathBuf>,
     /// Frames that start a new, unrelated shot (no velocity term across them).
     #[arg(long, value_delimiter = ',')]
-    pub cuts: Vec<usize>,
+    pub(crate) cuts: Vec<usize>,
     /// Directory of pre-made pieces `<part>_<NN>.obj` (e.g. `OLD/pieces` of an earlier run);
     /// they are kept and new pieces are added up to the library size. The printed back
     /// surfaces `<part>_back.obj` there are reused, so the new pieces seat on the same head.
     #[arg(long, value_name = "DIR")]
-    pub fixed: Option<PathBuf>,
+    pub(crate) fixed: Option<PathBuf>,
     /// Algorithm.
     #[arg(long, value_enum, default_value_t = MethodArg::Stopshop)]
-    pub method: MethodArg,
+    pub(crate) method: MethodArg,
     /// Printed height of the whole model in millimetres (scales the STL files and the errors).
     #[arg(long, value_name = "MM", default_value_t = DEFAULT_PRINT_HEIGHT_MM)]
-    pub print_height: f64,
+    pub(crate) print_height: f64,
     /// Wall thickness of the printed pieces in millimetres.
     #[arg(long, value_name = "MM", default_value_t = DEFAULT_THICKNESS_MM)]
-    pub thickness: f64,
+    pub(crate) thickness: f64,
     /// Add male/female plugs (paper Fig. 13) across every seam shared by two parts: a pin
     /// under the first part, a socket tube under the second, fused into the pieces' STL files
     /// as extra shells (slicers union them). Placed on the rest geometry; listed in
     /// report.json under "plugs".
     #[arg(long)]
-    pub plugs: bool,
+    pub(crate) plugs: bool,
     /// Pin radius of the plugs in millimetres.
     #[arg(long, value_name = "MM", requires = "plugs", default_value_t = DEFAULT_PLUG_RADIUS_MM)]
-    pub plug_radius: f64,
+    pub(crate) plug_radius: f64,
     /// Plug length (boss + pin) in millimetres.
     #[arg(long, value_name = "MM", requires = "plugs", default_value_t = DEFAULT_PLUG_LENGTH_MM)]
-    pub plug_length: f64,
+    pub(crate) plug_length: f64,
     /// Radial clearance between pin and socket in millimetres (tune to the printer;
     /// default: --clearance when given, else 0.15).
     #[arg(long, value_name = "MM", requires = "plugs")]
-    pub plug_clearance: Option<f64>,
+    pub(crate) plug_clearance: Option<f64>,
     /// A disc magnet DIAMETERxHEIGHT in millimetres (e.g. 3x2): every piece gets a pocket
     /// for it at one place of its part's back that all pieces share (so one magnet in the
     /// head holds every piece), and the part's mount pieces/<part>_back.stl the matching
     /// pocket.
     #[arg(long, value_name = "DxH", conflicts_with = "no_print")]
-    pub magnets: Option<String>,
+    pub(crate) magnets: Option<String>,
     /// Clearance of printed fits in millimetres (magnet pockets, the mount's key sockets and
     /// plugs); default: 3 × --resolution, at least 0.1 (0.15 at 0.05 mm: a tight resin fit;
     /// 0.3 gives a loose one).
     #[arg(long, value_name = "MM", allow_negative_numbers = true)]
-    pub clearance: Option<f64>,
+    pub(crate) clearance: Option<f64>,
     /// Files of the printable solids: one STL per piece, one library.3mf (every piece a
     /// named object, one colour per part, laid out on build plates), or both.
     #[arg(long, value_name = "stl|3mf|stl,3mf", default_value = "stl")]
-    pub print_format: String,
+    pub(crate) print_format: String,
     /// Build plate WIDTHxDEPTH in millimetres where library.3mf lays the pieces out.
     #[arg(long, value_name = "WxD", default_value = "120x68")]
-    pub plate: String,
+    pub(crate) plate: String,
     /// The printer's thinnest wall in millimetres: thinner walls of a piece or mount are
     /// reported (a warning naming the pieces and the fix, report.json
     /// "printing.printability"); magnet pockets keep at least this much material around.
     #[arg(
         long,
         value_name = "MM",
-        default_value_t = crate::DEFAULT_MIN_WALL_MM,
+        default_value_t = ::stopmo::DEFAULT_MIN_WALL_MM,
         allow_negative_numbers = true
     )]
-    pub min_wall: f64,
+    pub(crate) min_wall: f64,
     /// The printer's smallest free-standing feature in millimetres: smaller embossed IDs,
     /// keys or plug pins are reported.
     #[arg(
         long,
         value_name = "MM",
-        default_value_t = crate::DEFAULT_MIN_FEATURE_MM,
+        default_value_t = ::stopmo::DEFAULT_MIN_FEATURE_MM,
         allow_negative_numbers = true
     )]
-    pub min_feature: f64,
+    pub(crate) min_feature: f64,
     /// Printer resolution in millimetres: pieces that differ from a sibling by less are
     /// reported (a warning and report.json "printing.parts[].below_resolution").
-    #[arg(long, value_name = "MM", default_value_t = crate::DEFAULT_RESOLUTION_MM)]
-    pub resolution: f64,
+    #[arg(long, value_name = "MM", default_value_t = ::stopmo::DEFAULT_RESOLUTION_MM)]
+    pub(crate) resolution: f64,
     /// No registration keys (domes on the shared back surface that fix all six degrees of
     /// freedom on the armature/head).
     #[arg(long)]
-    pub no_keys: bool,
+    pub(crate) no_keys: bool,
     /// No piece ID (`P-NN`) embossed on the back of every piece.
     #[arg(long)]
-    pub no_ids: bool,
+    pub(crate) no_ids: bool,
     /// No printable solids: the pieces' surfaces (`pieces/*.obj`), labels, errors and
     /// sheets only, in a fraction of the time — to judge a library size before printing it.
     #[arg(long, conflicts_with = "plugs")]
-    pub no_print: bool,
+    pub(crate) no_print: bool,
     /// Also write the JSON report here (it is always written to DIR/report.json).
     #[arg(long)]
-    pub report: Option<PathBuf>,
+    pub(crate) report: Option<PathBuf>,
 }
 
 impl LibraryOptionsArgs {
@@ -317,7 +299,7 @@ impl LibraryOptionsArgs {
     /// # Errors
     /// A bad `--pieces`, `--max-error` or `--thickness`, or an unreadable `--saliency` file
     /// or `--fixed` folder.
-    pub fn options(&self, names: &[String]) -> Result<LibraryJobOptions> {
+    pub(crate) fn options(&self, names: &[String]) -> Result<LibraryJobOptions> {
         let pieces = match (&self.pieces, self.max_error, self.budget) {
             (Some(p), _, _) => parse_pieces(p)?,
             (None, Some(e), _) => {
@@ -333,18 +315,23 @@ impl LibraryOptionsArgs {
             bail!("--thickness must be a positive number of millimetres");
         }
         if let Some(c) = self.clearance {
-            if !(c.is_finite() && (0.0..=5.0).contains(&c)) {
-                bail!("--clearance must be between 0 and 5 millimetres, got {c}");
+            let r = ::stopmo::CLEARANCE_RANGE_MM;
+            if !(c.is_finite() && r.contains(&c)) {
+                bail!(
+                    "--clearance must be between {} and {} millimetres, got {c}",
+                    r.start(),
+                    r.end()
+                );
             }
         }
         let magnets = match &self.magnets {
             Some(m) => Some(
-                crate::library::MagnetOptions::parse(m)
+                ::stopmo::library::MagnetOptions::parse(m)
                     .with_context(|| format!("--magnets {m}"))?,
             ),
             None => None,
         };
-        let Some(print_format) = crate::PrintFormat::parse(&self.print_format) else {
+        let Some(print_format) = ::stopmo::PrintFormat::parse(&self.print_format) else {
             bail!(
                 "--print-format {}: expected stl, 3mf or stl,3mf",
                 self.print_format
@@ -355,8 +342,13 @@ impl LibraryOptionsArgs {
             ("--min-wall", self.min_wall),
             ("--min-feature", self.min_feature),
         ] {
-            if !(v.is_finite() && (0.0..=10.0).contains(&v)) {
-                bail!("{flag} must be between 0 and 10 millimetres, got {v}");
+            let r = ::stopmo::PRINTER_MINIMUM_RANGE_MM;
+            if !(v.is_finite() && r.contains(&v)) {
+                bail!(
+                    "{flag} must be between {} and {} millimetres, got {v}",
+                    r.start(),
+                    r.end()
+                );
             }
         }
         let saliency = match &self.saliency {
@@ -406,7 +398,7 @@ impl LibraryOptionsArgs {
 
     /// Names the file or option a library error is about: `--saliency FILE`, `--fixed DIR`,
     /// `--pieces …`, otherwise the input.
-    pub fn context(&self, e: crate::Error, input: &Path) -> FlagError {
+    pub(crate) fn context(&self, e: ::stopmo::Error, input: &Path) -> FlagError {
         let at = match (e.option(), &self.saliency, &self.fixed) {
             (Some("saliency"), Some(p), _) => p.display().to_string(),
             (Some("fixed"), _, Some(d)) => format!("--fixed {}", d.display()),
@@ -424,21 +416,19 @@ impl LibraryOptionsArgs {
     }
 }
 
-/// Parses `--plate`: `WxD` in millimetres, each between 10 and 2000.
+/// Parses `--plate`: `WxD` in millimetres, each in [`::stopmo::PLATE_SIDE_RANGE_MM`].
 fn parse_plate(spec: &str) -> Result<[f64; 2]> {
+    let r = ::stopmo::PLATE_SIDE_RANGE_MM;
     let parsed = spec
         .trim()
         .split_once(['x', 'X'])
         .and_then(|(w, d)| Some([w.trim().parse::<f64>().ok()?, d.trim().parse::<f64>().ok()?]));
     match parsed {
-        Some(p)
-            if p.iter()
-                .all(|v| v.is_finite() && (10.0..=2000.0).contains(v)) =>
-        {
-            Ok(p)
-        }
+        Some(p) if p.iter().all(|v| v.is_finite() && r.contains(v)) => Ok(p),
         _ => bail!(
-            "--plate {spec}: expected WIDTHxDEPTH in millimetres (10 to 2000 each), e.g. 120x68"
+            "--plate {spec}: expected WIDTHxDEPTH in millimetres ({} to {} each), e.g. 120x68",
+            r.start(),
+            r.end()
         ),
     }
 }
