@@ -228,22 +228,7 @@ async fn strokes_give_a_line_through_them_and_a_moving_character() {
     let dir = tempfile::tempdir().unwrap();
     let app = app(dir.path());
     let (w, h) = (800.0, 600.0);
-    let arc = |bend: f64| -> Vec<[f64; 2]> {
-        (0..=20)
-            .map(|i| {
-                let t = i as f64 / 20.0;
-                [
-                    400.0 + bend * (std::f64::consts::PI * t).sin(),
-                    150.0 + 300.0 * t,
-                ]
-            })
-            .collect()
-    };
-    let keys = json!([
-        {"frame": 0, "points": arc(-60.0)},
-        {"frame": 12, "points": arc(0.0)},
-        {"frame": 24, "points": arc(60.0)},
-    ]);
+    let keys = common::bending_keystrokes();
     let (status, bytes) = send(
         &app,
         post(
@@ -276,7 +261,9 @@ async fn strokes_give_a_line_through_them_and_a_moving_character() {
     let (status, line) = send(&app, get("/api/loa/line")).await;
     assert_eq!(status, StatusCode::OK);
     let line: Value = serde_json::from_slice(&line).unwrap();
-    for (k, bend) in [(0, -60.0), (12, 0.0), (24, 60.0)] {
+    for key in keys.as_array().unwrap() {
+        let k = key["frame"].as_u64().unwrap();
+        let stroke: Vec<[f64; 2]> = serde_json::from_value(key["points"].clone()).unwrap();
         let frame = line["frames"]
             .as_array()
             .unwrap()
@@ -284,7 +271,7 @@ async fn strokes_give_a_line_through_them_and_a_moving_character() {
             .find(|f| f["frame"] == k)
             .unwrap();
         let pts: Vec<[f64; 2]> = serde_json::from_value(frame["points"].clone()).unwrap();
-        let far = arc(bend)
+        let far = stroke
             .iter()
             .map(|p| {
                 pts.iter()

@@ -118,22 +118,7 @@ async fn a_request_beside_a_running_job_is_503_until_that_job_gives_its_memory_b
         .unwrap();
     let (status, body) = send(&app, stylize()).await;
     assert_busy(status, &body);
-    let arc = |bend: f64| -> Vec<[f64; 2]> {
-        (0..=20)
-            .map(|i| {
-                let t = i as f64 / 20.0;
-                [
-                    400.0 + bend * (std::f64::consts::PI * t).sin(),
-                    150.0 + 300.0 * t,
-                ]
-            })
-            .collect()
-    };
-    let keys = json!([
-        {"frame": 0, "points": arc(-60.0)},
-        {"frame": 12, "points": arc(0.0)},
-        {"frame": 24, "points": arc(60.0)},
-    ]);
+    let keys = common::bending_keystrokes();
     let animate = json!({"keystrokes": keys, "width": 800, "height": 600});
     let (status, body) = send(&app, post("/api/loa/animate", animate.clone())).await;
     assert_busy(status, &body);

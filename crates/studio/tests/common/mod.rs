@@ -70,3 +70,24 @@ pub(crate) fn error_of(bytes: &[u8]) -> String {
         .expect("an \"error\" string")
         .to_string()
 }
+
+/// Three keystrokes on an 800×600 canvas at frames 0, 12 and 24: a vertical arc bending
+/// from left to right (a line of action with anticipation and follow-through to animate).
+pub(crate) fn bending_keystrokes() -> Value {
+    let arc = |bend: f64| -> Vec<[f64; 2]> {
+        (0..=20)
+            .map(|i| {
+                let t = i as f64 / 20.0;
+                [
+                    400.0 + bend * (std::f64::consts::PI * t).sin(),
+                    150.0 + 300.0 * t,
+                ]
+            })
+            .collect()
+    };
+    serde_json::json!([
+        {"frame": 0, "points": arc(-60.0)},
+        {"frame": 12, "points": arc(0.0)},
+        {"frame": 24, "points": arc(60.0)},
+    ])
+}
