@@ -61,6 +61,7 @@
 //! ```
 
 mod cut;
+mod cut_animation;
 mod error;
 mod geodesic;
 mod graphcut;
