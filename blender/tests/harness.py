@@ -96,6 +96,17 @@ def run(tests):
     return 1 if failed else 0
 
 
+def finish(code, report, out):
+    """Writes `report` to `out`/report.json and prints it (CI reads the line), then exits
+    with `code` at once: bpy's interpreter teardown can crash after a headless run."""
+    import json
+
+    with open(os.path.join(out, "report.json"), "w") as f:
+        json.dump(report, f, indent=1)
+    print("blender report:", json.dumps(report), flush=True)
+    os._exit(code)
+
+
 def tmpdir():
     return tempfile.mkdtemp(prefix="toonkit-blender-")
 

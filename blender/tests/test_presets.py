@@ -21,7 +21,6 @@ where the file puts them, in every frame and at rest, and its size is 8.132 (doc
 measures both imports.
 """
 
-import json
 import os
 import re
 import subprocess
@@ -35,7 +34,7 @@ os.environ.setdefault("BLENDER_USER_RESOURCES", os.path.join(
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from harness import (ASSETS, REPO, check, empty_scene, run, start, tmpdir,  # noqa: E402
+from harness import (ASSETS, REPO, check, empty_scene, finish, run, start, tmpdir,  # noqa: E402
                      world_positions)
 
 toonkit, OUT = start()
@@ -286,7 +285,4 @@ if __name__ == "__main__":
         test_the_robots_bone_parented_parts_follow_the_bone_heuristic,
         test_every_preset_on_the_benchmark_tube_as_the_cli,
     ])
-    with open(os.path.join(OUT, "report.json"), "w") as f:
-        json.dump(REPORT, f, indent=1)
-    print("blender report:", json.dumps(REPORT), flush=True)
-    os._exit(code)  # bpy's interpreter teardown can crash after a headless run
+    finish(code, REPORT, OUT)

@@ -27,7 +27,7 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
 from harness import (ASSETS, argv_after_dashes, check, empty_scene, install, rel,  # noqa: E402
-                     run, tmpdir, world_positions)
+                     finish, run, tmpdir, world_positions)
 
 ARGS = argv_after_dashes()
 ZIP = os.path.abspath(ARGS[0])
@@ -491,7 +491,4 @@ if __name__ == "__main__":
         test_results_equal_the_cli_on_both_sampling_paths,
         test_tube_speed,
     ])
-    with open(os.path.join(OUT, "report.json"), "w") as f:
-        json.dump(REPORT, f, indent=1)
-    print("blender report:", json.dumps(REPORT), flush=True)
-    os._exit(code)  # bpy's interpreter teardown can crash after a headless run
+    finish(code, REPORT, OUT)

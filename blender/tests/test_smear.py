@@ -24,7 +24,7 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
 from harness import (ASSETS, argv_after_dashes, attribute, check, empty_scene, install, rel,  # noqa: E402
-                     run, tmpdir, world_positions)
+                     finish, run, tmpdir, world_positions)
 
 ARGS = argv_after_dashes()
 ZIP = os.path.abspath(ARGS[0])
@@ -575,7 +575,4 @@ if __name__ == "__main__":
         test_render_save_reload_unbake,
         test_a_style_means_the_same_in_centimetres_and_metres,
     ])
-    with open(os.path.join(OUT, "report.json"), "w") as f:
-        json.dump(REPORT, f, indent=1)
-    print("blender report:", json.dumps(REPORT), flush=True)
-    os._exit(code)  # bpy's interpreter teardown can crash after a headless run
+    finish(code, REPORT, OUT)
