@@ -68,8 +68,8 @@ def bake_blocker(context):
 
 def _moves(s):
     """Whether any vertex of the sample moves over its frames (no copy of the frames)."""
-    first = s.positions[0]
-    return any(not np.array_equal(first, p) for p in s.positions[1:])
+    first = s.y_up[0]
+    return any(not np.array_equal(first, p) for p in s.y_up[1:])
 
 
 def _prepare(context, objects, settings):
@@ -91,7 +91,7 @@ def _prepare(context, objects, settings):
     if not _moves(s) and s.camera is None:
         names = ", ".join(s.names[:3]) + (" …" if len(s.names) > 3 else "")
         raise JobError(f"{names}: does not move over frames {s.frame_start}-"
-                       f"{s.frame_start + len(s.positions) - 1}, nothing to smear; animate it "
+                       f"{s.frame_start + s.frame_count - 1}, nothing to smear; animate it "
                        "or set the scene range to where it moves")
     positions, skin = sample.to_camera(s)
     try:
@@ -142,7 +142,7 @@ class _Pending:
 
 def _current(scene, s):
     """The clip frame index of the scene's frame, clamped to the baked range."""
-    return min(max(scene.frame_current - s.frame_start, 0), len(s.positions) - 1)
+    return min(max(scene.frame_current - s.frame_start, 0), s.frame_count - 1)
 
 
 def write_pending(scene, frame_only=True):
@@ -208,7 +208,7 @@ def _show(scene, s, look):
     writes its frames."""
     import bpy
 
-    start, end = s.frame_start, s.frame_start + len(s.positions) - 1
+    start, end = s.frame_start, s.frame_start + s.frame_count - 1
     bodies = {o[results.SOURCE]: o for o in results.owned("body")}
     for name, _ in s.objects:
         body = bodies.get(name)
@@ -270,7 +270,7 @@ def _show_lazily(scene, s, look, wanted, lazy):
     _show(scene, s, look)
     if lazy:
         k = look.first_frame
-        _PENDING[scene.name] = _Pending(wanted, set(range(len(s.positions))) - {k})
+        _PENDING[scene.name] = _Pending(wanted, set(range(s.frame_count)) - {k})
         _flush_when_idle()
 
 

@@ -21,8 +21,9 @@ SOURCE = "toonkit_source"  # the original object's name
 HIDDEN = "toonkit_hidden"  # the original's (hide_viewport, hide_render) before the bake
 
 
-def _frame_name(n, prefix, frame):
-    """`prefix + str(frame)` from the scene frame clamped to [Start, End] (node links)."""
+def _frame_text(n):
+    """The scene frame rounded and clamped to [Start, End] (node links): the clamp node and
+    the frame as text, shared by every per-frame attribute the group reads."""
     g = n.id_data
     t = n.new("GeometryNodeInputSceneTime")
     gi = n.new("NodeGroupInput")
@@ -35,6 +36,12 @@ def _frame_name(n, prefix, frame):
     g.links.new(gi.outputs["End"], clamp.inputs["Max"])
     text = n.new("FunctionNodeValueToString")
     g.links.new(clamp.outputs[0], text.inputs["Value"])
+    return clamp, text
+
+
+def _frame_attribute(n, prefix, text):
+    """The attribute `prefix + text` (the frame's, see `_frame_text`)."""
+    g = n.id_data
     head = n.new("FunctionNodeInputString")
     head.string = prefix
     join = n.new("GeometryNodeStringJoin")
@@ -44,7 +51,7 @@ def _frame_name(n, prefix, frame):
     attr = n.new("GeometryNodeInputNamedAttribute")
     attr.data_type = {"tk_P": "FLOAT_VECTOR", "tk_I": "INT"}.get(prefix, "FLOAT")
     g.links.new(join.outputs[0], attr.inputs["Name"])
-    return attr, clamp
+    return attr
 
 
 def node_group():
@@ -59,8 +66,9 @@ def node_group():
     g.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
     n, links = g.nodes, g.links
     gin, gout = n.new("NodeGroupInput"), n.new("NodeGroupOutput")
-    pos, clamp = _frame_name(n, "tk_P", None)
-    alpha, _ = _frame_name(n, "tk_A", None)
+    clamp, text = _frame_text(n)
+    pos = _frame_attribute(n, "tk_P", text)
+    alpha = _frame_attribute(n, "tk_A", text)
     setpos = n.new("GeometryNodeSetPosition")
     links.new(gin.outputs["Geometry"], setpos.inputs["Geometry"])
     links.new(pos.outputs["Exists"], setpos.inputs["Selection"])
@@ -72,7 +80,7 @@ def node_group():
     links.new(alpha.outputs["Exists"], store.inputs["Selection"])
     links.new(alpha.outputs["Attribute"], store.inputs["Value"])
     # Stop-motion reconstructions: the piece shown at this frame, as the integer `piece`.
-    piece, _ = _frame_name(n, "tk_I", None)
+    piece = _frame_attribute(n, "tk_I", text)
     store_piece = n.new("GeometryNodeStoreNamedAttribute")
     store_piece.data_type, store_piece.domain = "INT", "POINT"
     store_piece.inputs["Name"].default_value = "piece"

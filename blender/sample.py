@@ -36,7 +36,7 @@ class Sample:
 
     names: list                 # original object names, in vertex order
     ranges: list                # vertex range of each object
-    positions: np.ndarray       # (frames, vertices, 3) float32, world space
+    y_up: np.ndarray            # (frames, vertices, 3) float32 C-contiguous, world turned Y-up
     triangles: np.ndarray       # (t, 3) int32
     frame_start: int
     fps: float
@@ -45,10 +45,23 @@ class Sample:
     bones: list = field(default_factory=list)
     camera: np.ndarray = None   # (frames, 4, 4) camera world matrices (camera-relative mode)
     rest: np.ndarray = None     # (vertices, 3) float32 world space at the rest pose
+    _world: np.ndarray = field(default=None, repr=False)
 
     @property
     def objects(self):
         return [(n, r) for n, r in zip(self.names, self.ranges)]
+
+    @property
+    def frame_count(self):
+        return len(self.y_up)
+
+    @property
+    def positions(self):
+        """(frames, vertices, 3) float32 in Blender's Z-up world: `y_up` turned back (exact),
+        made once on first use; the bake itself hands the core `y_up`."""
+        if self._world is None:
+            self._world = np.ascontiguousarray(from_y_up(self.y_up))
+        return self._world
 
 
 def armature_of(obj, viewport=False):
@@ -108,7 +121,12 @@ def _evaluated(obj, depsgraph):
 
 
 def _triangles(ev):
-    """The loop triangles (t, 3) of the evaluated object `ev`'s mesh."""
+    """The loop triangles (t, 3) of the evaluated object `ev`'s mesh: its own mesh's corners
+    when every face is a triangle and only Armature modifiers act (a triangle's triangulation
+    is itself whatever the pose, and its loop triangle its corners in order)."""
+    own = _own_triangles(ev.original)
+    if own is not None:
+        return own
     mesh = ev.to_mesh()
     try:
         mesh.calc_loop_triangles()
@@ -117,6 +135,23 @@ def _triangles(ev):
         return tris.reshape(-1, 3)
     finally:
         ev.to_mesh_clear()
+
+
+def _own_triangles(obj):
+    """(t, 3) int32 corners of `obj`'s own mesh when all its faces are triangles (3 corners
+    per face: faces own consecutive corners) and only Armature modifiers act, else None.
+    Read from the `.corner_vert` attribute in one bulk copy (`loop_triangles.foreach_get`
+    goes item by item)."""
+    mesh = obj.data
+    if (not mesh.polygons or len(mesh.loops) != 3 * len(mesh.polygons)
+            or any(m.type != "ARMATURE" for m in obj.modifiers)):
+        return None
+    corners = mesh.attributes.get(".corner_vert")
+    if corners is None or len(corners.data) != len(mesh.loops):
+        return None
+    tris = np.empty(len(mesh.loops), np.int32)
+    corners.data.foreach_get("value", tris)
+    return tris.reshape(-1, 3)
 
 
 def _groups(obj, n):
@@ -229,13 +264,13 @@ def _rest_matrices(context, meshes):
         context.evaluated_depsgraph_get().update()
 
 
-def _rest_positions(meshes, ranges, matrices, positions):
+def _rest_positions(meshes, ranges, matrices, y_up):
     """(vertices, 3) float32: each mesh's own vertices through its rest matrix, or its first
-    frame when a modifier changed its vertex count."""
+    frame (of the Y-up `y_up`) when a modifier changed its vertex count."""
     rest = np.empty((ranges[-1].stop, 3), np.float32)
     for o, r in zip(meshes, ranges):
         if len(o.data.vertices) != len(r):
-            rest[r.start:r.stop] = positions[0, r.start:r.stop]
+            rest[r.start:r.stop] = from_y_up(y_up[0, r.start:r.stop])
             continue
         co = _co(o).astype(np.float64)
         m = matrices[o.name]
@@ -296,8 +331,11 @@ class _Pose:
             ev.pose.bones.foreach_get("matrix", self.pose[i][k])
 
     def skin(self, toonkit):
-        """Every frame's world vertices of the pose-only objects, concatenated in their order:
-        one `toonkit.skin` call, float32 (frames, vertices, 3)."""
+        """Every frame's world vertices of the pose-only objects turned Y-up (`to_y_up`),
+        concatenated in their order: one `toonkit.skin` call, float32 (frames, vertices, 3),
+        the array the core reads. The turn is folded into the skinning matrices (a signed
+        permutation of their rows), so the vertices are `to_y_up` of the world's bit for bit
+        with no pass over them."""
         rests, indices, weights, matrices = [], [], [], []
         self.ranges, start, slots = {}, 0, 0
         for i, o in enumerate(self.objects):
@@ -323,7 +361,7 @@ class _Pose:
         weights = [np.pad(w, [(0, 0), (0, width - w.shape[1])]) for w in weights]
         return toonkit.skin(np.concatenate(rests), np.concatenate(indices),
                             np.concatenate(weights),
-                            np.concatenate(matrices, axis=1).astype(np.float32))
+                            _rows_y_up(np.concatenate(matrices, axis=1)).astype(np.float32))
 
     def _skinning(self, o, a, world):
         """Per-frame skinning matrices of `o`'s deforming bones (world space: armature world ·
@@ -349,11 +387,23 @@ class _Pose:
             if g is not None:
                 np.maximum(g, 0.0, out=dense[:, j])
         dense[dense.sum(axis=1) <= ARMATURE_MIN_WEIGHT] = 0.0
-        most = max(1, int((dense > 0).sum(axis=1).max(initial=0)))
-        order = np.argsort(-dense, axis=1, kind="stable")[:, :most]
-        weights = np.take_along_axis(dense, order, axis=1)
-        indices = np.where(weights > 0, order, -1).astype(np.int64)
+        indices, weights = _compact(dense)
         return matrices, indices, weights
+
+
+def _compact(dense):
+    """The nonzero entries of `dense` (vertices, bones) as per-vertex influences: bone indices
+    (-1 pads) and weights (vertices, k), k the most any vertex has, in bone order."""
+    rows, cols = np.nonzero(dense)
+    counts = np.bincount(rows, minlength=len(dense))
+    most = max(1, int(counts.max(initial=0)))
+    first = np.cumsum(counts) - counts
+    slot = np.arange(len(rows)) - first[rows]
+    indices = np.full((len(dense), most), -1, np.int64)
+    weights = np.zeros((len(dense), most), np.float32)
+    indices[rows, slot] = cols
+    weights[rows, slot] = dense[rows, cols]
+    return indices, weights
 
 
 def bake_range(scene):
@@ -387,7 +437,7 @@ def sample(context, objects, camera_relative=False, pose_only=True):
                                         if pose_only and pose_only_reason(o) is None])
     evaluated = [o for o in meshes if o not in posed]
     pose = _Pose(posed, frames, groups) if posed else None
-    rig = _Rig(armature, joint_names, frames) if armature is not None else None
+    rig = _Rig(armature, joint_names, frames, pose) if armature is not None else None
     current = scene.frame_current, scene.frame_subframe
     per_object = {o.name: [] for o in evaluated}
     tris, cams = {}, []
@@ -428,12 +478,12 @@ def sample(context, objects, camera_relative=False, pose_only=True):
         ranges.append(range(offset, offset + c))
         all_tris.append(tris[o.name] + offset)
         offset += c
-    positions = _positions(context, meshes, ranges, frames, pose, per_object)
+    y_up = _positions(context, meshes, ranges, frames, pose, per_object)
     result = Sample(
-        names=[o.name for o in meshes], ranges=ranges, positions=positions,
+        names=[o.name for o in meshes], ranges=ranges, y_up=y_up,
         triangles=np.concatenate(all_tris).astype(np.int32), frame_start=start,
         fps=scene.render.fps / scene.render.fps_base, bones=joint_names,
-        rest=_rest_positions(meshes, ranges, rest_matrices, positions))
+        rest=_rest_positions(meshes, ranges, rest_matrices, y_up))
     _skin_and_attributes(result, meshes, counts, groups, armature, parents,
                          rig.matrices() if rig is not None else None)
     if camera_relative:
@@ -471,14 +521,21 @@ class _Rig:
     """The joint world matrices of the articulated group's armature per frame (SMEAR Eqs.
     3-9), read with one foreach_get per frame."""
 
-    def __init__(self, armature, joint_names, frames):
+    def __init__(self, armature, joint_names, frames, pose=None):
         self.armature = armature
         order = {pb.name: i for i, pb in enumerate(armature.pose.bones)}
         self.order = [order[n] for n in joint_names]
         self.world = np.empty((frames, 4, 4), np.float64)
         self.pose = np.empty((frames, len(order) * 16), np.float32)
+        # The pose-only sampling reads this armature already: its buffers are these.
+        self.shared = pose is not None and armature in pose.armatures
+        if self.shared:
+            i = pose.armatures.index(armature)
+            self.world, self.pose = pose.arm_world[:, i], pose.pose[i]
 
     def read(self, k, dg):
+        if self.shared:
+            return
         ev = self.armature.evaluated_get(dg)
         self.world[k] = _matrix(ev.matrix_world)
         ev.pose.bones.foreach_get("matrix", self.pose[k])
@@ -490,8 +547,8 @@ class _Rig:
 
 
 def _positions(context, meshes, ranges, frames, pose, per_object):
-    """(frames, vertices, 3) float32 of `meshes` in order: the core's skinned array itself when
-    every mesh is pose-only, else both paths' vertices in their ranges."""
+    """(frames, vertices, 3) float32 of `meshes` in order, turned Y-up: the core's skinned
+    array itself when every mesh is pose-only, else both paths' vertices in their ranges."""
     import toonkit
 
     skinned = pose.skin(toonkit) if pose is not None else None
@@ -501,7 +558,7 @@ def _positions(context, meshes, ranges, frames, pose, per_object):
     for o, r in zip(meshes, ranges):
         if o.name in per_object:
             for k, p in enumerate(per_object[o.name]):
-                positions[k, r.start:r.stop] = p
+                positions[k, r.start:r.stop] = to_y_up(p)
         else:
             r0 = pose.ranges[o.name]
             positions[:, r.start:r.stop] = skinned[:, r0.start:r0.stop]
@@ -546,10 +603,8 @@ def to_camera(sample):
     if sample.camera is None:
         skin = None
         if sample.skin is not None:
-            skin = dict(sample.skin)
-            m = sample.skin["matrices"]
-            skin["matrices"] = m[..., [0, 2, 1, 3], :] * np.array([1, 1, -1, 1], m.dtype)[:, None]
-        return to_y_up(sample.positions), skin
+            skin = dict(sample.skin, matrices=_rows_y_up(sample.skin["matrices"]))
+        return sample.y_up, skin
     inv = affine_inverse(sample.camera)
     p = sample.positions.astype(np.float64)
     p = np.einsum("fij,fvj->fvi", inv[:, :3, :3], p) + inv[:, None, :3, 3]
@@ -559,6 +614,11 @@ def to_camera(sample):
         skin["matrices"] = np.einsum("fij,fkjl->fkil", inv,
                                      sample.skin["matrices"].astype(np.float64)).astype(np.float32)
     return p.astype(np.float32), skin
+
+
+def _rows_y_up(m):
+    """Matrices (..., 4, 4) followed by `to_y_up`: their rows signed and permuted (exact)."""
+    return m[..., [0, 2, 1, 3], :] * np.array([1, 1, -1, 1], m.dtype)[:, None]
 
 
 def to_y_up(points):

@@ -69,7 +69,7 @@ pub(crate) fn frozen<'py, T: Element>(
     Ok(a)
 }
 
-/// Flattens 3D points into `[x, y, z, …]`.
+/// Flattens 3D points into `[x, y, z, …]` (one copy of their memory).
 pub(crate) fn flat3(points: &[glam::Vec3]) -> Vec<f32> {
-    points.iter().flat_map(|p| p.to_array()).collect()
+    bytemuck::cast_slice(points).to_vec()
 }

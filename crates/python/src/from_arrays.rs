@@ -36,8 +36,8 @@ pub(crate) fn sampled(
             "positions must have at least one frame and one vertex, got shape {s:?}"
         )));
     }
-    let p = values(positions);
-    let points: Vec<Vec3> = p.chunks_exact(3).map(Vec3::from_slice).collect();
+    // One copy of the host's buffer (its shape ends in 3, so it casts whole).
+    let points: Vec<Vec3> = bytemuck::cast_slice(&values(positions)).to_vec();
     let rest: Vec<Vec3> = match rest {
         Some(r) => {
             shape(r, "rest", &[Some(vertices), Some(3)])?;

@@ -6,12 +6,12 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use anim::{MeshAnimation, SampleOptions, SampledScene};
-use numpy::PyArrayDyn;
+use numpy::{PyArrayDyn, ToPyArray};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyRange};
 use tkio::{LoadOptions, Loaded};
 
-use crate::arrays::{flat3, frozen};
+use crate::arrays::frozen;
 use crate::errors::{anim_error, io_error, value_error};
 
 /// A clip sampled at a fixed frame rate.
@@ -48,13 +48,35 @@ impl Scene {
         file_scene: Option<Arc<anim::Scene>>,
         inputs: Option<tkio::ReadScope>,
     ) -> PyResult<Scene> {
+        Scene::with_positions(py, sampled, source, file_scene, inputs, None)
+    }
+
+    /// [`Scene::new`] whose merged positions array is `merged` when given (a host's
+    /// frame-major array in object order, copied by numpy: no second merge of the frames).
+    pub(crate) fn with_positions(
+        py: Python<'_>,
+        sampled: SampledScene,
+        source: String,
+        file_scene: Option<Arc<anim::Scene>>,
+        inputs: Option<tkio::ReadScope>,
+        merged: Option<Bound<'_, PyArrayDyn<f32>>>,
+    ) -> PyResult<Scene> {
         let (frames, vertices) = (sampled.frame_count, sampled.vertex_count());
-        let mut positions = Vec::with_capacity(frames * vertices * 3);
-        for f in 0..frames {
-            for o in &sampled.objects {
-                positions.extend(flat3(o.animation.frame(f)));
+        let positions = match merged {
+            Some(p) => {
+                p.call_method1("setflags", (false,))?;
+                p
             }
-        }
+            None => {
+                let mut positions = Vec::with_capacity(frames * vertices * 3);
+                for f in 0..frames {
+                    for o in &sampled.objects {
+                        positions.extend_from_slice(bytemuck::cast_slice(o.animation.frame(f)));
+                    }
+                }
+                frozen(py, &[frames, vertices, 3], positions)?
+            }
+        };
         let mut triangles = Vec::new();
         let mut base = 0i32;
         for o in &sampled.objects {
@@ -65,7 +87,7 @@ impl Scene {
         }
         let nt = triangles.len() / 3;
         Ok(Scene {
-            positions: frozen(py, &[frames, vertices, 3], positions)?.unbind(),
+            positions: positions.unbind(),
             triangles: frozen(py, &[nt, 3], triangles)?.unbind(),
             sampled: Arc::new(sampled),
             source,
@@ -252,7 +274,17 @@ impl Scene {
             attributes,
             rest.as_ref(),
         )?;
-        Scene::new(py, sampled, "<arrays>".to_string(), None, None)
+        // `sampled` checked the shape; the objects tile the vertices in order, so the merged
+        // positions are the given ones (numpy's copy: its allocator, one memcpy).
+        let merged = positions.as_array().to_pyarray(py);
+        Scene::with_positions(
+            py,
+            sampled,
+            "<arrays>".to_string(),
+            None,
+            None,
+            Some(merged),
+        )
     }
 
     /// float32 ``(frames, vertices, 3)``: world-space positions, objects merged in order.
