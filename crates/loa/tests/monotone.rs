@@ -3,7 +3,8 @@
 //! varied lengths, orientations and spacing). Over the documented ranges
 //! ([`loa::STIFFNESS_RANGE`], [`loa::DAMPING_RANGE`]), on every sequence:
 //!
-//! * more damping → strictly less overshoot of the chain's angles past the next keystroke;
+//! * more damping → strictly less overshoot of the chain's angles past the next keystroke, by
+//!   at least [`MIN_DAMPING_STEP`] of it per step of the grid;
 //! * more stiffness → strictly earlier arrival on the next keystroke and a strictly higher
 //!   settle frequency;
 //! * no chain point moves more than 15 % of the line's length in one frame.
@@ -41,6 +42,9 @@ use loa::{Animation, Keystroke, Keystrokes, LineOptions, Mode, PhysicsOptions, S
 const SEQUENCES: u64 = 260;
 /// The per-frame motion promise, as a fraction of the line's length.
 const MAX_JUMP: f64 = 0.15;
+/// Least drop of the overshoot from one damping of the grid to the next, as a fraction of
+/// the less damped one's: every step of the slider is visible, not just ordered.
+const MIN_DAMPING_STEP: f64 = 0.04;
 /// Smallest key-to-key change (radians, all angles) whose progress is measured.
 const MIN_CHANGE: f64 = 1e-6;
 /// Settle frames of the stiffness runs (10 s at 24 fps): more than half a period of the
@@ -273,6 +277,9 @@ fn damping_lowers_the_overshoot_on_any_keystrokes() {
     let dampings = grid(loa::DAMPING_RANGE, 6);
     let mut worst_jump: f64 = 0.0;
     let mut failures = Vec::new();
+    // Per sequence: the smallest drop of the overshoot from one damping to the next
+    // (fraction of the less damped one's), and the ratio from the least to the most damped.
+    let (mut steps, mut spans) = (Vec::new(), Vec::new());
     for (seed, keys) in sequences() {
         let k = grid(loa::STIFFNESS_RANGE, 4)[seed as usize % 4];
         let values: Vec<f64> = dampings
@@ -287,13 +294,33 @@ fn damping_lowers_the_overshoot_on_any_keystrokes() {
         if !values.windows(2).all(|w| w[1] < w[0]) {
             failures.push(format!("seed {seed} k={k:.1}: overshoot {values:.4?}"));
         }
+        steps.push(
+            values
+                .windows(2)
+                .map(|w| 1.0 - w[1] / w[0])
+                .fold(f64::INFINITY, f64::min),
+        );
+        spans.push(values[0] / values[values.len() - 1]);
     }
+    steps.sort_by(f64::total_cmp);
+    spans.sort_by(f64::total_cmp);
     println!("largest per-frame motion: {:.1} %", 100.0 * worst_jump);
+    println!(
+        "smallest drop of the overshoot per damping step: least {:.4}, median {:.4}; \
+         overshoot ratio ζ {:.2} / {:.2}: least {:.2}, median {:.2}",
+        steps[0],
+        steps[steps.len() / 2],
+        dampings[0],
+        dampings[dampings.len() - 1],
+        spans[0],
+        spans[spans.len() / 2],
+    );
     println!("{} not strictly monotone:", failures.len());
     for f in failures.iter().take(12) {
         println!("  {f}");
     }
     assert!(failures.is_empty());
+    assert!(steps[0] >= MIN_DAMPING_STEP, "{}", steps[0]);
     assert!(worst_jump <= MAX_JUMP, "{worst_jump}");
 }
 
@@ -302,6 +329,8 @@ fn stiffness_brings_the_arrival_earlier_and_the_settle_faster_on_any_keystrokes(
     let stiffnesses = grid(loa::STIFFNESS_RANGE, 6);
     let mut worst_jump: f64 = 0.0;
     let (mut failures, mut measured, mut unmeasured) = (Vec::new(), 0, 0);
+    // Per sequence: arrival at the softest over the stiffest, settle frequency stiffest over softest.
+    let (mut arrival_spans, mut hz_spans) = (Vec::new(), Vec::new());
     for (seed, keys) in sequences() {
         let z = grid(loa::DAMPING_RANGE, 4)[seed as usize % 4];
         let (mut arrivals, mut frequencies) = (Vec::new(), Vec::new());
@@ -318,9 +347,11 @@ fn stiffness_brings_the_arrival_earlier_and_the_settle_faster_on_any_keystrokes(
         if !arrivals.windows(2).all(|w| w[1] < w[0]) {
             failures.push(format!("seed {seed} ζ={z:.3}: arrival {arrivals:.4?}"));
         }
+        arrival_spans.push(arrivals[0] / arrivals[arrivals.len() - 1]);
         match frequencies.iter().copied().collect::<Option<Vec<f64>>>() {
             Some(hz) => {
                 measured += 1;
+                hz_spans.push(hz[hz.len() - 1] / hz[0]);
                 if !hz.windows(2).all(|w| w[1] > w[0]) {
                     failures.push(format!("seed {seed} ζ={z:.3}: settle Hz {hz:.4?}"));
                 }
@@ -330,6 +361,16 @@ fn stiffness_brings_the_arrival_earlier_and_the_settle_faster_on_any_keystrokes(
     }
     println!("largest per-frame motion: {:.1} %", 100.0 * worst_jump);
     println!("settle frequency measured on {measured} sequences ({unmeasured} without a settle)");
+    arrival_spans.sort_by(f64::total_cmp);
+    hz_spans.sort_by(f64::total_cmp);
+    println!(
+        "arrival ratio k 5 / 100: least {:.2}, median {:.2}; settle Hz ratio k 100 / 5: \
+         least {:.2}, median {:.2}",
+        arrival_spans[0],
+        arrival_spans[arrival_spans.len() / 2],
+        hz_spans[0],
+        hz_spans[hz_spans.len() / 2],
+    );
     println!("{} not strictly monotone:", failures.len());
     for f in failures.iter().take(12) {
         println!("  {f}");
