@@ -4,7 +4,8 @@
 //! ([`loa::STIFFNESS_RANGE`], [`loa::DAMPING_RANGE`]), on every sequence:
 //!
 //! * more damping → strictly less overshoot of the chain's angles past the next keystroke, by
-//!   at least [`MIN_DAMPING_STEP`] of it per step of the grid;
+//!   at least [`MIN_DAMPING_STEP`] of it per step of the grid, and never more swings in the
+//!   settle (strictly fewer from the range's least damping to its most);
 //! * more stiffness → strictly earlier arrival on the next keystroke and a strictly higher
 //!   settle frequency;
 //! * no chain point moves more than 15 % of the line's length in one frame.
@@ -25,6 +26,8 @@
 //!   changes sign along the offset's first direction (interpolated between frames). A line
 //!   that reaches the last keystroke at rest has no settle to measure: such a sequence is
 //!   left out of this measure and counted (at least 200 must be measured).
+//! * **swings**: the settle's turning points (along the offset's first direction, over
+//!   [`SETTLE_FRAMES`]) that reach at least [`VISIBLE_SWING`] of its largest offset.
 //! * **jump**: the largest motion of any chain point between consecutive frames over the
 //!   line's length.
 //!
@@ -45,6 +48,8 @@ const MAX_JUMP: f64 = 0.15;
 /// Least drop of the overshoot from one damping of the grid to the next, as a fraction of
 /// the less damped one's: every step of the slider is visible, not just ordered.
 const MIN_DAMPING_STEP: f64 = 0.04;
+/// A settle swing counts when it reaches this fraction of the settle's largest offset.
+const VISIBLE_SWING: f64 = 0.05;
 /// Smallest key-to-key change (radians, all angles) whose progress is measured.
 const MIN_CHANGE: f64 = 1e-6;
 /// Settle frames of the stiffness runs (10 s at 24 fps): more than half a period of the
@@ -212,6 +217,36 @@ fn change(a: &Animation, k0: i64, k1: i64) -> f64 {
         .sqrt()
 }
 
+/// Visible swings of the settle: see the module docs. 0 when the line does not move after
+/// the last keystroke.
+fn settle_swings(a: &Animation) -> usize {
+    let last = *a.keystroke_frames.last().unwrap();
+    let key = a.chain_at(last).unwrap().angles().to_vec();
+    let offsets: Vec<Vec<f64>> = (last + 1..)
+        .map_while(|f| a.chain_at(f))
+        .map(|c| c.angles().iter().zip(&key).map(|(x, y)| x - y).collect())
+        .collect();
+    let Some(first) = offsets.first() else {
+        return 0;
+    };
+    let norm = first.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if norm < 1e-9 {
+        return 0;
+    }
+    let q: Vec<f64> = offsets
+        .iter()
+        .map(|o| o.iter().zip(first).map(|(x, y)| x * y).sum::<f64>() / norm)
+        .collect();
+    let largest = q.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    q.windows(3)
+        .filter(|w| {
+            (w[1] - w[0]) * (w[2] - w[1]) <= 0.0
+                && w[1].abs() >= VISIBLE_SWING * largest
+                && w[1].abs() >= w[0].abs().max(w[2].abs())
+        })
+        .count()
+}
+
 /// Settle frequency (Hz): see the module docs. `None` when the line does not move after
 /// the last keystroke or does not swing back through it within the settle.
 fn settle_frequency(a: &Animation) -> Option<f64> {
@@ -279,7 +314,7 @@ fn damping_lowers_the_overshoot_on_any_keystrokes() {
     let mut failures = Vec::new();
     // Per sequence: the smallest drop of the overshoot from one damping to the next
     // (fraction of the less damped one's), and the ratio from the least to the most damped.
-    let (mut steps, mut spans) = (Vec::new(), Vec::new());
+    let (mut steps, mut spans, mut swings) = (Vec::new(), Vec::new(), Vec::new());
     for (seed, keys) in sequences() {
         let k = grid(loa::STIFFNESS_RANGE, 4)[seed as usize % 4];
         let values: Vec<f64> = dampings
@@ -294,6 +329,21 @@ fn damping_lowers_the_overshoot_on_any_keystrokes() {
         if !values.windows(2).all(|w| w[1] < w[0]) {
             failures.push(format!("seed {seed} k={k:.1}: overshoot {values:.4?}"));
         }
+        let counts: Vec<usize> = dampings
+            .iter()
+            .map(|&z| {
+                let line = run(
+                    &with(&keys, k, z),
+                    Mode::Physics,
+                    Settle::Frames(SETTLE_FRAMES),
+                );
+                settle_swings(&line.animation)
+            })
+            .collect();
+        if !counts.windows(2).all(|w| w[1] <= w[0]) || counts[counts.len() - 1] >= counts[0] {
+            failures.push(format!("seed {seed} k={k:.1}: settle swings {counts:?}"));
+        }
+        swings.push((counts[0], counts[counts.len() - 1]));
         steps.push(
             values
                 .windows(2)
@@ -314,6 +364,15 @@ fn damping_lowers_the_overshoot_on_any_keystrokes() {
         dampings[dampings.len() - 1],
         spans[0],
         spans[spans.len() / 2],
+    );
+    swings.sort();
+    println!(
+        "settle swings at ζ {:.2} → {:.2}: median {:?}, fewer on {} of {} sequences",
+        dampings[0],
+        dampings[dampings.len() - 1],
+        swings[swings.len() / 2],
+        swings.iter().filter(|(a, b)| b < a).count(),
+        swings.len(),
     );
     println!("{} not strictly monotone:", failures.len());
     for f in failures.iter().take(12) {
