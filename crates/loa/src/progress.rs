@@ -39,7 +39,6 @@ pub(crate) struct Progress {
     natural: f64,
     speed: f64,
     damping: f64,
-    shape_damping: f64,
     window: f64,
 }
 
@@ -57,10 +56,9 @@ impl Progress {
             0.0
         };
         // The smallest raise that lands the swing: a smooth maximum with the extra damping.
-        // The shape's chain uses it (its overlap and anticipation keep their size); so do
-        // the speed and the window, which depend only on the documented range's ends.
+        // The speed and the window use it at the documented range's ends only.
         let smooth = |z: f64| (z.max(0.0).powi(4) + extra.powi(4)).powf(0.25);
-        // The progress uses the chord of `smooth` over the documented range (above it, the
+        // The damping used is the chord of `smooth` over the documented range (above it, the
         // range's ends shared): a smooth maximum flattens the slider's low end onto the extra
         // damping, the chord keeps every step of the slider visible in the swing.
         let top = *DAMPING_RANGE.end();
@@ -88,7 +86,6 @@ impl Progress {
             natural,
             speed,
             damping: effective(damping),
-            shape_damping: smooth(damping),
             window: latest / speed,
         }
     }
@@ -114,14 +111,6 @@ impl Progress {
     /// short for its swing).
     pub(crate) fn damping(&self) -> f64 {
         self.damping
-    }
-
-    /// The damping ratio for the interval's shape (the chain's swings orthogonal to the
-    /// change): the keystroke's, raised only as far as the interval needs (a smooth maximum
-    /// with the extra damping), so the overlap and anticipation keep their size; still
-    /// strictly increasing in the keystroke's damping.
-    pub(crate) fn shape_damping(&self) -> f64 {
-        self.shape_damping
     }
 
     /// Natural radians per frame.

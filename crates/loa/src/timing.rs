@@ -141,7 +141,7 @@ impl Interval<'_> {
         // The shape: the chain simulated on the progress's time scale, `Δ` removed.
         let rate = progress.time_scale().min(MAX_TIME_SCALE);
         let mut pose = from.clone();
-        pose.damping = progress.shape_damping();
+        pose.damping = progress.damping();
         let sim_velocity: Vec<f64> = velocity.iter().map(|v| v * options.fps / rate).collect();
         let sim_frames = (gap * rate).ceil() as u32 + 2;
         let sim = simulate(&pose, to.chain.angles(), &sim_velocity, sim_frames, options)?;

@@ -3,7 +3,8 @@
 //! varied lengths, orientations and spacing). Over the documented ranges
 //! ([`loa::STIFFNESS_RANGE`], [`loa::DAMPING_RANGE`]), on every sequence:
 //!
-//! * more damping → strictly less overshoot of the chain's angles past the next keystroke, by
+//! * more damping → strictly less overshoot of the chain's angles past the next keystroke (as
+//!   a whole and of any single angle past its own key-to-key range), by
 //!   at least [`MIN_DAMPING_STEP`] of it per step of the grid, and never more swings in the
 //!   settle (strictly fewer from the range's least damping to its most);
 //! * more stiffness → strictly earlier arrival on the next keystroke and a strictly higher
@@ -19,6 +20,8 @@
 //!   out (the random sequences below never hold; `tests/parameters.rs` covers holds).
 //! * **overshoot**: the largest progress − 1 over every interval's inner frames and, for the
 //!   last interval, the settle frames after it (measured against the last change).
+//! * **single-angle overshoot**: the largest excursion of one angle past its own key-to-key
+//!   range, over the interval's largest angle change (same frames as the overshoot).
 //! * **arrival**: the mean over the intervals of the fraction of the interval after which
 //!   the progress first reaches 0.9 (interpolated between frames).
 //! * **settle frequency**: after the last keystroke the line swings about it and comes to
@@ -179,6 +182,36 @@ fn overshoot(a: &Animation) -> f64 {
     worst
 }
 
+/// Largest excursion of any single angle past its own key-to-key range, over the largest
+/// angle change of the interval (every interval's inner frames and the settle after the last).
+fn angle_overshoot(a: &Animation) -> f64 {
+    let k = &a.keystroke_frames;
+    let end = a.frames.last().unwrap().frame;
+    let mut worst: f64 = 0.0;
+    for (i, w) in k.windows(2).enumerate() {
+        if change(a, w[0], w[1]) < MIN_CHANGE {
+            continue;
+        }
+        let (g0, g1) = (
+            a.chain_at(w[0]).unwrap().angles().to_vec(),
+            a.chain_at(w[1]).unwrap().angles().to_vec(),
+        );
+        let largest = g0
+            .iter()
+            .zip(&g1)
+            .map(|(x, y)| (y - x).abs())
+            .fold(0.0, f64::max);
+        let last = if i + 2 == k.len() { end } else { w[1] };
+        for f in w[0] + 1..last {
+            for ((x, a0), a1) in a.chain_at(f).unwrap().angles().iter().zip(&g0).zip(&g1) {
+                let past = (x - a0.max(*a1)).max(a0.min(*a1) - x).max(0.0);
+                worst = worst.max(past / largest);
+            }
+        }
+    }
+    worst
+}
+
 /// Mean over the intervals of the fraction of the interval after which the angles have
 /// covered 90 % of the change.
 fn arrival(a: &Animation) -> f64 {
@@ -315,6 +348,7 @@ fn damping_lowers_the_overshoot_on_any_keystrokes() {
     // Per sequence: the smallest drop of the overshoot from one damping to the next
     // (fraction of the less damped one's), and the ratio from the least to the most damped.
     let (mut steps, mut spans, mut swings) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut per_angle, mut angle_steps) = (Vec::new(), Vec::new());
     for (seed, keys) in sequences() {
         let k = grid(loa::STIFFNESS_RANGE, 4)[seed as usize % 4];
         let values: Vec<f64> = dampings
@@ -323,9 +357,19 @@ fn damping_lowers_the_overshoot_on_any_keystrokes() {
                 let line = run(&with(&keys, k, z), Mode::Physics, Settle::KeyInterval);
                 let j = max_jump(&line.animation);
                 worst_jump = worst_jump.max(j);
+                per_angle.push(angle_overshoot(&line.animation));
                 overshoot(&line.animation)
             })
             .collect();
+        let a = &per_angle[per_angle.len() - values.len()..];
+        if !a.windows(2).all(|w| w[1] < w[0]) {
+            failures.push(format!("seed {seed} k={k:.1}: single angles {a:.4?}"));
+        }
+        angle_steps.push(
+            a.windows(2)
+                .map(|w| 1.0 - w[1] / w[0])
+                .fold(f64::INFINITY, f64::min),
+        );
         if !values.windows(2).all(|w| w[1] < w[0]) {
             failures.push(format!("seed {seed} k={k:.1}: overshoot {values:.4?}"));
         }
@@ -373,6 +417,12 @@ fn damping_lowers_the_overshoot_on_any_keystrokes() {
         swings[swings.len() / 2],
         swings.iter().filter(|(a, b)| b < a).count(),
         swings.len(),
+    );
+    angle_steps.sort_by(f64::total_cmp);
+    println!(
+        "single angles: smallest drop per step least {:.4}, median {:.4}",
+        angle_steps[0],
+        angle_steps[angle_steps.len() / 2]
     );
     println!("{} not strictly monotone:", failures.len());
     for f in failures.iter().take(12) {
