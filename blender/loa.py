@@ -24,6 +24,10 @@ PRESETS = [
     ("CUSTOM", "Bones…", "A comma-separated list of bones along the line (e.g. FootR,Head)"),
 ]
 HIERARCHY = ("foot-head", "spine-head")  # presets that read no bone names
+# The documented slider ranges, defined once in the loa crate; a value outside is refused by
+# the core with a message naming the range (reported by the operator).
+STIFFNESS = _core.STIFFNESS_RANGE
+DAMPING = _core.DAMPING_RANGE
 
 MODES = [
     ("physics", "Physics", "An elastic chain re-targeted onto every keystroke (LoA Eqs. 1-2)"),
@@ -52,12 +56,13 @@ class LoaSettings(bpy.types.PropertyGroup):
                            description="Comma-separated bones (when the set is 'Bones…')")
     bone_keys: CollectionProperty(type=LoaBoneKey, name="Bone sets per frame")
     mode: EnumProperty(name="Line", items=MODES, default="physics")
-    stiffness: FloatProperty(name="Stiffness", default=0.0, min=0.0, max=100.0,
-                             description="Spring stiffness of every keystroke, 5 to 100 "
+    stiffness: FloatProperty(name="Stiffness", default=0.0, min=0.0, max=STIFFNESS[1],
+                             description="Spring stiffness of every keystroke, "
+                                         f"{STIFFNESS[0]:g} to {STIFFNESS[1]:g} "
                                          "(0: the default)")
-    damping: FloatProperty(name="Damping", default=0.0, min=0.0, max=0.5,
-                           description="Damping ratio of every keystroke, 0.05 to 0.5 "
-                                       "(0: the default)")
+    damping: FloatProperty(name="Damping", default=0.0, min=0.0, max=DAMPING[1],
+                           description="Damping ratio of every keystroke, "
+                                       f"{DAMPING[0]:g} to {DAMPING[1]:g} (0: the default)")
     line_width: FloatProperty(name="Line width", default=0.0, min=0.0, precision=4,
                               description="Bevel of the line curve; 0 = 0.5 % of the height")
 

@@ -417,6 +417,18 @@ def test_loa_errors():
     fails("RobotArmature: no joint named 'NoSuchBone'")
     bpy.ops.toonkit.loa_bone_key_remove(index=0)
     check(len(scene.toonkit_loa.bone_keys) == 0, "the bone set was not removed")
+    # Slider values: the hard limits are the core's ranges; a value below the documented
+    # range (the slider allows 0 = the default) is refused naming the range.
+    props = type(scene.toonkit_loa).bl_rna.properties
+    for name, rng in (("stiffness", toonkit.loa.STIFFNESS_RANGE),
+                      ("damping", toonkit.loa.DAMPING_RANGE)):
+        check(props[name].hard_max == rng[1], f"{name} slider max {props[name].hard_max}")
+    scene.toonkit_loa.stiffness = 2.0
+    fails("stiffness = 2 is outside the documented range [5, 100]")
+    scene.toonkit_loa.stiffness = 0.0
+    scene.toonkit_loa.damping = 0.01
+    fails("is outside the documented range [0.05, 0.5]")
+    scene.toonkit_loa.damping = 0.0
     scene.camera = None
     fails("no active camera")
 

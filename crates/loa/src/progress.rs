@@ -55,12 +55,20 @@ impl Progress {
         } else {
             0.0
         };
-        let effective = |z: f64| (z.max(0.0).powi(4) + extra.powi(4)).powf(0.25);
+        // The smallest raise that lands the swing: a smooth maximum with the extra damping.
+        // The speed and the window use it at the documented range's ends only.
+        let smooth = |z: f64| (z.max(0.0).powi(4) + extra.powi(4)).powf(0.25);
+        // The damping used is the chord of `smooth` over the documented range (above it, the
+        // range's ends shared): a smooth maximum flattens the slider's low end onto the extra
+        // damping, the chord keeps every step of the slider visible in the swing.
+        let top = *DAMPING_RANGE.end();
+        let effective = |z: f64| (extra + (smooth(top) - extra) * z.max(0.0) / top).max(smooth(z));
         // Natural time by which the most damped documented response has arrived.
-        let latest = first_arrival(effective(*DAMPING_RANGE.end()));
+        let latest = first_arrival(effective(top));
         let arrive = latest / (ARRIVAL_SHARE * gap);
+        // (`smooth` is below `effective`: its peak speed bounds the fastest response's.)
         let cap = if reach > 0.0 {
-            MAX_FRAME_MOTION / (reach * peak_speed(effective(*DAMPING_RANGE.start())))
+            MAX_FRAME_MOTION / (reach * peak_speed(smooth(*DAMPING_RANGE.start())))
         } else {
             f64::INFINITY
         };

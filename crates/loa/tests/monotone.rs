@@ -3,7 +3,10 @@
 //! varied lengths, orientations and spacing). Over the documented ranges
 //! ([`loa::STIFFNESS_RANGE`], [`loa::DAMPING_RANGE`]), on every sequence:
 //!
-//! * more damping → strictly less overshoot of the chain's angles past the next keystroke;
+//! * more damping → strictly less overshoot of the chain's angles past the next keystroke (as
+//!   a whole and of any single angle past its own key-to-key range), by
+//!   at least [`MIN_DAMPING_STEP`] of it per step of the grid, and never more swings in the
+//!   settle (strictly fewer from the range's least damping to its most);
 //! * more stiffness → strictly earlier arrival on the next keystroke and a strictly higher
 //!   settle frequency;
 //! * no chain point moves more than 15 % of the line's length in one frame.
@@ -17,6 +20,8 @@
 //!   out (the random sequences below never hold; `tests/parameters.rs` covers holds).
 //! * **overshoot**: the largest progress − 1 over every interval's inner frames and, for the
 //!   last interval, the settle frames after it (measured against the last change).
+//! * **single-angle overshoot**: the largest excursion of one angle past its own key-to-key
+//!   range, over the interval's largest angle change (same frames as the overshoot).
 //! * **arrival**: the mean over the intervals of the fraction of the interval after which
 //!   the progress first reaches 0.9 (interpolated between frames).
 //! * **settle frequency**: after the last keystroke the line swings about it and comes to
@@ -24,6 +29,8 @@
 //!   changes sign along the offset's first direction (interpolated between frames). A line
 //!   that reaches the last keystroke at rest has no settle to measure: such a sequence is
 //!   left out of this measure and counted (at least 200 must be measured).
+//! * **swings**: the settle's turning points (along the offset's first direction, over
+//!   [`SETTLE_FRAMES`]) that reach at least [`VISIBLE_SWING`] of its largest offset.
 //! * **jump**: the largest motion of any chain point between consecutive frames over the
 //!   line's length.
 //!
@@ -41,6 +48,11 @@ use loa::{Animation, Keystroke, Keystrokes, LineOptions, Mode, PhysicsOptions, S
 const SEQUENCES: u64 = 260;
 /// The per-frame motion promise, as a fraction of the line's length.
 const MAX_JUMP: f64 = 0.15;
+/// Least drop of the overshoot from one damping of the grid to the next, as a fraction of
+/// the less damped one's: every step of the slider is visible, not just ordered.
+const MIN_DAMPING_STEP: f64 = 0.04;
+/// A settle swing counts when it reaches this fraction of the settle's largest offset.
+const VISIBLE_SWING: f64 = 0.05;
 /// Smallest key-to-key change (radians, all angles) whose progress is measured.
 const MIN_CHANGE: f64 = 1e-6;
 /// Settle frames of the stiffness runs (10 s at 24 fps): more than half a period of the
@@ -170,6 +182,36 @@ fn overshoot(a: &Animation) -> f64 {
     worst
 }
 
+/// Largest excursion of any single angle past its own key-to-key range, over the largest
+/// angle change of the interval (every interval's inner frames and the settle after the last).
+fn angle_overshoot(a: &Animation) -> f64 {
+    let k = &a.keystroke_frames;
+    let end = a.frames.last().unwrap().frame;
+    let mut worst: f64 = 0.0;
+    for (i, w) in k.windows(2).enumerate() {
+        if change(a, w[0], w[1]) < MIN_CHANGE {
+            continue;
+        }
+        let (g0, g1) = (
+            a.chain_at(w[0]).unwrap().angles().to_vec(),
+            a.chain_at(w[1]).unwrap().angles().to_vec(),
+        );
+        let largest = g0
+            .iter()
+            .zip(&g1)
+            .map(|(x, y)| (y - x).abs())
+            .fold(0.0, f64::max);
+        let last = if i + 2 == k.len() { end } else { w[1] };
+        for f in w[0] + 1..last {
+            for ((x, a0), a1) in a.chain_at(f).unwrap().angles().iter().zip(&g0).zip(&g1) {
+                let past = (x - a0.max(*a1)).max(a0.min(*a1) - x).max(0.0);
+                worst = worst.max(past / largest);
+            }
+        }
+    }
+    worst
+}
+
 /// Mean over the intervals of the fraction of the interval after which the angles have
 /// covered 90 % of the change.
 fn arrival(a: &Animation) -> f64 {
@@ -206,6 +248,36 @@ fn change(a: &Animation, k0: i64, k1: i64) -> f64 {
         .map(|(x, y)| (x - y) * (x - y))
         .sum::<f64>()
         .sqrt()
+}
+
+/// Visible swings of the settle: see the module docs. 0 when the line does not move after
+/// the last keystroke.
+fn settle_swings(a: &Animation) -> usize {
+    let last = *a.keystroke_frames.last().unwrap();
+    let key = a.chain_at(last).unwrap().angles().to_vec();
+    let offsets: Vec<Vec<f64>> = (last + 1..)
+        .map_while(|f| a.chain_at(f))
+        .map(|c| c.angles().iter().zip(&key).map(|(x, y)| x - y).collect())
+        .collect();
+    let Some(first) = offsets.first() else {
+        return 0;
+    };
+    let norm = first.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if norm < 1e-9 {
+        return 0;
+    }
+    let q: Vec<f64> = offsets
+        .iter()
+        .map(|o| o.iter().zip(first).map(|(x, y)| x * y).sum::<f64>() / norm)
+        .collect();
+    let largest = q.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    q.windows(3)
+        .filter(|w| {
+            (w[1] - w[0]) * (w[2] - w[1]) <= 0.0
+                && w[1].abs() >= VISIBLE_SWING * largest
+                && w[1].abs() >= w[0].abs().max(w[2].abs())
+        })
+        .count()
 }
 
 /// Settle frequency (Hz): see the module docs. `None` when the line does not move after
@@ -273,6 +345,10 @@ fn damping_lowers_the_overshoot_on_any_keystrokes() {
     let dampings = grid(loa::DAMPING_RANGE, 6);
     let mut worst_jump: f64 = 0.0;
     let mut failures = Vec::new();
+    // Per sequence: the smallest drop of the overshoot from one damping to the next
+    // (fraction of the less damped one's), and the ratio from the least to the most damped.
+    let (mut steps, mut spans, mut swings) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut per_angle, mut angle_steps) = (Vec::new(), Vec::new());
     for (seed, keys) in sequences() {
         let k = grid(loa::STIFFNESS_RANGE, 4)[seed as usize % 4];
         let values: Vec<f64> = dampings
@@ -281,19 +357,79 @@ fn damping_lowers_the_overshoot_on_any_keystrokes() {
                 let line = run(&with(&keys, k, z), Mode::Physics, Settle::KeyInterval);
                 let j = max_jump(&line.animation);
                 worst_jump = worst_jump.max(j);
+                per_angle.push(angle_overshoot(&line.animation));
                 overshoot(&line.animation)
             })
             .collect();
+        let a = &per_angle[per_angle.len() - values.len()..];
+        if !a.windows(2).all(|w| w[1] < w[0]) {
+            failures.push(format!("seed {seed} k={k:.1}: single angles {a:.4?}"));
+        }
+        angle_steps.push(
+            a.windows(2)
+                .map(|w| 1.0 - w[1] / w[0])
+                .fold(f64::INFINITY, f64::min),
+        );
         if !values.windows(2).all(|w| w[1] < w[0]) {
             failures.push(format!("seed {seed} k={k:.1}: overshoot {values:.4?}"));
         }
+        let counts: Vec<usize> = dampings
+            .iter()
+            .map(|&z| {
+                let line = run(
+                    &with(&keys, k, z),
+                    Mode::Physics,
+                    Settle::Frames(SETTLE_FRAMES),
+                );
+                settle_swings(&line.animation)
+            })
+            .collect();
+        if !counts.windows(2).all(|w| w[1] <= w[0]) || counts[counts.len() - 1] >= counts[0] {
+            failures.push(format!("seed {seed} k={k:.1}: settle swings {counts:?}"));
+        }
+        swings.push((counts[0], counts[counts.len() - 1]));
+        steps.push(
+            values
+                .windows(2)
+                .map(|w| 1.0 - w[1] / w[0])
+                .fold(f64::INFINITY, f64::min),
+        );
+        spans.push(values[0] / values[values.len() - 1]);
     }
+    steps.sort_by(f64::total_cmp);
+    spans.sort_by(f64::total_cmp);
     println!("largest per-frame motion: {:.1} %", 100.0 * worst_jump);
+    println!(
+        "smallest drop of the overshoot per damping step: least {:.4}, median {:.4}; \
+         overshoot ratio ζ {:.2} / {:.2}: least {:.2}, median {:.2}",
+        steps[0],
+        steps[steps.len() / 2],
+        dampings[0],
+        dampings[dampings.len() - 1],
+        spans[0],
+        spans[spans.len() / 2],
+    );
+    swings.sort();
+    println!(
+        "settle swings at ζ {:.2} → {:.2}: median {:?}, fewer on {} of {} sequences",
+        dampings[0],
+        dampings[dampings.len() - 1],
+        swings[swings.len() / 2],
+        swings.iter().filter(|(a, b)| b < a).count(),
+        swings.len(),
+    );
+    angle_steps.sort_by(f64::total_cmp);
+    println!(
+        "single angles: smallest drop per step least {:.4}, median {:.4}",
+        angle_steps[0],
+        angle_steps[angle_steps.len() / 2]
+    );
     println!("{} not strictly monotone:", failures.len());
     for f in failures.iter().take(12) {
         println!("  {f}");
     }
     assert!(failures.is_empty());
+    assert!(steps[0] >= MIN_DAMPING_STEP, "{}", steps[0]);
     assert!(worst_jump <= MAX_JUMP, "{worst_jump}");
 }
 
@@ -302,6 +438,8 @@ fn stiffness_brings_the_arrival_earlier_and_the_settle_faster_on_any_keystrokes(
     let stiffnesses = grid(loa::STIFFNESS_RANGE, 6);
     let mut worst_jump: f64 = 0.0;
     let (mut failures, mut measured, mut unmeasured) = (Vec::new(), 0, 0);
+    // Per sequence: arrival at the softest over the stiffest, settle frequency stiffest over softest.
+    let (mut arrival_spans, mut hz_spans) = (Vec::new(), Vec::new());
     for (seed, keys) in sequences() {
         let z = grid(loa::DAMPING_RANGE, 4)[seed as usize % 4];
         let (mut arrivals, mut frequencies) = (Vec::new(), Vec::new());
@@ -318,9 +456,11 @@ fn stiffness_brings_the_arrival_earlier_and_the_settle_faster_on_any_keystrokes(
         if !arrivals.windows(2).all(|w| w[1] < w[0]) {
             failures.push(format!("seed {seed} ζ={z:.3}: arrival {arrivals:.4?}"));
         }
+        arrival_spans.push(arrivals[0] / arrivals[arrivals.len() - 1]);
         match frequencies.iter().copied().collect::<Option<Vec<f64>>>() {
             Some(hz) => {
                 measured += 1;
+                hz_spans.push(hz[hz.len() - 1] / hz[0]);
                 if !hz.windows(2).all(|w| w[1] > w[0]) {
                     failures.push(format!("seed {seed} ζ={z:.3}: settle Hz {hz:.4?}"));
                 }
@@ -330,6 +470,16 @@ fn stiffness_brings_the_arrival_earlier_and_the_settle_faster_on_any_keystrokes(
     }
     println!("largest per-frame motion: {:.1} %", 100.0 * worst_jump);
     println!("settle frequency measured on {measured} sequences ({unmeasured} without a settle)");
+    arrival_spans.sort_by(f64::total_cmp);
+    hz_spans.sort_by(f64::total_cmp);
+    println!(
+        "arrival ratio k 5 / 100: least {:.2}, median {:.2}; settle Hz ratio k 100 / 5: \
+         least {:.2}, median {:.2}",
+        arrival_spans[0],
+        arrival_spans[arrival_spans.len() / 2],
+        hz_spans[0],
+        hz_spans[hz_spans.len() / 2],
+    );
     println!("{} not strictly monotone:", failures.len());
     for f in failures.iter().take(12) {
         println!("  {f}");

@@ -494,3 +494,22 @@ async fn the_whole_clip_sent_as_changes_rebuilds_the_cores_body_exactly() {
         assert!(sent.len() < dense.len());
     }
 }
+
+#[tokio::test]
+async fn the_loa_view_gives_the_keystroke_ranges_and_defaults_of_the_loa_crate() {
+    let dir = tempfile::tempdir().unwrap();
+    let app = app(dir.path());
+    let (status, body) = send(&app, get("/api/loa/view?file=0")).await;
+    assert_eq!(status, StatusCode::OK, "{}", String::from_utf8_lossy(&body));
+    let view: Value = serde_json::from_slice(&body).unwrap();
+    for (name, range, default) in [
+        ("stiffness", loa::STIFFNESS_RANGE, loa::DEFAULT_STIFFNESS),
+        ("damping", loa::DAMPING_RANGE, loa::DEFAULT_DAMPING),
+    ] {
+        assert_eq!(
+            view[name],
+            json!({"range": [range.start(), range.end()], "default": default}),
+            "{name}"
+        );
+    }
+}

@@ -126,7 +126,7 @@ export class LoaPanel {
     const bones = $('loa-bones').value || undefined;
     const old = this.keys.find((k) => k.frame === frame);
     if (old) old.points = points;
-    else this.keys.push({ frame, points, stiffness: 60, damping: 0.35, bones });
+    else this.keys.push({ frame, points, stiffness: this.view.stiffness.default, damping: this.view.damping.default, bones });
     this.keys.sort((a, b) => a.frame - b.frame);
     this.table();
     return this.update(t0);
@@ -138,10 +138,12 @@ export class LoaPanel {
     this.keys.forEach((k, i) => {
       const row = document.createElement('tr');
       const cell = (html) => { const td = document.createElement('td'); td.innerHTML = html; row.appendChild(td); return td; };
-      const num = (v, step, set) => { const td = cell(`<input type="number" step="${step}" value="${v}">`); td.firstChild.addEventListener('change', (e) => { set(Number(e.target.value)); this.keys.sort((a, b) => a.frame - b.frame); this.table(); this.update(performance.now()); }); };
+      // The sliders' documented ranges come from the loa crate (/api/loa/view); the server
+      // refuses a typed value outside them, naming the range.
+      const num = (v, step, set, range) => { const lim = range ? ` min="${range[0]}" max="${range[1]}"` : ''; const td = cell(`<input type="number" step="${step}"${lim} value="${v}">`); td.firstChild.addEventListener('change', (e) => { set(Number(e.target.value)); this.keys.sort((a, b) => a.frame - b.frame); this.table(); this.update(performance.now()); }); };
       num(k.frame, 1, (v) => { k.frame = Math.round(v); });
-      num(k.stiffness, 5, (v) => { k.stiffness = v; });
-      num(k.damping, 0.05, (v) => { k.damping = v; });
+      num(k.stiffness, 5, (v) => { k.stiffness = v; }, this.view.stiffness.range);
+      num(k.damping, 0.05, (v) => { k.damping = v; }, this.view.damping.range);
       const sel = document.createElement('select');
       for (const o of $('loa-bones').options) sel.add(new Option(o.text, o.value));
       sel.value = k.bones || '';

@@ -52,8 +52,9 @@ fn camera(c: &Character) -> ActionCamera {
 }
 
 /// `GET /api/loa/view?file=`: the action camera (`center`, `right`, `up`, `forward`,
-/// `half_height`), the bone-set presets, the joints and the rest pose's mesh (buffers
-/// `triangles`, `positions`: one frame).
+/// `half_height`), the bone-set presets, the joints, the keystrokes' `stiffness` and
+/// `damping` (`{"range": [lo, hi], "default"}`, the loa crate's) and the rest pose's mesh
+/// (buffers `triangles`, `positions`: one frame).
 pub(crate) async fn view(
     State(studio): State<Arc<Studio>>,
     Query(q): Query<FileQuery>,
@@ -65,6 +66,14 @@ pub(crate) async fn view(
             "camera": camera(&c),
             "presets": presets,
             "joints": c.joint_names(),
+            "stiffness": {
+                "range": [loa::STIFFNESS_RANGE.start(), loa::STIFFNESS_RANGE.end()],
+                "default": loa::DEFAULT_STIFFNESS,
+            },
+            "damping": {
+                "range": [loa::DAMPING_RANGE.start(), loa::DAMPING_RANGE.end()],
+                "default": loa::DEFAULT_DAMPING,
+            },
         })))
     })
     .await
