@@ -9,6 +9,7 @@
 # Needs /usr/bin/time (Debian package `time`).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo build --release -p toonkit-cli
-exec cargo bench -p toonkit-stopmo --bench scale -- \
+# --workspace, as CI builds: `-p` resolves other features and rebuilds the dependencies.
+cargo build --release --workspace --bins
+exec cargo bench --workspace --bench scale -- \
     --out "$PWD/target/stopmo-scale" --toonkit "$PWD/target/release/toonkit" "$@"

@@ -252,16 +252,8 @@ pub(crate) fn library(
 ) -> PyResult<Library> {
     let seg = segmented.get();
     let opts: LibraryJobOptions = options("library", options_json)?;
-    let parts: Vec<anim::MeshAnimation> = seg
-        .segmented
-        .parts
-        .iter()
-        .map(|p| {
-            let mut a = p.animation.clone();
-            a.mesh.name = p.name.clone();
-            a
-        })
-        .collect();
+    // Borrowed: each part's mesh is named after the part (no copy of the frames).
+    let parts = seg.segmented.part_animations();
     report(py, progress.as_ref(), "library", 0.0)?;
     let result = py
         .detach(|| stopmo::library(&parts, &opts))

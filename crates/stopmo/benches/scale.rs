@@ -17,7 +17,7 @@
 //! energy and `peak_memory_mib` of its `report.json`. `--cases face20,table1` picks cases.
 //!
 //! Run: `scripts/bench_stopmo.sh` (builds the release CLI first), or
-//! `cargo bench -p toonkit-stopmo --bench scale -- --toonkit target/release/toonkit`.
+//! `cargo bench --workspace --bench scale -- --toonkit target/release/toonkit`.
 //! Without `--toonkit` only the inputs are written (to `--out DIR`, default
 //! `target/stopmo-scale`; existing inputs are kept).
 

@@ -122,3 +122,18 @@ fn speech_face_is_seeded_and_solves() {
         );
     }
 }
+
+/// The library job borrows its parts: references to parts held elsewhere (a segmentation's,
+/// a session's) give the library of the parts themselves, with no copy of their frames.
+#[test]
+fn borrowed_parts_give_the_library_of_owned_parts() {
+    let anim = round_trip(&speech_face(&face_scene(), 90, 30.0, 3));
+    let owned = stopmo::library(std::slice::from_ref(&anim), &options(4)).expect("owned");
+    let borrowed = stopmo::library(&[&anim], &options(4)).expect("borrowed");
+    assert_eq!(borrowed.library.parts, owned.library.parts);
+    assert_eq!(borrowed.report.energy, owned.report.energy);
+    assert_eq!(
+        stopmo::library_memory(&[&anim]).total(),
+        stopmo::library_memory(std::slice::from_ref(&anim)).total()
+    );
+}

@@ -1,6 +1,7 @@
 //! The library job: size rule → StopShop Eq. 10 libraries and labels → printable pieces,
 //! assembly, shooting order, reconstruction, report; and `run` (segment, then library).
 
+use std::borrow::Borrow;
 use std::time::Instant;
 
 use anim::MeshAnimation;
@@ -43,18 +44,23 @@ pub fn file_safe_name(name: &str) -> String {
 
 /// Builds the replacement library of `parts` (one animation per part, named by its mesh
 /// name) and everything needed to print and shoot it (StopShop Sections 3.3–3.4, 5): the
-/// whole job of `toonkit stopmo library`.
+/// whole job of `toonkit stopmo library`. The parts are borrowed, owned or behind
+/// references (`&[MeshAnimation]` or `&[&MeshAnimation]`): the job never copies their
+/// frames.
 ///
 /// # Errors
 /// [`Error::Option`] for an invalid size rule, thickness, saliency or fixed pieces (see
 /// [`Error::option`]); the optimization's and fabrication's own errors
 /// ([`Error::Library`]).
-pub fn library(parts: &[MeshAnimation], opts: &LibraryJobOptions) -> Result<LibraryResult> {
+pub fn library<A: Borrow<MeshAnimation>>(
+    parts: &[A],
+    opts: &LibraryJobOptions,
+) -> Result<LibraryResult> {
     library_memory(parts)
         .check(MEMORY_HINT)
         .map_err(anim::AnimError::from)?;
-    let refs: Vec<&MeshAnimation> = parts.iter().collect();
-    let names: Vec<String> = parts.iter().map(|a| a.mesh.name.clone()).collect();
+    let refs: Vec<&MeshAnimation> = parts.iter().map(Borrow::borrow).collect();
+    let names: Vec<String> = refs.iter().map(|a| a.mesh.name.clone()).collect();
     build(&refs, &names, opts, None)
 }
 
@@ -69,9 +75,9 @@ const MEMORY_HINT: &str = "lower --fps or pick a shorter clip";
 
 /// What building a library of `parts` will hold ([`library`] checks it before the solver
 /// allocates; a server reserves it): [`LIBRARY_COPIES`] copies of the parts' frames.
-pub fn library_memory(parts: &[MeshAnimation]) -> anim::budget::JobMemory {
-    let frames = parts.first().map_or(0, MeshAnimation::frame_count);
-    let vertices = parts.iter().map(MeshAnimation::vertex_count).sum();
+pub fn library_memory<A: Borrow<MeshAnimation>>(parts: &[A]) -> anim::budget::JobMemory {
+    let frames = parts.first().map_or(0, |a| a.borrow().frame_count());
+    let vertices = parts.iter().map(|a| a.borrow().vertex_count()).sum();
     memory(frames, vertices, LIBRARY_COPIES)
 }
 

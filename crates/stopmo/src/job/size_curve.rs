@@ -5,6 +5,7 @@
 //! once per size and keeps the solved libraries, so [`library_of`] only prints and plans
 //! the chosen one (the second half of [`library`](crate::library())), never solving again.
 
+use std::borrow::Borrow;
 use std::time::Instant;
 
 use anim::MeshAnimation;
@@ -60,8 +61,8 @@ impl SizeCurve {
 /// # Errors
 /// [`Error::Option`] for no size or a size of 0; the options' and the optimization's
 /// errors as for [`library`](crate::library()) (e.g. more pieces than frames).
-pub fn size_curve(
-    parts: &[MeshAnimation],
+pub fn size_curve<A: Borrow<MeshAnimation>>(
+    parts: &[A],
     opts: &LibraryJobOptions,
     sizes: &[usize],
     on_point: &mut dyn FnMut(usize, usize) -> bool,
@@ -75,8 +76,8 @@ pub fn size_curve(
             "give one or more library sizes of at least 1 piece per part",
         ));
     }
-    let anims: Vec<&MeshAnimation> = parts.iter().collect();
-    let names: Vec<String> = parts.iter().map(|a| a.mesh.name.clone()).collect();
+    let anims: Vec<&MeshAnimation> = parts.iter().map(Borrow::borrow).collect();
+    let names: Vec<String> = anims.iter().map(|a| a.mesh.name.clone()).collect();
     let mut curve = SizeCurve {
         points: Vec::new(),
         libraries: Vec::new(),
@@ -111,16 +112,16 @@ pub fn size_curve(
 /// # Errors
 /// [`Error::Option`] when `solved` is not a library of `parts` (other part names, vertex
 /// or frame counts); fabrication errors as for [`library`](crate::library()).
-pub fn library_of(
-    parts: &[MeshAnimation],
+pub fn library_of<A: Borrow<MeshAnimation>>(
+    parts: &[A],
     opts: &LibraryJobOptions,
     solved: &Library,
 ) -> Result<LibraryResult> {
     let start = Instant::now();
-    let anims: Vec<&MeshAnimation> = parts.iter().collect();
-    let names: Vec<String> = parts.iter().map(|a| a.mesh.name.clone()).collect();
-    let matches = solved.parts.len() == parts.len()
-        && solved.parts.iter().zip(parts).all(|(p, a)| {
+    let anims: Vec<&MeshAnimation> = parts.iter().map(Borrow::borrow).collect();
+    let names: Vec<String> = anims.iter().map(|a| a.mesh.name.clone()).collect();
+    let matches = solved.parts.len() == anims.len()
+        && solved.parts.iter().zip(&anims).all(|(p, a)| {
             p.name == a.mesh.name
                 && p.vertices == a.vertex_count()
                 && p.solution.labels.len() == a.frame_count()

@@ -256,7 +256,7 @@ fn run(
             opts.lambda,
             d,
         );
-        lib = solve_pieces(&a, &b, d, q, nf, prob.fixed_coords())?;
+        lib = solve_pieces(&a, b, d, q, nf, prob.fixed_coords())?;
         iterations += 1;
         prev.copy_from_slice(&labels);
         let e = label(prob, &lib, d, opts.lambda, par, &mut buf, &mut labels);
@@ -313,7 +313,7 @@ fn finish(
     };
     let a = system_matrix(&labels, &prob.chains, lambda, d);
     let b = right_hand_side(&positions, &labels, &prob.chains, lambda, d);
-    let flat = solve_pieces(&a, &b, d, 3 * m, nf, &prob.fixed_rows)?;
+    let flat = solve_pieces(&a, b, d, 3 * m, nf, &prob.fixed_rows)?;
     let pieces = flat
         .chunks_exact(3 * m)
         .map(|r| {

@@ -165,20 +165,20 @@ pub(crate) fn right_hand_side<R: FrameRows>(
 /// * `fixed_rows` — row-major `fixed × cols` values of the fixed pieces (indices `0..fixed`).
 ///
 /// # Returns
-/// All `d` pieces, row-major `d × cols` (fixed ones copied).
+/// All `d` pieces, row-major `d × cols` (fixed ones copied), written over `b`: the step
+/// holds the right-hand side and the solver's copy of it, never a third `d × cols` buffer.
 pub(crate) fn solve_pieces(
     a: &[f64],
-    b: &[f64],
+    mut b: Vec<f64>,
     d: usize,
     cols: usize,
     fixed: usize,
     fixed_rows: &[f64],
 ) -> Result<Vec<f64>> {
     let nf = d - fixed;
-    let mut out = vec![0.0; d * cols];
-    out[..fixed * cols].copy_from_slice(&fixed_rows[..fixed * cols]);
     if nf == 0 {
-        return Ok(out);
+        b[..fixed * cols].copy_from_slice(&fixed_rows[..fixed * cols]);
+        return Ok(b);
     }
     let aff = Mat::<f64>::from_fn(nf, nf, |i, j| a[(i + fixed) * d + j + fixed]);
     let llt = aff
@@ -198,13 +198,15 @@ pub(crate) fn solve_pieces(
         }
     }
     llt.solve_in_place(rhs.as_mut());
+    let out = &mut b;
+    out[..fixed * cols].copy_from_slice(&fixed_rows[..fixed * cols]);
     for i in 0..nf {
         let row = &mut out[(i + fixed) * cols..(i + fixed + 1) * cols];
         for (c, o) in row.iter_mut().enumerate() {
             *o = rhs[(i, c)];
         }
     }
-    Ok(out)
+    Ok(b)
 }
 
 #[cfg(test)]
@@ -235,7 +237,7 @@ mod tests {
         for lambda in [0.0, 2.0, 7.5] {
             let a = system_matrix(&labels, &chains, lambda, 3);
             let b = right_hand_side(&Dense { data: &x, cols: 1 }, &labels, &chains, lambda, 3);
-            let r = solve_pieces(&a, &b, 3, 1, 0, &[]).unwrap();
+            let r = solve_pieces(&a, b, 3, 1, 0, &[]).unwrap();
             let e0 = energy(&x, &r, &labels, &chains, lambda);
             // Any perturbation of the solution raises the energy (the minimum is unique).
             for k in 0..3 {
@@ -253,7 +255,7 @@ mod tests {
         // λ = 0: pieces are the means of their frames (Lloyd's step).
         let a = system_matrix(&labels, &chains, 0.0, 3);
         let b = right_hand_side(&Dense { data: &x, cols: 1 }, &labels, &chains, 0.0, 3);
-        let r = solve_pieces(&a, &b, 3, 1, 0, &[]).unwrap();
+        let r = solve_pieces(&a, b, 3, 1, 0, &[]).unwrap();
         assert!((r[0] - (0.0 + 0.3 + 0.1) / 3.0).abs() < 1e-12, "{r:?}");
     }
 
@@ -264,7 +266,7 @@ mod tests {
         let chains = std::iter::once(0..5).collect::<Vec<_>>();
         let a = system_matrix(&labels, &chains, 2.0, 2);
         let b = right_hand_side(&Dense { data: &x, cols: 1 }, &labels, &chains, 2.0, 2);
-        let r = solve_pieces(&a, &b, 2, 1, 1, &[5.0]).unwrap();
+        let r = solve_pieces(&a, b, 2, 1, 1, &[5.0]).unwrap();
         assert_eq!(r[0], 5.0);
         let e0 = energy(&x, &r, &labels, &chains, 2.0);
         for eps in [-1e-3, 1e-3] {
