@@ -1,0 +1,115 @@
+//! The scene-level job's outputs, written through `tkio` (atomically, never over a file the
+//! job read): the motion as `.glb` or `.bvh`, a preview as `.gif` or `.png`.
+
+use std::path::Path;
+
+use tkio::Format;
+
+use super::{SceneJobError, SceneMotion};
+
+/// The formats a motion is written as: the character with the clip (`.glb`) or the skeleton
+/// and motion (`.bvh`), in the order messages list them.
+pub const MOTION_FORMATS: [Format; 2] = [Format::Glb, Format::Bvh];
+
+/// The extensions of a motion preview: every frame (`gif`) or the first (`png`).
+pub const PREVIEW_EXTENSIONS: [&str; 2] = ["gif", "png"];
+
+/// The motion format of `path` (by extension), checked before any work; `what` names the
+/// output in the message (`output`, `--bvh`).
+///
+/// # Errors
+/// [`SceneJobError::Extension`] for any other extension.
+pub fn check_motion_path(
+    path: &Path,
+    what: &'static str,
+    formats: &[Format],
+) -> Result<Format, SceneJobError> {
+    Format::from_extension(path)
+        .filter(|f| formats.contains(f))
+        .ok_or_else(|| SceneJobError::Extension {
+            path: path.to_path_buf(),
+            what,
+            expected: Format::list(formats),
+        })
+}
+
+/// Whether the preview at `path` is a GIF (else a PNG), checked before any work.
+///
+/// # Errors
+/// [`SceneJobError::Extension`] for another extension.
+pub fn check_preview_path(path: &Path) -> Result<bool, SceneJobError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    if PREVIEW_EXTENSIONS.contains(&ext.as_str()) {
+        return Ok(ext == "gif");
+    }
+    let dotted: Vec<String> = PREVIEW_EXTENSIONS.iter().map(|e| format!(".{e}")).collect();
+    Err(SceneJobError::Extension {
+        path: path.to_path_buf(),
+        what: "render",
+        expected: dotted.join(" or "),
+    })
+}
+
+impl SceneMotion {
+    /// The skeleton and motion as BVH text.
+    ///
+    /// # Errors
+    /// [`SceneJobError::Animate`] when the motion does not fit the skeleton,
+    /// [`SceneJobError::Write`] when BVH cannot hold it.
+    pub fn bvh(&self) -> Result<String, SceneJobError> {
+        let skeletal = self
+            .motion
+            .skeletal_animation(&self.skeleton)
+            .map_err(SceneJobError::Animate)?;
+        tkio::bvh::write(&self.skeleton, &skeletal).map_err(SceneJobError::Write)
+    }
+
+    /// The character with the motion's clip as binary glTF.
+    ///
+    /// # Errors
+    /// [`SceneJobError::Write`] when glTF cannot hold the scene.
+    pub fn glb(&self) -> Result<Vec<u8>, SceneJobError> {
+        tkio::gltf::write_glb(&self.scene).map_err(SceneJobError::Write)
+    }
+
+    /// Writes the motion as `.glb` (the character with the clip) or `.bvh`, by `path`'s
+    /// extension, atomically.
+    ///
+    /// # Errors
+    /// [`SceneJobError::Extension`] for another extension, else as [`SceneMotion::bvh`],
+    /// [`SceneMotion::glb`] and the write.
+    pub fn save(&self, path: &Path) -> Result<(), SceneJobError> {
+        let saved = match check_motion_path(path, "output", &MOTION_FORMATS)? {
+            Format::Bvh => tkio::save(path, &tkio::Output::Text(&self.bvh()?)),
+            _ => tkio::save(path, &tkio::Output::Bytes(&self.glb()?)),
+        };
+        saved.map(|_| ()).map_err(SceneJobError::Write)
+    }
+
+    /// Writes a preview of the character with the line, in a view that follows the character
+    /// (or through the options' scene camera): `.gif` (every frame) or `.png` (the first).
+    ///
+    /// # Errors
+    /// [`SceneJobError::Extension`], [`SceneJobError::Preview`], or the write.
+    pub fn save_preview(&self, path: &Path) -> Result<(), SceneJobError> {
+        let gif = check_preview_path(path)?;
+        let bytes = crate::preview::motion_preview(
+            &self.scene,
+            &self.motion,
+            &self.skeleton,
+            self.camera.as_ref(),
+            gif,
+        )
+        .map_err(|source| SceneJobError::Preview {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        tkio::save(path, &tkio::Output::Bytes(&bytes))
+            .map(|_| ())
+            .map_err(SceneJobError::Write)
+    }
+}
