@@ -103,7 +103,7 @@ fn scene_job_refuses_unknown_outputs_and_files_without_a_character() {
     let err = done
         .save_preview(&dir.path().join("motion.mp4"))
         .unwrap_err();
-    assert!(err.to_string().contains("use .gif or .png"), "{err}");
+    assert!(err.to_string().contains("use .png or .gif"), "{err}");
 
     let err = job::open_character(&data("meshes/spot.obj"), 24.0).unwrap_err();
     assert!(matches!(err, SceneJobError::NotACharacter(_)), "{err}");

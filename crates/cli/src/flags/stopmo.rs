@@ -252,7 +252,7 @@ pub(crate) struct LibraryOptionsArgs {
     #[arg(long, value_name = "stl|3mf|stl,3mf", default_value = "stl")]
     pub(crate) print_format: String,
     /// Build plate WIDTHxDEPTH in millimetres where library.3mf lays the pieces out.
-    #[arg(long, value_name = "WxD", default_value = "120x68")]
+    #[arg(long, value_name = "WxD", default_value_t = plate_spec(::stopmo::DEFAULT_PLATE_MM))]
     pub(crate) plate: String,
     /// The printer's thinnest wall in millimetres: thinner walls of a piece or mount are
     /// reported (a warning naming the pieces and the fix, report.json
@@ -416,6 +416,11 @@ impl LibraryOptionsArgs {
     }
 }
 
+/// A plate as `--plate` writes it: `WxD` in millimetres.
+fn plate_spec([w, d]: [f64; 2]) -> String {
+    format!("{w}x{d}")
+}
+
 /// Parses `--plate`: `WxD` in millimetres, each in [`::stopmo::PLATE_SIDE_RANGE_MM`].
 fn parse_plate(spec: &str) -> Result<[f64; 2]> {
     let r = ::stopmo::PLATE_SIDE_RANGE_MM;
@@ -426,9 +431,10 @@ fn parse_plate(spec: &str) -> Result<[f64; 2]> {
     match parsed {
         Some(p) if p.iter().all(|v| v.is_finite() && r.contains(v)) => Ok(p),
         _ => bail!(
-            "--plate {spec}: expected WIDTHxDEPTH in millimetres ({} to {} each), e.g. 120x68",
+            "--plate {spec}: expected WIDTHxDEPTH in millimetres ({} to {} each), e.g. {}",
             r.start(),
-            r.end()
+            r.end(),
+            plate_spec(::stopmo::DEFAULT_PLATE_MM)
         ),
     }
 }

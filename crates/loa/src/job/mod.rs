@@ -9,7 +9,7 @@
 //! * [`SceneMotion`]: the line, the [`Motion`](crate::animate::Motion), the character scene
 //!   holding the clip [`CLIP_NAME`](crate::animate::CLIP_NAME), its [`SceneReport`];
 //!   [`SceneMotion::save`] writes `.glb` or `.bvh` ([`MOTION_FORMATS`]) and
-//!   [`SceneMotion::save_preview`] a `.gif` or `.png` ([`PREVIEW_EXTENSIONS`]).
+//!   [`SceneMotion::save_preview`] a `.png` or `.gif` (`render::OutputFormat`).
 
 mod error;
 mod options;
@@ -19,6 +19,8 @@ mod run;
 
 pub use error::SceneJobError;
 pub use options::SceneOptions;
-pub use output::{check_motion_path, check_preview_path, MOTION_FORMATS, PREVIEW_EXTENSIONS};
+pub use output::{
+    check_line_path, check_motion_path, check_preview_path, LINE_TEXT_EXTENSIONS, MOTION_FORMATS,
+};
 pub use report::{SceneReport, WorstPercent};
 pub use run::{animate_line, animate_scene, open_character, SceneMotion};

@@ -1,5 +1,6 @@
 //! The scene-level job's outputs, written through `tkio` (atomically, never over a file the
-//! job read): the motion as `.glb` or `.bvh`, a preview as `.gif` or `.png`.
+//! job read): the motion as `.glb` or `.bvh`, a preview as `.png` or `.gif`; and the
+//! extension checks of every loa output (`loa line`'s too), made before any work.
 
 use std::path::Path;
 
@@ -11,11 +12,12 @@ use super::{SceneJobError, SceneMotion};
 /// and motion (`.bvh`), in the order messages list them.
 pub const MOTION_FORMATS: [Format; 2] = [Format::Glb, Format::Bvh];
 
-/// The extensions of a motion preview: every frame (`gif`) or the first (`png`).
-pub const PREVIEW_EXTENSIONS: [&str; 2] = ["gif", "png"];
+/// The outputs of a line (`loa line`) besides the images ([`render::OutputFormat`]): its
+/// frames as JSON, its onion skin as SVG.
+pub const LINE_TEXT_EXTENSIONS: [&str; 2] = ["json", "svg"];
 
-/// The motion format of `path` (by extension), checked before any work; `what` names the
-/// output in the message (`output`, `--bvh`).
+/// The motion format of `path` (by extension) among `formats`, checked before any work;
+/// `what` names the output in the message (`output`, `--bvh`).
 ///
 /// # Errors
 /// [`SceneJobError::Extension`] for any other extension.
@@ -33,24 +35,48 @@ pub fn check_motion_path(
         })
 }
 
-/// Whether the preview at `path` is a GIF (else a PNG), checked before any work.
+/// Whether the preview at `path` is a GIF (else a PNG, the first frame), checked before any
+/// work.
 ///
 /// # Errors
 /// [`SceneJobError::Extension`] for another extension.
 pub fn check_preview_path(path: &Path) -> Result<bool, SceneJobError> {
+    match render::OutputFormat::from_extension(path) {
+        Some(format) => Ok(format == render::OutputFormat::Gif),
+        None => Err(SceneJobError::Extension {
+            path: path.to_path_buf(),
+            what: "render",
+            expected: render::OutputFormat::list(),
+        }),
+    }
+}
+
+/// The extension of a line output `path` (`json`, `svg`, `png` or `gif`, lower case),
+/// checked before any work.
+///
+/// # Errors
+/// [`SceneJobError::Extension`] for another extension.
+pub fn check_line_path(path: &Path) -> Result<String, SceneJobError> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
         .unwrap_or_default();
-    if PREVIEW_EXTENSIONS.contains(&ext.as_str()) {
-        return Ok(ext == "gif");
+    let known = LINE_TEXT_EXTENSIONS
+        .iter()
+        .chain(&render::OutputFormat::EXTENSIONS);
+    if known.clone().any(|e| *e == ext) {
+        return Ok(ext);
     }
-    let dotted: Vec<String> = PREVIEW_EXTENSIONS.iter().map(|e| format!(".{e}")).collect();
+    let dotted: Vec<String> = known.map(|e| format!(".{e}")).collect();
+    let expected = match dotted.split_last() {
+        Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+        None => String::new(),
+    };
     Err(SceneJobError::Extension {
         path: path.to_path_buf(),
-        what: "render",
-        expected: dotted.join(" or "),
+        what: "output",
+        expected,
     })
 }
 
