@@ -119,9 +119,11 @@ pub(crate) fn open_error(e: job::SceneJobError) -> PyErr {
 }
 
 /// The native half of `toonkit.loa.animate`: bone sets, contacts and twists as the CLI's
-/// `--bones`, `--contact`, `--twist` strings; the other `AnimateOptions` as JSON.
+/// `--bones`, `--contact`, `--twist` strings; the other `AnimateOptions` as JSON; `canvas`
+/// the `(width, height)` in pixels of a canvas the keystrokes were drawn on through the
+/// default camera (as the studio's page draws them).
 #[pyfunction(name = "loa_animate")]
-#[pyo3(signature = (character, line, bones, contacts, twists, pose, options_json, progress=None))]
+#[pyo3(signature = (character, line, bones, contacts, twists, pose, options_json, progress=None, canvas=None))]
 pub(crate) fn animate(
     py: Python<'_>,
     character: CharacterArg<'_>,
@@ -132,6 +134,7 @@ pub(crate) fn animate(
     pose: &str,
     options_json: &str,
     progress: Option<Py<PyAny>>,
+    canvas: Option<[f64; 2]>,
 ) -> PyResult<Motion> {
     let mut options: AnimateOptions = serde_json::from_str(options_json)
         .map_err(|e| value_error(format!("animate options: {e}")))?;
@@ -182,6 +185,7 @@ pub(crate) fn animate(
     let options = job::SceneOptions {
         motion: options,
         pose,
+        canvas,
         ..Default::default()
     };
     report(py, progress.as_ref(), "animate", 0.0)?;
