@@ -27,14 +27,6 @@ pub(crate) fn write_animation(
     )?)
 }
 
-/// The lower-case extension of `path` ("" when it has none).
-pub(crate) fn extension(path: &Path) -> String {
-    path.extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .unwrap_or_default()
-}
-
 /// What a write produced, for the summary line: "out.obj", or "out_0001.obj … out_0048.obj
 /// (48 files)" for a sequence.
 pub(crate) fn files(written: &[PathBuf]) -> String {

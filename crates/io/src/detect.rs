@@ -48,6 +48,21 @@ impl Format {
         Format::Abc,
     ];
 
+    /// The formats a deforming mesh (a point cache, a flipbook) is written as by
+    /// [`save`](crate::save), in the order messages list them.
+    pub const MESH_ANIMATIONS: [Format; 10] = [
+        Format::Glb,
+        Format::Usda,
+        Format::Usdc,
+        Format::Usdz,
+        Format::Abc,
+        Format::Pc2,
+        Format::Mdd,
+        Format::Obj,
+        Format::Stl,
+        Format::Npy,
+    ];
+
     /// Whether the format is one of [`Format::SCENES`].
     pub fn holds_scenes(self) -> bool {
         Format::SCENES.contains(&self)
@@ -337,5 +352,9 @@ mod tests {
             assert!(f.holds_scenes());
         }
         assert!(!Format::Obj.holds_scenes());
+        assert_eq!(
+            Format::list(&Format::MESH_ANIMATIONS),
+            ".glb, .usda, .usdc, .usdz, .abc, .pc2, .mdd, .obj, .stl or .npy"
+        );
     }
 }

@@ -15,6 +15,7 @@
 mod atomic;
 mod error;
 mod inputs;
+mod layout;
 mod save;
 mod shapes;
 
@@ -38,6 +39,7 @@ pub use atomic::{
 };
 pub use error::{describe_io, FilePath, IoError, Result};
 pub use inputs::{check_not_input, note_read, same_file, ReadScope};
+pub use layout::{save_files, FileData, OutputFile};
 pub use save::{save, save_with, Layout, Output, SaveOptions};
 pub use shapes::ShapeAnimation;
 

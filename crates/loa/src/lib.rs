@@ -12,7 +12,11 @@
 //!   Options: [`AnimateOptions`](animate::AnimateOptions). [`Motion::to_scene`](animate::Motion::to_scene)
 //!   puts the motion back into the character's scene for writing.
 //!
-//! The crate is pure computation: it never touches files.
+//! * [`job`] — the scene-level job every front end calls: a character scene and keystrokes
+//!   → line → motion → the character holding the motion, saved as `.glb`/`.bvh` through
+//!   `tkio` ([`job::animate_scene`], options [`job::SceneOptions`]).
+//!
+//! The crate computes on in-memory data; only [`job`] reads and writes files, through `tkio`.
 //!
 //! # Paper map
 //!
@@ -162,6 +166,7 @@ mod dynamics;
 mod error;
 mod fit;
 mod hermite;
+pub mod job;
 mod keypose;
 mod keystroke;
 mod linalg;

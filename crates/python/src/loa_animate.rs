@@ -4,7 +4,8 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use loa::animate::{AnimateOptions, Character, ContactKey, InitialPose, Motion as LoaMotion};
+use loa::animate::{AnimateOptions, ContactKey, InitialPose};
+use loa::job::{self, SceneMotion};
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -25,9 +26,7 @@ pub(crate) enum CharacterArg<'py> {
 /// Joint motion synthesized from a line of action.
 #[pyclass(module = "toonkit.loa", name = "Motion", frozen)]
 pub(crate) struct Motion {
-    motion: LoaMotion,
-    scene: Arc<anim::Scene>,
-    joint_names: Vec<String>,
+    done: SceneMotion,
     source: String,
     /// The character file read (when given by path): no save of the motion may replace it.
     _inputs: Option<tkio::ReadScope>,
@@ -39,7 +38,7 @@ impl Motion {
     /// ``(x, y, z, w)``.
     #[getter]
     fn rotations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let m = &self.motion;
+        let m = &self.done.motion;
         let data = m.rotations.iter().flat_map(|q| q.to_array()).collect();
         output(py, &[m.frames(), m.joints, 4], data)
     }
@@ -47,7 +46,7 @@ impl Motion {
     /// float64 ``(frames, joints, 3)``: world position of every joint per frame.
     #[getter]
     fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let m = &self.motion;
+        let m = &self.done.motion;
         let data = m.positions.iter().flat_map(|p| p.to_array()).collect();
         output(py, &[m.frames(), m.joints, 3], data)
     }
@@ -55,26 +54,26 @@ impl Motion {
     /// Joint names, in the order of the arrays' joint axis.
     #[getter]
     fn joint_names(&self) -> Vec<String> {
-        self.joint_names.clone()
+        self.done.joint_names.clone()
     }
 
     /// Frames per second (the line's).
     #[getter]
     fn fps(&self) -> f64 {
-        self.motion.fps
+        self.done.motion.fps
     }
 
     /// Frame number of the first frame (the first keystroke).
     #[getter]
     fn first_frame(&self) -> i64 {
-        self.motion.first_frame
+        self.done.motion.first_frame
     }
 
     /// Measurements: distance to the line (fraction of its length), largest rotation step,
     /// contact error, body height.
     #[getter]
     fn report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let r = &self.motion.report;
+        let r = &self.done.motion.report;
         let d = PyDict::new(py);
         d.set_item("line_distance_mean", r.line_distance_mean)?;
         d.set_item("line_distance_p95", r.line_distance_p95)?;
@@ -94,33 +93,8 @@ impl Motion {
     /// Writes the character with the synthesized clip as ``.glb`` or the motion as ``.bvh``,
     /// as ``toonkit loa animate`` does, atomically. Returns the path.
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<PathBuf> {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        let p = path.clone();
-        let named = |e: &dyn std::fmt::Display| toonkit_error(at(&p.display().to_string(), e));
-        let result = py.detach(|| -> Result<(), String> {
-            match ext.as_deref() {
-                Some("bvh") => {
-                    let (skeleton, _) = self.scene.skeleton();
-                    let skeletal = self
-                        .motion
-                        .skeletal_animation(&skeleton)
-                        .map_err(|e| e.to_string())?;
-                    let text = tkio::bvh::write(&skeleton, &skeletal).map_err(|e| e.to_string())?;
-                    tkio::save(&p, &tkio::Output::Text(&text)).map_err(|e| e.to_string())?;
-                }
-                Some("glb") => {
-                    let out = self.motion.to_scene(&self.scene);
-                    let bytes = tkio::gltf::write_glb(&out).map_err(|e| e.to_string())?;
-                    tkio::save(&p, &tkio::Output::Bytes(&bytes)).map_err(|e| e.to_string())?;
-                }
-                _ => return Err("a motion is saved as .glb or .bvh".to_string()),
-            }
-            Ok(())
-        });
-        result.map_err(|e| named(&e))?;
+        py.detach(|| self.done.save(&path))
+            .map_err(|e| toonkit_error(e.to_string()))?;
         Ok(path)
     }
 
@@ -128,17 +102,28 @@ impl Motion {
         format!(
             "<toonkit.loa.Motion {}: {} frames × {} joints at {} fps>",
             self.source,
-            self.motion.frames(),
-            self.motion.joints,
-            self.motion.fps
+            self.done.motion.frames(),
+            self.done.motion.joints,
+            self.done.motion.fps
         )
     }
 }
 
+/// A character file that cannot be read (`FileNotFoundError` / `ToonkitError`) or holds no
+/// character (`ValueError`).
+pub(crate) fn open_error(e: job::SceneJobError) -> PyErr {
+    match e {
+        job::SceneJobError::Read(e) => io_error(e),
+        e => value_error(e.to_string()),
+    }
+}
+
 /// The native half of `toonkit.loa.animate`: bone sets, contacts and twists as the CLI's
-/// `--bones`, `--contact`, `--twist` strings; the other `AnimateOptions` as JSON.
+/// `--bones`, `--contact`, `--twist` strings; the other `AnimateOptions` as JSON; `canvas`
+/// the `(width, height)` in pixels of a canvas the keystrokes were drawn on through the
+/// default camera (as the studio's page draws them).
 #[pyfunction(name = "loa_animate")]
-#[pyo3(signature = (character, line, bones, contacts, twists, pose, options_json, progress=None))]
+#[pyo3(signature = (character, line, bones, contacts, twists, pose, options_json, progress=None, canvas=None))]
 pub(crate) fn animate(
     py: Python<'_>,
     character: CharacterArg<'_>,
@@ -149,6 +134,7 @@ pub(crate) fn animate(
     pose: &str,
     options_json: &str,
     progress: Option<Py<PyAny>>,
+    canvas: Option<[f64; 2]>,
 ) -> PyResult<Motion> {
     let mut options: AnimateOptions = serde_json::from_str(options_json)
         .map_err(|e| value_error(format!("animate options: {e}")))?;
@@ -186,38 +172,29 @@ pub(crate) fn animate(
             (scene, s.source.clone())
         }
         CharacterArg::Path(path) => {
-            let load = tkio::LoadOptions {
-                fps: fps as f32,
-                ..Default::default()
-            };
             let source = path.display().to_string();
             let read = tkio::ReadScope::open();
-            let loaded = py.detach(|| tkio::load(&path, &load)).map_err(io_error)?;
+            let scene = py
+                .detach(|| job::open_character(&path, fps))
+                .map_err(open_error)?;
             read.freeze();
             inputs = Some(read);
-            match loaded {
-                tkio::Loaded::Scene(scene) => (Arc::from(scene), source),
-                _ => {
-                    return Err(value_error(format!(
-                        "{source}: not a character (use a skinned glTF/GLB or a BVH file)"
-                    )))
-                }
-            }
+            (Arc::new(scene), source)
         }
     };
+    let options = job::SceneOptions {
+        motion: options,
+        pose,
+        canvas,
+        ..Default::default()
+    };
     report(py, progress.as_ref(), "animate", 0.0)?;
-    let motion = py
-        .detach(|| {
-            let character = Character::from_scene(&scene, &pose, fps)?;
-            let names = character.joint_names().to_vec();
-            loa::animate(&character, &line.line, &options).map(|m| (m, names))
-        })
+    let done = py
+        .detach(|| job::animate_line(&scene, line.line.clone(), &options))
         .map_err(|e| value_error(at(&source, e)))?;
     report(py, progress.as_ref(), "animate", 1.0)?;
     Ok(Motion {
-        motion: motion.0,
-        joint_names: motion.1,
-        scene,
+        done,
         source,
         _inputs: inputs,
     })

@@ -92,16 +92,9 @@ pub(crate) fn bone_chain(
     let set: loa::animate::BoneSet = bones.parse().map_err(bad)?;
     let pose: loa::animate::InitialPose = pose.parse().map_err(bad)?;
     let fps = f64::from(anim::DEFAULT_FPS);
-    let load = tkio::LoadOptions {
-        fps: fps as f32,
-        ..Default::default()
-    };
-    let loaded = py.detach(|| tkio::load(&path, &load)).map_err(io_error)?;
-    let tkio::Loaded::Scene(scene) = loaded else {
-        return Err(value_error(format!(
-            "{source}: not a character (use a skinned glTF/GLB or a BVH file)"
-        )));
-    };
+    let scene = py
+        .detach(|| loa::job::open_character(&path, fps))
+        .map_err(crate::loa_animate::open_error)?;
     let character = loa::animate::Character::from_scene(&scene, &pose, fps).map_err(bad)?;
     let chain = character.bone_chain(&set).map_err(bad)?;
     Ok(chain

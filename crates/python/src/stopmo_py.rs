@@ -186,7 +186,7 @@ impl Library {
             .result
             .files()
             .map_err(|e| toonkit_error(at(&self.source, e)))?;
-        py.detach(|| stopmo::save_files(&dir, &files))
+        py.detach(|| tkio::save_files(&dir, &files))
             .map_err(io_error)?;
         Ok(files.into_iter().map(|f| f.path).collect())
     }

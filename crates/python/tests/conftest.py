@@ -9,7 +9,9 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
+import urllib.request
 from pathlib import Path
 
 import numpy as np
@@ -87,3 +89,42 @@ def read_pc2(path: Path) -> np.ndarray:
 def robot() -> toonkit.Scene:
     """RobotExpressive's Dance clip at 24 fps."""
     return toonkit.load(asset(ROBOT), clip="Dance")
+
+
+# The files a test studio serves, by index: the two bundled characters the agreement tests use.
+STUDIO_FILES = ["characters/CesiumMan.glb", ROBOT]
+
+
+@pytest.fixture(scope="session")
+def studio(tmp_path_factory):
+    """`toonkit studio` on `STUDIO_FILES`, on a free port: (url, output folder)."""
+    out = tmp_path_factory.mktemp("studio-out")
+    files = [asset(rel) for rel in STUDIO_FILES]
+    server = subprocess.Popen([str(CLI), "studio", *map(str, files), "--port", "0", "--no-open",
+                               "--out", str(out)], stdout=subprocess.PIPE, text=True, cwd=REPO)
+    try:
+        line = server.stdout.readline()
+        match = re.search(r"http://127\.0\.0\.1:(\d+)/", line)
+        assert match, f"the studio did not start: {line!r}"
+        yield f"http://127.0.0.1:{match.group(1)}", out
+    finally:
+        server.terminate()
+        server.wait(timeout=30)
+
+
+def studio_post(url: str, route: str, body: dict) -> bytes:
+    """POSTs `body` as JSON to the studio's `route`, as the page does; the answer's bytes."""
+    request = urllib.request.Request(url + route, data=json.dumps(body).encode(),
+                                     headers={"Content-Type": "application/json"})
+    with urllib.request.urlopen(request, timeout=300) as answer:
+        return answer.read()
+
+
+def studio_unpack(data: bytes):
+    """The studio's binary answer (crates/studio/src/pack.rs): JSON header, then buffers."""
+    size = int.from_bytes(data[:4], "little")
+    header = json.loads(data[4:4 + size])
+    start = 4 + size
+    return header, {b["name"]: np.frombuffer(data, "<f4" if b["type"] == "f32" else "<u4",
+                                             b["count"], start + b["offset"])
+                    for b in header["buffers"]}

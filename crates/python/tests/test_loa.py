@@ -1,4 +1,5 @@
-"""toonkit.loa against `toonkit loa line` on the examples' keystrokes."""
+"""toonkit.loa against `toonkit loa line` / `loa animate` and the studio's loa panel on the
+examples' keystrokes: all of them call the loa crate's one scene-level job."""
 
 import json
 import re
@@ -83,6 +84,44 @@ def test_animate_equals_cli_bvh(robot, tmp_path):
                                 bones=["right-leg-spine-head@0", "left-leg-spine-head@22"],
                                 contacts="FootL@0..3", twists=["Torso_1@22:20"])
     np.testing.assert_array_equal(again.rotations, motion.rotations)
+
+
+# Two bundled characters and a bone set each finds (the robot's names, CesiumMan's hierarchy).
+LOA_CHARACTERS = {
+    "robot": ("characters/RobotExpressive.glb", "right-leg-spine-head"),
+    "cesium": ("characters/CesiumMan.glb", "foot-head"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(LOA_CHARACTERS))
+def test_the_loa_job_gives_the_same_files_through_the_cli_python_and_the_studio(
+        name, studio, tmp_path):
+    from conftest import STUDIO_FILES, asset, studio_post, studio_unpack
+
+    rel, preset = LOA_CHARACTERS[name]
+    keys, fps = keystrokes("jump.json")
+    line = toonkit.loa.line(keys, fps=fps)
+    bones = f"{preset}@{keys[0]['frame']}"
+    run_cli("loa", "animate", asset(rel), example("loa/jump.json"), "-o", tmp_path / "cli.glb",
+            "--bvh", tmp_path / "cli.bvh", "--bones", bones)
+    motion = toonkit.loa.animate(asset(rel), line, bones=[bones])
+    assert motion.save(tmp_path / "py.bvh").read_text() == (tmp_path / "cli.bvh").read_text()
+    assert motion.save(tmp_path / "py.glb").read_bytes() == (tmp_path / "cli.glb").read_bytes()
+    # The studio's page: the same keystrokes drawn on a canvas, then its export.
+    url, out = studio
+    width, height = 800.0, 600.0
+    page = [{"frame": k["frame"], "points": np.asarray(k["points"]).tolist(),
+             **{o: k[o] for o in ("stiffness", "damping") if o in k}} for k in keys]
+    page[0]["bones"] = preset
+    header, _ = studio_unpack(studio_post(url, "/api/loa/animate", {
+        "file": STUDIO_FILES.index(rel), "keystrokes": page, "width": width, "height": height,
+        "fps": fps, "frame": 0}))
+    studio_post(url, "/api/loa/export", {"name": f"{name}.bvh"})
+    drawn = toonkit.loa.animate(asset(rel), line, bones=[bones], canvas=(width, height))
+    assert header["motion"]["frames"] == len(line.frames)
+    assert drawn.save(tmp_path / "drawn.bvh").read_text() == (out / f"{name}.bvh").read_text()
+    # The canvas is a different screen map from the CLI's fitted one: a different motion.
+    assert not np.array_equal(drawn.rotations, motion.rotations)
 
 
 def test_animate_bad_input(robot):

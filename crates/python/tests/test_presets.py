@@ -11,17 +11,14 @@ bone-parented parts as the file does (Bone Dir: Temperance; with the default the
 from __future__ import annotations
 
 import inspect
-import json
 import re
-import subprocess
-import urllib.request
 
 import numpy as np
 import pytest
 
 import toonkit
 
-from conftest import CLI, REPO, asset, read_pc2, run_cli
+from conftest import STUDIO_FILES, asset, read_pc2, run_cli, studio_post, studio_unpack
 
 CHARACTERS = {
     "robot": ("characters/RobotExpressive.glb", "Wave"),
@@ -42,40 +39,6 @@ def character(request):
     return request.param, scene, toonkit.smear.prepare(scene)
 
 
-@pytest.fixture(scope="module")
-def studio(tmp_path_factory):
-    """`toonkit studio` on both characters (file 0 the robot, 1 CesiumMan), on a free port."""
-    out = tmp_path_factory.mktemp("studio-out")
-    files = [asset(CHARACTERS[name][0]) for name in sorted(CHARACTERS)]
-    server = subprocess.Popen([str(CLI), "studio", *map(str, files), "--port", "0", "--no-open",
-                               "--out", str(out)], stdout=subprocess.PIPE, text=True, cwd=REPO)
-    try:
-        line = server.stdout.readline()
-        match = re.search(r"http://127\.0\.0\.1:(\d+)/", line)
-        assert match, f"the studio did not start: {line!r}"
-        yield f"http://127.0.0.1:{match.group(1)}", out
-    finally:
-        server.terminate()
-        server.wait(timeout=30)
-
-
-def _post(url, route, body):
-    request = urllib.request.Request(url + route, data=json.dumps(body).encode(),
-                                     headers={"Content-Type": "application/json"})
-    with urllib.request.urlopen(request, timeout=300) as answer:
-        return answer.read()
-
-
-def _unpack(data):
-    """The studio's binary answer (crates/studio/src/pack.rs): JSON header, then buffers."""
-    size = int.from_bytes(data[:4], "little")
-    header = json.loads(data[4:4 + size])
-    start = 4 + size
-    return header, {b["name"]: np.frombuffer(data, "<f4" if b["type"] == "f32" else "<u4",
-                                             b["count"], start + b["offset"])
-                    for b in header["buffers"]}
-
-
 @pytest.mark.parametrize("preset", PRESETS)
 def test_every_preset_gives_the_clis_bytes(character, preset, studio, tmp_path):
     name, scene, prepared = character
@@ -92,11 +55,11 @@ def test_every_preset_gives_the_clis_bytes(character, preset, studio, tmp_path):
     assert look.save(tmp_path / "py.glb").read_bytes() == styled.read_bytes()
     # The studio's API: the page's request (stylize) and its export.
     url, out = studio
-    request = {"file": sorted(CHARACTERS).index(name), "clip": CHARACTERS[name][1] or "",
+    request = {"file": STUDIO_FILES.index(CHARACTERS[name][0]), "clip": CHARACTERS[name][1] or "",
                "style": style}
-    _, buffers = _unpack(_post(url, "/api/smear/stylize", request))
+    _, buffers = studio_unpack(studio_post(url, "/api/smear/stylize", request))
     np.testing.assert_array_equal(buffers["body"].reshape(look.elongated.shape), look.elongated)
-    _post(url, "/api/smear/export", {**request, "name": f"{name}-{preset}.glb"})
+    studio_post(url, "/api/smear/export", {**request, "name": f"{name}-{preset}.glb"})
     assert (out / f"{name}-{preset}.glb").read_bytes() == styled.read_bytes()
     diag = float(np.linalg.norm(np.ptp(scene.positions[0], axis=0)))
     assert np.abs(look.elongated - scene.positions).max() > 1e-3 * diag  # it did elongate

@@ -50,6 +50,16 @@ pub fn parse_size(s: &str) -> Option<(u32, u32)> {
 }
 
 impl OutputFormat {
+    /// The extensions of image outputs ([`OutputFormat::from_extension`]), in the order
+    /// messages list them.
+    pub const EXTENSIONS: [&'static str; 2] = ["png", "gif"];
+
+    /// The image extensions as a message lists them: ".png or .gif".
+    pub fn list() -> String {
+        let dotted: Vec<String> = Self::EXTENSIONS.iter().map(|e| format!(".{e}")).collect();
+        dotted.join(" or ")
+    }
+
     /// The format of a `.png` or `.gif` file (any case).
     pub fn from_extension(path: &Path) -> Option<OutputFormat> {
         let ext = path.extension()?.to_str()?.to_ascii_lowercase();

@@ -427,3 +427,27 @@ fn a_surface_that_presses_through_itself_is_reported_with_advice() {
         0
     );
 }
+
+#[test]
+fn a_pieces_folder_gives_each_part_its_pieces_and_back_by_name() {
+    let names = vec!["upper".to_string(), "upper_lip".to_string()];
+    let mesh = |x: f32| anim::Mesh {
+        positions: vec![Vec3::splat(x)],
+        ..anim::Mesh::default()
+    };
+    let files = vec![
+        ("upper_01".to_string(), mesh(1.0)),
+        ("upper_02".to_string(), mesh(2.0)),
+        ("upper_back".to_string(), mesh(3.0)),
+        ("upper_lip_01".to_string(), mesh(4.0)),
+        ("upper_x1".to_string(), mesh(5.0)),
+    ];
+    assert!(stopmo::is_library_piece("upper_lip_01", &names));
+    assert!(!stopmo::is_library_piece("upper_x1", &names));
+    assert!(!stopmo::is_library_piece("lower_01", &names));
+    let (fixed, backs) = stopmo::library_pieces(&names, files);
+    assert_eq!(fixed["upper"].len(), 2);
+    assert_eq!(fixed["upper_lip"], vec![vec![Vec3::splat(4.0)]]);
+    assert_eq!(backs["upper"], vec![Vec3::splat(3.0)]);
+    assert!(!backs.contains_key("upper_lip"));
+}

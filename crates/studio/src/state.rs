@@ -23,12 +23,9 @@ pub struct LoaSession {
     pub keys: loa::Keystrokes,
     /// The keystrokes in `loa line`'s JSON layout (as exported).
     pub keys_json: String,
-    /// The line (LoA Section 3).
-    pub line: loa::Line,
-    /// The character with the synthesized clip (LoA Section 4).
-    pub scene: anim::Scene,
-    /// The synthesized joint motion.
-    pub motion: loa::animate::Motion,
+    /// The line (LoA Section 3), the joint motion and the character with the synthesized
+    /// clip (LoA Section 4).
+    pub done: loa::job::SceneMotion,
     /// The character's meshes merged, every motion frame (`GET /api/loa/motion`), shared
     /// with the answers that send it.
     pub merged: Arc<anim::MeshAnimation>,

@@ -74,8 +74,9 @@ impl PreviewFlags {
     pub(crate) fn check(&self, output: &Path) -> Result<CheckedPreview, String> {
         let Some(format) = OutputFormat::from_extension(output) else {
             return Err(format!(
-                "{}: unknown output extension (use .png or .gif)",
-                output.display()
+                "{}: unknown output extension (use {})",
+                output.display(),
+                OutputFormat::list()
             ));
         };
         let view = (self.view.parse()).map_err(|e| format!("--view {}: {e}", self.view))?;

@@ -252,7 +252,7 @@ pub(crate) struct LibraryOptionsArgs {
     #[arg(long, value_name = "stl|3mf|stl,3mf", default_value = "stl")]
     pub(crate) print_format: String,
     /// Build plate WIDTHxDEPTH in millimetres where library.3mf lays the pieces out.
-    #[arg(long, value_name = "WxD", default_value = "120x68")]
+    #[arg(long, value_name = "WxD", default_value_t = plate_spec(::stopmo::DEFAULT_PLATE_MM))]
     pub(crate) plate: String,
     /// The printer's thinnest wall in millimetres: thinner walls of a piece or mount are
     /// reported (a warning naming the pieces and the fix, report.json
@@ -302,18 +302,10 @@ impl LibraryOptionsArgs {
     pub(crate) fn options(&self, names: &[String]) -> Result<LibraryJobOptions> {
         let pieces = match (&self.pieces, self.max_error, self.budget) {
             (Some(p), _, _) => parse_pieces(p)?,
-            (None, Some(e), _) => {
-                if !(e.is_finite() && e > 0.0) {
-                    bail!("--max-error must be a positive number of millimetres, got {e}");
-                }
-                PieceCount::MaxErrorMm(e)
-            }
+            (None, Some(e), _) => PieceCount::MaxErrorMm(e),
             (None, None, Some(b)) => PieceCount::Budget(b),
             (None, None, None) => PieceCount::default(),
         };
-        if !(self.thickness.is_finite() && self.thickness > 0.0) {
-            bail!("--thickness must be a positive number of millimetres");
-        }
         if let Some(c) = self.clearance {
             let r = ::stopmo::CLEARANCE_RANGE_MM;
             if !(c.is_finite() && r.contains(&c)) {
@@ -352,14 +344,19 @@ impl LibraryOptionsArgs {
             }
         }
         let saliency = match &self.saliency {
-            Some(p) => Some(read_saliency(p)?),
+            Some(p) => Some(tkio::npy::read_per_vertex(p)?),
             None => None,
         };
         let (fixed, backs) = match &self.fixed {
-            Some(dir) => (read_fixed(dir, names)?, read_backs(dir, names)?),
+            Some(dir) => {
+                let files =
+                    tkio::obj::read_folder(dir, |stem| ::stopmo::is_library_piece(stem, names))
+                        .with_context(|| format!("--fixed {}", dir.display()))?;
+                ::stopmo::library_pieces(names, files)
+            }
             None => (BTreeMap::new(), BTreeMap::new()),
         };
-        Ok(LibraryJobOptions {
+        let options = LibraryJobOptions {
             pieces,
             method: self.method.into(),
             solve: SolveOptions {
@@ -393,7 +390,19 @@ impl LibraryOptionsArgs {
             min_wall_mm: self.min_wall,
             min_feature_mm: self.min_feature,
             print: !self.no_print,
-        })
+        };
+        // The core's checks of the lengths, before the job reads its input.
+        options.check_lengths().map_err(|e| {
+            let flag = match e.option() {
+                Some("max_error_mm") => format!("--max-error {}", self.max_error.unwrap_or(0.0)),
+                _ => format!("--thickness {}", self.thickness),
+            };
+            FlagError::At {
+                at: flag,
+                source: Box::new(e),
+            }
+        })?;
+        Ok(options)
     }
 
     /// Names the file or option a library error is about: `--saliency FILE`, `--fixed DIR`,
@@ -416,6 +425,11 @@ impl LibraryOptionsArgs {
     }
 }
 
+/// A plate as `--plate` writes it: `WxD` in millimetres.
+fn plate_spec([w, d]: [f64; 2]) -> String {
+    format!("{w}x{d}")
+}
+
 /// Parses `--plate`: `WxD` in millimetres, each in [`::stopmo::PLATE_SIDE_RANGE_MM`].
 fn parse_plate(spec: &str) -> Result<[f64; 2]> {
     let r = ::stopmo::PLATE_SIDE_RANGE_MM;
@@ -426,9 +440,10 @@ fn parse_plate(spec: &str) -> Result<[f64; 2]> {
     match parsed {
         Some(p) if p.iter().all(|v| v.is_finite() && r.contains(v)) => Ok(p),
         _ => bail!(
-            "--plate {spec}: expected WIDTHxDEPTH in millimetres ({} to {} each), e.g. 120x68",
+            "--plate {spec}: expected WIDTHxDEPTH in millimetres ({} to {} each), e.g. {}",
             r.start(),
-            r.end()
+            r.end(),
+            plate_spec(::stopmo::DEFAULT_PLATE_MM)
         ),
     }
 }
@@ -451,62 +466,4 @@ fn parse_pieces(spec: &str) -> Result<PieceCount> {
         sizes.insert(name.trim().to_string(), n);
     }
     Ok(PieceCount::PerPart(sizes))
-}
-
-/// The saliency weights of a float32 `.npy` of shape (vertices,) or (1, vertices).
-fn read_saliency(path: &Path) -> Result<Vec<f32>> {
-    let bytes = tkio::read_file(path)?;
-    let (shape, values) = tkio::npy::read_f32(&bytes).map_err(|e| e.at(path))?;
-    if !matches!(shape.as_slice(), [_] | [1, _]) {
-        bail!(
-            "{}: saliency shape {shape:?}, expected (vertices,) or (1, vertices) (one weight per vertex)",
-            path.display()
-        );
-    }
-    Ok(values)
-}
-
-/// The fixed pieces `<part>_<NN>.obj` in `dir` of every part in `names`, in file-name order.
-fn read_fixed(dir: &Path, names: &[String]) -> Result<BTreeMap<String, Vec<Vec<Vec3>>>> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .with_context(|| format!("--fixed {}", dir.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "obj"))
-        .collect();
-    files.sort();
-    let mut out = BTreeMap::new();
-    for name in names {
-        let prefix = format!("{name}_");
-        let pieces = files
-            .iter()
-            .filter(|p| {
-                p.file_stem().and_then(|s| s.to_str()).is_some_and(|s| {
-                    s.strip_prefix(&prefix)
-                        .is_some_and(|n| !n.is_empty() && n.chars().all(|c| c.is_ascii_digit()))
-                })
-            })
-            .map(|f| {
-                Ok(tkio::obj::read(&tkio::read_file(f)?)
-                    .map_err(|e| e.at(f))?
-                    .positions)
-            })
-            .collect::<Result<Vec<_>>>()?;
-        if !pieces.is_empty() {
-            out.insert(name.clone(), pieces);
-        }
-    }
-    Ok(out)
-}
-
-/// The printed back surfaces `<part>_back.obj` in `dir` of the parts in `names` (those present).
-fn read_backs(dir: &Path, names: &[String]) -> Result<BTreeMap<String, Vec<Vec3>>> {
-    let mut out = BTreeMap::new();
-    for name in names {
-        let f = dir.join(format!("{name}_back.obj"));
-        if f.is_file() {
-            let mesh = tkio::obj::read(&tkio::read_file(&f)?).map_err(|e| e.at(&f))?;
-            out.insert(name.clone(), mesh.positions);
-        }
-    }
-    Ok(out)
 }

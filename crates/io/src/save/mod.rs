@@ -334,9 +334,10 @@ pub fn save_with(path: &Path, output: &Output<'_>, options: SaveOptions) -> Resu
 /// The format of an output path, or an error naming the extensions toonkit writes.
 fn output_format(path: &Path) -> Result<Format> {
     Format::from_extension(path).ok_or_else(|| {
-        IoError::unsupported(
-            "unknown output extension (use .glb, .usda, .usdc, .usdz, .abc, .pc2, .mdd, .obj, .stl or .npy)",
-        )
+        IoError::unsupported(format!(
+            "unknown output extension (use {})",
+            Format::list(&Format::MESH_ANIMATIONS)
+        ))
         .at(path)
     })
 }

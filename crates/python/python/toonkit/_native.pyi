@@ -1,7 +1,7 @@
 """Type stubs of the compiled core (import ``toonkit`` instead)."""
 
 import os
-from typing import Any, Callable, Mapping, Optional, Sequence, Union
+from typing import Any, Callable, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -179,6 +179,7 @@ def loa_animate(
     pose: str,
     options_json: str,
     progress: Optional[Callable[[str, float], Any]] = None,
+    canvas: Optional[Tuple[float, float]] = None,
 ) -> Motion: ...
 
 class Segmented:

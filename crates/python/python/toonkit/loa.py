@@ -13,7 +13,7 @@ Example::
 from __future__ import annotations
 
 import json
-from typing import Any, Callable, Iterable, Mapping, Optional, Union
+from typing import Any, Callable, Iterable, Mapping, Optional, Tuple, Union
 
 import numpy as np
 
@@ -160,6 +160,7 @@ def animate(
     twists: Union[str, Iterable[str], None] = None,
     pose: str = "rest",
     progress: Optional[Callable[[str, float], None]] = None,
+    canvas: Optional[Tuple[float, float]] = None,
     **options: Any,
 ) -> Motion:
     """3D character motion that follows a line of action (LoA Section 4 and 4.1).
@@ -167,7 +168,9 @@ def animate(
     ``character`` is a skinned glTF/GLB or BVH file (path, or a :class:`toonkit.Scene` loaded
     from one). ``bones``, ``contacts`` and ``twists`` are written as the CLI's ``--bones``,
     ``--contact`` and ``--twist`` values (``"right-leg-spine-head@0"``, ``"FootL@0..3"``,
-    ``"Torso_1@22:20"``); ``pose`` is ``"rest"`` or ``"CLIP@FRAME"``. Other ``options`` are
+    ``"Torso_1@22:20"``); ``pose`` is ``"rest"`` or ``"CLIP@FRAME"``. ``canvas`` is the
+    ``(width, height)`` in pixels of a canvas the keystrokes were drawn on through the default
+    front camera (y down), as the studio's page draws them. Other ``options`` are
     fields of the loa crate's ``AnimateOptions`` (``plane_normal``, ``weights``,
     ``max_iterations``). Returns a :class:`Motion` with per-frame joint ``.rotations``
     ``(frames, joints, 4)``, ``.positions``, ``.report`` and ``.save(path)`` (``.glb``/``.bvh``).
@@ -189,4 +192,5 @@ def animate(
         str(pose),
         json.dumps(options),
         progress,
+        None if canvas is None else (float(canvas[0]), float(canvas[1])),
     )

@@ -1,6 +1,6 @@
 """Dynamic lines of action (SBIM 2015) (type stubs)."""
 
-from typing import Any, Callable, Iterable, Mapping, Optional, Union
+from typing import Any, Callable, Iterable, Mapping, Optional, Tuple, Union
 
 import os
 
@@ -25,6 +25,7 @@ def animate(
     twists: Union[str, Iterable[str], None] = None,
     pose: str = "rest",
     progress: Optional[Callable[[str, float], Any]] = None,
+    canvas: Optional[Tuple[float, float]] = None,
     **options: Any,
 ) -> Motion: ...
 def bone_chain(

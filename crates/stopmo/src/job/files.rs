@@ -1,47 +1,11 @@
-//! The output layout of a library (SPEC "Output layouts"), as relative paths and data, and
-//! [`save_files`], the one mapping of that data to [`tkio::save`] every front end uses.
-
-use std::borrow::Cow;
-use std::path::{Path, PathBuf};
+//! The output layout of a library (SPEC "Output layouts"), as relative paths and data
+//! ([`OutputFile`]); [`tkio::save_files`] writes them (stopmo does no file work itself).
 
 use anim::{Mesh, MeshAnimation};
+use tkio::{FileData, OutputFile};
 
 use super::error::{Error, Result};
 use super::result::LibraryResult;
-
-/// What one output file holds; the path's extension says which format it is written in.
-#[derive(Debug, Clone)]
-pub enum FileData<'a> {
-    /// Text written as is (CSV, JSON, Markdown).
-    Text(String),
-    /// Bytes written as is (an encoded PNG).
-    Bytes(Vec<u8>),
-    /// One static mesh (`.obj` surface or `.stl` solid).
-    Mesh(&'a Mesh),
-    /// Several animations with the same frames, one node per part (`.glb`, morph targets).
-    Parts(Vec<&'a MeshAnimation>),
-    /// One point cache (`.pc2`).
-    PointCache(Cow<'a, MeshAnimation>),
-    /// Parts showing one of their pieces per frame (`.glb` with the pieces as morph
-    /// targets, or `.pc2` merged in part order and streamed, `rest` beside it as `.obj`).
-    Shapes {
-        /// The parts.
-        parts: Vec<tkio::ShapeAnimation<'a>>,
-        /// The merged rest mesh.
-        rest: Mesh,
-    },
-    /// A rest mesh that is not borrowed from the result (`.obj`).
-    OwnedMesh(Mesh),
-}
-
-/// One file of the layout: a path relative to the output directory and its data.
-#[derive(Debug, Clone)]
-pub struct OutputFile<'a> {
-    /// Relative path with `/` separators (`pieces/upper_03.stl`, `report.json`, …).
-    pub path: String,
-    /// The data.
-    pub data: FileData<'a>,
-}
 
 impl LibraryResult {
     /// Every file of the output layout: `pieces/<part>_<NN>.obj` and `.stl` (no `.stl` when
@@ -177,50 +141,6 @@ impl LibraryResult {
             }
         })
     }
-}
-
-impl FileData<'_> {
-    /// Writes the data to `path` with [`tkio::save`] (the format follows the extension;
-    /// parts as one morph-target glTF) and returns every file written.
-    ///
-    /// # Errors
-    /// [`tkio::IoError`] naming the file.
-    pub fn save(&self, path: &Path) -> tkio::Result<Vec<PathBuf>> {
-        let layers: Vec<(&MeshAnimation, Option<&[[f32; 4]]>)>;
-        let output = match self {
-            FileData::Text(t) => tkio::Output::Text(t),
-            FileData::Bytes(b) => tkio::Output::Bytes(b),
-            FileData::Mesh(m) => tkio::Output::Mesh(m),
-            FileData::OwnedMesh(m) => tkio::Output::Mesh(m),
-            FileData::PointCache(a) => tkio::Output::Animation {
-                animation: a,
-                layout: tkio::Layout::default(),
-                colors: None,
-            },
-            FileData::Shapes { parts, rest } => tkio::Output::Shapes { parts, rest },
-            FileData::Parts(parts) => {
-                layers = parts.iter().map(|a| (*a, None)).collect();
-                tkio::Output::Parts {
-                    parts: &layers,
-                    layout: tkio::Layout::Morph,
-                }
-            }
-        };
-        tkio::save(path, &output)
-    }
-}
-
-/// Writes every file of a layout under `dir` (in parallel) and returns the files written.
-///
-/// # Errors
-/// The first [`tkio::IoError`], naming its file.
-pub fn save_files(dir: &Path, files: &[OutputFile<'_>]) -> tkio::Result<Vec<PathBuf>> {
-    use rayon::prelude::*;
-    let written: Vec<Vec<PathBuf>> = files
-        .par_iter()
-        .map(|f| f.data.save(&dir.join(&f.path)))
-        .collect::<tkio::Result<_>>()?;
-    Ok(written.into_iter().flatten().collect())
 }
 
 fn file(path: impl Into<String>, data: FileData<'_>) -> OutputFile<'_> {

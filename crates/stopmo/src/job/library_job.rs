@@ -228,12 +228,7 @@ fn library_size(
             LibrarySize::PerPart(names.iter().map(|n| sizes[n]).collect())
         }
         PieceCount::MaxErrorMm(e) => {
-            if !(e.is_finite() && *e > 0.0) {
-                return Err(Error::option_error(
-                    "max_error_mm",
-                    format!("must be a positive number of millimetres, got {e}"),
-                ));
-            }
+            super::check_positive_mm("max_error_mm", *e)?;
             LibrarySize::MaxError(e / print_scale(anims, opts.print_height_mm))
         }
         PieceCount::Budget(b) => LibrarySize::Budget(*b),
@@ -310,12 +305,7 @@ pub(super) fn solve(
         }
     }
     let size = library_size(opts, anims, names)?;
-    if !(opts.thickness_mm.is_finite() && opts.thickness_mm > 0.0) {
-        return Err(Error::option_error(
-            "thickness_mm",
-            "must be a positive number of millimetres",
-        ));
-    }
+    super::check_positive_mm("thickness_mm", opts.thickness_mm)?;
     if !(opts.resolution_mm.is_finite() && opts.resolution_mm >= 0.0) {
         return Err(Error::option_error(
             "resolution_mm",

@@ -1,9 +1,11 @@
 //! Whole jobs on in-memory data: [`segment`], [`library`], [`run`], with serde options and
 //! results that carry their reports and list their output files.
 
+mod checks;
 mod error;
 mod figure;
 mod files;
+mod fixed_pieces;
 mod library_job;
 mod magnets;
 mod options;
@@ -18,8 +20,9 @@ mod sheets;
 mod size_curve;
 mod text;
 
+pub use checks::check_positive_mm;
 pub use error::{Error, Result};
-pub use files::{save_files, FileData, OutputFile};
+pub use fixed_pieces::{is_library_piece, library_pieces, PiecesFolder};
 pub use library_job::{file_safe_name, library, library_memory, run};
 pub use options::{
     default_clearance_mm, LibraryJobOptions, PieceCount, PrintFormat, RunOptions,
@@ -40,3 +43,4 @@ pub use segment_job::{
     SegmentSummary, Segmented,
 };
 pub use size_curve::{library_of, size_curve, SizeCurve, SizePoint};
+pub use tkio::{FileData, OutputFile};

@@ -10,13 +10,13 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use anim::glam::DVec2;
 use axum::body::Bytes;
 use axum::extract::rejection::BytesRejection;
 use axum::extract::{Query, State};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
-use loa::animate::{ActionCamera, AnimateOptions, Character, InitialPose, Preset, ScreenMap};
+use loa::animate::{ActionCamera, AnimateOptions, Character, InitialPose, Preset};
+use loa::job;
 use serde::Deserialize;
 use serde_json::{json, Value};
 
@@ -164,24 +164,28 @@ pub(crate) async fn animate(
         let mut options = loa::LineOptions::default();
         options.physics.fps = fps;
         options.wobbles = r.wobbles.clone();
+        // The line first (the job's first half), so the sampled motion's memory is reserved
+        // before the solve.
         let line = loa::line(&keys, &options).map_err(|e| {
             let over = matches!(e, loa::LoaError::OverBudget(_));
             ApiError::refused(format!("line: {e}"), over)
         })?;
         let line_seconds = start.elapsed().as_secs_f64();
 
-        let (c, label) = character(&studio, r.file, fps)?;
+        let f = studio.file(r.file)?;
+        let label = f.label();
+        let scene = f.scene().ok_or_else(|| {
+            ApiError::bad(format!(
+                "{label}: not a character (open a skinned glTF/GLB or a BVH file)"
+            ))
+        })?;
         // The motion is sampled over the line's frames on every vertex the file's meshes
         // have (as `anim::sample` counts them): reserved before the solve and the sampling.
-        let vertices = studio
-            .file(r.file)?
-            .scene()
-            .map_or(0, |s| s.meshes.iter().map(|m| m.mesh.vertex_count()).sum());
+        let vertices = scene.meshes.iter().map(|m| m.mesh.vertex_count()).sum();
         let held = studio.reserve(
             r.file,
             &anim::SampledScene::merged_memory(line.animation.frames.len(), vertices),
         )?;
-        let cam = camera(&c);
         let mut bone_sets = Vec::new();
         for k in &r.keystrokes {
             if let Some(b) = k.bones.as_deref().filter(|b| !b.is_empty()) {
@@ -192,30 +196,24 @@ pub(crate) async fn animate(
                 bone_sets.push(set);
             }
         }
-        let animate_options = AnimateOptions {
-            bone_sets,
-            camera: Some(cam),
-            screen: Some(ScreenMap {
-                anchor: DVec2::new(r.width / 2.0, r.height / 2.0),
-                origin: DVec2::ZERO,
-                scale: 2.0 * cam.half_height / r.height,
-            }),
+        let options = job::SceneOptions {
+            motion: AnimateOptions {
+                bone_sets,
+                ..Default::default()
+            },
+            canvas: Some([r.width, r.height]),
             ..Default::default()
         };
-        let motion = loa::animate(&c, &line, &animate_options).map_err(|e| {
-            let over = matches!(e, loa::animate::AnimateError::OverBudget(_));
+        let done = job::animate_line(scene, line, &options).map_err(|e| {
+            let over = e.over_budget();
             ApiError::refused(format!("{label}: {e}"), over)
         })?;
-        let scene = studio
-            .file(r.file)?
-            .scene()
-            .ok_or_else(|| ApiError::bad("not a character"))?;
-        let out = motion.to_scene(scene);
+        let (out, motion, line) = (&done.scene, &done.motion, &done.line);
         let clip = out
             .find_clip(loa::animate::CLIP_NAME)
             .map_err(|e| ApiError::internal(e.to_string()))?;
         let sampled = anim::sample(
-            &out,
+            out,
             &anim::SampleOptions {
                 fps: fps as f32,
                 clip: Some(clip),
@@ -288,11 +286,9 @@ pub(crate) async fn animate(
             file: r.file,
             keys,
             keys_json: keys_json.to_string(),
-            line,
-            scene: out,
-            motion,
             merged: m,
             version,
+            done,
         });
         Ok(pack.response(header))
     })
@@ -331,7 +327,7 @@ pub(crate) async fn line(State(studio): State<Arc<Studio>>) -> ApiResult<Respons
     let s = guard
         .as_ref()
         .ok_or_else(|| ApiError::conflict("no line yet: draw keystrokes first"))?;
-    let text = s.line.animation.to_json_string();
+    let text = s.done.line.animation.to_json_string();
     Ok((
         [(axum::http::header::CONTENT_TYPE, "application/json")],
         text,
@@ -375,26 +371,12 @@ pub(crate) async fn export(
         };
         match (ext.as_str(), r.what.as_deref()) {
             ("json", Some("keystrokes")) => text(&s.keys_json)?,
-            ("json", _) => text(&s.line.animation.to_json_string())?,
-            ("svg", _) => text(&loa::to_svg_string(&s.line.animation, Some(&s.keys)))?,
-            ("glb", _) => {
-                let bytes = tkio::gltf::write_glb(&s.scene).map_err(|e| io(e.to_string()))?;
-                tkio::save(&path, &tkio::Output::Bytes(&bytes))
-                    .map_err(|e| ApiError::from_io(&e))?;
-            }
-            ("bvh", _) => {
-                let scene = studio
-                    .file(s.file)?
-                    .scene()
-                    .ok_or_else(|| ApiError::bad("not a character"))?;
-                let (skeleton, _) = scene.skeleton();
-                let skeletal = s
-                    .motion
-                    .skeletal_animation(&skeleton)
-                    .map_err(|e| io(e.to_string()))?;
-                let t = tkio::bvh::write(&skeleton, &skeletal).map_err(|e| io(e.to_string()))?;
-                text(&t)?;
-            }
+            ("json", _) => text(&s.done.line.animation.to_json_string())?,
+            ("svg", _) => text(&loa::to_svg_string(&s.done.line.animation, Some(&s.keys)))?,
+            ("glb" | "bvh", _) => s.done.save(&path).map_err(|e| match e {
+                job::SceneJobError::Write(e) => ApiError::from_io(&e),
+                e => io(e.to_string()),
+            })?,
             _ => {
                 return Err(ApiError::bad(format!(
                 "{}: export keystrokes/line as .json, the line as .svg, the motion as .glb or .bvh",

@@ -311,7 +311,7 @@ pub(crate) async fn export(
             .files()
             .map_err(|e| ApiError::internal(format!("library files: {e}")))?;
         let written =
-            stopmo::save_files(&dir, &files).map_err(|e| ApiError::internal(e.to_string()))?;
+            tkio::save_files(&dir, &files).map_err(|e| ApiError::internal(e.to_string()))?;
         let mut names: Vec<String> = written
             .iter()
             .filter_map(|p| p.strip_prefix(&studio.out_dir).ok())

@@ -3,12 +3,11 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{bail, Context as _, Result};
+use anyhow::{Context as _, Result};
 use clap::Args;
 use serde_json::json;
 
 use super::{read_keystrokes, warn, Context, LineFlags};
-use crate::output::extension;
 
 /// Arguments of `toonkit loa line`.
 #[derive(Debug, Args)]
@@ -28,13 +27,7 @@ pub(crate) struct LineArgs {
 pub(crate) fn run(ctx: &Context, args: LineArgs) -> Result<()> {
     let start = Instant::now();
     // Check the output first so a typo does not cost a computation.
-    let ext = extension(&args.output);
-    if !matches!(ext.as_str(), "json" | "svg" | "png" | "gif") {
-        bail!(
-            "{}: unknown output extension (use .json, .svg, .png or .gif)",
-            args.output.display()
-        );
-    }
+    let ext = loa::job::check_line_path(&args.output)?;
     let keys = read_keystrokes(&args.input)?;
     let options = args.line.options(&keys)?;
     let line = loa::line(&keys, &options).with_context(|| args.input.display().to_string())?;

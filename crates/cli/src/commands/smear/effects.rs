@@ -113,8 +113,9 @@ pub(crate) fn elongate(ctx: &Context, args: ElongateArgs) -> Result<()> {
     let start = Instant::now();
     if Format::from_extension(&args.io.output).is_none() {
         bail!(
-            "{}: unknown output extension (use .glb, .usda, .pc2, .mdd or .obj)",
-            args.io.output.display()
+            "{}: unknown output extension (use {})",
+            args.io.output.display(),
+            Format::list(&Format::MESH_ANIMATIONS)
         );
     }
     args.effect.function(&args.offsets)?;

@@ -32,14 +32,18 @@ pub(crate) struct OffsetsArgs {
     pub(crate) offsets: OffsetArgs,
 }
 
+/// What `smear offsets` writes: the field itself (`.npy`) or a flipbook coloured by it.
+const OFFSETS_FORMATS: [Format; 2] = [Format::Npy, Format::Glb];
+
 /// Runs `toonkit smear offsets`.
 pub(crate) fn run(ctx: &Context, args: OffsetsArgs) -> Result<()> {
     let start = Instant::now();
     let format = Format::from_extension(&args.output);
-    if !matches!(format, Some(Format::Npy) | Some(Format::Glb)) {
+    if !format.is_some_and(|f| OFFSETS_FORMATS.contains(&f)) {
         bail!(
-            "{}: smear offsets writes .npy or .glb",
-            args.output.display()
+            "{}: smear offsets writes {}",
+            args.output.display(),
+            Format::list(&OFFSETS_FORMATS)
         );
     }
     let sampled = tkio::open(&args.input, &args.input_args.options())?;

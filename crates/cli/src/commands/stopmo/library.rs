@@ -57,7 +57,7 @@ pub(super) fn library(ctx: &Context, args: LibraryArgs) -> Result<()> {
     spinner.finish_and_clear();
     drop(anims);
     result.report.input = Some(args.input.display().to_string());
-    stopmo::save_files(&args.output, &result.files()?)?;
+    tkio::save_files(&args.output, &result.files()?)?;
     warn(ctx, &result);
     let report = serde_json::to_value(&result.report)?;
     if let Some(p) = &args.library.report {

@@ -74,7 +74,7 @@ pub(super) fn run(ctx: &Context, args: RunArgs) -> Result<()> {
     drop(anim);
     result.report.input = Some(args.input.display().to_string());
     let dir = &args.output;
-    stopmo::save_files(dir, &result.files()?)?;
+    tkio::save_files(dir, &result.files()?)?;
     warn(ctx, &result);
     let seg = result
         .segmented
