@@ -267,6 +267,25 @@ fn fortran_to_c(shape: &[usize], values: &[f32]) -> Vec<f32> {
     out
 }
 
+/// One `f32` per vertex from the `.npy` at `path`: a float array of shape `(vertices,)` or
+/// `(1, vertices)` (per-vertex weights such as a saliency map), read through
+/// [`read_file`](crate::read_file).
+///
+/// # Errors
+/// The read, [`read_f32`]'s errors, or [`IoError::Unsupported`] for another shape (the
+/// message gives the shape found and the one expected).
+pub fn read_per_vertex(path: &std::path::Path) -> Result<Vec<f32>> {
+    let bytes = crate::read_file(path)?;
+    let (shape, values) = read_f32(&bytes).map_err(|e| e.at(path))?;
+    if !matches!(shape.as_slice(), [_] | [1, _]) {
+        return Err(IoError::unsupported(format!(
+            "shape {shape:?}, expected (vertices,) or (1, vertices) (one weight per vertex)"
+        ))
+        .at(path));
+    }
+    Ok(values)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -347,23 +366,4 @@ mod tests {
         assert!(read_f32(&with_header(no_shape, data)).is_err());
         assert!(write_f32(&[3], &[1.0]).is_err());
     }
-}
-
-/// One `f32` per vertex from the `.npy` at `path`: a float array of shape `(vertices,)` or
-/// `(1, vertices)` (per-vertex weights such as a saliency map), read through
-/// [`read_file`](crate::read_file).
-///
-/// # Errors
-/// The read, [`read_f32`]'s errors, or [`IoError::Unsupported`] for another shape (the
-/// message gives the shape found and the one expected).
-pub fn read_per_vertex(path: &std::path::Path) -> Result<Vec<f32>> {
-    let bytes = crate::read_file(path)?;
-    let (shape, values) = read_f32(&bytes).map_err(|e| e.at(path))?;
-    if !matches!(shape.as_slice(), [_] | [1, _]) {
-        return Err(IoError::unsupported(format!(
-            "shape {shape:?}, expected (vertices,) or (1, vertices) (one weight per vertex)"
-        ))
-        .at(path));
-    }
-    Ok(values)
 }

@@ -514,6 +514,32 @@ pub fn write_sequence(anim: &MeshAnimation, base: &Path) -> Vec<(PathBuf, String
         .collect()
 }
 
+/// The `.obj` files of the folder `dir` whose stem (file name without `.obj`) `keep`
+/// accepts, read through [`read_file`](crate::read_file), as `(stem, mesh)` in file-name
+/// order.
+///
+/// # Errors
+/// The folder cannot be listed, or a kept file cannot be read or is not valid OBJ.
+pub fn read_folder(dir: &Path, keep: impl Fn(&str) -> bool) -> Result<Vec<(String, Mesh)>> {
+    let mut files: Vec<(String, PathBuf)> = std::fs::read_dir(dir)
+        .map_err(|e| IoError::io(dir, e))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "obj"))
+        .filter_map(|p| {
+            let stem = p.file_stem()?.to_str()?.to_string();
+            keep(&stem).then_some((stem, p))
+        })
+        .collect();
+    files.sort_by(|a, b| a.1.cmp(&b.1));
+    files
+        .into_iter()
+        .map(|(stem, p)| {
+            let mesh = read(&crate::read_file(&p)?).map_err(|e| e.at(&p))?;
+            Ok((stem, mesh))
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -587,30 +613,4 @@ mod tests {
         crate::write_atomic(&dir.path().join("nonum.obj"), b"v 0 0 0\n").unwrap();
         assert!(sequence_paths(&dir.path().join("nonum.obj")).is_err());
     }
-}
-
-/// The `.obj` files of the folder `dir` whose stem (file name without `.obj`) `keep`
-/// accepts, read through [`read_file`](crate::read_file), as `(stem, mesh)` in file-name
-/// order.
-///
-/// # Errors
-/// The folder cannot be listed, or a kept file cannot be read or is not valid OBJ.
-pub fn read_folder(dir: &Path, keep: impl Fn(&str) -> bool) -> Result<Vec<(String, Mesh)>> {
-    let mut files: Vec<(String, PathBuf)> = std::fs::read_dir(dir)
-        .map_err(|e| IoError::io(dir, e))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "obj"))
-        .filter_map(|p| {
-            let stem = p.file_stem()?.to_str()?.to_string();
-            keep(&stem).then_some((stem, p))
-        })
-        .collect();
-    files.sort_by(|a, b| a.1.cmp(&b.1));
-    files
-        .into_iter()
-        .map(|(stem, p)| {
-            let mesh = read(&crate::read_file(&p)?).map_err(|e| e.at(&p))?;
-            Ok((stem, mesh))
-        })
-        .collect()
 }
