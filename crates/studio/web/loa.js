@@ -168,15 +168,21 @@ export class LoaPanel {
       };
       // One answer: the line (every frame) and the character's whole motion, as float32.
       const r = await getPack('/api/loa/animate', body);
+      const fetched = performance.now();
       this.result = r;
       s.showError('');
       const h = r.header;
-      s.view.setAnimation({ triangles: r.buffers.triangles, positions: r.buffers.positions, frames: h.motion.positions_frames, vertices: h.motion.vertices }, { frame: false });
+      // Every answer of one file holds the same triangles: the viewport keeps its mesh (and
+      // the index uploaded to the GPU) when they are the array it already draws.
+      const tri = r.buffers.triangles, shown = s.view.anim && s.view.anim.triangles;
+      const triangles = shown && shown.length === tri.length && shown.every((t, i) => t === tri[i]) ? shown : tri;
+      s.view.setAnimation({ triangles, positions: r.buffers.positions, frames: h.motion.positions_frames, vertices: h.motion.vertices }, { frame: false });
       s.setTimeline(Math.max(TIMELINE, h.line.first_frame + h.line.frames + 12), 24);
       this.onFrame(s.frame);
+      const applied = performance.now();
       await s.view.rendered();
       const ms = performance.now() - t0;
-      const stat = { ms, server_ms: h.seconds.total * 1000, bytes: r.bytes };
+      const stat = { ms, server_ms: h.seconds.total * 1000, bytes: r.bytes, fetch_ms: fetched - t0, apply_ms: applied - fetched, draw_ms: performance.now() - applied };
       s.stats.loa.push(stat);
       s.stats.loaAll.push(stat);
       $('loa-report').textContent = loaSummary(h) + `\n\nredrawn in ${ms.toFixed(0)} ms: line ${(h.seconds.line * 1000).toFixed(0)} ms, motion ${(h.seconds.animate * 1000).toFixed(0)} ms on the server, ${(r.bytes / 1048576).toFixed(1)} MiB`;
