@@ -304,6 +304,8 @@ try {
   }
   // Printed, not asserted (as above); target: stroke → whole motion drawn ≤ 60 ms.
   console.log(`latency new stroke → line + whole character motion drawn: median ${median(loaAll.map((l) => l.ms)).toFixed(1)} ms of ${loaAll.length}, max ${Math.max(...loaAll.map((l) => l.ms)).toFixed(1)} ms, server median ${median(loaAll.map((l) => l.server_ms)).toFixed(1)} ms, ${(median(loaAll.map((l) => l.bytes)) / 1048576).toFixed(2)} MiB; target 60 ms`);
+  const partLoa = (k) => median(loaAll.map((l) => l[k])).toFixed(1);
+  console.log(`  of which: request until answer ${partLoa('fetch_ms')} ms, into the scene ${partLoa('apply_ms')} ms, until the next render is done ${partLoa('draw_ms')} ms`);
   const motion = await page.evaluate(() => { const r = window.studio.panels.loa.result, m = r.header.motion; return { floats: r.buffers.positions.length, frames: m.frames, vertices: m.vertices, drawn: window.studio.view.anim.frames }; });
   check('a stroke brings the whole motion in one answer (every frame × every vertex)', motion.frames > 24 && motion.floats === motion.frames * motion.vertices * 3 && motion.drawn === motion.frames, JSON.stringify(motion));
 

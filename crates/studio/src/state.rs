@@ -33,6 +33,24 @@ pub struct LoaSession {
     pub version: u64,
 }
 
+/// A file's character prepared for the stroke path once per file (and frame rate): its rig
+/// (`loa::animate::Character::from_scene`), the action camera the strokes are drawn
+/// through and the vertex count the motion's memory is reserved for. Every stroke reuses
+/// it; only the line, the solve and the skinning run again.
+#[derive(Debug)]
+pub struct LoaCharacter {
+    /// The file's name in messages.
+    pub label: String,
+    /// The frame rate the rig was prepared at.
+    pub fps: f64,
+    /// The rig in its rest pose (LoA Section 4).
+    pub character: loa::animate::Character,
+    /// The action camera fitted to the character (`ActionCamera::front_fitted`).
+    pub camera: loa::animate::ActionCamera,
+    /// Vertices of the file's meshes (as `anim::sample` counts them).
+    pub vertices: usize,
+}
+
 /// The last segmentation of the stopmo panel, its size curve and the library built from it
 /// (for the curve, build, reconstruction and export requests).
 #[derive(Debug)]
@@ -59,6 +77,8 @@ pub struct Studio {
     preparing: Mutex<()>,
     /// The last line of action.
     pub loa: Mutex<Option<LoaSession>>,
+    /// The characters the stroke path prepared, by file (at the last frame rate asked for).
+    pub characters: Mutex<HashMap<usize, Arc<LoaCharacter>>>,
     /// The stopmo panel's segmentation, curve and library.
     pub stopmo: Mutex<Option<StopmoSession>>,
     /// Long jobs (stopmo).
@@ -77,6 +97,7 @@ impl Studio {
             prepared: Mutex::default(),
             preparing: Mutex::default(),
             loa: Mutex::default(),
+            characters: Mutex::default(),
             stopmo: Mutex::default(),
             jobs: Jobs::default(),
             memory: MemoryPool::job_budget(),

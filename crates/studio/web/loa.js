@@ -37,6 +37,7 @@ export class LoaPanel {
     this.active = false;
     this.overlay.classList.remove('drawing');
     this.ctx.clearRect(0, 0, this.overlay.width, this.overlay.height);
+    this.dirty = true;
     this.studio.view.setActionCamera(null);
   }
 
@@ -58,12 +59,14 @@ export class LoaPanel {
   }
 
   showRest() {
+    this.dirty = true;
     const s = this.studio;
     s.view.setAnimation({ ...this.rest, frames: 1 }, { frame: false });
     s.setTimeline(TIMELINE, 24);
   }
 
   onFrame(f) {
+    this.dirty = true;
     const r = this.result;
     if (!r) return;
     this.studio.view.setFrame(f - r.header.motion.first_frame);
@@ -99,13 +102,15 @@ export class LoaPanel {
       }
     }
     this.stroke = [p];
+    this.dirty = true;
   }
 
   move(e) {
-    if (this.stroke) { this.stroke.push(this.point(e)); }
+    if (this.stroke) { this.stroke.push(this.point(e)); this.dirty = true; }
   }
 
   up(e) {
+    this.dirty = true;
     const p = this.point(e);
     if (this.drag) {
       const d = this.drag; this.drag = null;
@@ -133,6 +138,7 @@ export class LoaPanel {
   }
 
   table() {
+    this.dirty = true;
     const body = $('keys').querySelector('tbody');
     body.innerHTML = '';
     this.keys.forEach((k, i) => {
@@ -170,15 +176,22 @@ export class LoaPanel {
       };
       // One answer: the line (every frame) and the character's whole motion, as float32.
       const r = await getPack('/api/loa/animate', body);
+      const fetched = performance.now();
       this.result = r;
+      this.dirty = true;
       s.showError('');
       const h = r.header;
-      s.view.setAnimation({ triangles: r.buffers.triangles, positions: r.buffers.positions, frames: h.motion.positions_frames, vertices: h.motion.vertices }, { frame: false });
+      // Every answer of one file holds the same triangles: the viewport keeps its mesh (and
+      // the index uploaded to the GPU) when they are the array it already draws.
+      const tri = r.buffers.triangles, shown = s.view.anim && s.view.anim.triangles;
+      const triangles = shown && shown.length === tri.length && shown.every((t, i) => t === tri[i]) ? shown : tri;
+      s.view.setAnimation({ triangles, positions: r.buffers.positions, frames: h.motion.positions_frames, vertices: h.motion.vertices }, { frame: false });
       s.setTimeline(Math.max(TIMELINE, h.line.first_frame + h.line.frames + 12), 24);
       this.onFrame(s.frame);
+      const applied = performance.now();
       await s.view.rendered();
       const ms = performance.now() - t0;
-      const stat = { ms, server_ms: h.seconds.total * 1000, bytes: r.bytes };
+      const stat = { ms, server_ms: h.seconds.total * 1000, bytes: r.bytes, fetch_ms: fetched - t0, apply_ms: applied - fetched, draw_ms: performance.now() - applied };
       s.stats.loa.push(stat);
       s.stats.loaAll.push(stat);
       $('loa-report').textContent = loaSummary(h) + `\n\nredrawn in ${ms.toFixed(0)} ms: line ${(h.seconds.line * 1000).toFixed(0)} ms, motion ${(h.seconds.animate * 1000).toFixed(0)} ms on the server, ${(r.bytes / 1048576).toFixed(1)} MiB`;
@@ -192,9 +205,14 @@ export class LoaPanel {
 
   draw() {
     const c = this.overlay, ctx = this.ctx;
+    const f = this.studio.frame;
+    // Drawn only when what it shows changed: an overlay redrawn every animation frame keeps
+    // the page compositing (on the CPU with software GL) while the server answers a stroke.
+    const size = `${c.clientWidth}x${c.clientHeight}`;
+    if (!this.dirty && size === this.shown) return;
+    this.dirty = false; this.shown = size;
     if (c.width !== c.clientWidth || c.height !== c.clientHeight) { c.width = c.clientWidth; c.height = c.clientHeight; }
     ctx.clearRect(0, 0, c.width, c.height);
-    const f = this.studio.frame;
     const path = (pts, color, width) => {
       if (!pts || pts.length < 2) return;
       ctx.strokeStyle = color; ctx.lineWidth = width; ctx.beginPath();

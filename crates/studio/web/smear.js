@@ -2,7 +2,7 @@
 // generated from the style's JSON (keyframeable on the timeline, smear_keys.js), the
 // weight-group picker (smear_weights.js), the TOML editor with inline errors, the offsets
 // view, exports. Every change restyles the prepared offsets on the server: the current frame
-// first, the whole clip after.
+// first, the whole clip right after its answer.
 import { getJSON, getPack, postJSON } from './api.js';
 import { KEYABLE, keyable, isCurve, paramAt, setKey, deleteKey, drawKeys, styleParams } from './smear_keys.js';
 import { WeightPicker } from './smear_weights.js';
@@ -250,10 +250,10 @@ export class SmearPanel {
   }
 
   /**
-   * Restyles: the current frame (a one-frame answer, drawn at once) and every frame (asked
-   * for at the same time, drawn when it arrives, cancelled by the next change); frames
-   * scrubbed to meanwhile are asked for one by one. While a first-frame request is in flight
-   * only the newest change waits.
+   * Restyles: the current frame (a one-frame answer, drawn at once), then every frame (asked
+   * for as soon as the current frame is answered, drawn when it arrives, cancelled by the
+   * next change); frames scrubbed to meanwhile are asked for one by one. While a first-frame
+   * request is in flight only the newest change waits.
    */
   async request(body, t0) {
     this.gen = (this.gen || 0) + 1;
@@ -267,18 +267,19 @@ export class SmearPanel {
     this.inflight = true;
     const s = this.studio;
     const f = s.frame;
-    // The whole clip is asked for now, not after the current frame is drawn: the server
-    // answers the small request meanwhile, and the clip arrives one round trip sooner.
-    const ctl = new AbortController();
-    const rest = getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...body, changes: true }, ctl.signal);
-    rest.catch(() => {});
-    this.restCtl = ctl;
     this.fresh = null;
     try {
       const r = await getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...body, frames: [f, f + 1] });
       const fetched = performance.now();
       if (!this.pending) {
         const gen = this.gen;
+        // The whole clip is asked for now, after the current frame's answer and before it is
+        // drawn: the small request does not wait behind the clip's on the server's cores,
+        // and the server restyles the clip while the page draws the frame.
+        const ctl = new AbortController();
+        const rest = getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...body, changes: true }, ctl.signal);
+        rest.catch(() => {});
+        this.restCtl = ctl;
         $('style-error').textContent = '';
         s.showError('');
         this.style = r.header.style;
@@ -298,7 +299,6 @@ export class SmearPanel {
         this.loadRest(gen, t0, rest, ctl);
       }
     } catch (e) {
-      ctl.abort();
       $('style-error').textContent = e.message;
       s.showError(e.message);
     } finally {

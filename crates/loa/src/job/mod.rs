@@ -23,4 +23,4 @@ pub use output::{
     check_line_path, check_motion_path, check_preview_path, LINE_TEXT_EXTENSIONS, MOTION_FORMATS,
 };
 pub use report::{SceneReport, WorstPercent};
-pub use run::{animate_line, animate_scene, open_character, SceneMotion};
+pub use run::{animate_character, animate_line, animate_scene, open_character, SceneMotion};

@@ -72,14 +72,29 @@ pub fn animate_line(
     line: Line,
     options: &SceneOptions,
 ) -> Result<SceneMotion, SceneJobError> {
+    let character = Character::from_scene(scene, &options.pose, line.animation.fps)
+        .map_err(SceneJobError::Character)?;
+    animate_character(scene, &character, line, options)
+}
+
+/// [`animate_line`] for a `character` already made from `scene` (in `options.pose`, at the
+/// line's rate): a front end that keeps the character between strokes (the studio) skips
+/// [`Character::from_scene`], and gets the same motion.
+///
+/// # Errors
+/// As [`animate_line`], without [`SceneJobError::Character`].
+pub fn animate_character(
+    scene: &Scene,
+    character: &Character,
+    line: Line,
+    options: &SceneOptions,
+) -> Result<SceneMotion, SceneJobError> {
     let fps = line.animation.fps;
-    let character =
-        Character::from_scene(scene, &options.pose, fps).map_err(SceneJobError::Character)?;
     let mut motion_options = options.motion.clone();
     let camera =
         match &options.camera {
             Some(name) => {
-                let (action, camera) = ActionCamera::from_scene(scene, name, &character, fps)
+                let (action, camera) = ActionCamera::from_scene(scene, name, character, fps)
                     .map_err(|source| SceneJobError::Camera {
                         name: name.clone(),
                         source,
@@ -102,9 +117,9 @@ pub fn animate_line(
     }
     let start = Instant::now();
     let motion =
-        crate::animate(&character, &line, &motion_options).map_err(SceneJobError::Animate)?;
+        crate::animate(character, &line, &motion_options).map_err(SceneJobError::Animate)?;
     let solve_seconds = start.elapsed().as_secs_f64();
-    let report = SceneReport::new(&character, &line, &motion, solve_seconds);
+    let report = SceneReport::new(character, &line, &motion, solve_seconds);
     let (skeleton, _) = scene.skeleton();
     Ok(SceneMotion {
         scene: motion.to_scene(scene),

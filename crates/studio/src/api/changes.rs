@@ -20,7 +20,9 @@ pub(crate) fn pack_changes<'a>(
 ) {
     let words = vertices.div_ceil(32);
     let mut mask = vec![0u32; frames * words];
-    let mut moved: Vec<f32> = Vec::new();
+    // Room for every vertex at once: no regrowth copies, and the pages no moved vertex
+    // reaches are never touched (not resident).
+    let mut moved: Vec<f32> = Vec::with_capacity(frames * vertices * 3);
     for f in 0..frames {
         let bits = &mut mask[f * words..(f + 1) * words];
         let before = input(f);
@@ -37,5 +39,6 @@ pub(crate) fn pack_changes<'a>(
         }
     }
     pack.u32("body.changed", mask);
-    pack.f32_slices("body.positions", [&moved[..]]);
+    // Sent from the vector itself, not copied once more into the pack.
+    pack.shared("body.positions", moved, |m| &m[..]);
 }

@@ -24,7 +24,7 @@ use super::{blocking, body};
 use crate::error::{ApiError, ApiResult};
 use crate::files::{merged, output_path};
 use crate::pack::{coordinates, Pack};
-use crate::state::{lock, LoaSession, Studio};
+use crate::state::{lock, LoaCharacter, LoaSession, Studio};
 
 /// A file index (query string).
 #[derive(Debug, Deserialize)]
@@ -33,7 +33,12 @@ pub(crate) struct FileQuery {
     file: usize,
 }
 
-fn character(studio: &Studio, file: usize, fps: f64) -> ApiResult<(Character, String)> {
+/// The character of file `file` at `fps`, prepared once ([`LoaCharacter`]) and shared by
+/// every later stroke at that rate (another rate replaces it: one per file is kept).
+fn character(studio: &Studio, file: usize, fps: f64) -> ApiResult<Arc<LoaCharacter>> {
+    if let Some(c) = lock(&studio.characters).get(&file).filter(|c| c.fps == fps) {
+        return Ok(c.clone());
+    }
     let f = studio.file(file)?;
     let label = f.label();
     let scene = f.scene().ok_or_else(|| {
@@ -41,14 +46,18 @@ fn character(studio: &Studio, file: usize, fps: f64) -> ApiResult<(Character, St
             "{label}: not a character (open a skinned glTF/GLB or a BVH file)"
         ))
     })?;
-    let c = Character::from_scene(scene, &InitialPose::Rest, fps)
+    let character = Character::from_scene(scene, &InitialPose::Rest, fps)
         .map_err(|e| ApiError::bad(format!("{label}: {e}")))?;
-    Ok((c, label))
-}
-
-fn camera(c: &Character) -> ActionCamera {
-    let (lo, hi) = c.bounds();
-    ActionCamera::front_fitted(lo, hi)
+    let (lo, hi) = character.bounds();
+    let prepared = Arc::new(LoaCharacter {
+        label,
+        fps,
+        camera: ActionCamera::front_fitted(lo, hi),
+        vertices: scene.meshes.iter().map(|m| m.mesh.vertex_count()).sum(),
+        character,
+    });
+    lock(&studio.characters).insert(file, prepared.clone());
+    Ok(prepared)
 }
 
 /// `GET /api/loa/view?file=`: the action camera (`center`, `right`, `up`, `forward`,
@@ -60,12 +69,12 @@ pub(crate) async fn view(
     Query(q): Query<FileQuery>,
 ) -> ApiResult<Json<Value>> {
     blocking(move || {
-        let (c, _) = character(&studio, q.file, loa::DEFAULT_FPS)?;
+        let c = character(&studio, q.file, loa::DEFAULT_FPS)?;
         let presets: Vec<&str> = Preset::ALL.iter().map(|(_, n)| *n).collect();
         Ok(Json(json!({
-            "camera": camera(&c),
+            "camera": c.camera,
             "presets": presets,
-            "joints": c.joint_names(),
+            "joints": c.character.joint_names(),
             "stiffness": {
                 "range": [loa::STIFFNESS_RANGE.start(), loa::STIFFNESS_RANGE.end()],
                 "default": loa::DEFAULT_STIFFNESS,
@@ -172,19 +181,17 @@ pub(crate) async fn animate(
         })?;
         let line_seconds = start.elapsed().as_secs_f64();
 
+        let prepared = character(&studio, r.file, fps)?;
+        let label = &prepared.label;
         let f = studio.file(r.file)?;
-        let label = f.label();
-        let scene = f.scene().ok_or_else(|| {
-            ApiError::bad(format!(
-                "{label}: not a character (open a skinned glTF/GLB or a BVH file)"
-            ))
-        })?;
+        let scene = f
+            .scene()
+            .ok_or_else(|| ApiError::bad(format!("{label}: not a character")))?;
         // The motion is sampled over the line's frames on every vertex the file's meshes
         // have (as `anim::sample` counts them): reserved before the solve and the sampling.
-        let vertices = scene.meshes.iter().map(|m| m.mesh.vertex_count()).sum();
         let held = studio.reserve(
             r.file,
-            &anim::SampledScene::merged_memory(line.animation.frames.len(), vertices),
+            &anim::SampledScene::merged_memory(line.animation.frames.len(), prepared.vertices),
         )?;
         let mut bone_sets = Vec::new();
         for k in &r.keystrokes {
@@ -204,7 +211,8 @@ pub(crate) async fn animate(
             canvas: Some([r.width, r.height]),
             ..Default::default()
         };
-        let done = job::animate_line(scene, line, &options).map_err(|e| {
+        let done = job::animate_character(scene, &prepared.character, line, &options)
+            .map_err(|e| {
             let over = e.over_budget();
             ApiError::refused(format!("{label}: {e}"), over)
         })?;
@@ -224,7 +232,7 @@ pub(crate) async fn animate(
             let over = matches!(e, anim::AnimError::OverBudget(_));
             ApiError::refused(format!("{label}: {e}"), over)
         })?;
-        let m = merged(&label, &sampled)?;
+        let m = merged(label, &sampled)?;
         let animate_seconds = start.elapsed().as_secs_f64() - line_seconds;
 
         let frames = &line.animation.frames;
