@@ -34,7 +34,6 @@ pub mod api;
 pub mod error;
 pub mod files;
 pub mod guard;
-pub mod heap;
 pub mod jobs;
 mod lock;
 pub mod memory;

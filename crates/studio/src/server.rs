@@ -68,8 +68,6 @@ pub fn serve(options: &ServeOptions) -> Result<(), StudioError> {
             "give at least one file to open".into(),
         ));
     }
-    // Before any clip is read: freed clips go back to the system (`heap`).
-    crate::heap::return_large_buffers();
     let files = options
         .files
         .iter()
