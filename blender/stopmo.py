@@ -153,30 +153,6 @@ def options(s):
     return opts
 
 
-def read_obj(path):
-    """Vertices and triangles of the `rest.obj` a library writes."""
-    v, f = [], []
-    with open(path, encoding="utf-8") as fh:
-        for line in fh:
-            if line.startswith("v "):
-                v.append([float(x) for x in line.split()[1:4]])
-            elif line.startswith("f "):
-                f.append([int(x.split("/")[0]) - 1 for x in line.split()[1:4]])
-    return np.array(v, np.float32), np.array(f, np.int32)
-
-
-def read_pc2(path):
-    """Frames of a `.pc2` point cache: (frames, points, 3) float32."""
-    with open(path, "rb") as fh:
-        head = fh.read(32)
-        if head[:12] != b"POINTCACHE2\0":
-            raise job.JobError(f"{path}: not a .pc2 point cache")
-        points = int(np.frombuffer(head[16:20], "<i4")[0])
-        frames = int(np.frombuffer(head[28:32], "<i4")[0])
-        data = np.frombuffer(fh.read(), "<f4")
-    return data[: frames * points * 3].reshape(frames, points, 3)
-
-
 WARNINGS = "toonkit_warnings"
 """Custom property of the reconstruction object: the job's warnings, one per line."""
 
@@ -212,8 +188,10 @@ def show(scene, obj, folder, lib, start):
     for old in results.owned("stopmo"):
         if old[results.SOURCE] == obj.name:
             results.remove(old)
-    rest, tris = read_obj(os.path.join(folder, "rest.obj"))
-    frames = read_pc2(os.path.join(folder, "reconstruction.pc2"))
+    # The reconstruction from the library itself (the core's merge, as in rest.obj and
+    # reconstruction.pc2), not read back from the files just written.
+    r = lib.reconstruction
+    rest, tris, frames = r["rest"], r["triangles"], r["positions"]
     mesh = bpy.data.meshes.new(f"{obj.name} stopmo")
     mesh.from_pydata(rest.tolist(), [], tris.tolist())
     end = start + len(frames) - 1

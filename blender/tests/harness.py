@@ -116,6 +116,14 @@ def check(cond, message):
         raise AssertionError(message)
 
 
+def read_pc2(path):
+    """(frames, points, 3) float32 of a PC2 point cache (as the CLI writes it)."""
+    data = open(path, "rb").read()
+    check(data[:12] == b"POINTCACHE2\0", f"{path}: not a PC2 file")
+    points, _, _, frames = np.frombuffer(data[16:32], "<i4,<f4,<f4,<i4")[0]
+    return np.frombuffer(data, "<f4", offset=32).reshape(frames, points, 3)
+
+
 def rel(a, b, diag):
     return float(np.abs(np.asarray(a, np.float64) - np.asarray(b, np.float64)).max() / diag)
 

@@ -34,8 +34,8 @@ os.environ.setdefault("BLENDER_USER_RESOURCES", os.path.join(
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from harness import (ASSETS, REPO, check, empty_scene, finish, run, start, tmpdir,  # noqa: E402
-                     world_positions)
+from harness import (ASSETS, REPO, check, empty_scene, finish, read_pc2, run, start,  # noqa: E402
+                     tmpdir, world_positions)
 
 toonkit, OUT = start()
 CLI = os.environ.get("TOONKIT_CLI") or os.path.join(REPO, "target", "debug", "toonkit")
@@ -52,14 +52,6 @@ def cli(*args):
     out = subprocess.run([CLI, *map(str, args)], capture_output=True, text=True, cwd=REPO)
     check(out.returncode == 0, f"toonkit {args}: {out.stderr}")
     return out.stdout
-
-
-def read_pc2(path):
-    """(frames, points, 3) float32 of a PC2 point cache (as the CLI writes it)."""
-    data = open(path, "rb").read()
-    check(data[:12] == b"POINTCACHE2\0", f"{path}: not a PC2 file")
-    points, _, _, frames = np.frombuffer(data[16:32], "<i4,<f4,<f4,<i4")[0]
-    return np.frombuffer(data, "<f4", offset=32).reshape(frames, points, 3)
 
 
 def character(path, clip=None, bone_heuristic="BLENDER"):

@@ -28,8 +28,8 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 from mathutils import Vector  # noqa: E402
 
-from harness import (REPO, argv_after_dashes, attribute, check, empty_scene, install, run,  # noqa: E402
-                     tmpdir, world_positions)
+from harness import (REPO, argv_after_dashes, attribute, check, empty_scene, install,  # noqa: E402
+                     read_pc2, run, tmpdir, world_positions)
 
 ARGS = argv_after_dashes()
 ZIP = os.path.abspath(ARGS[0])
@@ -167,9 +167,7 @@ def reconstruction_glb_plays(scene, folder):
     """reconstruction.glb (each part's pieces as morph targets, STEP weights) imports through
     Blender's glTF importer and plays: at frame k every part shows the positions of
     reconstruction.pc2's frame k (glTF axes there, Z up here), within the quantization."""
-    from bl_ext.user_default.toonkit import stopmo
-
-    frames = stopmo.read_pc2(os.path.join(folder, "reconstruction.pc2"))
+    frames = read_pc2(os.path.join(folder, "reconstruction.pc2"))
     before = set(bpy.data.objects)
     bpy.ops.import_scene.gltf(filepath=os.path.join(folder, "reconstruction.glb"))
     # Blender suffixes a name that is taken (".001").

@@ -166,6 +166,36 @@ impl Library {
             .collect()
     }
 
+    /// The stop-motion reconstruction, every part merged in part order (what
+    /// ``reconstruction.pc2`` and ``rest.obj`` hold): ``{"positions" (frames, v, 3),
+    /// "rest" (v, 3), "triangles" (t, 3)}``, model units.
+    #[getter]
+    fn reconstruction<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let err = |e| toonkit_error(at(&self.source, e));
+        let frames = self.result.merged_reconstruction().map_err(err)?;
+        let d = PyDict::new(py);
+        d.set_item(
+            "positions",
+            output(
+                py,
+                &[frames.frame_count(), frames.vertex_count(), 3],
+                flat3(frames.positions()),
+            )?,
+        )?;
+        let rest = &frames.mesh;
+        d.set_item(
+            "rest",
+            output(py, &[rest.vertex_count(), 3], flat3(&rest.positions))?,
+        )?;
+        let t: Vec<i32> = rest
+            .triangles
+            .iter()
+            .flat_map(|t| t.map(|i| i as i32))
+            .collect();
+        d.set_item("triangles", output(py, &[rest.triangles.len(), 3], t)?)?;
+        Ok(d)
+    }
+
     /// Piece ids per frame (the rows of ``assembly.csv``).
     #[getter]
     fn assembly(&self) -> Vec<Vec<String>> {
