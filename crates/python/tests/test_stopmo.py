@@ -55,6 +55,19 @@ def test_no_print_is_the_cli_without_solids(face, tmp_path):
     assert pieces == [f"{part}_{k:02}.obj" for part in ("lower", "upper") for k in range(3)]
     assert lib.report["printing"] is None
     assert json.loads((cli / "report.json").read_text())["printing"] is None
+    # The reconstruction in memory is what the files hold (read here by hand, independently).
+    rec = lib.reconstruction
+    data = (py / "reconstruction.pc2").read_bytes()
+    assert data[:12] == b"POINTCACHE2\0"
+    points, frames = np.frombuffer(data[16:20], "<i4")[0], np.frombuffer(data[28:32], "<i4")[0]
+    pc2 = np.frombuffer(data, "<f4", offset=32).reshape(frames, points, 3)
+    assert rec["positions"].shape == pc2.shape == (face.frame_count, len(rec["rest"]), 3)
+    assert np.array_equal(rec["positions"], pc2)
+    obj = (py / "rest.obj").read_text().splitlines()
+    rest = np.array([[float(x) for x in l.split()[1:4]] for l in obj if l.startswith("v ")])
+    tris = np.array([[int(x.split("/")[0]) - 1 for x in l.split()[1:4]]
+                     for l in obj if l.startswith("f ")])
+    assert np.allclose(rec["rest"], rest, atol=1e-5) and np.array_equal(rec["triangles"], tris)
 
 
 def test_segment_then_library(face, tmp_path):
