@@ -64,9 +64,9 @@ def test_no_print_is_the_cli_without_solids(face, tmp_path):
     assert rec["positions"].shape == pc2.shape == (face.frame_count, len(rec["rest"]), 3)
     assert np.array_equal(rec["positions"], pc2)
     obj = (py / "rest.obj").read_text().splitlines()
-    rest = np.array([[float(x) for x in l.split()[1:4]] for l in obj if l.startswith("v ")])
-    tris = np.array([[int(x.split("/")[0]) - 1 for x in l.split()[1:4]]
-                     for l in obj if l.startswith("f ")])
+    rest = np.array([[float(x) for x in ln.split()[1:4]] for ln in obj if ln.startswith("v ")])
+    tris = np.array([[int(x.split("/")[0]) - 1 for x in ln.split()[1:4]]
+                     for ln in obj if ln.startswith("f ")])
     assert np.allclose(rec["rest"], rest, atol=1e-5) and np.array_equal(rec["triangles"], tris)
 
 
