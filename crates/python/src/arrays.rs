@@ -73,3 +73,16 @@ pub(crate) fn frozen<'py, T: Element>(
 pub(crate) fn flat3(points: &[glam::Vec3]) -> Vec<f32> {
     bytemuck::cast_slice(points).to_vec()
 }
+
+/// int32 ``(t, 3)``: the triangles of `mesh`.
+pub(crate) fn triangles<'py>(
+    py: Python<'py>,
+    mesh: &anim::Mesh,
+) -> PyResult<Bound<'py, PyArrayDyn<i32>>> {
+    let t: Vec<i32> = mesh
+        .triangles
+        .iter()
+        .flat_map(|t| t.map(|i| i as i32))
+        .collect();
+    output(py, &[mesh.triangles.len(), 3], t)
+}

@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use smear::{OffsetOptions, PrepareOptions, Style};
 
-use crate::arrays::{flat3, output};
+use crate::arrays::{flat3, output, triangles};
 use crate::errors::{at, io_error, smear_error, value_error};
 use crate::progress::report;
 use crate::scene::Scene;
@@ -237,15 +237,6 @@ fn animation_dict<'py>(
     };
     d.set_item("alpha", output(py, &[f, v], alpha)?)?;
     Ok(d)
-}
-
-fn triangles<'py>(py: Python<'py>, mesh: &anim::Mesh) -> PyResult<Bound<'py, PyArrayDyn<i32>>> {
-    let t: Vec<i32> = mesh
-        .triangles
-        .iter()
-        .flat_map(|t| t.map(|i| i as i32))
-        .collect();
-    output(py, &[mesh.triangles.len(), 3], t)
 }
 
 #[pymethods]

@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use stopmo::{FileData, LibraryJobOptions, OutputFile, RunOptions, SegmentJobOptions};
 
-use crate::arrays::{flat3, output};
+use crate::arrays::{flat3, output, triangles};
 use crate::errors::{at, io_error, toonkit_error, value_error};
 use crate::progress::report;
 use crate::scene::Scene;
@@ -33,13 +33,7 @@ fn part_dict<'py>(py: Python<'py>, part: &stopmo::segment::Part) -> PyResult<Bou
             flat3(a.positions()),
         )?,
     )?;
-    let t: Vec<i32> = a
-        .mesh
-        .triangles
-        .iter()
-        .flat_map(|t| t.map(|i| i as i32))
-        .collect();
-    d.set_item("triangles", output(py, &[a.mesh.triangles.len(), 3], t)?)?;
+    d.set_item("triangles", triangles(py, &a.mesh)?)?;
     let v: Vec<i64> = part.vertices.iter().map(|&v| v as i64).collect();
     d.set_item("vertices", output(py, &[v.len()], v)?)?;
     Ok(d)
@@ -155,12 +149,7 @@ impl Library {
                     "positions",
                     output(py, &[m.vertex_count(), 3], flat3(&m.positions))?,
                 )?;
-                let t: Vec<i32> = m
-                    .triangles
-                    .iter()
-                    .flat_map(|t| t.map(|i| i as i32))
-                    .collect();
-                d.set_item("triangles", output(py, &[m.triangles.len(), 3], t)?)?;
+                d.set_item("triangles", triangles(py, m)?)?;
                 Ok(d)
             })
             .collect()
@@ -187,12 +176,7 @@ impl Library {
             "rest",
             output(py, &[rest.vertex_count(), 3], flat3(&rest.positions))?,
         )?;
-        let t: Vec<i32> = rest
-            .triangles
-            .iter()
-            .flat_map(|t| t.map(|i| i as i32))
-            .collect();
-        d.set_item("triangles", output(py, &[rest.triangles.len(), 3], t)?)?;
+        d.set_item("triangles", triangles(py, rest)?)?;
         Ok(d)
     }
 
