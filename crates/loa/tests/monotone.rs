@@ -167,42 +167,42 @@ fn progress(a: &Animation, k0: i64, k1: i64, frame: i64) -> f64 {
 /// Largest overshoot of the angles past the next keystroke, relative to the change, over
 /// every interval and the settle after the last keystroke (measured against the last change).
 fn overshoot(a: &Animation) -> f64 {
-    let k = &a.keystroke_frames;
-    let end = a.frames.last().unwrap().frame;
     let mut worst: f64 = 0.0;
-    for (i, w) in k.windows(2).enumerate() {
-        if change(a, w[0], w[1]) < MIN_CHANGE {
-            continue;
-        }
-        let last = if i + 2 == k.len() { end } else { w[1] };
-        for f in w[0] + 1..last {
-            worst = worst.max(progress(a, w[0], w[1], f) - 1.0);
+    for (k0, k1, last) in measured_intervals(a) {
+        for f in k0 + 1..last {
+            worst = worst.max(progress(a, k0, k1, f) - 1.0);
         }
     }
     worst
 }
 
+/// The key-to-key intervals whose change is measurable, as `(from key, to key, last frame
+/// measured)`: an interval's inner frames, and for the last one the settle after it.
+fn measured_intervals(a: &Animation) -> Vec<(i64, i64, i64)> {
+    let k = &a.keystroke_frames;
+    let end = a.frames.last().unwrap().frame;
+    k.windows(2)
+        .enumerate()
+        .filter(|(_, w)| change(a, w[0], w[1]) >= MIN_CHANGE)
+        .map(|(i, w)| (w[0], w[1], if i + 2 == k.len() { end } else { w[1] }))
+        .collect()
+}
+
 /// Largest excursion of any single angle past its own key-to-key range, over the largest
 /// angle change of the interval (every interval's inner frames and the settle after the last).
 fn angle_overshoot(a: &Animation) -> f64 {
-    let k = &a.keystroke_frames;
-    let end = a.frames.last().unwrap().frame;
     let mut worst: f64 = 0.0;
-    for (i, w) in k.windows(2).enumerate() {
-        if change(a, w[0], w[1]) < MIN_CHANGE {
-            continue;
-        }
+    for (k0, k1, last) in measured_intervals(a) {
         let (g0, g1) = (
-            a.chain_at(w[0]).unwrap().angles().to_vec(),
-            a.chain_at(w[1]).unwrap().angles().to_vec(),
+            a.chain_at(k0).unwrap().angles().to_vec(),
+            a.chain_at(k1).unwrap().angles().to_vec(),
         );
         let largest = g0
             .iter()
             .zip(&g1)
             .map(|(x, y)| (y - x).abs())
             .fold(0.0, f64::max);
-        let last = if i + 2 == k.len() { end } else { w[1] };
-        for f in w[0] + 1..last {
+        for f in k0 + 1..last {
             for ((x, a0), a1) in a.chain_at(f).unwrap().angles().iter().zip(&g0).zip(&g1) {
                 let past = (x - a0.max(*a1)).max(a0.min(*a1) - x).max(0.0);
                 worst = worst.max(past / largest);

@@ -86,3 +86,15 @@ pub(crate) fn triangles<'py>(
         .collect();
     output(py, &[mesh.triangles.len(), 3], t)
 }
+
+/// float32 ``(frames, v, 3)``: every frame's positions of `anim`.
+pub(crate) fn frames_array<'py>(
+    py: Python<'py>,
+    anim: &anim::MeshAnimation,
+) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
+    output(
+        py,
+        &[anim.frame_count(), anim.vertex_count(), 3],
+        flat3(anim.positions()),
+    )
+}

@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use stopmo::{FileData, LibraryJobOptions, OutputFile, RunOptions, SegmentJobOptions};
 
-use crate::arrays::{flat3, output, triangles};
+use crate::arrays::{flat3, frames_array, output, triangles};
 use crate::errors::{at, io_error, toonkit_error, value_error};
 use crate::progress::report;
 use crate::scene::Scene;
@@ -25,14 +25,7 @@ fn part_dict<'py>(py: Python<'py>, part: &stopmo::segment::Part) -> PyResult<Bou
     let a = &part.animation;
     let d = PyDict::new(py);
     d.set_item("name", &part.name)?;
-    d.set_item(
-        "positions",
-        output(
-            py,
-            &[a.frame_count(), a.vertex_count(), 3],
-            flat3(a.positions()),
-        )?,
-    )?;
+    d.set_item("positions", frames_array(py, a)?)?;
     d.set_item("triangles", triangles(py, &a.mesh)?)?;
     let v: Vec<i64> = part.vertices.iter().map(|&v| v as i64).collect();
     d.set_item("vertices", output(py, &[v.len()], v)?)?;
@@ -163,14 +156,7 @@ impl Library {
         let err = |e| toonkit_error(at(&self.source, e));
         let frames = self.result.merged_reconstruction().map_err(err)?;
         let d = PyDict::new(py);
-        d.set_item(
-            "positions",
-            output(
-                py,
-                &[frames.frame_count(), frames.vertex_count(), 3],
-                flat3(frames.positions()),
-            )?,
-        )?;
+        d.set_item("positions", frames_array(py, &frames)?)?;
         let rest = &frames.mesh;
         d.set_item(
             "rest",
