@@ -17,8 +17,9 @@ pub use super::piece::Piece;
 use super::printability::{measure_part, printability, PartGeometry};
 use super::report::{PartPrintReport, PieceReport, PrintReport, PrintTime};
 use crate::library::{
-    add_plugs, build_shells, material, piece_id, regularize, self_intersecting_triangles, volume,
-    Bitmap, Key, KeyOptions, Library, PartShell, ShellInput, ShellOptions, DEFAULT_ID_RELIEF_MM,
+    add_plugs, build_shells, first_thinnest, material, piece_id, regularize,
+    self_intersecting_triangles, volume, Bitmap, Key, KeyOptions, Library, PartShell, ShellInput,
+    ShellOptions, DEFAULT_ID_RELIEF_MM,
 };
 
 /// Resin layer height assumed by the print-time estimate (mm).
@@ -175,6 +176,9 @@ pub(crate) fn print_pieces(
             );
             mounts_out.push(cut_mount(&shell, &mount, q, &keys, &id_keys, s)?);
         }
+        // Every piece's thinnest wall, once: the printability check lists them, the part's
+        // statistics and warning take the thinnest.
+        let walls = shell.thinnest_walls(&refs);
         measured.push(measure_part(
             &PartGeometry {
                 part: p,
@@ -184,6 +188,7 @@ pub(crate) fn print_pieces(
                 keys: &keys,
                 pocket: pocket.as_ref(),
                 id_keys: &id_keys,
+                thinnest: &walls,
             },
             s,
         ));
@@ -266,7 +271,7 @@ pub(crate) fn print_pieces(
             .filter_map(|m| m.surface_crossing.map(|(n, at)| (&m.piece, n, at)))
             .collect();
         let surface_triangles: usize = surface.iter().map(|(_, n, _)| n).sum();
-        let thinnest = shell.thinnest_wall(&refs);
+        let thinnest = first_thinnest(walls.iter().copied());
         if let Some(t) = thinnest {
             shell.stats.min_wall_mm = t.mm;
         }

@@ -24,7 +24,7 @@ use serde::Serialize;
 
 use super::magnets::{id_pixel_mm, id_recess, lateral_distance as lateral, Cut, MagnetPlan};
 use super::options::PrintSettings;
-use crate::library::{piece_id, Key, PartShell, Pocket, DEFAULT_ID_RELIEF_MM};
+use crate::library::{piece_id, Key, PartShell, Pocket, ThinnestWall, DEFAULT_ID_RELIEF_MM};
 
 /// What a wall or feature measure is of.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
@@ -199,13 +199,15 @@ pub(crate) struct PartGeometry<'a> {
     pub(crate) pocket: Option<&'a Pocket>,
     /// What the ID keeps away from (keys and the pocket).
     pub(crate) id_keys: &'a [Key],
+    /// Where every piece's wall is thinnest ([`PartShell::thinnest_walls`]).
+    pub(crate) thinnest: &'a [Option<ThinnestWall>],
 }
 
 /// Measures the walls and features of every piece of a part and of its mount.
 ///
 /// # Performance
-/// One nearest-back-triangle query per front vertex and piece (in parallel over pieces),
-/// one pass over the front per piece for the pocket; the rest is per key.
+/// The walls in front of the back come measured ([`PartGeometry::thinnest`]); one pass over
+/// the front per piece for the pocket; the rest is per key.
 pub(crate) fn measure_part(g: &PartGeometry<'_>, s: &PrintSettings<'_>) -> PartMeasures {
     let n = g.pieces.len();
     let mut solids: Vec<Measured> = g
@@ -215,7 +217,7 @@ pub(crate) fn measure_part(g: &PartGeometry<'_>, s: &PrintSettings<'_>) -> PartM
         .map(|(k, piece)| Measured {
             id: piece_id(g.name, k, n),
             mount: false,
-            walls: piece_walls(g, piece, s),
+            walls: piece_walls(g, k, piece, s),
             features: piece_features(g, s),
         })
         .collect();
@@ -236,11 +238,12 @@ pub(crate) fn measure_part(g: &PartGeometry<'_>, s: &PrintSettings<'_>) -> PartM
 /// Walls of one piece: front to back, around the pocket, plug sockets.
 fn piece_walls(
     g: &PartGeometry<'_>,
+    k: usize,
     piece: &[Vec3],
     s: &PrintSettings<'_>,
 ) -> Vec<(Thin, f64, Option<Vec3>)> {
     let mut walls = Vec::new();
-    if let Some(t) = g.shell.thinnest_wall(&[piece]) {
+    if let Some(t) = g.thinnest.get(k).copied().flatten() {
         walls.push((Thin::FrontToBack, t.mm, Some(t.at)));
     }
     if let Some(q) = g.pocket {

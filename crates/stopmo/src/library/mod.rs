@@ -70,8 +70,8 @@ pub use assembly::{
     DEFAULT_TWO_OPT_PASSES,
 };
 pub use back_surface::{
-    build_shells, Boss, DirectionField, PartShell, Pocket, PocketMiss, PocketSpec, ShellInput,
-    ShellOptions, ShellStats, ThinnestWall, DEFAULT_BACK_SMOOTHING_ITERATIONS,
+    build_shells, first_thinnest, Boss, DirectionField, PartShell, Pocket, PocketMiss, PocketSpec,
+    ShellInput, ShellOptions, ShellStats, ThinnestWall, DEFAULT_BACK_SMOOTHING_ITERATIONS,
     DEFAULT_CAP_FRACTION, DEFAULT_EDGE_RING_RADIUS_MM, DEFAULT_ENVELOPE_LATERAL,
     DEFAULT_ENVELOPE_REACH, DEFAULT_NORMAL_SMOOTHING_MM, DEFAULT_REPAIR_ROUNDS,
     DEFAULT_RESOLVE_ROUNDS,

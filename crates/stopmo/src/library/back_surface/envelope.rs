@@ -3,14 +3,112 @@
 //! direction, so a back surface that leaves the wall under the nose tip does not pass through
 //! the nostrils behind it, nor one under a lip through the mouth corner.
 
-use std::collections::HashMap;
-
 use glam::Vec3;
+use rayon::prelude::*;
+
+use crate::library::nearest::floor_i32;
+
+/// Grid cells per column radius (`lateral`): a column's bounding box then covers few cells
+/// beyond it, whatever its direction.
+const CELLS_PER_LATERAL: f32 = 2.0;
+
+/// Every front point of every piece binned in a uniform grid, each cell's points stored
+/// contiguously (cell-major), for the column queries of [`envelope_limits`].
+struct PointGrid {
+    lo: Vec3,
+    cell: f32,
+    dims: [i32; 3],
+    /// Start of every cell's points in `points` (cell `x + dims[0]·(y + dims[1]·z)`), plus
+    /// the end.
+    start: Vec<u32>,
+    points: Vec<Vec3>,
+}
+
+impl PointGrid {
+    fn new(fronts: &[Vec<Vec3>], n: usize, cell: f32) -> PointGrid {
+        let all = || fronts.iter().flat_map(|f| f.iter().take(n).copied());
+        let (lo, hi) = all().filter(|p| p.is_finite()).fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(p), hi.max(p)),
+        );
+        let (lo, hi) = if lo.cmple(hi).all() {
+            (lo, hi)
+        } else {
+            (Vec3::ZERO, Vec3::ZERO)
+        };
+        // Coarser cells where the points spread far (a stray vertex): at most a few cells
+        // per point.
+        let points = fronts.iter().map(|f| f.len().min(n)).sum::<usize>();
+        let budget = (4 * points).max(1 << 12) as f64;
+        let mut cell = cell;
+        let dims = loop {
+            let dims = ((hi - lo) / cell)
+                .to_array()
+                .map(|x| floor_i32(x).clamp(0, 1 << 20) + 1);
+            if dims.iter().map(|&d| f64::from(d)).product::<f64>() <= budget {
+                break dims;
+            }
+            cell *= 2.0;
+        };
+        let mut grid = PointGrid {
+            lo,
+            cell,
+            dims,
+            start: Vec::new(),
+            points: Vec::new(),
+        };
+        let cells = dims.iter().map(|&d| d as usize).product::<usize>();
+        let mut count = vec![0u32; cells + 1];
+        for p in all() {
+            count[grid.index(p) + 1] += 1;
+        }
+        for i in 0..cells {
+            count[i + 1] += count[i];
+        }
+        let mut next = count.clone();
+        grid.points = vec![Vec3::ZERO; count[cells] as usize];
+        for p in all() {
+            let slot = &mut next[grid.index(p)];
+            grid.points[*slot as usize] = p;
+            *slot += 1;
+        }
+        grid.start = count;
+        grid
+    }
+
+    /// Cell coordinates of `p`, clamped to the grid.
+    fn coords(&self, p: Vec3) -> [i32; 3] {
+        let q = ((p - self.lo) / self.cell).to_array();
+        [0, 1, 2].map(|k| floor_i32(q[k]).clamp(0, self.dims[k] - 1))
+    }
+
+    fn index(&self, p: Vec3) -> usize {
+        let [x, y, z] = self.coords(p);
+        (x + self.dims[0] * (y + self.dims[1] * z)) as usize
+    }
+
+    /// The points of every cell that meets the box `lo..=hi`.
+    fn in_box(&self, lo: Vec3, hi: Vec3) -> impl Iterator<Item = &[Vec3]> + '_ {
+        let (a, b) = (self.coords(lo), self.coords(hi));
+        (a[2]..=b[2]).flat_map(move |z| {
+            (a[1]..=b[1]).map(move |y| {
+                let row = self.dims[0] * (y + self.dims[1] * z);
+                let (s, e) = ((row + a[0]) as usize, (row + b[0]) as usize + 1);
+                &self.points[self.start[s] as usize..self.start[e] as usize]
+            })
+        })
+    }
+}
 
 /// Per shell vertex `v`, the largest height `back[v]·normals[v]` the back may have: the
 /// smallest `q·normals[v]` over the front points `q` of every piece within `lateral` of the
 /// line through `average[v]` along `normals[v]` and at most `reach` deeper or `lateral`
 /// higher than `average[v]`, minus `wall`.
+///
+/// # Performance
+/// The points of all pieces in one flat grid of cells half a column radius wide; each
+/// vertex reads the cells of its column's bounding box only (a minimum: which cells are
+/// read does not change it, as long as they hold the whole column).
 pub(super) fn envelope_limits(
     average: &[Vec3],
     fronts: &[Vec<Vec3>],
@@ -20,43 +118,25 @@ pub(super) fn envelope_limits(
     reach: f32,
 ) -> Vec<f32> {
     let n = average.len();
-    let cell = (reach + lateral).max(1e-3);
-    let key = |p: Vec3| {
-        let q = (p / cell).floor();
-        [q.x as i32, q.y as i32, q.z as i32]
-    };
-    // Bins of every vertex of every piece (a piece moves a vertex at most a little from the
-    // average, the bins are indexed by its own position).
-    let mut grid: HashMap<[i32; 3], Vec<(u32, u32)>> = HashMap::new();
-    for (k, f) in fronts.iter().enumerate() {
-        for (u, p) in f.iter().enumerate().take(n) {
-            grid.entry(key(*p)).or_default().push((k as u32, u as u32));
-        }
-    }
-    use rayon::prelude::*;
+    let grid = PointGrid::new(fronts, n, (lateral / CELLS_PER_LATERAL).max(1e-3));
     (0..n)
         .into_par_iter()
         .map(|v| {
             let (c, d) = (average[v], normals[v]);
             let mut lowest = fronts.iter().map(|f| f[v].dot(d)).fold(c.dot(d), f32::min);
-            let kc = key(c);
-            for x in kc[0] - 1..=kc[0] + 1 {
-                for y in kc[1] - 1..=kc[1] + 1 {
-                    for z in kc[2] - 1..=kc[2] + 1 {
-                        let Some(list) = grid.get(&[x, y, z]) else {
-                            continue;
-                        };
-                        for &(k, u) in list {
-                            let q = fronts[k as usize][u as usize];
-                            let e = q - c;
-                            let h = e.dot(d);
-                            if h < -reach || h > lateral {
-                                continue;
-                            }
-                            if (e - d * h).length_squared() <= lateral * lateral {
-                                lowest = lowest.min(q.dot(d));
-                            }
-                        }
+            // A column point is `c + d·h + s` with `h ∈ [−reach, lateral]` and `|s| ≤ lateral`
+            // (`d` unit): its box, with a margin for rounding.
+            let (deep, high) = (c - d * reach, c + d * lateral);
+            let pad = Vec3::splat(lateral * 1.01 + 1e-3);
+            for list in grid.in_box(deep.min(high) - pad, deep.max(high) + pad) {
+                for &q in list {
+                    let e = q - c;
+                    let h = e.dot(d);
+                    if h < -reach || h > lateral {
+                        continue;
+                    }
+                    if (e - d * h).length_squared() <= lateral * lateral {
+                        lowest = lowest.min(q.dot(d));
                     }
                 }
             }

@@ -24,6 +24,19 @@ pub struct ThinnestWall {
     pub on_boundary: bool,
 }
 
+/// The thinnest of per-piece thinnest walls (in piece order): the first of the thinnest.
+pub fn first_thinnest(
+    walls: impl IntoIterator<Item = Option<ThinnestWall>>,
+) -> Option<ThinnestWall> {
+    walls
+        .into_iter()
+        .flatten()
+        .fold(None, |best: Option<ThinnestWall>, t| match best {
+            Some(b) if b.mm <= t.mm => Some(b),
+            _ => Some(t),
+        })
+}
+
 impl PartShell {
     /// Smallest distance (mm) from a front vertex of `piece` to the back surface's triangles.
     pub fn min_wall(&self, piece: &[Vec3]) -> f64 {
@@ -36,29 +49,83 @@ impl PartShell {
     }
 
     /// Where the wall is thinnest over `pieces`: the front vertex closest to the back surface
-    /// (`None` without pieces or triangles).
+    /// (`None` without pieces or triangles); of equally thin ones, the first piece's first.
     ///
     /// # Performance
-    /// One grid of the back surface; the running minimum bounds every later query to a few
+    /// One grid of the back surface. The first piece is measured alone, the others in
+    /// parallel below its minimum: the running minimum bounds every later query to a few
     /// grid rings, so the cost is close to one nearest-triangle query per front vertex.
     pub fn thinnest_wall(&self, pieces: &[&[Vec3]]) -> Option<ThinnestWall> {
         let grid = TriangleGrid::new(&self.back, &self.triangles);
-        let mut best: Option<ThinnestWall> = None;
-        for (k, piece) in pieces.iter().enumerate() {
-            for (v, &p) in self.front(piece).iter().enumerate() {
-                let limit = best.as_ref().map_or(f64::INFINITY, |b| b.mm);
-                let d = grid.distance_below(p, limit);
-                if d < limit {
-                    best = Some(ThinnestWall {
-                        mm: d,
-                        piece: k,
-                        at: p,
-                        on_boundary: self.on_boundary.get(v).copied().unwrap_or(false),
-                    });
-                }
+        let (first, rest) = pieces.split_first()?;
+        let (head, _) = self.thinnest_in(&grid, 0, first, f64::INFINITY, None);
+        let limit = head.map_or(f64::INFINITY, |t| t.mm);
+        let tail: Vec<Option<ThinnestWall>> = rest
+            .par_iter()
+            .enumerate()
+            .map(|(k, piece)| self.thinnest_in(&grid, k + 1, piece, limit, None).0)
+            .collect();
+        first_thinnest(std::iter::once(head).chain(tail))
+    }
+
+    /// [`PartShell::thinnest_wall`] of every piece on its own; [`first_thinnest`] of them is
+    /// the thinnest over all.
+    ///
+    /// # Performance
+    /// One grid of the back surface; the first piece is measured alone, the others in
+    /// parallel, each starting below its own wall at the first piece's thinnest vertex (the
+    /// pieces of a part are thin in the same places): every query after it is bounded to a
+    /// few grid rings.
+    pub fn thinnest_walls(&self, pieces: &[&[Vec3]]) -> Vec<Option<ThinnestWall>> {
+        let grid = TriangleGrid::new(&self.back, &self.triangles);
+        let Some((first, rest)) = pieces.split_first() else {
+            return Vec::new();
+        };
+        let (head, at) = self.thinnest_in(&grid, 0, first, f64::INFINITY, None);
+        let tail: Vec<Option<ThinnestWall>> = rest
+            .par_iter()
+            .enumerate()
+            .map(|(k, piece)| self.thinnest_in(&grid, k + 1, piece, f64::INFINITY, at).0)
+            .collect();
+        std::iter::once(head).chain(tail).collect()
+    }
+
+    /// The first front vertex of `piece` (index `k`) closest to the back surface (`grid`), if
+    /// closer than `limit`, and its index. With `seed`, that vertex is measured first and
+    /// bounds the others' queries to just above its distance: which vertex is the first
+    /// thinnest does not change (only queries that cannot win are cut short).
+    fn thinnest_in(
+        &self,
+        grid: &TriangleGrid<'_>,
+        k: usize,
+        piece: &[Vec3],
+        limit: f64,
+        seed: Option<usize>,
+    ) -> (Option<ThinnestWall>, Option<usize>) {
+        let front = self.front(piece);
+        let mut limit = limit;
+        if let Some(&p) = seed.and_then(|v| front.get(v)) {
+            let d = grid.distance_below(p, limit);
+            if d < limit {
+                // Just above `d`, so that the seed (or an equal vertex before it) is taken.
+                limit = d + (d.abs() * 1e-9).max(1e-12);
             }
         }
-        best
+        let mut best: Option<(ThinnestWall, usize)> = None;
+        for (v, &p) in front.iter().enumerate() {
+            let limit = best.as_ref().map_or(limit, |b| b.0.mm);
+            let d = grid.distance_below(p, limit);
+            if d < limit {
+                let t = ThinnestWall {
+                    mm: d,
+                    piece: k,
+                    at: p,
+                    on_boundary: self.on_boundary.get(v).copied().unwrap_or(false),
+                };
+                best = Some((t, v));
+            }
+        }
+        (best.map(|b| b.0), best.map(|b| b.1))
     }
 
     /// Where the animated surface of `piece` (millimetres, input vertex order) crosses

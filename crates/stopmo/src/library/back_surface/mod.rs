@@ -48,7 +48,7 @@ mod thicken;
 mod topology;
 mod untangle;
 
-pub use measure::ThinnestWall;
+pub use measure::{first_thinnest, ThinnestWall};
 pub use options::{
     DirectionField, ShellOptions, ShellStats, DEFAULT_BACK_SMOOTHING_ITERATIONS,
     DEFAULT_CAP_FRACTION, DEFAULT_EDGE_RING_RADIUS_MM, DEFAULT_ENVELOPE_LATERAL,
