@@ -144,3 +144,66 @@ pub(super) fn envelope_limits(
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// [`envelope_limits`] as it was: every point of every piece tested against every column.
+    fn every_point(
+        average: &[Vec3],
+        fronts: &[Vec<Vec3>],
+        normals: &[Vec3],
+        wall: f32,
+        lateral: f32,
+        reach: f32,
+    ) -> Vec<f32> {
+        (0..average.len())
+            .map(|v| {
+                let (c, d) = (average[v], normals[v]);
+                let mut lowest = fronts.iter().map(|f| f[v].dot(d)).fold(c.dot(d), f32::min);
+                for q in fronts.iter().flat_map(|f| f.iter().take(average.len())) {
+                    let e = *q - c;
+                    let h = e.dot(d);
+                    if h >= -reach
+                        && h <= lateral
+                        && (e - d * h).length_squared() <= lateral * lateral
+                    {
+                        lowest = lowest.min(q.dot(d));
+                    }
+                }
+                lowest - wall
+            })
+            .collect()
+    }
+
+    #[test]
+    fn columns_in_the_grid_find_what_a_scan_of_every_point_finds() {
+        // A wavy sheet 40 × 40 mm, five pieces pressing it in and out, tilted directions.
+        let mut rng = anim::SplitMix64::new(19, 0);
+        let mut r = |s: f32| (rng.next_f32() - 0.5) * s;
+        let average: Vec<Vec3> = (0..900)
+            .map(|i| {
+                let (x, y) = ((i % 30) as f32 * 1.4 - 20.0, (i / 30) as f32 * 1.4 - 20.0);
+                Vec3::new(x, y, 3.0 * (x * 0.2).sin() * (y * 0.15).cos())
+            })
+            .collect();
+        let fronts: Vec<Vec<Vec3>> = (0..5)
+            .map(|_| {
+                average
+                    .iter()
+                    .map(|p| *p + Vec3::new(r(1.0), r(1.0), r(6.0)))
+                    .collect()
+            })
+            .collect();
+        let normals: Vec<Vec3> = average
+            .iter()
+            .map(|_| Vec3::new(r(1.5), r(1.5), 1.0).normalize())
+            .collect();
+        for (lateral, reach) in [(3.0, 4.5), (0.7, 9.0), (12.0, 2.0)] {
+            let grid = envelope_limits(&average, &fronts, &normals, 1.5, lateral, reach);
+            let scan = every_point(&average, &fronts, &normals, 1.5, lateral, reach);
+            assert_eq!(grid, scan, "lateral {lateral}, reach {reach}");
+        }
+    }
+}
