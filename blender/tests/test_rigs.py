@@ -7,9 +7,9 @@ every scene; bone-parented props, several meshes, a scene range past the keys, a
 clip, shape keys on a rig, an object that does not move, the panel's bake state, a preview
 range; with TOONKIT_CLI=toonkit (as .ci/blender.sh sets it) the results on both paths equal
 the CLI's on CesiumMan. With
-TOONKIT_TUBE=tube.glb (written by `write_tube`, as .ci/blender.sh does) it prints the bake
-time, the slider + frame change time and Blender's own floor on the benchmark tube (printed,
-never asserted: docs/blender.md, "Speed").
+TOONKIT_TUBE=tube.glb (written by `write_tube`, as .ci/blender.sh does) it prints the first
+and the repeated bake's times, the slider + frame change time and Blender's own floor on the
+benchmark tube (printed, never asserted: docs/blender.md, "Speed").
 """
 
 import json
