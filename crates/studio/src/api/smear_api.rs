@@ -138,7 +138,7 @@ pub(crate) struct StyleRequest {
     #[serde(default)]
     weights: Option<Value>,
     /// The body as what changed from the input clip ([`super::changes`]): `body.changed`
-    /// and `body.positions` instead of `body` (the page's whole-clip request).
+    /// and the moved vertices instead of `body` (the page's whole-clip request).
     #[serde(default)]
     changes: bool,
 }
@@ -196,7 +196,8 @@ fn stylized(
 /// `copyN.alpha` (frames × copy vertices), `copyN.triangles`; per line set
 /// `linesN.counts` (u32 per frame: vertices, triangles), `linesN.positions`,
 /// `linesN.triangles`, `linesN.alpha`. With `"changes": true` the body comes as
-/// `body.changed` and `body.positions` instead ([`super::changes`]).
+/// `body.changed` and `body.step` + `body.delta` (or `body.positions`) instead
+/// ([`super::changes`]).
 pub(crate) async fn stylize(
     State(studio): State<Arc<Studio>>,
     request: Result<Bytes, BytesRejection>,
@@ -222,13 +223,17 @@ pub(crate) async fn stylize(
             None
         };
         match clip.as_ref().map(|c| c.merged()) {
-            Some(m) if m.vertex_count() == vertices => pack_changes(
-                &mut pack,
-                frames,
-                vertices,
-                |f| bodies.iter().map(|a| a.frame(f)).collect(),
-                |f| m.frame(s.first_frame + f),
-            ),
+            Some(m) if m.vertex_count() == vertices => {
+                let bounds = m.bbox();
+                pack_changes(
+                    &mut pack,
+                    frames,
+                    vertices,
+                    (bounds.max - bounds.min).length(),
+                    |f| bodies.iter().map(|a| a.frame(f)).collect(),
+                    |f| m.frame(s.first_frame + f),
+                )
+            }
             _ => {
                 pack.f32_slices(
                     "body",
