@@ -264,6 +264,23 @@ pub fn read_u32(bytes: &[u8], name: &str) -> Option<Vec<u32>> {
     )
 }
 
+/// Reads a pack back: the named int16 buffer (for tests and tools).
+pub fn read_i16(bytes: &[u8], name: &str) -> Option<Vec<i16>> {
+    let (header, data) = split(bytes)?;
+    let entry = header["buffers"]
+        .as_array()?
+        .iter()
+        .find(|b| b["name"] == name && b["type"] == "i16")?;
+    let offset = entry["offset"].as_u64()? as usize;
+    let count = entry["count"].as_u64()? as usize;
+    let raw = data.get(offset..offset + count * 2)?;
+    Some(
+        raw.chunks_exact(2)
+            .map(|c| i16::from_le_bytes([c[0], c[1]]))
+            .collect(),
+    )
+}
+
 /// Splits a pack into its header and data.
 pub fn split(bytes: &[u8]) -> Option<(Value, &[u8])> {
     let len = u32::from_le_bytes(bytes.get(..4)?.try_into().ok()?) as usize;
@@ -295,6 +312,7 @@ mod tests {
         assert_eq!(header["buffers"][5]["type"], "i16");
         assert_eq!(header["buffers"][6]["offset"], 56);
         assert_eq!(read_u32(&bytes, "aligned").unwrap(), vec![5]);
+        assert_eq!(read_i16(&bytes, "small").unwrap(), vec![-3, 7, 1]);
         assert_eq!(header["buffers"][1]["offset"], 12);
         let len = u32::from_le_bytes(bytes[..4].try_into().unwrap()) as usize;
         assert_eq!(len % 4, 0);
