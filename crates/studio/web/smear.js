@@ -278,7 +278,8 @@ export class SmearPanel {
       if (!this.pending) {
         const gen = this.gen;
         // The whole clip is asked for now, after the current frame's answer and before it is
-        // drawn: the small request does not wait behind the clip's on the server's cores,
+        // drawn: the small request does not wait behind the clip's on the server's cores
+        // (asked for together, the current frame took twice as long on a loaded machine),
         // and the server restyles the clip while the page draws the frame.
         const ctl = new AbortController();
         const rest = getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...body, changes: true }, ctl.signal);

@@ -29,7 +29,6 @@ export class Viewport {
     this.lines = [];
     this.offsets = null;
     this.vertexColors = null;
-    this.onRendered = [];
     this.resize();
     new ResizeObserver(() => this.resize()).observe(canvas);
   }
@@ -254,10 +253,11 @@ export class Viewport {
     this.renderer.render(this.scene, this.camera);
     this.renderMs = performance.now() - t;
     this.dirty = false;
-    const done = this.onRendered; this.onRendered = [];
-    for (const f of done) f();
   }
 
-  /** Resolves after the next render. */
-  rendered() { this.dirty = true; return new Promise((resolve) => this.onRendered.push(resolve)); }
+  /**
+   * Renders now (new geometry is drawn as soon as it is in the scene, not at the next
+   * animation frame) and resolves once done.
+   */
+  rendered() { this.render(); return Promise.resolve(); }
 }

@@ -19,7 +19,8 @@ pub(crate) const MAX_QUANTIZATION_ERROR: f32 = 1e-5;
 /// `v / 32` set when vertex `v` moved), `body.step` (f32 per frame) and `body.delta` (i16 xyz
 /// of the moved vertices, frame-major, in vertex order: the position is the input's plus
 /// `delta × step`). When a frame's displacements are too large for 16 bits within
-/// [`MAX_QUANTIZATION_ERROR`] of `diagonal`, `body.positions` (f32 xyz of the moved
+/// [`MAX_QUANTIZATION_ERROR`] of the diagonal of the input's bounding box over the frames
+/// answered, `body.positions` (f32 xyz of the moved
 /// vertices) replaces `body.step` and `body.delta`. `body(f)` and `input(f)` are the merged
 /// vertices of frame `f` of the answer and of the input clip. Frames are compared and packed
 /// in parallel; only the answer's own buffers are allocated.
@@ -27,19 +28,22 @@ pub(crate) fn pack_changes<'a>(
     pack: &mut Pack,
     frames: usize,
     vertices: usize,
-    diagonal: f32,
     body: impl Fn(usize) -> Vec<&'a [Vec3]> + Sync,
     input: impl Fn(usize) -> &'a [Vec3] + Sync,
 ) {
     let words = vertices.div_ceil(32);
     let mut mask = vec![0u32; frames * words];
-    // Per frame: moved vertices and the largest displacement coordinate.
-    let moved: Vec<(usize, f32)> = mask
+    // Per frame: moved vertices, the largest displacement coordinate, the input's bounds.
+    let scan: Vec<(usize, f32, Vec3, Vec3)> = mask
         .par_chunks_mut(words.max(1))
         .enumerate()
         .map(|(f, bits)| {
             let before = input(f);
             let (mut count, mut largest) = (0, 0.0f32);
+            let (lo, hi) = before.iter().fold(
+                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+            );
             each_vertex(&body(f), |v, p| {
                 // Bit-exact: an unmoved vertex is drawn from the input itself.
                 match before.get(v) {
@@ -52,9 +56,15 @@ pub(crate) fn pack_changes<'a>(
                     }
                 }
             });
-            (count, largest)
+            (count, largest, lo, hi)
         })
         .collect();
+    let (lo, hi) = scan.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), s| (lo.min(s.2), hi.max(s.3)),
+    );
+    let diagonal = if frames > 0 { (hi - lo).length() } else { 0.0 };
+    let moved: Vec<(usize, f32)> = scan.iter().map(|s| (s.0, s.1)).collect();
     let limit = 2.0 * f32::from(i16::MAX) * MAX_QUANTIZATION_ERROR * diagonal;
     let quantized = moved.iter().all(|&(_, d)| d <= limit);
     let total = moved.iter().map(|&(n, _)| 3 * n).sum::<usize>();

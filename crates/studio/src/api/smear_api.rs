@@ -206,6 +206,8 @@ pub(crate) async fn stylize(
     blocking(move || {
         let start = Instant::now();
         let (style, s, held) = stylized(&studio, &r, false)?;
+        // Shared with the answer: the multiples are sent from the result, not copied.
+        let s = Arc::new(s);
         let toml = style.to_toml_string().unwrap_or_default();
         let mut pack = Pack::new();
         pack.keep(held);
@@ -223,17 +225,13 @@ pub(crate) async fn stylize(
             None
         };
         match clip.as_ref().map(|c| c.merged()) {
-            Some(m) if m.vertex_count() == vertices => {
-                let bounds = m.bbox();
-                pack_changes(
-                    &mut pack,
-                    frames,
-                    vertices,
-                    (bounds.max - bounds.min).length(),
-                    |f| bodies.iter().map(|a| a.frame(f)).collect(),
-                    |f| m.frame(s.first_frame + f),
-                )
-            }
+            Some(m) if m.vertex_count() == vertices => pack_changes(
+                &mut pack,
+                frames,
+                vertices,
+                |f| bodies.iter().map(|a| a.frame(f)).collect(),
+                |f| m.frame(s.first_frame + f),
+            ),
             _ => {
                 pack.f32_slices(
                     "body",
@@ -250,10 +248,9 @@ pub(crate) async fn stylize(
                     s.flipbook.parts.get(i)
                 {
                     let n = copies.len();
-                    pack.f32_slices(
-                        &format!("copy{n}.positions"),
-                        [coordinates(animation.positions())],
-                    );
+                    pack.shared(&format!("copy{n}.positions"), (s.clone(), i), |(s, i)| {
+                        copy_positions(s, *i)
+                    });
                     pack.u32(
                         &format!("copy{n}.triangles"),
                         animation.mesh.triangles.iter().flatten().copied(),
@@ -313,6 +310,14 @@ pub(crate) async fn stylize(
         })))
     })
     .await
+}
+
+/// The positions of flipbook part `i` of `s` when it is an animation (a multiple).
+fn copy_positions(s: &smear::Stylized, i: usize) -> &[f32] {
+    match s.flipbook.parts.get(i) {
+        Some(anim::FlipbookPart::Animation { animation, .. }) => coordinates(animation.positions()),
+        _ => &[],
+    }
 }
 
 /// `POST /api/smear/export`: `name` ending in `.toml` writes the style (as the CLI and the
