@@ -7,9 +7,9 @@ Operators: `bpy.ops.toonkit.smear_bake()`, `bpy.ops.toonkit.smear_update()`,
 `toonkit_loa`; panels in View3D ▸ Sidebar ▸ toonkit.
 """
 
-from . import loa_ui, operators, panel, settings, stopmo_ui
+from . import loa_ui, operators, panel, settings, stopmo_ui, weights
 
-_MODULES = (settings, operators, panel, stopmo_ui, loa_ui)
+_MODULES = (settings, weights, operators, panel, stopmo_ui, loa_ui)
 
 
 def register():

@@ -25,6 +25,8 @@ from itertools import chain
 
 import numpy as np
 
+from . import weights
+
 
 class SampleError(Exception):
     """The selection cannot be sampled; the message is one line for the operator."""
@@ -152,26 +154,6 @@ def _own_triangles(obj):
     tris = np.empty(len(mesh.loops), np.int32)
     corners.data.foreach_get("value", tris)
     return tris.reshape(-1, 3)
-
-
-def _groups(obj, n):
-    """Every vertex group of `obj` as a dense (n,) weight array. Blender has no bulk read of
-    vertex weights: one pass over the vertices collects (group, vertex, weight) triples in
-    lists, and numpy scatters them at once."""
-    names = {g.index: g.name for g in obj.vertex_groups}
-    dense = np.zeros((max(names, default=-1) + 1, n), np.float32)
-    group, vertex, weight = [], [], []
-    for i, v in enumerate(obj.data.vertices):
-        for g in v.groups:
-            group.append(g.group)
-            vertex.append(i)
-            weight.append(g.weight)
-    if group:
-        group = np.array(group, np.int64)
-        known = group < len(dense)  # a weight of a group that no longer exists
-        dense[group[known], np.array(vertex, np.int64)[known]] = np.array(weight,
-                                                                         np.float32)[known]
-    return {name: dense[i] for i, name in names.items()}
 
 
 #: A vertex whose deforming weights sum to at most this stays at rest (the Armature modifier's
@@ -428,11 +410,18 @@ def sample(context, objects, camera_relative=False, pose_only=True):
     start, end, what = bake_range(scene)
     if end <= start:
         raise SampleError(f"the {what} {start}-{end} needs at least two frames")
+    with weights.own_updates(context):
+        return _sample(context, meshes, camera_relative, pose_only)
+
+
+def _sample(context, meshes, camera_relative, pose_only):
+    scene = context.scene
+    start, end, _ = bake_range(scene)
     armature = _group_armature(meshes)
     joint_names, parents = _joint_order(armature) if armature else ([], [])
 
     frames = end - start + 1
-    groups = {o.name: _groups(o, len(o.data.vertices)) for o in meshes}
+    groups = {o.name: weights.read(o, len(o.data.vertices)) for o in meshes}
     posed = _readers_evaluated(meshes, [o for o in meshes
                                         if pose_only and pose_only_reason(o) is None])
     evaluated = [o for o in meshes if o not in posed]

@@ -8,8 +8,10 @@ TUBE.glb: `cargo run -p toonkit-smear --example write_tube -- TUBE.glb 40`; EXTE
 never part of this repository), whose package directory is imported as `SMEAR`. Run with the
 Python of a `bpy` venv. The add-on's bake is its operator body without the node-group setup
 (it appends node groups from a .blend the timing does not need): the frame loop, its offsets
-and their attribute writes. Prints one JSON line with the median, least and CPU times and
-their ratios.
+and their attribute writes. RUNS interleaved rounds of the extension's first bake (the
+mesh's vertex weights read), its repeated bake (kept weights, as after an unbake) and the
+add-on's bake, on the same mesh. Prints one JSON line with the median, least and CPU times
+and their ratios.
 """
 
 import importlib.util
@@ -50,19 +52,20 @@ def addon(path):
     return panel
 
 
-def timed(bake, runs, before=lambda: None):
-    """Median and least wall time, and median process CPU time (every thread's), of `runs`
-    calls of `bake`. On a shared machine the least wall time and the CPU time are the figures
-    least disturbed by other processes; the CPU time of a parallel bake bounds an idle
-    machine's wall time from above."""
-    times, cpu = [], []
-    for _ in range(runs):
-        before()
-        t, c = time.perf_counter(), time.process_time()
-        bake()
-        times.append(time.perf_counter() - t)
-        cpu.append(time.process_time() - c)
-    return float(np.median(times)), float(min(times)), float(np.median(cpu))
+def clock(bake):
+    """Wall and process CPU time (every thread's) of one call of `bake`."""
+    t, c = time.perf_counter(), time.process_time()
+    bake()
+    return time.perf_counter() - t, time.process_time() - c
+
+
+def summary(times):
+    """Median and least wall time, median CPU time, in seconds. On a shared machine the least
+    wall time and the CPU time are the figures least disturbed by other processes; the CPU
+    time of a parallel bake bounds an idle machine's wall time from above."""
+    wall = [w for w, _ in times]
+    return (round(float(np.median(wall)), 4), round(min(wall), 4),
+            round(float(np.median([c for _, c in times])), 4))
 
 
 def main():
@@ -72,33 +75,72 @@ def main():
     r = bpy.ops.extensions.package_install_files(filepath=os.path.abspath(zip_path),
                                                  repo="user_default", enable_on_install=True)
     assert r == {"FINISHED"}, r
-    mesh = tube(path)
-    def unbaked():  # a bake hides its original: unbake and select it again
-        bpy.ops.toonkit.smear_unbake()
-        mesh.select_set(True)
+    from bl_ext.user_default.toonkit import weights
 
-    ours = timed(lambda: bpy.ops.toonkit.smear_bake(), runs, unbaked)
-    bpy.ops.toonkit.smear_unbake()
-    figures = {"blender": bpy.app.version_string, "vertices": len(mesh.data.vertices),
-               "frames": bpy.context.scene.frame_end - bpy.context.scene.frame_start + 1,
-               "extension_bake_s": round(ours[0], 4), "extension_bake_min_s": round(ours[1], 4),
-               "extension_bake_cpu_s": round(ours[2], 4)}
+    addon_error = None
     if addon_dir:
         addon(addon_dir)
-        mesh = tube(path)
-        try:
-            theirs = timed(lambda: bpy.ops.scene.bake_deltas_and_trajectories(), runs)
-        except RuntimeError as e:  # e.g. Blender 5.0, whose actions have no `fcurves`
-            lines = [ln for ln in str(e).splitlines() if "Error" in ln]
-            figures["addon_error"] = lines[-1].strip() if lines else str(e)
-            print(json.dumps(figures), flush=True)
-            return
-        check = [a.name for a in mesh.data.attributes if a.name.startswith("delta_")]
-        assert len(check) == figures["frames"], f"the add-on wrote {len(check)} frames"
-        figures.update(addon_bake_s=round(theirs[0], 4), addon_bake_min_s=round(theirs[1], 4),
-                       addon_bake_cpu_s=round(theirs[2], 4),
-                       ratio=round(theirs[0] / ours[0], 1), ratio_min=round(theirs[1] / ours[1], 1),
-                       ratio_cpu=round(theirs[2] / ours[2], 1))
+    mesh = tube(path)
+
+    def select():
+        for o in bpy.data.objects:
+            o.select_set(False)
+        mesh.select_set(True)
+        bpy.context.view_layer.objects.active = mesh
+
+    def ours(first):
+        bpy.ops.toonkit.smear_unbake()  # a bake hides its original
+        select()
+        if first:  # as on a first bake of the mesh: its vertex weights are read
+            weights.forget()
+        return clock(lambda: bpy.ops.toonkit.smear_bake())
+
+    def theirs():
+        bpy.ops.toonkit.smear_unbake()
+        select()
+        # Each add-on bake writes its attributes anew (no earlier bake's to overwrite).
+        for name in [a.name for a in mesh.data.attributes if a.name.startswith("delta_")]:
+            mesh.data.attributes.remove(mesh.data.attributes[name])
+        t = clock(lambda: bpy.ops.scene.bake_deltas_and_trajectories())
+        written = [a.name for a in mesh.data.attributes if a.name.startswith("delta_")]
+        frames = bpy.context.scene.frame_end - bpy.context.scene.frame_start + 1
+        assert len(written) == frames, f"the add-on wrote {len(written)} frames"
+        for name in written:  # our bakes copy the mesh: leave it as it was
+            mesh.data.attributes.remove(mesh.data.attributes[name])
+        return t
+
+    # Interleaved rounds (first bake, repeated bake, the add-on's) after one warm-up round,
+    # so that a busy machine slows all three alike.
+    first, repeated, addon_times = [], [], []
+    for i in range(runs + 1):
+        a, b = ours(True), ours(False)
+        c = None
+        if addon_dir and addon_error is None:
+            try:
+                c = theirs()
+            except RuntimeError as e:  # e.g. Blender 5.0, whose actions have no `fcurves`
+                lines = [ln for ln in str(e).splitlines() if "Error" in ln]
+                addon_error = lines[-1].strip() if lines else str(e)
+        if i > 0:
+            first.append(a)
+            repeated.append(b)
+            if c is not None:
+                addon_times.append(c)
+    bpy.ops.toonkit.smear_unbake()
+    figures = {"blender": bpy.app.version_string, "vertices": len(mesh.data.vertices),
+               "frames": bpy.context.scene.frame_end - bpy.context.scene.frame_start + 1}
+    for label, times in (("first_bake", first), ("repeated_bake", repeated)):
+        wall, least, cpu = summary(times)
+        figures.update({f"{label}_s": wall, f"{label}_min_s": least, f"{label}_cpu_s": cpu})
+    if addon_error is not None:
+        figures["addon_error"] = addon_error
+    elif addon_times:
+        wall, least, cpu = summary(addon_times)
+        figures.update(addon_bake_s=wall, addon_bake_min_s=least, addon_bake_cpu_s=cpu)
+        for label in ("first_bake", "repeated_bake"):
+            figures[f"ratio_{label}"] = round(wall / figures[f"{label}_s"], 1)
+            figures[f"ratio_{label}_min"] = round(least / figures[f"{label}_min_s"], 1)
+            figures[f"ratio_{label}_cpu"] = round(cpu / figures[f"{label}_cpu_s"], 1)
     figures["load_average"] = os.getloadavg()[0]
     print(json.dumps(figures), flush=True)
 

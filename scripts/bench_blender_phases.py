@@ -1,13 +1,16 @@
 """Where the extension's smear bake spends its time, phase by phase, in one bpy process on the
 benchmark tube (docs/blender.md, "Speed"):
 
-    python scripts/bench_blender_phases.py TUBE.glb EXTENSION.zip [RUNS]
+    python scripts/bench_blender_phases.py TUBE.glb EXTENSION.zip [RUNS] [first|repeated]
 
 TUBE.glb: `cargo run -p toonkit-smear --example write_tube -- TUBE.glb 40`; EXTENSION.zip:
 `python blender/build.py`. Run with the Python of a `bpy` venv. Wraps the extension's sampling,
 transfer, core and write-back functions with timers (process CPU time of every thread, and wall
 time), bakes RUNS times after two warm-up bakes and prints the median bake and each phase's
-time per bake, largest first. Nested phases are included in their callers' times.
+time per bake, largest first. Nested phases are included in their callers' times. `first`
+(the default) forgets the vertex weights the extension keeps per mesh before each bake, as
+on a first bake of the mesh; `repeated` keeps them, as on a bake after an unbake or a restyle
+without an edit of the mesh.
 """
 
 import functools
@@ -42,9 +45,11 @@ def wrap(owner, name, label):
 
 def instrument():
     import toonkit
-    from bl_ext.user_default.toonkit import job, results, sample
+    from bl_ext.user_default.toonkit import job, results, sample, weights
 
-    for name, label in (("sample", "sample (all of it)"), ("_groups", "sample: vertex weights"),
+    wrap(weights, "read", "sample: vertex weights (kept or read)")
+    wrap(weights, "_read", "sample: vertex weights read")
+    for name, label in (("sample", "sample (all of it)"),
                         ("_rest_matrices", "sample: rest pose matrices"),
                         ("_rest_positions", "sample: rest positions"),
                         ("_skin_and_attributes", "sample: SMEAR skin + attributes"),
@@ -67,6 +72,7 @@ def instrument():
 def main():
     path, zip_path = sys.argv[1], sys.argv[2]
     runs = int(sys.argv[3]) if len(sys.argv) > 3 else 10
+    fresh = (sys.argv[4] if len(sys.argv) > 4 else "first") == "first"
     r = bpy.ops.extensions.package_install_files(filepath=os.path.abspath(zip_path),
                                                  repo="user_default", enable_on_install=True)
     assert r == {"FINISHED"}, r
@@ -87,12 +93,15 @@ def main():
             o.select_set(False)
         mesh.select_set(True)
         bpy.context.view_layer.objects.active = mesh
+        if fresh:
+            from bl_ext.user_default.toonkit import weights
+            weights.forget()
         c, t = time.process_time(), time.perf_counter()
         bpy.ops.toonkit.smear_bake()
         if i >= 2:
             bakes.append((time.process_time() - c, time.perf_counter() - t))
-    print(f"bake ({bpy.app.version_string}, {len(mesh.data.vertices)} vertices, "
-          f"{scene.frame_end - scene.frame_start + 1} frames): median CPU "
+    print(f"{'first' if fresh else 'repeated'} bake ({bpy.app.version_string}, "
+          f"{len(mesh.data.vertices)} vertices, {scene.frame_end - scene.frame_start + 1} frames): median CPU "
           f"{1000 * np.median([c for c, _ in bakes]):.1f} ms, wall "
           f"{1000 * np.median([w for _, w in bakes]):.1f} ms (least "
           f"{1000 * min(w for _, w in bakes):.1f}), load average {os.getloadavg()[0]:.1f}")

@@ -142,6 +142,22 @@ try {
   const partAll = (k) => median(latAll.map((l) => l[k])).toFixed(1);
   console.log(`  of which: request until answer ${partAll('fetch_ms')} ms, laid over the clip and into the scene ${partAll('apply_ms')} ms, until the next render is done ${partAll('draw_ms')} ms`);
   const whole = await page.evaluate(() => { const p = window.studio.panels.smear; return { body: p.body.length, frames: p.anim.frames, vertices: p.anim.vertices }; });
+  // The quantized answer (crates/studio/src/api/changes.rs) against the core's float32 body.
+  const quant = await page.evaluate(async () => {
+    const s = window.studio, p = s.panels.smear;
+    const r = await fetch('/api/smear/stylize', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify({ file: s.file, clip: s.clip, style: p.style }) });
+    const m = await r.arrayBuffer(), view = new DataView(m), len = view.getUint32(0, true);
+    const head = JSON.parse(new TextDecoder().decode(new Uint8Array(m, 4, len)));
+    const b = head.buffers.find((x) => x.name === 'body');
+    const exact = new Float32Array(m, 4 + len + b.offset, b.count), input = p.anim.positions;
+    let lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+    for (let i = 0; i < input.length; i++) { lo[i % 3] = Math.min(lo[i % 3], input[i]); hi[i % 3] = Math.max(hi[i % 3], input[i]); }
+    const diag = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+    let worst = 0;
+    for (let i = 0; i < exact.length; i++) worst = Math.max(worst, Math.abs(exact[i] - p.body[i]));
+    return { worst, diag, rel: worst / diag, floats: exact.length };
+  });
+  check('the whole clip drawn matches the core\'s body within 1e-5 of the diagonal', quant.floats === 81 * whole.vertices * 3 && quant.rel <= 1e-5, JSON.stringify(quant));
   check('every slider move brings the whole clip (81 frames × every vertex)', latAll.every((l) => l.frames === 81) && whole.frames === 81 && whole.body === 81 * whole.vertices * 3, `${JSON.stringify(latAll.map((l) => l.frames))}; body ${whole.body} floats`);
   // The panel's report of the whole clip in sight (docs/studio.png).
   await page.evaluate(() => document.getElementById('smear-report').scrollIntoView());
@@ -278,14 +294,47 @@ try {
     for (const p of d.pts) worst = Math.max(worst, Math.min(...f.points.map((q) => Math.hypot(p[0] - q[0], p[1] - q[1]))));
   }
   check('the line passes through the three strokes (API query)', worst < 0.05 * box.height, `farthest stroke point ${worst.toFixed(1)} px from the line`);
-  const moved = await page.evaluate(() => {
+  // The core's positions of the motion (every frame × vertex), as exports write them.
+  const corePositions = () => page.evaluate(async () => {
     const r = window.studio.panels.loa.result;
+    const m = await (await fetch(`/api/loa/motion?version=${r.header.version}`)).arrayBuffer();
+    const view = new DataView(m), len = view.getUint32(0, true);
+    const head = JSON.parse(new TextDecoder().decode(new Uint8Array(m, 4, len)));
+    const b = head.buffers.find((x) => x.name === 'positions');
+    window.__core = new Float32Array(m, 4 + len + b.offset, b.count);
+    return b.count;
+  });
+  await corePositions();
+  const moved = await page.evaluate(() => {
+    const r = window.studio.panels.loa.result, p = window.__core;
     const n = r.header.motion.vertices * 3, f = r.header.motion.frames;
-    const a = r.buffers.positions.subarray(0, n), b = r.buffers.positions.subarray((f - 1) * n, f * n);
+    const a = p.subarray(0, n), b = p.subarray((f - 1) * n, f * n);
     let m = 0; for (let i = 0; i < n; i++) m = Math.max(m, Math.abs(a[i] - b[i]));
     return m;
   });
   check('the character moves', moved > 0.01, `largest vertex displacement ${moved.toFixed(3)}`);
+  // The renderer skins the pose (SkinnedMesh): the vertices it draws at three frames (three.js
+  // getVertexPosition, the shader's skinning on the CPU) against the core's skinned positions.
+  const skinErr = await page.evaluate(() => {
+    const s = window.studio, r = s.panels.loa.result, p = window.__core, v = s.view;
+    const nv = r.header.motion.vertices, nf = r.header.motion.frames;
+    let lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+    for (let i = 0; i < p.length; i++) { lo[i % 3] = Math.min(lo[i % 3], p[i]); hi[i % 3] = Math.max(hi[i % 3], p[i]); }
+    const diag = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+    if (!v.mesh.isSkinnedMesh) return { skinned: false, diag };
+    const first = r.header.motion.first_frame, q = new v.mesh.position.constructor();
+    let worst = 0;
+    for (const f of [0, Math.floor(nf / 2), nf - 1]) {
+      s.setFrame(first + f);
+      for (let i = 0; i < nv; i++) {
+        v.mesh.getVertexPosition(i, q);
+        const o = (f * nv + i) * 3;
+        worst = Math.max(worst, Math.hypot(q.x - p[o], q.y - p[o + 1], q.z - p[o + 2]));
+      }
+    }
+    return { skinned: true, worst, diag, rel: worst / diag };
+  });
+  check('the drawn (renderer-skinned) vertices match the core\'s at three frames within 1e-4 of the diagonal', skinErr.skinned && skinErr.rel <= 1e-4, JSON.stringify(skinErr));
   await page.evaluate(() => window.studio.setFrame(6));
   await page.waitForTimeout(300);
   await page.screenshot({ path: join(shots, 'loa.png') });
@@ -306,8 +355,8 @@ try {
   console.log(`latency new stroke → line + whole character motion drawn: median ${median(loaAll.map((l) => l.ms)).toFixed(1)} ms of ${loaAll.length}, max ${Math.max(...loaAll.map((l) => l.ms)).toFixed(1)} ms, server median ${median(loaAll.map((l) => l.server_ms)).toFixed(1)} ms, ${(median(loaAll.map((l) => l.bytes)) / 1048576).toFixed(2)} MiB; target 60 ms`);
   const partLoa = (k) => median(loaAll.map((l) => l[k])).toFixed(1);
   console.log(`  of which: request until answer ${partLoa('fetch_ms')} ms, into the scene ${partLoa('apply_ms')} ms, until the next render is done ${partLoa('draw_ms')} ms`);
-  const motion = await page.evaluate(() => { const r = window.studio.panels.loa.result, m = r.header.motion; return { floats: r.buffers.positions.length, frames: m.frames, vertices: m.vertices, drawn: window.studio.view.anim.frames }; });
-  check('a stroke brings the whole motion in one answer (every frame × every vertex)', motion.frames > 24 && motion.floats === motion.frames * motion.vertices * 3 && motion.drawn === motion.frames, JSON.stringify(motion));
+  const motion = await page.evaluate(() => { const r = window.studio.panels.loa.result, m = r.header.motion; return { floats: (r.buffers['skin.world'] || []).length, nodes: m.skin && m.skin.nodes, frames: m.frames, vertices: m.vertices, drawn: window.studio.view.anim.frames }; });
+  check('a stroke brings the whole motion in one answer (the pose of every frame)', motion.frames > 24 && motion.floats === motion.frames * motion.nodes * 16 && motion.drawn === motion.frames, JSON.stringify(motion));
 
   // stopmo: two seed clicks on the face + run → two parts.
   await page.evaluate(() => window.studio.activate('stopmo'));

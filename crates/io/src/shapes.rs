@@ -163,17 +163,25 @@ pub(crate) fn write_pc2(path: &Path, parts: &[ShapeAnimation<'_>]) -> Result<()>
         let io = |e| IoError::io(path, e);
         let header = crate::pc2::header_bytes(vertices, frames, first.start_time, first.fps);
         w.write_all(&header).map_err(io)?;
-        let mut frame = Vec::with_capacity(vertices * 12);
+        let mut le = Vec::new();
         for f in 0..frames {
-            frame.clear();
             for p in parts {
-                for v in &p.shapes[p.shown[f] as usize] {
-                    for c in v.to_array() {
-                        frame.extend_from_slice(&c.to_le_bytes());
-                    }
-                }
+                let shape: &[Vec3] = &p.shapes[p.shown[f] as usize];
+                // PC2 is little-endian: on such machines a shape's memory is its bytes.
+                let bytes: &[u8] = if cfg!(target_endian = "little") {
+                    bytemuck::cast_slice(shape)
+                } else {
+                    le.clear();
+                    le.extend(
+                        shape
+                            .iter()
+                            .flat_map(|v| v.to_array())
+                            .flat_map(f32::to_le_bytes),
+                    );
+                    &le
+                };
+                w.write_all(bytes).map_err(io)?;
             }
-            w.write_all(&frame).map_err(io)?;
         }
         w.flush().map_err(io)
     })

@@ -6,8 +6,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use anim::{MeshAnimation, SampleOptions, SampledScene};
-use numpy::{PyArrayDyn, ToPyArray};
+use numpy::PyArrayDyn;
 use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyList, PyRange};
 use tkio::{LoadOptions, Loaded};
 
@@ -33,14 +34,17 @@ pub(crate) struct Scene {
     /// The scene as read (hierarchy, skins, clips) when it came from a glTF/BVH file: what
     /// `toonkit.loa.animate` poses.
     pub(crate) file_scene: Option<Arc<anim::Scene>>,
-    positions: Py<PyArrayDyn<f32>>,
+    /// Every object's positions merged per frame, made on first read: a host that hands
+    /// its arrays to `from_arrays` and prepares at once never pays a copy of the clip it
+    /// already holds (docs/blender.md, "Speed").
+    positions: PyOnceLock<Py<PyArrayDyn<f32>>>,
     triangles: Py<PyArrayDyn<i32>>,
     /// The files the load read: while the scene lives, no save may replace them.
     _inputs: Option<tkio::ReadScope>,
 }
 
 impl Scene {
-    /// Wraps a sampled scene (merging its objects once for the array views).
+    /// Wraps a sampled scene; its merged positions array is made on first use.
     pub(crate) fn new(
         py: Python<'_>,
         sampled: SampledScene,
@@ -48,35 +52,6 @@ impl Scene {
         file_scene: Option<Arc<anim::Scene>>,
         inputs: Option<tkio::ReadScope>,
     ) -> PyResult<Scene> {
-        Scene::with_positions(py, sampled, source, file_scene, inputs, None)
-    }
-
-    /// [`Scene::new`] whose merged positions array is `merged` when given (a host's
-    /// frame-major array in object order, copied by numpy: no second merge of the frames).
-    pub(crate) fn with_positions(
-        py: Python<'_>,
-        sampled: SampledScene,
-        source: String,
-        file_scene: Option<Arc<anim::Scene>>,
-        inputs: Option<tkio::ReadScope>,
-        merged: Option<Bound<'_, PyArrayDyn<f32>>>,
-    ) -> PyResult<Scene> {
-        let (frames, vertices) = (sampled.frame_count, sampled.vertex_count());
-        let positions = match merged {
-            Some(p) => {
-                p.call_method1("setflags", (false,))?;
-                p
-            }
-            None => {
-                let mut positions = Vec::with_capacity(frames * vertices * 3);
-                for f in 0..frames {
-                    for o in &sampled.objects {
-                        positions.extend_from_slice(bytemuck::cast_slice(o.animation.frame(f)));
-                    }
-                }
-                frozen(py, &[frames, vertices, 3], positions)?
-            }
-        };
         let mut triangles = Vec::new();
         let mut base = 0i32;
         for o in &sampled.objects {
@@ -87,7 +62,7 @@ impl Scene {
         }
         let nt = triangles.len() / 3;
         Ok(Scene {
-            positions: positions.unbind(),
+            positions: PyOnceLock::new(),
             triangles: frozen(py, &[nt, 3], triangles)?.unbind(),
             sampled: Arc::new(sampled),
             source,
@@ -274,23 +249,23 @@ impl Scene {
             attributes,
             rest.as_ref(),
         )?;
-        // `sampled` checked the shape; the objects tile the vertices in order, so the merged
-        // positions are the given ones (numpy's copy: its allocator, one memcpy).
-        let merged = positions.as_array().to_pyarray(py);
-        Scene::with_positions(
-            py,
-            sampled,
-            "<arrays>".to_string(),
-            None,
-            None,
-            Some(merged),
-        )
+        Scene::new(py, sampled, "<arrays>".to_string(), None, None)
     }
 
     /// float32 ``(frames, vertices, 3)``: world-space positions, objects merged in order.
     #[getter]
-    fn positions(&self, py: Python<'_>) -> Py<PyArrayDyn<f32>> {
-        self.positions.clone_ref(py)
+    fn positions(&self, py: Python<'_>) -> PyResult<Py<PyArrayDyn<f32>>> {
+        let p = self.positions.get_or_try_init(py, || {
+            let (frames, vertices) = (self.sampled.frame_count, self.sampled.vertex_count());
+            let mut positions = Vec::with_capacity(frames * vertices * 3);
+            for f in 0..frames {
+                for o in &self.sampled.objects {
+                    positions.extend_from_slice(bytemuck::cast_slice(o.animation.frame(f)));
+                }
+            }
+            frozen(py, &[frames, vertices, 3], positions).map(Bound::unbind)
+        })?;
+        Ok(p.clone_ref(py))
     }
 
     /// int32 ``(t, 3)``: triangles indexing ``positions``' vertices.

@@ -288,7 +288,7 @@ fn face_run_equals_segment_then_library_and_searches_a_size() {
 
 /// A clip handed over to the job (its frames grown into the cut's in place) segments exactly
 /// as a borrowed one: the same cut animation, parts and reports, bit for bit, with fresh seeds
-/// and when reusing a saved cut.
+/// and when reusing a saved cut; with the cut's frames moved into the parts, the same parts.
 #[test]
 fn face_handed_over_segments_bit_for_bit_as_borrowed() {
     let anim = common::face(1.0);
@@ -327,6 +327,23 @@ fn face_handed_over_segments_bit_for_bit_as_borrowed() {
         assert_eq!(owned.parts.len(), expected.parts.len());
         for (p, q) in owned.parts.iter().zip(&expected.parts) {
             assert_eq!(p.vertices, q.vertices);
+            assert_eq!(p.animation.positions(), q.animation.positions());
+        }
+        // Keeping only the parts: the cut's frames moved into them, the same parts and
+        // report (the summary still counts every frame).
+        let taken = stopmo::segment_into_parts(anim.clone(), opts).unwrap();
+        assert_eq!(taken.segmentation.animation.frame_count(), 1);
+        let (a, b) = (taken.summary(), expected.summary());
+        assert_eq!((a.parts, a.frames), (b.parts, b.frames));
+        assert_eq!(
+            untimed(&taken.report_json()),
+            untimed(&expected.report_json())
+        );
+        assert_eq!(taken.parts.len(), expected.parts.len());
+        for (p, q) in taken.parts.iter().zip(&expected.parts) {
+            assert_eq!(p.vertices, q.vertices);
+            assert_eq!(p.animation.mesh.triangles, q.animation.mesh.triangles);
+            assert_eq!(p.animation.fps, q.animation.fps);
             assert_eq!(p.animation.positions(), q.animation.positions());
         }
     }

@@ -3,7 +3,7 @@
 //!
 //! Layout: `u32` header length `H`, `H` bytes of JSON (space-padded to a multiple of 4),
 //! then the buffers back to back. The header is the caller's JSON object plus
-//! `"buffers": [{"name", "type": "f32"|"u32", "offset", "count"}]` (offset in bytes from the
+//! `"buffers": [{"name", "type": "f32"|"u32"|"i16", "offset", "count"}]` (offset in bytes from the
 //! start of the data, count in elements), so the page can view each one as a typed array
 //! without copying.
 //!
@@ -139,6 +139,21 @@ impl Pack {
         self.entry(name, "u32", offset, count)
     }
 
+    /// Adds an int16 buffer (zero-padded to a multiple of 4 bytes, so the buffers after it
+    /// stay aligned for the page's typed arrays).
+    pub fn i16(&mut self, name: &str, values: impl IntoIterator<Item = i16>) -> &mut Pack {
+        let offset = self.offset();
+        let mut count = 0usize;
+        for v in values {
+            self.data.extend_from_slice(&v.to_le_bytes());
+            count += 1;
+        }
+        if count % 2 == 1 {
+            self.data.extend_from_slice(&[0, 0]);
+        }
+        self.entry(name, "i16", offset, count)
+    }
+
     fn entry(&mut self, name: &str, kind: &str, offset: usize, count: usize) -> &mut Pack {
         self.entries.push(json!({
             "name": name, "type": kind, "offset": offset, "count": count
@@ -249,6 +264,23 @@ pub fn read_u32(bytes: &[u8], name: &str) -> Option<Vec<u32>> {
     )
 }
 
+/// Reads a pack back: the named int16 buffer (for tests and tools).
+pub fn read_i16(bytes: &[u8], name: &str) -> Option<Vec<i16>> {
+    let (header, data) = split(bytes)?;
+    let entry = header["buffers"]
+        .as_array()?
+        .iter()
+        .find(|b| b["name"] == name && b["type"] == "i16")?;
+    let offset = entry["offset"].as_u64()? as usize;
+    let count = entry["count"].as_u64()? as usize;
+    let raw = data.get(offset..offset + count * 2)?;
+    Some(
+        raw.chunks_exact(2)
+            .map(|c| i16::from_le_bytes([c[0], c[1]]))
+            .collect(),
+    )
+}
+
 /// Splits a pack into its header and data.
 pub fn split(bytes: &[u8]) -> Option<(Value, &[u8])> {
     let len = u32::from_le_bytes(bytes.get(..4)?.try_into().ok()?) as usize;
@@ -268,6 +300,7 @@ mod tests {
         let held = std::sync::Arc::new(vec![4.0f32, 5.0, 6.0]);
         p.shared("held", held.clone(), |v| &v[..]);
         p.u32("after", [9]);
+        p.i16("small", [-3, 7, 1]).u32("aligned", [5]);
         let bytes = p.finish(json!({"frames": 3}));
         let (header, pos) = read_f32(&bytes, "pos").unwrap();
         assert_eq!(pos, vec![1.5, -2.0]);
@@ -276,6 +309,10 @@ mod tests {
         assert_eq!(header["buffers"][3]["offset"], 32);
         assert_eq!(header["buffers"][4]["offset"], 44);
         assert_eq!(header["frames"], 3);
+        assert_eq!(header["buffers"][5]["type"], "i16");
+        assert_eq!(header["buffers"][6]["offset"], 56);
+        assert_eq!(read_u32(&bytes, "aligned").unwrap(), vec![5]);
+        assert_eq!(read_i16(&bytes, "small").unwrap(), vec![-3, 7, 1]);
         assert_eq!(header["buffers"][1]["offset"], 12);
         let len = u32::from_le_bytes(bytes[..4].try_into().unwrap()) as usize;
         assert_eq!(len % 4, 0);

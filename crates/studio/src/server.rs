@@ -6,6 +6,7 @@ use std::sync::Arc;
 
 use axum::extract::DefaultBodyLimit;
 use axum::routing::get;
+use axum::serve::ListenerExt;
 use axum::Router;
 
 use crate::error::{ApiError, StudioError};
@@ -90,6 +91,11 @@ pub fn serve(options: &ServeOptions) -> Result<(), StudioError> {
         if options.open {
             open_browser(&url);
         }
+        // Answers go out as a header chunk then the buffers: without TCP_NODELAY the small
+        // writes wait for the page's delayed acknowledgement (tens of milliseconds).
+        let listener = listener.tap_io(|tcp| {
+            let _ = tcp.set_nodelay(true);
+        });
         axum::serve(listener, router(studio, port)).await
     })?;
     Ok(())

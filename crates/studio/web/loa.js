@@ -173,6 +173,9 @@ export class LoaPanel {
         height: this.overlay.clientHeight,
         keystrokes: this.keys.map((k) => ({ frame: k.frame, points: k.points, stiffness: k.stiffness, damping: k.damping, bones: k.bones })),
         wobbles: this.wobbles,
+        // The renderer skins the motion: the answer is the skeleton's pose per frame (and
+        // the binding, when the one held is not the character's).
+        skin: this.binding ? this.binding.id : '',
       };
       // One answer: the line (every frame) and the character's whole motion, as float32.
       const r = await getPack('/api/loa/animate', body);
@@ -185,7 +188,16 @@ export class LoaPanel {
       // the index uploaded to the GPU) when they are the array it already draws.
       const tri = r.buffers.triangles, shown = s.view.anim && s.view.anim.triangles;
       const triangles = shown && shown.length === tri.length && shown.every((t, i) => t === tri[i]) ? shown : tri;
-      s.view.setAnimation({ triangles, positions: r.buffers.positions, frames: h.motion.positions_frames, vertices: h.motion.vertices }, { frame: false });
+      const skin = h.motion.skin;
+      if (skin && r.buffers['skin.rest']) {
+        const b = r.buffers;
+        this.binding = { id: skin.id, rest: b['skin.rest'], index: b['skin.index'], weight: b['skin.weight'], node: b['skin.node'], inverse: b['skin.inverse'] };
+      }
+      if (skin && this.binding && this.binding.id === skin.id) {
+        s.view.setSkinned({ triangles, binding: this.binding, world: r.buffers['skin.world'], nodes: skin.nodes, frames: h.motion.frames, vertices: h.motion.vertices });
+      } else {
+        s.view.setAnimation({ triangles, positions: r.buffers.positions, frames: h.motion.positions_frames, vertices: h.motion.vertices }, { frame: false });
+      }
       s.setTimeline(Math.max(TIMELINE, h.line.first_frame + h.line.frames + 12), 24);
       this.onFrame(s.frame);
       const applied = performance.now();

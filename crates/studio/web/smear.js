@@ -26,22 +26,26 @@ function splitLines(buffers, i) {
 
 /**
  * The body of a whole-clip answer sent as changes (`body.changed` bits per frame and vertex,
- * `body.positions` of the moved vertices; crates/studio/src/api/changes.rs) rebuilt over the
- * input clip: the core's exact numbers from fewer bytes.
+ * then the moved vertices as `body.delta` × `body.step` from the input, or as
+ * `body.positions`; crates/studio/src/api/changes.rs) rebuilt over the input clip: the
+ * core's numbers within 1e-5 of the clip's diagonal (docs/studio.md), unmoved vertices exact.
  */
 export function expandChanges(buffers, input, first, frames) {
   const n = input.vertices, words = Math.ceil(n / 32);
   const body = input.positions.slice(first * n * 3, (first + frames) * n * 3);
-  const bits = buffers['body.changed'], moved = buffers['body.positions'];
+  const bits = buffers['body.changed'], exact = buffers['body.positions'];
+  const delta = buffers['body.delta'], steps = buffers['body.step'];
   let k = 0;
   for (let f = 0; f < frames; f++) {
+    const step = steps ? steps[f] : 0;
     for (let w = 0; w < words; w++) {
       let word = bits[f * words + w];
       while (word) {
         const b = 31 - Math.clz32(word & -word);
         word &= word - 1;
         const o = (f * n + w * 32 + b) * 3;
-        body[o] = moved[k]; body[o + 1] = moved[k + 1]; body[o + 2] = moved[k + 2];
+        if (exact) { body[o] = exact[k]; body[o + 1] = exact[k + 1]; body[o + 2] = exact[k + 2]; }
+        else { body[o] += delta[k] * step; body[o + 1] += delta[k + 1] * step; body[o + 2] += delta[k + 2] * step; }
         k += 3;
       }
     }
@@ -274,7 +278,8 @@ export class SmearPanel {
       if (!this.pending) {
         const gen = this.gen;
         // The whole clip is asked for now, after the current frame's answer and before it is
-        // drawn: the small request does not wait behind the clip's on the server's cores,
+        // drawn: the small request does not wait behind the clip's on the server's cores
+        // (asked for together, the current frame took twice as long on a loaded machine),
         // and the server restyles the clip while the page draws the frame.
         const ctl = new AbortController();
         const rest = getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...body, changes: true }, ctl.signal);

@@ -29,7 +29,6 @@ export class Viewport {
     this.lines = [];
     this.offsets = null;
     this.vertexColors = null;
-    this.onRendered = [];
     this.resize();
     new ResizeObserver(() => this.resize()).observe(canvas);
   }
@@ -45,8 +44,9 @@ export class Viewport {
 
   /** Shows an animation: {triangles: Uint32Array, positions: Float32Array, frames, vertices}. */
   setAnimation(anim, { frame = true } = {}) {
-    const reuse = this.mesh && this.anim && this.anim.vertices === anim.vertices && this.anim.triangles === anim.triangles;
+    const reuse = this.mesh && !this.mesh.isSkinnedMesh && this.anim && this.anim.vertices === anim.vertices && this.anim.triangles === anim.triangles;
     this.anim = anim;
+    this.skinned = null;
     if (!reuse) {
       if (this.mesh) { this.scene.remove(this.mesh); this.mesh.geometry.dispose(); }
       const g = new THREE.BufferGeometry();
@@ -59,6 +59,45 @@ export class Viewport {
       if (frame) this.frameCamera(anim);
     }
     this.setFrame(Math.min(this.frame, anim.frames - 1));
+  }
+
+  /**
+   * Shows a motion the renderer skins (three.js SkinnedMesh, linear blend skinning):
+   * {triangles, binding: {rest, index, weight, node, inverse} (crates/studio/src/api/loa_skin.rs),
+   * world (frames × nodes × 16, column-major), nodes, frames, vertices}. The mesh and its
+   * buffers stay on the GPU while the binding and triangles are the same: a new motion
+   * uploads only the bone matrices of the frame shown.
+   */
+  setSkinned(skinned) {
+    const b = skinned.binding;
+    const reuse = this.mesh && this.mesh.isSkinnedMesh && this.skinned && this.skinned.binding === b && this.skinned.triangles === skinned.triangles;
+    this.anim = { triangles: skinned.triangles, frames: skinned.frames, vertices: skinned.vertices, positions: null };
+    this.skinned = skinned;
+    if (!reuse) {
+      if (this.mesh) { this.scene.remove(this.mesh); this.mesh.geometry.dispose(); }
+      const g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.BufferAttribute(b.rest, 3));
+      g.setAttribute('color', new THREE.BufferAttribute(new Float32Array(skinned.vertices * 3).fill(0.78), 3));
+      g.setAttribute('skinIndex', new THREE.BufferAttribute(Uint16Array.from(b.index), 4));
+      g.setAttribute('skinWeight', new THREE.BufferAttribute(b.weight, 4));
+      g.setIndex(new THREE.BufferAttribute(skinned.triangles, 1));
+      g.computeVertexNormals();
+      // One bone per node of the pose, its world matrix set from the answer (not from a
+      // scene graph); the palette repeats a bone under each mesh's inverse bind matrix.
+      this.bones = Array.from({ length: skinned.nodes }, () => {
+        const bone = new THREE.Bone();
+        bone.matrixAutoUpdate = false; bone.matrixWorldAutoUpdate = false;
+        return bone;
+      });
+      const palette = Array.from(b.node, (n) => this.bones[n]);
+      const inverses = Array.from(b.node, (_, k) => new THREE.Matrix4().fromArray(b.inverse, k * 16));
+      const mesh = new THREE.SkinnedMesh(g, this.material);
+      mesh.bind(new THREE.Skeleton(palette, inverses), new THREE.Matrix4());
+      mesh.frustumCulled = false;
+      this.mesh = mesh;
+      this.scene.add(mesh);
+    }
+    this.setFrame(Math.min(this.frame, skinned.frames - 1));
   }
 
   frameCamera(anim) {
@@ -97,12 +136,18 @@ export class Viewport {
   setFrame(f) {
     if (!this.anim) return;
     this.frame = Math.max(0, Math.min(f, this.anim.frames - 1));
-    const n = this.anim.vertices * 3;
-    const pos = this.mesh.geometry.attributes.position;
-    pos.array.set(this.anim.positions.subarray(this.frame * n, (this.frame + 1) * n));
-    pos.needsUpdate = true;
-    this.mesh.geometry.computeVertexNormals();
-    this.mesh.geometry.computeBoundingSphere();
+    if (this.skinned) {
+      const s = this.skinned, base = this.frame * s.nodes * 16;
+      this.bones.forEach((bone, i) => bone.matrixWorld.fromArray(s.world, base + i * 16));
+      this.mesh.skeleton.update();
+    } else {
+      const n = this.anim.vertices * 3;
+      const pos = this.mesh.geometry.attributes.position;
+      pos.array.set(this.anim.positions.subarray(this.frame * n, (this.frame + 1) * n));
+      pos.needsUpdate = true;
+      this.mesh.geometry.computeVertexNormals();
+      this.mesh.geometry.computeBoundingSphere();
+    }
     this.updateColors();
     for (const c of this.copies) this.copyFrame(c);
     for (const l of this.lines) this.lineFrame(l);
@@ -208,10 +253,11 @@ export class Viewport {
     this.renderer.render(this.scene, this.camera);
     this.renderMs = performance.now() - t;
     this.dirty = false;
-    const done = this.onRendered; this.onRendered = [];
-    for (const f of done) f();
   }
 
-  /** Resolves after the next render. */
-  rendered() { this.dirty = true; return new Promise((resolve) => this.onRendered.push(resolve)); }
+  /**
+   * Renders now (new geometry is drawn as soon as it is in the scene, not at the next
+   * animation frame) and resolves once done.
+   */
+  rendered() { this.render(); return Promise.resolve(); }
 }

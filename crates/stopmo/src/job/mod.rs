@@ -39,8 +39,8 @@ pub use report::{
 };
 pub use result::{LibraryResult, Reconstruction};
 pub use segment_job::{
-    check_segment_memory, saved_segmentation, segment, segment_memory, segment_owned, PartSummary,
-    SegmentSummary, Segmented,
+    check_segment_memory, saved_segmentation, segment, segment_into_parts, segment_memory,
+    segment_owned, PartSummary, SegmentSummary, Segmented,
 };
 pub use size_curve::{library_of, size_curve, SizeCurve, SizePoint};
 pub use tkio::{FileData, OutputFile};

@@ -88,7 +88,7 @@ pub fn check_segment_memory(anim: &MeshAnimation) -> Result<()> {
 /// the clip's copies would be over [`anim::budget::DEFAULT_MAX_JOB_BYTES`], or the
 /// segmentation's own errors ([`Error::Segment`]).
 pub fn segment(anim: &MeshAnimation, opts: &SegmentJobOptions) -> Result<Segmented> {
-    segment_input(Cow::Borrowed(anim), opts)
+    segment_input(Cow::Borrowed(anim), opts, false)
 }
 
 /// [`segment`] of an animation handed over: the same result, but the input's frames become
@@ -98,10 +98,25 @@ pub fn segment(anim: &MeshAnimation, opts: &SegmentJobOptions) -> Result<Segment
 /// # Errors
 /// As [`segment`].
 pub fn segment_owned(anim: MeshAnimation, opts: &SegmentJobOptions) -> Result<Segmented> {
-    segment_input(Cow::Owned(anim), opts)
+    segment_input(Cow::Owned(anim), opts, false)
 }
 
-fn segment_input(anim: Cow<'_, MeshAnimation>, opts: &SegmentJobOptions) -> Result<Segmented> {
+/// [`segment_owned`] for a front end that keeps only the parts: the input's frames become
+/// the cut's, and the cut's move into the parts ([`Segmentation::take_parts`]), so the clip
+/// is resident about once at the peak. The result's `segmentation.animation` then holds
+/// only the cut mesh (one frame); everything else is as [`segment`] gives it.
+///
+/// # Errors
+/// As [`segment`].
+pub fn segment_into_parts(anim: MeshAnimation, opts: &SegmentJobOptions) -> Result<Segmented> {
+    segment_input(Cow::Owned(anim), opts, true)
+}
+
+fn segment_input(
+    anim: Cow<'_, MeshAnimation>,
+    opts: &SegmentJobOptions,
+    take: bool,
+) -> Result<Segmented> {
     let start = Instant::now();
     check_segment_memory(&anim)?;
     let (input_vertices, input_triangles) = (anim.vertex_count(), anim.mesh.triangle_count());
@@ -122,14 +137,19 @@ fn segment_input(anim: Cow<'_, MeshAnimation>, opts: &SegmentJobOptions) -> Resu
         }
     };
     segmentation.check_parts()?;
+    let mut segmentation = segmentation;
     let saved = segmentation.saved(input_vertices, input_triangles);
-    let parts = segmentation.parts()?;
     let figure = if opts.figure {
         Some(render::encode_png(&super::figure::parts_figure(
             &segmentation,
         )?)?)
     } else {
         None
+    };
+    let parts = if take {
+        segmentation.take_parts()?
+    } else {
+        segmentation.parts()?
     };
     Ok(Segmented {
         segmentation,
@@ -162,6 +182,14 @@ impl Segmented {
         self.parts.iter().map(|p| &p.animation).collect()
     }
 
+    /// Frames of the clip (the parts', which hold them all whichever job made them).
+    fn frame_count(&self) -> usize {
+        self.parts.first().map_or_else(
+            || self.segmentation.animation.frame_count(),
+            |p| p.animation.frame_count(),
+        )
+    }
+
     /// A short summary (no paths, no timing).
     pub fn summary(&self) -> SegmentSummary {
         let s = &self.segmentation;
@@ -175,7 +203,7 @@ impl Segmented {
                     triangles: p.animation.mesh.triangle_count(),
                 })
                 .collect(),
-            frames: s.animation.frame_count(),
+            frames: self.frame_count(),
             gamma: s.gamma,
             cut_length: s.cut_length,
             seam_vertices: s.seam_vertices.len(),
@@ -227,7 +255,7 @@ impl Segmented {
         format!(
             "{} over {} frames, cut length {:.3}, {} seam vertices",
             names.join(", "),
-            self.segmentation.animation.frame_count(),
+            self.frame_count(),
             self.segmentation.cut_length,
             self.segmentation.seam_vertices.len(),
         )

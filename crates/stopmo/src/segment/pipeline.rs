@@ -16,6 +16,10 @@ use super::smooth::{smooth_votes, vertex_votes, DEFAULT_SMOOTH_ITERATIONS, DEFAU
 use super::topology::{open_border, Topology};
 use super::weld::{Weld, DEFAULT_WELD_EPSILON};
 
+/// Vertices of the cut released at once while [`Segmentation::take_parts`] moves its frames
+/// (12 MiB: few reallocations, little held twice).
+const RELEASE_VERTICES: usize = 1 << 20;
+
 /// Parameters of [`segment`].
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
@@ -128,6 +132,64 @@ impl Segmentation {
     /// # Errors
     /// [`SegmentError::Parameter`] when `j` is not a part.
     pub fn part(&self, j: usize) -> Result<Part> {
+        let (mesh, vertices) = self.part_layout(j)?;
+        let positions: Vec<Vec3> = self
+            .animation
+            .frames()
+            .flat_map(|f| vertices.iter().map(move |&i| f[i as usize]))
+            .collect();
+        self.part_from(j, mesh, vertices, positions)
+    }
+
+    /// Every part as [`Segmentation::parts`] makes them, with the cut's frames moved into
+    /// them instead of copied: afterwards [`Segmentation::animation`] holds only the cut
+    /// mesh (one frame, its rest positions). The cut is released from its last frame down
+    /// as the parts are filled, so the clip is resident about once, not twice, at the peak.
+    ///
+    /// # Errors
+    /// As [`Segmentation::parts`].
+    pub fn take_parts(&mut self) -> Result<Vec<Part>> {
+        let layouts = (0..self.part_count())
+            .map(|j| self.part_layout(j))
+            .collect::<Result<Vec<_>>>()?;
+        let n = self.animation.vertex_count();
+        let frames = self.animation.frame_count();
+        let still = MeshAnimation::still(self.animation.mesh.clone());
+        let (fps, start_time) = (self.animation.fps, self.animation.start_time);
+        let (_, mut cut) = std::mem::replace(&mut self.animation, still).into_parts();
+        self.animation.fps = fps;
+        self.animation.start_time = start_time;
+        // Zeroed (fresh, untouched pages): a part's pages become resident as its frames are
+        // written, while the cut's are given back.
+        let mut out: Vec<Vec<Vec3>> = layouts
+            .iter()
+            .map(|(_, v)| bytemuck::zeroed_vec(frames * v.len()))
+            .collect();
+        for f in (0..frames).rev() {
+            let src = &cut[f * n..(f + 1) * n];
+            for ((_, vertices), dst) in layouts.iter().zip(&mut out) {
+                let m = vertices.len();
+                for (d, &i) in dst[f * m..(f + 1) * m].iter_mut().zip(vertices) {
+                    *d = src[i as usize];
+                }
+            }
+            if cut.len() - f * n >= RELEASE_VERTICES {
+                cut.truncate(f * n);
+                cut.shrink_to_fit();
+            }
+        }
+        drop(cut);
+        layouts
+            .into_iter()
+            .zip(out)
+            .enumerate()
+            .map(|(j, ((mesh, vertices), positions))| self.part_from(j, mesh, vertices, positions))
+            .collect()
+    }
+
+    /// Part `j`'s mesh (its triangles, vertices renumbered) and, for every part vertex, its
+    /// vertex in [`Segmentation::animation`].
+    fn part_layout(&self, j: usize) -> Result<(Mesh, Vec<u32>)> {
         if j >= self.part_count() {
             return Err(SegmentError::Parameter(format!("no part {j}")));
         }
@@ -168,12 +230,18 @@ impl Segmentation {
             .colors
             .as_ref()
             .map(|c| vertices.iter().map(|&i| c[i as usize]).collect());
-        let positions: Vec<Vec3> = self
-            .animation
-            .frames()
-            .flat_map(|f| vertices.iter().map(move |&i| f[i as usize]))
-            .collect();
-        let mut animation = MeshAnimation::new(part_mesh, self.animation.fps, positions)
+        Ok((part_mesh, vertices))
+    }
+
+    /// Part `j` from its layout and its frames.
+    fn part_from(
+        &self,
+        j: usize,
+        mesh: Mesh,
+        vertices: Vec<u32>,
+        positions: Vec<Vec3>,
+    ) -> Result<Part> {
+        let mut animation = MeshAnimation::new(mesh, self.animation.fps, positions)
             .map_err(|e| SegmentError::Invalid(e.to_string()))?;
         animation.start_time = self.animation.start_time;
         Ok(Part {

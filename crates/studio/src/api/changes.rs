@@ -1,44 +1,152 @@
 //! The whole clip's elongated body as what changed: per frame a bit per vertex (set where the
-//! style moved it off the input) and the moved vertices' positions. The page holds the input
-//! already (`/api/scene`), so it rebuilds the exact core result from fewer bytes — a speed
-//! style leaves the slow vertices (~60 % of the robot's Dance) where they were.
+//! style moved it off the input) and the moved vertices' displacements from the input,
+//! quantized to 16 bits with a per-frame step. The page holds the input already
+//! (`/api/scene`), so it rebuilds the core's result from few bytes — a speed style leaves the
+//! slow vertices (~60 % of the robot's Dance) where they were. The error bound is in
+//! docs/studio.md ("Whole clips").
 
 use anim::glam::Vec3;
+use rayon::prelude::*;
 
 use crate::pack::Pack;
 
+/// Largest quantization error of a moved vertex coordinate, as a fraction of the input clip's
+/// bounding-box diagonal: a frame whose displacements would need a coarser step sends the
+/// whole answer as float32 (`body.positions`).
+pub(crate) const MAX_QUANTIZATION_ERROR: f32 = 1e-5;
+
 /// Adds `body.changed` (u32 words, per frame `⌈vertices / 32⌉`, bit `v % 32` of word
-/// `v / 32` set when vertex `v` moved) and `body.positions` (f32 xyz of the moved vertices,
-/// frame-major, in vertex order). `body(f)` and `input(f)` are the merged vertices of frame
-/// `f` of the answer and of the input clip.
+/// `v / 32` set when vertex `v` moved), `body.step` (f32 per frame) and `body.delta` (i16 xyz
+/// of the moved vertices, frame-major, in vertex order: the position is the input's plus
+/// `delta × step`). When a frame's displacements are too large for 16 bits within
+/// [`MAX_QUANTIZATION_ERROR`] of the diagonal of the input's bounding box over the frames
+/// answered, `body.positions` (f32 xyz of the moved
+/// vertices) replaces `body.step` and `body.delta`. `body(f)` and `input(f)` are the merged
+/// vertices of frame `f` of the answer and of the input clip. Frames are compared and packed
+/// in parallel; only the answer's own buffers are allocated.
 pub(crate) fn pack_changes<'a>(
     pack: &mut Pack,
     frames: usize,
     vertices: usize,
-    body: impl Fn(usize) -> Vec<&'a [Vec3]>,
-    input: impl Fn(usize) -> &'a [Vec3],
+    body: impl Fn(usize) -> Vec<&'a [Vec3]> + Sync,
+    input: impl Fn(usize) -> &'a [Vec3] + Sync,
 ) {
     let words = vertices.div_ceil(32);
     let mut mask = vec![0u32; frames * words];
-    // Room for every vertex at once: no regrowth copies, and the pages no moved vertex
-    // reaches are never touched (not resident).
-    let mut moved: Vec<f32> = Vec::with_capacity(frames * vertices * 3);
-    for f in 0..frames {
-        let bits = &mut mask[f * words..(f + 1) * words];
-        let before = input(f);
-        let mut v = 0;
-        for slice in body(f) {
-            for p in slice {
-                // Bit-exact: the page must draw the core's numbers, not an approximation.
-                if before.get(v).is_none_or(|q| q.to_array() != p.to_array()) {
-                    bits[v / 32] |= 1 << (v % 32);
-                    moved.extend_from_slice(&p.to_array());
+    // Per frame: moved vertices, the largest displacement coordinate, the input's bounds.
+    let scan: Vec<(usize, f32, Vec3, Vec3)> = mask
+        .par_chunks_mut(words.max(1))
+        .enumerate()
+        .map(|(f, bits)| {
+            let before = input(f);
+            let (mut count, mut largest) = (0, 0.0f32);
+            let (lo, hi) = before.iter().fold(
+                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+            );
+            each_vertex(&body(f), |v, p| {
+                // Bit-exact: an unmoved vertex is drawn from the input itself.
+                match before.get(v) {
+                    Some(q) if q.to_array() == p.to_array() => {}
+                    q => {
+                        bits[v / 32] |= 1 << (v % 32);
+                        count += 1;
+                        largest =
+                            largest.max(q.map_or(f32::INFINITY, |q| (p - *q).abs().max_element()));
+                    }
                 }
-                v += 1;
-            }
+            });
+            (count, largest, lo, hi)
+        })
+        .collect();
+    let (lo, hi) = scan.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), s| (lo.min(s.2), hi.max(s.3)),
+    );
+    let diagonal = if frames > 0 { (hi - lo).length() } else { 0.0 };
+    let moved: Vec<(usize, f32)> = scan.iter().map(|s| (s.0, s.1)).collect();
+    let limit = 2.0 * f32::from(i16::MAX) * MAX_QUANTIZATION_ERROR * diagonal;
+    let quantized = moved.iter().all(|&(_, d)| d <= limit);
+    let total = moved.iter().map(|&(n, _)| 3 * n).sum::<usize>();
+    // Each frame's moved vertices in its own slice of the answer's buffer, filled in parallel.
+    let bits = |f: usize| &mask[f * words..(f + 1) * words];
+    if quantized {
+        let steps: Vec<f32> = moved
+            .iter()
+            .map(|&(_, d)| {
+                if d > 0.0 {
+                    d / f32::from(i16::MAX)
+                } else {
+                    1.0
+                }
+            })
+            .collect();
+        let mut delta = vec![0i16; total];
+        split_frames(&mut delta, &moved)
+            .into_par_iter()
+            .for_each(|(f, out)| {
+                let step = steps[f];
+                each_moved(&body(f), input(f), bits(f), |k, p, q| {
+                    let d = ((p - q) / step).round().to_array();
+                    for (o, x) in out[k..k + 3].iter_mut().zip(d) {
+                        *o = x as i16;
+                    }
+                });
+            });
+        pack.u32("body.changed", mask);
+        pack.f32("body.step", steps);
+        pack.i16("body.delta", delta);
+    } else {
+        let mut positions = vec![0.0f32; total];
+        split_frames(&mut positions, &moved)
+            .into_par_iter()
+            .for_each(|(f, out)| {
+                each_moved(&body(f), input(f), bits(f), |k, p, _| {
+                    out[k..k + 3].copy_from_slice(&p.to_array());
+                });
+            });
+        pack.u32("body.changed", mask);
+        // Sent from the vector itself, not copied once more into the pack.
+        pack.shared("body.positions", positions, |m| &m[..]);
+    }
+}
+
+/// Calls `visit(v, p)` for every vertex of a frame given as its objects' slices.
+fn each_vertex(slices: &[&[Vec3]], mut visit: impl FnMut(usize, Vec3)) {
+    let mut v = 0;
+    for slice in slices {
+        for p in *slice {
+            visit(v, *p);
+            v += 1;
         }
     }
-    pack.u32("body.changed", mask);
-    // Sent from the vector itself, not copied once more into the pack.
-    pack.shared("body.positions", moved, |m| &m[..]);
+}
+
+/// Calls `emit(k, p, q)` for every moved vertex (its bit set) of a frame: `k` its first value
+/// in the frame's slice, `p` its position, `q` the input's.
+fn each_moved(
+    slices: &[&[Vec3]],
+    before: &[Vec3],
+    bits: &[u32],
+    mut emit: impl FnMut(usize, Vec3, Vec3),
+) {
+    let mut k = 0;
+    each_vertex(slices, |v, p| {
+        if bits[v / 32] & (1 << (v % 32)) != 0 {
+            emit(k, p, before.get(v).copied().unwrap_or(Vec3::ZERO));
+            k += 3;
+        }
+    });
+}
+
+/// `buffer` cut into every frame's slice (three values per moved vertex of `moved`).
+fn split_frames<'b, T>(buffer: &'b mut [T], moved: &[(usize, f32)]) -> Vec<(usize, &'b mut [T])> {
+    let mut out = Vec::with_capacity(moved.len());
+    let mut rest = buffer;
+    for (f, &(n, _)) in moved.iter().enumerate() {
+        let (head, tail) = std::mem::take(&mut rest).split_at_mut(3 * n);
+        out.push((f, head));
+        rest = tail;
+    }
+    out
 }

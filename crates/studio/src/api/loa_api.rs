@@ -20,6 +20,7 @@ use loa::job;
 use serde::Deserialize;
 use serde_json::{json, Value};
 
+use super::loa_skin::Binding;
 use super::{blocking, body};
 use crate::error::{ApiError, ApiResult};
 use crate::files::{merged, output_path};
@@ -123,6 +124,11 @@ pub(crate) struct AnimateRequest {
     /// to the motion) and the page fetches the rest from `GET /api/loa/motion`.
     #[serde(default)]
     frame: Option<i64>,
+    /// The page skins the motion itself ([`super::loa_skin`]): the binding id it holds (`""`
+    /// for none). The answer then carries the pose (`skin.world`, and the binding when its
+    /// id differs) instead of `positions`, whenever the pose reproduces the core's positions.
+    #[serde(default)]
+    skin: Option<String>,
 }
 
 /// `GET /api/loa/motion` query: the `version` of the animate answer the page drew.
@@ -152,7 +158,9 @@ fn keystrokes_json(r: &AnimateRequest, fps: f64) -> Value {
 
 /// `POST /api/loa/animate`: buffers `line` (f32, line frames × joints × 2, canvas pixels),
 /// `positions` (f32, every motion frame × vertices × 3 in one answer — or only the motion
-/// frame `motion.positions_first` when the request names a `frame`), `triangles` (u32);
+/// frame `motion.positions_first` when the request names a `frame`; or, when the request
+/// asks for `skin` and `motion.skin` is set, the pose `skin.world` and the binding
+/// [`super::loa_skin`] instead), `triangles` (u32);
 /// `version` names the answer for `GET /api/loa/motion`.
 pub(crate) async fn animate(
     State(studio): State<Arc<Studio>>,
@@ -248,14 +256,29 @@ pub(crate) async fn animate(
         pack.u32("triangles", m.mesh.triangles.iter().flatten().copied());
         let m = Arc::new(m);
         let motion_frames = m.frame_count();
-        let shown = match r.frame {
-            Some(f) => {
+        let pose = r
+            .skin
+            .as_ref()
+            .and_then(|_| Binding::new(out, &sampled))
+            .and_then(|b| b.pose(&sampled, &m).map(|w| (b, w)));
+        let mut skin = Value::Null;
+        let shown = match (r.frame, pose) {
+            // The skeleton's pose for every frame; the binding when the page lacks it.
+            (None, Some((binding, world))) => {
+                if r.skin.as_deref() != Some(binding.id.as_str()) {
+                    binding.pack(&mut pack);
+                }
+                pack.shared("skin.world", world, |w| &w[..]);
+                skin = json!({"id": binding.id, "nodes": binding.node_count()});
+                0..motion_frames
+            }
+            (Some(f), _) => {
                 let k = (f - motion.first_frame).clamp(0, motion_frames.max(1) as i64 - 1) as usize;
                 pack.f32_slices("positions", [coordinates(m.frame(k))]);
                 k..k + 1
             }
             // The whole motion in this answer: sent from the session's copy, not another.
-            None => {
+            (None, None) => {
                 pack.shared("positions", m.clone(), |m| coordinates(m.positions()));
                 0..motion_frames
             }
@@ -277,6 +300,7 @@ pub(crate) async fn animate(
                 "fps": motion.fps,
                 "positions_first": shown.start,
                 "positions_frames": shown.len(),
+                "skin": skin,
             },
             "version": version,
             "warnings": line.warnings,

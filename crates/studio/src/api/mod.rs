@@ -11,7 +11,7 @@
 //! | `GET /api/smear/weight-sources?file=&clip=` | the file's weight groups / attributes (picker) |
 //! | `GET /api/smear/weights?file=&clip=&source=` | ω per vertex of one weight source (overlay) |
 //! | `GET /api/loa/view?file=` | the action camera the strokes are drawn through |
-//! | `POST /api/loa/animate` | keystrokes → line of action + character motion |
+//! | `POST /api/loa/animate` | keystrokes → line of action + character motion (positions, or the skeleton's pose) |
 //! | `GET /api/loa/motion?version=` | the rest of an animate answer's character motion |
 //! | `GET /api/loa/line` | the last line in the CLI's JSON layout |
 //! | `POST /api/loa/export` | keystrokes / line (json, svg) / motion (glb, bvh) |
@@ -24,6 +24,7 @@
 
 mod changes;
 mod loa_api;
+mod loa_skin;
 mod scene;
 mod smear_api;
 mod stopmo_api;

@@ -138,7 +138,7 @@ pub(crate) struct StyleRequest {
     #[serde(default)]
     weights: Option<Value>,
     /// The body as what changed from the input clip ([`super::changes`]): `body.changed`
-    /// and `body.positions` instead of `body` (the page's whole-clip request).
+    /// and the moved vertices instead of `body` (the page's whole-clip request).
     #[serde(default)]
     changes: bool,
 }
@@ -196,7 +196,8 @@ fn stylized(
 /// `copyN.alpha` (frames × copy vertices), `copyN.triangles`; per line set
 /// `linesN.counts` (u32 per frame: vertices, triangles), `linesN.positions`,
 /// `linesN.triangles`, `linesN.alpha`. With `"changes": true` the body comes as
-/// `body.changed` and `body.positions` instead ([`super::changes`]).
+/// `body.changed` and `body.step` + `body.delta` (or `body.positions`) instead
+/// ([`super::changes`]).
 pub(crate) async fn stylize(
     State(studio): State<Arc<Studio>>,
     request: Result<Bytes, BytesRejection>,
@@ -205,6 +206,8 @@ pub(crate) async fn stylize(
     blocking(move || {
         let start = Instant::now();
         let (style, s, held) = stylized(&studio, &r, false)?;
+        // Shared with the answer: the multiples are sent from the result, not copied.
+        let s = Arc::new(s);
         let toml = style.to_toml_string().unwrap_or_default();
         let mut pack = Pack::new();
         pack.keep(held);
@@ -245,10 +248,9 @@ pub(crate) async fn stylize(
                     s.flipbook.parts.get(i)
                 {
                     let n = copies.len();
-                    pack.f32_slices(
-                        &format!("copy{n}.positions"),
-                        [coordinates(animation.positions())],
-                    );
+                    pack.shared(&format!("copy{n}.positions"), (s.clone(), i), |(s, i)| {
+                        copy_positions(s, *i)
+                    });
                     pack.u32(
                         &format!("copy{n}.triangles"),
                         animation.mesh.triangles.iter().flatten().copied(),
@@ -308,6 +310,14 @@ pub(crate) async fn stylize(
         })))
     })
     .await
+}
+
+/// The positions of flipbook part `i` of `s` when it is an animation (a multiple).
+fn copy_positions(s: &smear::Stylized, i: usize) -> &[f32] {
+    match s.flipbook.parts.get(i) {
+        Some(anim::FlipbookPart::Animation { animation, .. }) => coordinates(animation.positions()),
+        _ => &[],
+    }
 }
 
 /// `POST /api/smear/export`: `name` ending in `.toml` writes the style (as the CLI and the

@@ -81,10 +81,11 @@ pub(crate) async fn segment(
             .map_err(cancelled)?;
         let _held = held;
         // The parts will hold the clip's frames: the cached clip is handed to the job (a new
-        // segmentation samples it again), whose cut grows in its buffer instead of copying it.
+        // segmentation samples it again), whose cut grows in its buffer instead of copying it
+        // and is given back as the parts are filled (the clip resident about once).
         job_studio.forget_clip(r.file, &r.clip);
         let input = crate::files::Clip::into_merged(clip);
-        let s = stopmo::segment_owned(input, &options).map_err(|e| format!("{label}: {e}"))?;
+        let s = stopmo::segment_into_parts(input, &options).map_err(|e| format!("{label}: {e}"))?;
         progress.stage("done", 1.0).map_err(cancelled)?;
         let (seam_vertices, seam_weights) = seam_lines(&s);
         let mut answer = json!({
