@@ -72,6 +72,86 @@ pub struct TriangleGrid<'a> {
     /// Bounding box of every triangle.
     boxes: Vec<(Vec3, Vec3)>,
     cells: FxHashMap<[i32; 3], Vec<u32>>,
+    /// Largest coordinate magnitude of the triangles' boxes (the scale of f32 rounding).
+    extent: f32,
+    /// The same cells as one flat array over `dims` (None when the box has more cells than
+    /// [`MAX_FLAT_CELLS`] allows): the ring search looks up every cell it passes, and an
+    /// index is cheaper than a hash.
+    flat: Option<FlatCells>,
+}
+
+/// Most cells of a flat cell array, per triangle and in all (a box of slivers under large
+/// triangles, or one that is not finite, keeps the hash map's cells only).
+const MAX_FLAT_CELLS_PER_TRIANGLE: usize = 128;
+const MAX_FLAT_CELLS: usize = 1 << 25;
+
+/// Every cell of a grid, `x`-major then `y` then `z`, as ranges of one array of triangles
+/// (each cell's triangles in the hash map's order, so that searches visit them alike).
+#[derive(Debug, Clone)]
+struct FlatCells {
+    /// `start[i]..start[i + 1]` of `triangles` are cell `i`'s triangles.
+    start: Vec<u32>,
+    triangles: Vec<u32>,
+}
+
+impl FlatCells {
+    /// The flat copy of `cells` over a grid of `dims` cells, or None when it would have more
+    /// than the budget's cells or a cell lies outside `dims`.
+    fn new(
+        cells: &FxHashMap<[i32; 3], Vec<u32>>,
+        dims: [i32; 3],
+        triangles: usize,
+    ) -> Option<FlatCells> {
+        let budget =
+            MAX_FLAT_CELLS.min(MAX_FLAT_CELLS_PER_TRIANGLE.saturating_mul(triangles.max(1)));
+        let mut count = 1usize;
+        for d in dims {
+            count = count.checked_mul(usize::try_from(d).ok()?)?;
+        }
+        if count > budget {
+            return None;
+        }
+        let entries: usize = cells.values().map(Vec::len).sum();
+        let mut lengths = vec![0u32; count];
+        for (k, list) in cells {
+            let i = flat_index(*k, dims)?;
+            lengths[i] = u32::try_from(list.len()).ok()?;
+        }
+        let mut start = Vec::with_capacity(count + 1);
+        let mut at = 0u32;
+        start.push(0);
+        for l in &lengths {
+            at = at.checked_add(*l)?;
+            start.push(at);
+        }
+        let mut flat = vec![0u32; entries];
+        for (k, list) in cells {
+            let i = flat_index(*k, dims)?;
+            flat[start[i] as usize..start[i + 1] as usize].copy_from_slice(list);
+        }
+        Some(FlatCells {
+            start,
+            triangles: flat,
+        })
+    }
+
+    /// The triangles of cell `i` (a [`flat_index`]).
+    #[inline]
+    fn get(&self, i: usize) -> &[u32] {
+        &self.triangles[self.start[i] as usize..self.start[i + 1] as usize]
+    }
+}
+
+/// Index of cell `k` in a flat array over `dims` cells (None outside it).
+#[inline]
+fn flat_index(k: [i32; 3], dims: [i32; 3]) -> Option<usize> {
+    if (0..3).all(|a| (0..dims[a]).contains(&k[a])) {
+        Some(
+            ((k[0] as usize * dims[1] as usize) + k[1] as usize) * dims[2] as usize + k[2] as usize,
+        )
+    } else {
+        None
+    }
 }
 
 /// The finest cell a uniform grid of `triangles` triangles over the box `lo..hi` may use:
@@ -127,6 +207,8 @@ impl<'a> TriangleGrid<'a> {
         } else {
             key(hi).map(|d| d + 1)
         };
+        let flat = FlatCells::new(&cells, dims, triangles.len());
+        let extent = lo.abs().max(hi.abs()).max_element();
         TriangleGrid {
             positions,
             triangles,
@@ -135,6 +217,17 @@ impl<'a> TriangleGrid<'a> {
             dims,
             boxes,
             cells,
+            extent,
+            flat,
+        }
+    }
+
+    /// The triangles whose boxes overlap cell `k` (empty for a cell nobody overlaps).
+    #[inline]
+    fn cell(&self, k: [i32; 3]) -> &[u32] {
+        match &self.flat {
+            Some(flat) => flat_index(k, self.dims).map_or(&[], |i| flat.get(i)),
+            None => self.cells.get(&k).map_or(&[], Vec::as_slice),
         }
     }
 
@@ -184,8 +277,17 @@ impl<'a> TriangleGrid<'a> {
             .unwrap_or(0)
             + 1;
         let mut best = (f64::INFINITY, None);
+        // A triangle whose box is farther than the best distance by more than f32 rounding
+        // of its closest point (1e-4 of the coordinates' size) cannot replace it: skipping
+        // it leaves the result as it was, without the closest-point computation.
+        let slack = 1e-4 * (1.0 + p.abs().max_element() + self.extent);
         let nearest_in = |list: &[u32], best: &mut (f64, Option<u32>)| {
             for &t in list {
+                let (lo, hi) = self.boxes[t as usize];
+                let gap = (lo - p).max(p - hi).max(Vec3::ZERO).length();
+                if f64::from(gap) > best.0 + f64::from(slack) {
+                    continue;
+                }
                 let [a, b, c] = self.triangles[t as usize].map(|v| self.positions[v as usize]);
                 let d = f64::from(closest_point_on_triangle(p, a, b, c).distance(p));
                 if d < best.0 {
@@ -194,9 +296,7 @@ impl<'a> TriangleGrid<'a> {
             }
         };
         let visit = |x: i32, y: i32, z: i32, best: &mut (f64, Option<u32>)| {
-            if let Some(list) = self.cells.get(&[x, y, z]) {
-                nearest_in(list, best);
-            }
+            nearest_in(self.cell([x, y, z]), best);
         };
         let mut visited = 0usize;
         for r in 0..=max_ring {
@@ -337,6 +437,47 @@ mod tests {
             let below = grid.distance_below(q, brute * 0.5);
             assert!(below >= brute * 0.5 - 1e-9);
             assert!((grid.distance_below(q, brute * 2.0) - brute).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn flat_cells_find_what_the_hash_map_and_a_scan_of_every_triangle_find() {
+        let mut rng = anim::SplitMix64::new(5, 0);
+        let mut r = |s: f32| (rng.next_f32() - 0.5) * s;
+        // A curved sheet of small triangles, like a back surface.
+        let p: Vec<Vec3> = (0..900)
+            .map(|_| {
+                let (x, y) = (r(30.0), r(20.0));
+                Vec3::new(x + r(0.8), y + r(0.8), 0.02 * x * x + r(0.8))
+            })
+            .collect();
+        let t: Vec<[u32; 3]> = (0..300).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+        let grid = TriangleGrid::new(&p, &t);
+        let flat = grid.flat.as_ref().expect("a flat cell array within budget");
+        for (k, list) in &grid.cells {
+            let i = flat_index(*k, grid.dims).expect("every occupied cell inside dims");
+            assert_eq!(flat.get(i), list.as_slice(), "{k:?}");
+        }
+        let occupied: usize = (0..flat.start.len() - 1)
+            .filter(|&i| !flat.get(i).is_empty())
+            .count();
+        assert_eq!(occupied, grid.cells.len());
+        let hashed = TriangleGrid {
+            flat: None,
+            ..grid.clone()
+        };
+        for i in 0..400 {
+            let scale = if i % 2 == 0 { 35.0 } else { 120.0 };
+            let q = Vec3::new(r(scale), r(scale), r(scale));
+            let found = grid.nearest_below(q, f64::INFINITY);
+            assert_eq!(found, hashed.nearest_below(q, f64::INFINITY), "{q}");
+            assert!((found.0 - brute(&p, &t, q)).abs() < 1e-9, "{q}");
+            let limit = found.0 * 0.7;
+            assert_eq!(
+                grid.nearest_below(q, limit),
+                hashed.nearest_below(q, limit),
+                "{q}"
+            );
         }
     }
 
