@@ -11,5 +11,16 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 # --workspace, as CI builds: `-p` resolves other features and rebuilds the dependencies.
 cargo build --release --workspace --bins
+# The bench runs from the crate's folder: other binaries' paths are made absolute here.
+args=()
+while [ $# -gt 0 ]; do
+    if [ "$1" = --toonkit ] && [ $# -gt 1 ]; then
+        args+=(--toonkit "$(realpath -- "$2")")
+        shift 2
+    else
+        args+=("$1")
+        shift
+    fi
+done
 exec cargo bench --workspace --bench scale -- \
-    --out "$PWD/target/stopmo-scale" --toonkit "$PWD/target/release/toonkit" "$@"
+    --out "$PWD/target/stopmo-scale" --toonkit "$PWD/target/release/toonkit" "${args[@]}"
