@@ -383,59 +383,12 @@ fn check_sampling(duration: f32, fps: f32, frames: usize, points: usize) -> Resu
     .map_err(AnimError::OverBudget)
 }
 
+mod morph;
+
+use morph::{morphed, rigid_batch, MORPH_BATCH};
+
+/// Per frame: every node's world matrix and every node's morph weights.
 type Pose = (Vec<Mat4>, Vec<Vec<f32>>);
-
-/// Most frames of an unskinned object morphed together (see [`rigid_batch`]).
-const MORPH_BATCH: usize = 32;
-/// Vertices per block of [`rigid_batch`]: the blocks of all morph targets stay in cache.
-const MORPH_BLOCK: usize = 256;
-
-/// `m += w · d`, component-wise (the same operations as on `Vec3`, vectorized).
-fn add_scaled(m: &mut [Vec3], d: &[Vec3], w: f32) {
-    let m: &mut [f32] = bytemuck::cast_slice_mut(m);
-    let d: &[f32] = bytemuck::cast_slice(d);
-    for (m, d) in m.iter_mut().zip(d) {
-        *m += w * *d;
-    }
-}
-
-/// Frames `batch` of an unskinned object into `out` (`batch.len()` frames): rest plus the
-/// active morph targets in target order, then the node's world matrix. Block by block of
-/// vertices, so each block of the targets is read once for the whole batch. Whether every
-/// position is finite.
-fn rigid_batch(
-    rest: &[Vec3],
-    targets: &[crate::MorphTarget],
-    node: usize,
-    batch: &[Pose],
-    out: &mut [Vec3],
-    morphed: &mut Vec<Vec3>,
-) -> bool {
-    let nv = rest.len();
-    for c0 in (0..nv).step_by(MORPH_BLOCK) {
-        let c1 = (c0 + MORPH_BLOCK).min(nv);
-        for ((world, weights), out) in batch.iter().zip(out.chunks_mut(nv)) {
-            let active = || targets.iter().zip(&weights[node]);
-            let source: &[Vec3] = if active().any(|(_, &w)| w != 0.0) {
-                morphed.clear();
-                morphed.extend_from_slice(&rest[c0..c1]);
-                for (t, &w) in active() {
-                    if w != 0.0 {
-                        add_scaled(morphed, &t.positions[c0..c1], w);
-                    }
-                }
-                &morphed[..]
-            } else {
-                &rest[c0..c1]
-            };
-            let m = world[node];
-            for (o, p) in out[c0..c1].iter_mut().zip(source) {
-                *o = m.transform_point3(*p);
-            }
-        }
-    }
-    out.iter().all(|p| p.is_finite())
-}
 
 fn sample_object(
     scene: &Scene,
@@ -504,8 +457,8 @@ fn sample_object(
         positions
             .par_chunks_mut(nv.max(1) * batch)
             .zip(poses.par_chunks(batch))
-            .map_init(Vec::new, |morphed, (out, frames)| {
-                rigid_batch(rest, &sm.morph_targets, node, frames, out, morphed)
+            .map_init(Vec::new, |scratch, (out, frames)| {
+                rigid_batch(rest, &sm.morph_targets, node, frames, out, scratch)
             })
             .all(|ok| ok)
     } else {
@@ -514,22 +467,8 @@ fn sample_object(
             .zip(poses.par_iter())
             .map_init(
                 || (Vec::new(), Vec::new()),
-                |(morphed, mats): &mut (Vec<Vec3>, Vec<Mat4>), (out, (world, weights))| {
-                    // Without an active morph target the rest positions are skinned as they
-                    // are (no per-frame copy).
-                    let active = || sm.morph_targets.iter().zip(&weights[node]);
-                    let source: &[Vec3] = if active().any(|(_, &w)| w != 0.0) {
-                        morphed.clear();
-                        morphed.extend_from_slice(rest);
-                        for (t, &w) in active() {
-                            if w != 0.0 {
-                                add_scaled(morphed, &t.positions, w);
-                            }
-                        }
-                        &morphed[..]
-                    } else {
-                        rest
-                    };
+                |(scratch, mats): &mut (Vec<Vec3>, Vec<Mat4>), (out, (world, weights))| {
+                    let source = morphed(rest, &sm.morph_targets, &weights[node], 0..nv, scratch);
                     if let (Some(s), Some(w)) = (&skin, &sm.joint_weights) {
                         mats.clear();
                         mats.extend(
