@@ -230,16 +230,22 @@ pub fn coordinates(points: &[anim::glam::Vec3]) -> &[f32] {
     bytemuck::cast_slice(points)
 }
 
-/// Reads a pack back: the header and the named float32 buffer (for tests and tools).
-pub fn read_f32(bytes: &[u8], name: &str) -> Option<(Value, Vec<f32>)> {
+/// The header and the bytes of the buffer `name` of type `ty` (`size` bytes per value).
+fn read_raw<'a>(bytes: &'a [u8], name: &str, ty: &str, size: usize) -> Option<(Value, &'a [u8])> {
     let (header, data) = split(bytes)?;
     let entry = header["buffers"]
         .as_array()?
         .iter()
-        .find(|b| b["name"] == name && b["type"] == "f32")?;
+        .find(|b| b["name"] == name && b["type"] == ty)?;
     let offset = entry["offset"].as_u64()? as usize;
     let count = entry["count"].as_u64()? as usize;
-    let raw = data.get(offset..offset + count * 4)?;
+    let raw = data.get(offset..offset + count * size)?;
+    Some((header, raw))
+}
+
+/// Reads a pack back: the header and the named float32 buffer (for tests and tools).
+pub fn read_f32(bytes: &[u8], name: &str) -> Option<(Value, Vec<f32>)> {
+    let (header, raw) = read_raw(bytes, name, "f32", 4)?;
     let values = raw
         .chunks_exact(4)
         .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
@@ -249,14 +255,7 @@ pub fn read_f32(bytes: &[u8], name: &str) -> Option<(Value, Vec<f32>)> {
 
 /// Reads a pack back: the named uint32 buffer (for tests and tools).
 pub fn read_u32(bytes: &[u8], name: &str) -> Option<Vec<u32>> {
-    let (header, data) = split(bytes)?;
-    let entry = header["buffers"]
-        .as_array()?
-        .iter()
-        .find(|b| b["name"] == name && b["type"] == "u32")?;
-    let offset = entry["offset"].as_u64()? as usize;
-    let count = entry["count"].as_u64()? as usize;
-    let raw = data.get(offset..offset + count * 4)?;
+    let (_, raw) = read_raw(bytes, name, "u32", 4)?;
     Some(
         raw.chunks_exact(4)
             .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
@@ -266,14 +265,7 @@ pub fn read_u32(bytes: &[u8], name: &str) -> Option<Vec<u32>> {
 
 /// Reads a pack back: the named int16 buffer (for tests and tools).
 pub fn read_i16(bytes: &[u8], name: &str) -> Option<Vec<i16>> {
-    let (header, data) = split(bytes)?;
-    let entry = header["buffers"]
-        .as_array()?
-        .iter()
-        .find(|b| b["name"] == name && b["type"] == "i16")?;
-    let offset = entry["offset"].as_u64()? as usize;
-    let count = entry["count"].as_u64()? as usize;
-    let raw = data.get(offset..offset + count * 2)?;
+    let (_, raw) = read_raw(bytes, name, "i16", 2)?;
     Some(
         raw.chunks_exact(2)
             .map(|c| i16::from_le_bytes([c[0], c[1]]))
