@@ -1,0 +1,166 @@
+//! Compact answers: a stroke answered as the skeleton's pose and a whole clip answered as
+//! 16-bit changes rebuild the core's positions within their stated bounds
+//! (docs/studio.md, "Whole clips").
+
+use serde_json::json;
+use studio::pack;
+
+mod common;
+use common::{app, get, post, send_ok};
+
+/// The u32 buffer `name` of a pack (panics when absent).
+fn read_u32(bytes: &[u8], name: &str) -> Vec<u32> {
+    pack::read_u32(bytes, name).unwrap_or_else(|| panic!("no u32 buffer {name}"))
+}
+
+/// Reads a float32 buffer of a pack (panics when absent).
+fn f32s(bytes: &[u8], name: &str) -> Vec<f32> {
+    pack::read_f32(bytes, name)
+        .unwrap_or_else(|| panic!("no {name}"))
+        .1
+}
+
+#[tokio::test]
+async fn a_stroke_answered_as_the_skeletons_pose_skins_to_the_cores_positions() {
+    let dir = tempfile::tempdir().unwrap();
+    let app = app(dir.path());
+    let keys = common::bending_keystrokes();
+    let request = json!({"keystrokes": keys, "width": 800.0, "height": 600.0, "skin": ""});
+    let answer = send_ok(&app, post("/api/loa/animate", request.clone())).await;
+    let (header, _) = pack::split(&answer).unwrap();
+    let m = &header["motion"];
+    let (frames, vertices) = (
+        m["frames"].as_u64().unwrap() as usize,
+        m["vertices"].as_u64().unwrap() as usize,
+    );
+    let nodes = m["skin"]["nodes"].as_u64().unwrap() as usize;
+    assert!(pack::read_f32(&answer, "positions").is_none());
+    let world = f32s(&answer, "skin.world");
+    assert_eq!(world.len(), frames * nodes * 16);
+    let (rest, weight, inverse) = (
+        f32s(&answer, "skin.rest"),
+        f32s(&answer, "skin.weight"),
+        f32s(&answer, "skin.inverse"),
+    );
+    let (index, node) = (
+        read_u32(&answer, "skin.index"),
+        read_u32(&answer, "skin.node"),
+    );
+    assert_eq!((rest.len(), index.len()), (vertices * 3, vertices * 4));
+    // Linear blend skinning of the binding with the pose, as the page's renderer does it.
+    let version = header["version"].as_u64().unwrap();
+    let core = f32s(
+        &send_ok(&app, get(&format!("/api/loa/motion?version={version}"))).await,
+        "positions",
+    );
+    let mat = |s: &[f32]| anim::glam::Mat4::from_cols_slice(s);
+    let mut worst = 0.0f32;
+    for f in 0..frames {
+        for v in 0..vertices {
+            let p = anim::glam::Vec3::from_slice(&rest[v * 3..v * 3 + 3]).extend(1.0);
+            let mut acc = anim::glam::Vec4::ZERO;
+            for k in 0..4 {
+                let e = index[v * 4 + k] as usize;
+                let n = node[e] as usize;
+                let m = mat(&world[(f * nodes + n) * 16..][..16]) * mat(&inverse[e * 16..][..16]);
+                acc += m * p * weight[v * 4 + k];
+            }
+            let q = anim::glam::Vec3::from_slice(&core[(f * vertices + v) * 3..][..3]);
+            worst = worst.max((acc.truncate() - q).length());
+        }
+    }
+    assert!(
+        worst < 1e-4,
+        "the pose skins {worst} off the core's positions"
+    );
+    // The binding is sent once: a page holding it gets the pose alone.
+    let mut again = request;
+    again["skin"] = m["skin"]["id"].clone();
+    let answer = send_ok(&app, post("/api/loa/animate", again)).await;
+    assert!(pack::read_f32(&answer, "skin.rest").is_none());
+    assert_eq!(f32s(&answer, "skin.world").len(), frames * nodes * 16);
+    assert!(answer.len() < 300_000, "{} bytes", answer.len());
+}
+
+#[tokio::test]
+async fn the_whole_clip_sent_as_changes_rebuilds_the_cores_body_within_its_bound() {
+    let dir = tempfile::tempdir().unwrap();
+    let app = app(dir.path());
+    let (_, input) = pack::read_f32(
+        &send_ok(&app, get("/api/scene?clip=Dance")).await,
+        "positions",
+    )
+    .unwrap();
+    // The bound of the 16-bit displacements: 1e-5 of the clip's bounding-box diagonal.
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for (i, &x) in input.iter().enumerate() {
+        lo[i % 3] = lo[i % 3].min(x);
+        hi[i % 3] = hi[i % 3].max(x);
+    }
+    let diagonal = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f32>().sqrt();
+    // Speeds are in character sizes per second: β max 2 is a moderate smear of the Dance.
+    let style =
+        json!({"elongate": {"function": {"stages": [{"op": "speed"}, {"op": "scale", "by": 2}]}}});
+    for range in [None, Some([30, 34])] {
+        let mut request = json!({"clip": "Dance", "style": style});
+        if let Some(r) = range {
+            request["frames"] = json!(r);
+        }
+        let dense = send_ok(&app, post("/api/smear/stylize", request.clone())).await;
+        let (header, body) = pack::read_f32(&dense, "body").unwrap();
+        request["changes"] = json!(true);
+        let sent = send_ok(&app, post("/api/smear/stylize", request)).await;
+        assert!(pack::read_f32(&sent, "body").is_none());
+        assert!(pack::read_f32(&sent, "body.positions").is_none());
+        let mask = read_u32(&sent, "body.changed");
+        let (_, steps) = pack::read_f32(&sent, "body.step").unwrap();
+        let delta = pack::read_i16(&sent, "body.delta").unwrap();
+        let frames = header["frames"].as_u64().unwrap() as usize;
+        let first = header["first_frame"].as_u64().unwrap() as usize;
+        let n = body.len() / frames / 3;
+        let words = n.div_ceil(32);
+        // The page's rebuild: the input clip, moved vertices displaced in vertex order.
+        let mut rebuilt = input[first * n * 3..(first + frames) * n * 3].to_vec();
+        let mut k = 0;
+        for f in 0..frames {
+            for v in 0..n {
+                if mask[f * words + v / 32] >> (v % 32) & 1 == 1 {
+                    let o = (f * n + v) * 3;
+                    for c in 0..3 {
+                        rebuilt[o + c] += f32::from(delta[k + c]) * steps[f];
+                    }
+                    k += 3;
+                } else {
+                    let o = (f * n + v) * 3;
+                    assert_eq!(
+                        rebuilt[o..o + 3],
+                        body[o..o + 3],
+                        "unmoved vertices are exact"
+                    );
+                }
+            }
+        }
+        assert_eq!(k, delta.len(), "{range:?}: every moved vertex is placed");
+        let worst = rebuilt
+            .iter()
+            .zip(&body)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f32, f32::max);
+        assert!(
+            worst <= 1e-5 * diagonal,
+            "{range:?}: the rebuilt body is {worst} off (diagonal {diagonal})"
+        );
+        assert!(
+            delta.len() * 2 < body.len(),
+            "{range:?}: the speed style moves {} of {} coordinates",
+            delta.len(),
+            body.len()
+        );
+        assert!(
+            sent.len() * 4 < dense.len(),
+            "{} of {} bytes",
+            sent.len(),
+            dense.len()
+        );
+    }
+}
