@@ -87,6 +87,14 @@ pub(crate) fn triangles<'py>(
     output(py, &[mesh.triangles.len(), 3], t)
 }
 
+/// float32 ``(v, 3)``: `points`.
+pub(crate) fn points_array<'py>(
+    py: Python<'py>,
+    points: &[glam::Vec3],
+) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
+    output(py, &[points.len(), 3], flat3(points))
+}
+
 /// float32 ``(frames, v, 3)``: every frame's positions of `anim`.
 pub(crate) fn frames_array<'py>(
     py: Python<'py>,

@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use smear::{OffsetOptions, PrepareOptions, Style};
 
-use crate::arrays::{flat3, output, triangles};
+use crate::arrays::{frames_array, output, points_array, triangles};
 use crate::errors::{at, io_error, smear_error, value_error};
 use crate::progress::report;
 use crate::scene::Scene;
@@ -226,10 +226,7 @@ fn animation_dict<'py>(
     let (f, v) = (animation.frame_count(), animation.vertex_count());
     let d = PyDict::new(py);
     d.set_item("name", &animation.mesh.name)?;
-    d.set_item(
-        "positions",
-        output(py, &[f, v, 3], flat3(animation.positions()))?,
-    )?;
+    d.set_item("positions", frames_array(py, animation)?)?;
     d.set_item("triangles", triangles(py, &animation.mesh)?)?;
     let alpha = match colors {
         Some(c) => c.iter().map(|c| c[3]).collect(),
@@ -298,10 +295,7 @@ impl Stylized {
                 .iter()
                 .map(|m| {
                     let d = PyDict::new(py);
-                    d.set_item(
-                        "positions",
-                        output(py, &[m.vertex_count(), 3], flat3(&m.positions))?,
-                    )?;
+                    d.set_item("positions", points_array(py, &m.positions)?)?;
                     d.set_item("triangles", triangles(py, m)?)?;
                     let alpha: Vec<f32> = match &m.colors {
                         Some(c) => c.iter().map(|c| c[3]).collect(),

@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use stopmo::{FileData, LibraryJobOptions, OutputFile, RunOptions, SegmentJobOptions};
 
-use crate::arrays::{flat3, frames_array, output, triangles};
+use crate::arrays::{frames_array, output, points_array, triangles};
 use crate::errors::{at, io_error, toonkit_error, value_error};
 use crate::progress::report;
 use crate::scene::Scene;
@@ -138,10 +138,7 @@ impl Library {
                 d.set_item("part", p.part)?;
                 d.set_item("index", p.index)?;
                 let m = &p.surface;
-                d.set_item(
-                    "positions",
-                    output(py, &[m.vertex_count(), 3], flat3(&m.positions))?,
-                )?;
+                d.set_item("positions", points_array(py, &m.positions)?)?;
                 d.set_item("triangles", triangles(py, m)?)?;
                 Ok(d)
             })
@@ -158,10 +155,7 @@ impl Library {
         let d = PyDict::new(py);
         d.set_item("positions", frames_array(py, &frames)?)?;
         let rest = &frames.mesh;
-        d.set_item(
-            "rest",
-            output(py, &[rest.vertex_count(), 3], flat3(&rest.positions))?,
-        )?;
+        d.set_item("rest", points_array(py, &rest.positions)?)?;
         d.set_item("triangles", triangles(py, rest)?)?;
         Ok(d)
     }
