@@ -113,7 +113,8 @@ pub(crate) fn prepare(
     let sampled = scene.sampled.clone();
     let prepared = py
         .detach(move || {
-            let mut p = smear::prepare((*sampled).clone(), &options)?;
+            // The clip is shared with the `Scene`, not copied.
+            let mut p = smear::prepare(sampled, &options)?;
             for o in colliders.iter().flat_map(|c| &c.objects) {
                 p.add_collider(smear::Collider::from_animation(&o.animation));
             }

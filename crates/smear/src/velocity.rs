@@ -179,7 +179,9 @@ fn differences(
     space: Option<&CameraSpace>,
     causal: bool,
 ) -> Vec<Vec3> {
-    let mut out = vec![Vec3::ZERO; frames * n];
+    // Zeroed by the allocator (fresh pages, no memset: `vec![Vec3::ZERO; _]` writes every
+    // element); each worker maps the pages of the frames it writes.
+    let mut out: Vec<Vec3> = bytemuck::allocation::zeroed_vec(frames * n);
     if n == 0 || positions.len() < frames * n {
         return out;
     }

@@ -2,6 +2,7 @@
 //! (SMEAR Eqs. 1–9) per object group, merged inside the crate, the camera, painted weights and
 //! the velocities the stylization functions read.
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use anim::{Camera, MeshAnimation, SampledScene};
@@ -92,7 +93,8 @@ struct Target {
 /// ([`stylize`](crate::stylize) only reads it).
 #[derive(Debug)]
 pub struct Prepared {
-    scene: SampledScene,
+    /// Shared with the caller when it passed an `Arc` (no copy of the clip).
+    scene: Arc<SampledScene>,
     options: PrepareOptions,
     field: SolvedField,
     camera: Option<Camera>,
@@ -236,18 +238,29 @@ pub fn offsets(scene: &SampledScene, options: &OffsetOptions) -> Result<SceneOff
 /// Unknown pruned joint, camera, weight joint, attribute or collider object; an inconsistent scene; merging a
 /// scene without objects.
 ///
+/// `scene` is a `SampledScene` (moved in) or an `Arc` of one a front end keeps (shared, not
+/// copied: the Python module's `Scene` and its prepared offsets hold the same clip).
+///
 /// # Performance
 /// The offset solve dominates (parallel over frames); velocities are one pass over the
-/// positions.
-pub fn prepare(mut scene: SampledScene, options: &PrepareOptions) -> Result<Prepared> {
+/// positions. The clip is copied only when `options.colliders` takes objects out of a
+/// shared scene.
+pub fn prepare(scene: impl Into<Arc<SampledScene>>, options: &PrepareOptions) -> Result<Prepared> {
     let start = Instant::now();
+    let mut scene = scene.into();
     // The clip, its velocities, a merged copy and the offsets (stylizing adds its own).
     check_memory(&scene, 2 + u64::from(options.merge.is_some()), 0)?;
-    let colliders = take_colliders(&mut scene, &options.colliders)?;
+    let colliders = if options.colliders.is_empty() {
+        Vec::new()
+    } else {
+        take_colliders(Arc::make_mut(&mut scene), &options.colliders)?
+    };
+    let scene = scene;
     let camera = options.offsets.selected_camera(&scene.cameras)?.cloned();
-    let field = SolvedField::new(&scene, &options.offsets)?;
+    let mut field = SolvedField::new(&scene, &options.offsets)?;
     let revolving = revolving_objects(&scene, &options.offsets.revolve)?;
-    let per_object = replace_offsets(&scene, &options.offsets, &revolving, field.all());
+    // The field keeps what surface points need; its raw offsets become the smoothed ones.
+    let per_object = replace_offsets(&scene, &options.offsets, &revolving, field.take_all());
     let solve_seconds = start.elapsed().as_secs_f64();
     let objects = object_reports(&scene, |i| field.mode(i), &per_object);
     let causal = options.offsets.causal;

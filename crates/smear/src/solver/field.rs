@@ -201,10 +201,17 @@ impl SolvedField {
         self.slots.iter().map(|s| self.slot_offsets(s)).collect()
     }
 
-    /// [`SolvedField::all`], consuming the field: an object alone in its group is smoothed in
-    /// its group's raw buffer, which becomes its offsets (no second `frames × vertices`
-    /// buffer, no copy).
+    /// [`SolvedField::all`], consuming the field: see [`SolvedField::take_all`].
     pub(crate) fn into_all(mut self) -> Vec<MotionOffsets> {
+        self.take_all()
+    }
+
+    /// [`SolvedField::all`], taking the raw offsets out of the field: an object alone in its
+    /// group is smoothed in its group's raw buffer, which becomes its offsets (no second
+    /// `frames × vertices` buffer, no copy); every raw buffer is dropped after. The field
+    /// still evaluates surface points ([`SolvedField::surface_offsets`]), but
+    /// [`SolvedField::vertex_offsets`] and [`SolvedField::all`] must not be called after.
+    pub(crate) fn take_all(&mut self) -> Vec<MotionOffsets> {
         let (frames, smooth, causal) = (self.frames, self.smooth, self.causal);
         let mut out = Vec::with_capacity(self.slots.len());
         for slot in &self.slots {
@@ -219,6 +226,9 @@ impl SolvedField {
             } else {
                 out.push(self.slot_offsets(slot));
             }
+        }
+        for grp in &mut self.groups {
+            grp.raw = Vec::new();
         }
         out
     }
