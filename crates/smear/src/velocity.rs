@@ -208,6 +208,26 @@ fn differences(
     out
 }
 
+/// The velocity at frame `f` of point `i` of a frame-major `frames × n` buffer, as
+/// [`buffer_velocities`] / [`camera_buffer_velocities`] compute it (the same operations,
+/// so the same value bit for bit), without a buffer: what a prepared scene's stylization
+/// reads, frame by frame. `f < frames`, `i < n` and `positions` of `frames × n`.
+#[inline]
+pub(crate) fn point_velocity(
+    positions: &[Vec3],
+    (frames, n): (usize, usize),
+    (f, i): (usize, usize),
+    space: Option<&CameraSpace>,
+    causal: bool,
+) -> Vec3 {
+    let (a, b, s) = difference_frames(f, frames, causal);
+    let (p, q) = (positions[a * n + i], positions[b * n + i]);
+    match space {
+        None => (q - p) * s,
+        Some(c) => (c.view[b].transform_point3(q) - c.view[a].transform_point3(p)) * s,
+    }
+}
+
 /// Speeds |v| of a velocity buffer (units per frame), as stylization uses them.
 pub fn speeds(velocities: &[Vec3]) -> Vec<f32> {
     velocities.par_iter().map(|v| v.length()).collect()

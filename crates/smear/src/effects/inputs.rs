@@ -3,6 +3,7 @@
 //! [`StyleInput`]s the same way.
 
 use std::borrow::Cow;
+use std::sync::OnceLock;
 
 use anim::MeshAnimation;
 use glam::Vec3;
@@ -10,6 +11,7 @@ use rayon::prelude::*;
 
 use super::{StyleInput, Trajectories};
 use crate::revolve::Arcs;
+use crate::velocity::{buffer_velocities, camera_buffer_velocities, point_velocity, CameraSpace};
 use crate::Collider;
 use crate::{MotionOffsets, Result, SmearError, SurfacePoint};
 
@@ -27,7 +29,7 @@ pub struct EffectInputs<'a> {
     frames: usize,
     points: usize,
     offsets: Cow<'a, MotionOffsets>,
-    velocities: Cow<'a, [Vec3]>,
+    velocities: Velocities<'a>,
     weights: Option<Vec<f32>>,
     /// The point cache the points are the vertices of (`None` for surface points).
     source: Option<&'a MeshAnimation>,
@@ -39,6 +41,21 @@ pub struct EffectInputs<'a> {
     arcs: Option<Cow<'a, Arcs>>,
     /// Collider meshes the displaced points never enter.
     colliders: &'a [Collider],
+}
+
+/// Where the velocities of [`EffectInputs`] come from.
+#[derive(Debug, Clone)]
+enum Velocities<'a> {
+    /// A frame-major `frames × points` buffer.
+    Buffer(Cow<'a, [Vec3]>),
+    /// Differences of the positions computed where they are read (a prepared scene: no
+    /// `frames × points` buffer, so preparing and stylizing a few frames never fill one);
+    /// [`EffectInputs::velocities`] fills `all` on first use.
+    Differences {
+        space: Option<&'a CameraSpace>,
+        causal: bool,
+        all: OnceLock<Vec<Vec3>>,
+    },
 }
 
 fn mismatch(name: &'static str, expected: usize, found: usize) -> SmearError {
@@ -67,7 +84,7 @@ impl<'a> EffectInputs<'a> {
     pub(crate) fn from_prepared(
         anim: &'a MeshAnimation,
         offsets: &'a MotionOffsets,
-        velocities: &'a [Vec3],
+        (space, causal): (Option<&'a CameraSpace>, bool),
         weights: Option<Vec<f32>>,
     ) -> EffectInputs<'a> {
         EffectInputs {
@@ -75,7 +92,11 @@ impl<'a> EffectInputs<'a> {
             frames: anim.frame_count(),
             points: anim.vertex_count(),
             offsets: Cow::Borrowed(offsets),
-            velocities: Cow::Borrowed(velocities),
+            velocities: Velocities::Differences {
+                space,
+                causal,
+                all: OnceLock::new(),
+            },
             weights,
             source: Some(anim),
             causal: false,
@@ -152,13 +173,13 @@ impl<'a> EffectInputs<'a> {
                 offsets.vertex_count(),
             ));
         }
-        let velocities = crate::velocity::buffer_velocities(&positions, frames, points, false);
+        let velocities = buffer_velocities(&positions, frames, points, false);
         Ok(EffectInputs {
             positions,
             frames,
             points,
             offsets,
-            velocities: Cow::Owned(velocities),
+            velocities: Velocities::Buffer(Cow::Owned(velocities)),
             weights: None,
             source: None,
             causal: false,
@@ -172,13 +193,14 @@ impl<'a> EffectInputs<'a> {
     /// and velocities computed here from the positions become backward differences
     /// (velocities given by [`prepare`](crate::prepare) are causal already when asked).
     pub fn with_causal(mut self, causal: bool) -> Self {
-        if causal && !self.causal && matches!(self.velocities, Cow::Owned(_)) {
-            self.velocities = Cow::Owned(crate::velocity::buffer_velocities(
+        let computed = matches!(self.velocities, Velocities::Buffer(Cow::Owned(_)));
+        if causal && !self.causal && computed {
+            self.velocities = Velocities::Buffer(Cow::Owned(buffer_velocities(
                 &self.positions,
                 self.frames,
                 self.points,
                 true,
-            ));
+            )));
         }
         self.causal = causal;
         self
@@ -255,7 +277,7 @@ impl<'a> EffectInputs<'a> {
                 velocities.len(),
             ));
         }
-        self.velocities = Cow::Owned(velocities);
+        self.velocities = Velocities::Buffer(Cow::Owned(velocities));
         Ok(self)
     }
 
@@ -272,13 +294,13 @@ impl<'a> EffectInputs<'a> {
             return self;
         };
         let space = crate::velocity::CameraSpace::new(camera, self.frames);
-        self.velocities = Cow::Owned(crate::velocity::camera_buffer_velocities(
+        self.velocities = Velocities::Buffer(Cow::Owned(camera_buffer_velocities(
             &self.positions,
             self.frames,
             self.points,
             &space,
             self.causal,
-        ));
+        )));
         self
     }
 
@@ -302,9 +324,17 @@ impl<'a> EffectInputs<'a> {
         &self.offsets
     }
 
-    /// The velocities, frame-major.
+    /// The velocities, frame-major (of a prepared scene: computed on the first call).
     pub fn velocities(&self) -> &[Vec3] {
-        &self.velocities
+        match &self.velocities {
+            Velocities::Buffer(v) => v,
+            Velocities::Differences { space, causal, all } => all.get_or_init(|| match space {
+                Some(c) => {
+                    camera_buffer_velocities(&self.positions, self.frames, self.points, c, *causal)
+                }
+                None => buffer_velocities(&self.positions, self.frames, self.points, *causal),
+            }),
+        }
     }
 
     /// The trajectories of the points (Section 4.1).
@@ -320,7 +350,16 @@ impl<'a> EffectInputs<'a> {
     #[inline]
     pub fn style_input(&self, f: usize, i: usize) -> StyleInput {
         let k = f * self.points + i;
-        let velocity = self.velocities[k];
+        let velocity = match &self.velocities {
+            Velocities::Buffer(v) => v[k],
+            Velocities::Differences { space, causal, .. } => point_velocity(
+                &self.positions,
+                (self.frames, self.points),
+                (f, i),
+                *space,
+                *causal,
+            ),
+        };
         StyleInput {
             delta: self.offsets.values()[k],
             speed: velocity.length(),

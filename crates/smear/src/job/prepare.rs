@@ -6,12 +6,12 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anim::{Camera, MeshAnimation, SampledScene};
-use glam::Vec3;
+
 use serde::{Deserialize, Serialize};
 
 use crate::revolve::{replace_offsets, revolving_objects, target_arcs, Arcs};
 use crate::solver::SolvedField;
-use crate::velocity::{buffer_velocities, camera_buffer_velocities, CameraSpace};
+use crate::velocity::CameraSpace;
 use crate::{
     Collider, EffectInputs, MotionOffsets, OffsetMode, OffsetOptions, Result, SizeReference,
     SmearError, SpeedUnits, StyleUnits, SurfacePoint, WeightSource,
@@ -83,7 +83,6 @@ pub struct PrepareReport {
 struct Target {
     name: String,
     offsets: MotionOffsets,
-    velocities: Vec<Vec3>,
     weights: Option<Vec<f32>>,
     /// Revolving parts (issue #22).
     arcs: Option<Arcs>,
@@ -98,6 +97,9 @@ pub struct Prepared {
     options: PrepareOptions,
     field: SolvedField,
     camera: Option<Camera>,
+    /// The camera's matrices per frame: velocities (speed) are differences of the positions
+    /// in its space, computed where a stylization reads them (no `frames × vertices` buffer).
+    space: Option<CameraSpace>,
     merged: Option<MeshAnimation>,
     targets: Vec<Target>,
     colliders: Vec<Collider>,
@@ -248,7 +250,9 @@ pub fn offsets(scene: &SampledScene, options: &OffsetOptions) -> Result<SceneOff
 pub fn prepare(scene: impl Into<Arc<SampledScene>>, options: &PrepareOptions) -> Result<Prepared> {
     let start = Instant::now();
     let mut scene = scene.into();
-    // The clip, its velocities, a merged copy and the offsets (stylizing adds its own).
+    // The clip, a buffer of its size for the velocities of a stylization that reads them
+    // whole ([`EffectInputs::velocities`]), a merged copy and the offsets (stylizing adds its
+    // own).
     check_memory(&scene, 2 + u64::from(options.merge.is_some()), 0)?;
     let colliders = if options.colliders.is_empty() {
         Vec::new()
@@ -263,16 +267,11 @@ pub fn prepare(scene: impl Into<Arc<SampledScene>>, options: &PrepareOptions) ->
     let per_object = replace_offsets(&scene, &options.offsets, &revolving, field.take_all());
     let solve_seconds = start.elapsed().as_secs_f64();
     let objects = object_reports(&scene, |i| field.mode(i), &per_object);
-    let causal = options.offsets.causal;
     let size = scene.rest_diagonal();
     let weight_units = StyleUnits::size(size as f64, scene.fps as f64);
-    let velocities = |anim: &MeshAnimation| {
-        let (p, f, n) = (anim.positions(), anim.frame_count(), anim.vertex_count());
-        match &camera {
-            Some(c) => camera_buffer_velocities(p, f, n, &CameraSpace::new(c, f), causal),
-            None => buffer_velocities(p, f, n, causal),
-        }
-    };
+    let space = camera
+        .as_ref()
+        .map(|c| CameraSpace::new(c, scene.frame_count));
     let resolve = |w: &WeightSource, i: usize| w.vertex_weights_in(&scene, i, &weight_units);
     let (merged, targets) = match &options.merge {
         Some(name) => {
@@ -300,7 +299,6 @@ pub fn prepare(scene: impl Into<Arc<SampledScene>>, options: &PrepareOptions) ->
             let target = Target {
                 name: name.clone(),
                 offsets,
-                velocities: velocities(&anim),
                 weights,
                 arcs: target_arcs(&scene, &revolving, None),
             };
@@ -312,7 +310,6 @@ pub fn prepare(scene: impl Into<Arc<SampledScene>>, options: &PrepareOptions) ->
                 targets.push(Target {
                     name: o.name.clone(),
                     offsets,
-                    velocities: velocities(&o.animation),
                     weights: match &options.weights {
                         Some(w) => Some(resolve(w, i)?),
                         None => None,
@@ -337,6 +334,7 @@ pub fn prepare(scene: impl Into<Arc<SampledScene>>, options: &PrepareOptions) ->
         options: options.clone(),
         field,
         camera,
+        space,
         merged,
         targets,
         colliders,
@@ -518,11 +516,12 @@ impl Prepared {
             index: i,
             count: self.targets.len(),
         })?;
-        let inputs =
-            EffectInputs::from_prepared(self.animation(i), &t.offsets, &t.velocities, None)
-                .with_causal(self.options.offsets.causal)
-                .with_arcs(t.arcs.as_ref().map(std::borrow::Cow::Borrowed))?
-                .with_colliders(&self.colliders);
+        let causal = self.options.offsets.causal;
+        let velocities = (self.space.as_ref(), causal);
+        let inputs = EffectInputs::from_prepared(self.animation(i), &t.offsets, velocities, None)
+            .with_causal(causal)
+            .with_arcs(t.arcs.as_ref().map(std::borrow::Cow::Borrowed))?
+            .with_colliders(&self.colliders);
         match weights {
             Some(w) => inputs.with_weights(w),
             None => Ok(inputs),
