@@ -155,3 +155,22 @@ fn bundled_face_is_read_as_weights_and_solves_as_its_positions() {
     assert!(same * 100 >= 99 * 1800, "{same} of 1800 labels agree");
     assert!((a.report.mm_per_unit / b.report.mm_per_unit - 1.0).abs() < 1e-6);
 }
+
+/// A skinned character is not morph-only: it is read as positions (and solved as before), and
+/// the report says so.
+#[test]
+fn skinned_character_is_read_as_positions() {
+    let path = testdata::asset("characters/CesiumMan.glb");
+    let open = tkio::OpenOptions {
+        fps: Some(12.0),
+        ..tkio::OpenOptions::default()
+    };
+    let frames = tkio::open_frames(&path, &open).expect("open as frames");
+    assert!(!frames.is_empty());
+    assert!(
+        frames.iter().all(|f| matches!(f, MeshFrames::Positions(_))),
+        "a skinned mesh was read as morph weights"
+    );
+    let result = stopmo::library_frames(&frames, &options(3)).expect("library");
+    assert_eq!(result.report.frames_form, FramesForm::Positions);
+}
