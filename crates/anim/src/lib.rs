@@ -29,6 +29,7 @@ mod flipbook;
 mod human;
 mod mesh;
 mod mesh_animation;
+mod morph_animation;
 mod rest;
 mod rng;
 mod sample;
@@ -46,8 +47,11 @@ pub use flipbook::{Flipbook, FlipbookPart};
 pub use human::human_number;
 pub use mesh::{area_normals, triangulate_polygon, vertex_normals, Aabb, Mesh};
 pub use mesh_animation::{MeshAnimation, DEFAULT_FPS};
+pub use morph_animation::{MeshFrames, MorphAnimation};
 pub use rng::{mix, SplitMix64};
-pub use sample::{rest_transform, sample, sample_owned, MeshObject, SampleOptions, SampledScene};
+pub use sample::{
+    rest_transform, sample, sample_morph, sample_owned, MeshObject, SampleOptions, SampledScene,
+};
 pub use scene::{MorphTarget, Node, Scene, SceneCamera, SceneMesh, SkinDef};
 pub use skeleton::{bones, Bone, Joint, SkeletalAnimation, Skeleton};
 pub use skin::{skin_frames, skin_positions, Skin, VertexWeights};

@@ -52,4 +52,4 @@ pub mod fbx;
 pub mod gltf;
 
 pub use detect::{detect, load, load_with_notes, Format, LoadOptions, Loaded};
-pub use sampling::{open, OpenError, OpenOptions};
+pub use sampling::{open, open_frames, OpenError, OpenOptions};

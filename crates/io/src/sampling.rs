@@ -143,6 +143,38 @@ pub fn open(path: &Path, options: &OpenOptions) -> Result<SampledScene> {
     }
 }
 
+/// Loads the mesh objects of an input for a job that can use morph weights
+/// ([`anim::MeshFrames`]): a scene clip whose selected objects are all unskinned, on nodes that
+/// do not move, comes back as weights ([`anim::sample_morph`]); anything else is sampled into
+/// positions as by [`open`]. In file order, named after the objects.
+///
+/// # Errors
+/// As [`open`].
+pub fn open_frames(path: &Path, options: &OpenOptions) -> Result<Vec<anim::MeshFrames>> {
+    if let Loaded::Scene(scene) = load(path, options)? {
+        let sample = sample_options(path, &scene, options)?;
+        if let Some(morphs) = anim::sample_morph(&scene, &sample).map_err(with_path(path))? {
+            return Ok(morphs.into_iter().map(anim::MeshFrames::Morph).collect());
+        }
+        let sampled = anim::sample_owned(*scene, &sample).map_err(with_path(path))?;
+        return Ok(positions(sampled));
+    }
+    Ok(positions(open(path, options)?))
+}
+
+/// The objects' positions, each mesh named after its object.
+fn positions(sampled: SampledScene) -> Vec<anim::MeshFrames> {
+    sampled
+        .objects
+        .into_iter()
+        .map(|o| {
+            let mut a = o.animation;
+            a.mesh.name = o.name;
+            anim::MeshFrames::Positions(a)
+        })
+        .collect()
+}
+
 /// All mesh objects merged into one point cache (the vertex order every per-vertex output
 /// uses, and that `toonkit convert IN rest.obj` writes).
 ///

@@ -101,13 +101,13 @@ pub mod library;
 pub mod segment;
 
 pub use job::{
-    check_positive_mm, check_segment_memory, file_safe_name, is_library_piece, library,
-    library_memory, library_of, library_pieces, piece_label, run, saved_segmentation, segment,
-    segment_into_parts, segment_memory, segment_owned, size_curve, Error, FileData,
-    LibraryJobOptions, LibraryReport, LibraryResult, OrderReport, OutputFile, PartPrintReport,
-    PartReport, PartSummary, Piece, PieceCount, PiecesFolder, PlugReport, PrintReport, PrintTime,
-    Reconstruction, Result, RunOptions, SegmentJobOptions, SegmentSummary, Segmented, SizeCurve,
-    SizePoint, DEFAULT_PIECES, DEFAULT_RESOLUTION_MM,
+    check_positive_mm, check_segment_memory, file_safe_name, frames_memory, is_library_piece,
+    library, library_frames, library_memory, library_of, library_pieces, piece_label, run,
+    saved_segmentation, segment, segment_into_parts, segment_memory, segment_owned, size_curve,
+    Error, FileData, FramesForm, LibraryJobOptions, LibraryReport, LibraryResult, OrderReport,
+    OutputFile, PartPrintReport, PartReport, PartSummary, Piece, PieceCount, PiecesFolder,
+    PlugReport, PrintReport, PrintTime, Reconstruction, Result, RunOptions, SegmentJobOptions,
+    SegmentSummary, Segmented, SizeCurve, SizePoint, DEFAULT_PIECES, DEFAULT_RESOLUTION_MM,
 };
 pub use job::{
     default_clearance_mm, PieceReport, Plate, PrintFormat, CLEARANCE_PER_RESOLUTION,

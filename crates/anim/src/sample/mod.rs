@@ -216,31 +216,7 @@ fn sample_with(
     spare: &mut [Option<Mesh>],
 ) -> Result<SampledScene> {
     scene.validate()?;
-    if !(options.fps.is_finite() && options.fps > 0.0) {
-        return Err(AnimError::Invalid(format!(
-            "frame rate must be positive, got {}",
-            options.fps
-        )));
-    }
-    let clip = match options.clip {
-        Some(i) => Some(scene.clips.get(i).ok_or_else(|| {
-            AnimError::NotFound {
-                kind: "clip",
-                name: i.to_string(),
-                available: scene
-                    .clips
-                    .iter()
-                    .map(|c| c.name.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            }
-        })?),
-        None => scene.clips.first(),
-    };
-    let (start, frames) = match clip {
-        Some(c) => (c.start(), frame_count(c.duration(), options.fps)),
-        None => (0.0, 1),
-    };
+    let (clip, start, frames) = clip_frames(scene, options)?;
     let fps = options.fps;
     let cache_values = frames.saturating_mul(
         scene
@@ -360,6 +336,39 @@ fn sample_with(
     })
 }
 
+/// The clip `options` pick, its start time and its frame count at `options.fps`.
+fn clip_frames<'s>(
+    scene: &'s Scene,
+    options: &SampleOptions,
+) -> Result<(Option<&'s crate::Clip>, f32, usize)> {
+    if !(options.fps.is_finite() && options.fps > 0.0) {
+        return Err(AnimError::Invalid(format!(
+            "frame rate must be positive, got {}",
+            options.fps
+        )));
+    }
+    let clip = match options.clip {
+        Some(i) => Some(scene.clips.get(i).ok_or_else(|| {
+            AnimError::NotFound {
+                kind: "clip",
+                name: i.to_string(),
+                available: scene
+                    .clips
+                    .iter()
+                    .map(|c| c.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            }
+        })?),
+        None => scene.clips.first(),
+    };
+    let (start, frames) = match clip {
+        Some(c) => (c.start(), frame_count(c.duration(), options.fps)),
+        None => (0.0, 1),
+    };
+    Ok((clip, start, frames))
+}
+
 /// The frame and point budgets of sampling `duration` seconds at `fps` into `frames` frames of
 /// `points` positions in all, checked before the poses are allocated.
 fn check_sampling(duration: f32, fps: f32, frames: usize, points: usize) -> Result<()> {
@@ -384,6 +393,9 @@ fn check_sampling(duration: f32, fps: f32, frames: usize, points: usize) -> Resu
 }
 
 mod morph;
+mod weights;
+
+pub use weights::sample_morph;
 
 use morph::{morphed, rigid_batch, MORPH_BATCH};
 

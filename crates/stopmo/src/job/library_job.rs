@@ -4,7 +4,7 @@
 use std::borrow::Borrow;
 use std::time::Instant;
 
-use anim::MeshAnimation;
+use anim::{MeshAnimation, MeshFrames, MorphAnimation};
 
 use super::error::{Error, Result};
 use super::options::{
@@ -13,13 +13,13 @@ use super::options::{
 };
 use super::plates::library_3mf;
 use super::print::{print_pieces, surface_pieces, PrintSettings};
-use super::report::{InputErrors, LibraryReport, ReportInputs};
+use super::report::{FramesForm, InputErrors, LibraryReport, ReportInputs};
 use super::result::{LibraryResult, Reconstruction};
 use super::segment_job::segment;
 use super::sheets::{assembly_sheets, catalogue_png};
 use crate::library::{
-    build_library, compare_frames, plan_plugs, print_scale, scaled, shooting_order, ErrorSummary,
-    Library, LibraryOptions, LibrarySize, PartInput, PartSetup, Plug, PlugOptions,
+    build_sources, compare_frames, plan_plugs, print_scale_of, scaled, shooting_order,
+    ErrorSummary, Library, LibraryOptions, LibrarySize, PartSetup, Plug, PlugOptions, Source,
 };
 
 /// A name that is safe as a file stem: every character other than letters, digits, `-` and
@@ -62,6 +62,95 @@ pub fn library<A: Borrow<MeshAnimation>>(
     let refs: Vec<&MeshAnimation> = parts.iter().map(Borrow::borrow).collect();
     let names: Vec<String> = refs.iter().map(|a| a.mesh.name.clone()).collect();
     build(&refs, &names, opts, None)
+}
+
+/// [`library`] of parts given as positions or as morph weights ([`MeshFrames`], as
+/// `tkio::open_frames` reads them): a morph-only clip on a still node is solved from its
+/// weights (exact, `docs/stopmo-scale.md`) and never expanded into positions, so a long clip
+/// fits in a fraction of the memory; the report's `frames_form` says which form was used.
+///
+/// # Errors
+/// As [`library`].
+pub fn library_frames(parts: &[MeshFrames], opts: &LibraryJobOptions) -> Result<LibraryResult> {
+    frames_memory(parts)
+        .check(MEMORY_HINT)
+        .map_err(anim::AnimError::from)?;
+    let sources: Vec<Source<'_>> = parts.iter().map(Source::of).collect();
+    let names: Vec<String> = parts.iter().map(|a| a.mesh().name.clone()).collect();
+    let start = Instant::now();
+    let lib = solve_sources(&sources, &names, opts)?;
+    // Printing, sheets and the reconstruction read the topology, timing and average shape:
+    // a morph clip stands in as its one average frame.
+    let stand_ins: Vec<Option<MeshAnimation>> = parts
+        .iter()
+        .map(|p| match p {
+            MeshFrames::Positions(_) => Ok(None),
+            MeshFrames::Morph(m) => average_frame(m).map(Some),
+        })
+        .collect::<Result<_>>()?;
+    let anims: Vec<&MeshAnimation> = parts
+        .iter()
+        .zip(&stand_ins)
+        .map(|(p, s)| match (p, s) {
+            (MeshFrames::Positions(a), _) => a,
+            (_, Some(s)) => s,
+            (MeshFrames::Morph(_), None) => unreachable!("a stand-in per morph clip"),
+        })
+        .collect();
+    let mut result = finish(lib, &anims, &names, opts, None, start)?;
+    result.report.frames_form = FramesForm::of(parts);
+    result.report.total_seconds = start.elapsed().as_secs_f64();
+    result.report.peak_memory_mib = super::report::peak_memory_mib();
+    Ok(result)
+}
+
+/// What [`library_frames`] holds: [`LIBRARY_COPIES`] copies of the parts given as positions,
+/// and for a morph clip its weights and targets (f32, twice again for the solver's f64
+/// copies) plus one expanded block and the reduced coordinates.
+pub fn frames_memory(parts: &[MeshFrames]) -> anim::budget::JobMemory {
+    let frames = parts.first().map_or(0, MeshFrames::frame_count);
+    let dense: usize = parts
+        .iter()
+        .filter(|p| matches!(p, MeshFrames::Positions(_)))
+        .map(MeshFrames::vertex_count)
+        .sum();
+    let floats: u64 = parts
+        .iter()
+        .filter_map(|p| match p {
+            MeshFrames::Morph(m) => {
+                let k = m.target_count() as u64 + 1;
+                Some(3 * k * (m.frame_count() as u64 + 3 * m.vertex_count() as u64))
+            }
+            MeshFrames::Positions(_) => None,
+        })
+        .sum();
+    memory(frames, dense, LIBRARY_COPIES)
+        .bytes("morph weights, targets and coordinates", 4 * floats)
+}
+
+/// A morph clip's average frame as a one-frame animation with its topology and timing:
+/// `b + T w̄`, the weights averaged in f64.
+fn average_frame(m: &MorphAnimation) -> Result<MeshAnimation> {
+    let (n, k, nv) = (m.frame_count(), m.target_count(), m.vertex_count());
+    let mut wbar = vec![0.0f64; k];
+    for f in 0..n {
+        for (a, &w) in wbar.iter_mut().zip(m.frame_weights(f)) {
+            *a += f64::from(w);
+        }
+    }
+    let (base, targets) = (m.base(), m.targets());
+    let average: Vec<anim::glam::Vec3> = (0..nv)
+        .map(|v| {
+            let mut p = base[v].as_dvec3();
+            for (j, &w) in wbar.iter().enumerate() {
+                p += targets[j * nv + v].as_dvec3() * (w / n as f64);
+            }
+            p.as_vec3()
+        })
+        .collect();
+    let mut a = MeshAnimation::new(m.mesh.clone(), m.fps, average).map_err(Error::from)?;
+    a.start_time = m.start_time;
+    Ok(a)
 }
 
 /// Copies of a part's positions a library build holds: the parts, and at most the solver's
@@ -202,7 +291,7 @@ fn input_errors(
 /// The library size rule of the options, resolved against the parts.
 fn library_size(
     opts: &LibraryJobOptions,
-    anims: &[&MeshAnimation],
+    sources: &[Source<'_>],
     names: &[String],
 ) -> Result<LibrarySize> {
     Ok(match &opts.pieces {
@@ -229,7 +318,7 @@ fn library_size(
         }
         PieceCount::MaxErrorMm(e) => {
             super::check_positive_mm("max_error_mm", *e)?;
-            LibrarySize::MaxError(e / print_scale(anims, opts.print_height_mm))
+            LibrarySize::MaxError(e / print_scale_of(sources, opts.print_height_mm))
         }
         PieceCount::Budget(b) => LibrarySize::Budget(*b),
     })
@@ -238,10 +327,10 @@ fn library_size(
 /// Per-part saliency, fixed pieces and cuts.
 fn setups(
     opts: &LibraryJobOptions,
-    anims: &[&MeshAnimation],
+    vertices: &[usize],
     names: &[String],
 ) -> Result<Vec<PartSetup>> {
-    let total: usize = anims.iter().map(|a| a.vertex_count()).sum();
+    let total: usize = vertices.iter().sum();
     if let Some(s) = &opts.saliency {
         if s.len() != total {
             return Err(Error::option_error(
@@ -260,11 +349,10 @@ fn setups(
         ));
     }
     let mut at = 0;
-    Ok(anims
+    Ok(vertices
         .iter()
         .zip(names)
-        .map(|(a, name)| {
-            let n = a.vertex_count();
+        .map(|(&n, name)| {
             let saliency = opts.saliency.as_ref().map(|s| s[at..at + n].to_vec());
             at += n;
             PartSetup {
@@ -296,6 +384,16 @@ pub(super) fn solve(
     names: &[String],
     opts: &LibraryJobOptions,
 ) -> Result<Library> {
+    let sources: Vec<Source<'_>> = anims.iter().map(|a| Source::Positions(a)).collect();
+    solve_sources(&sources, names, opts)
+}
+
+/// [`solve`] of parts given as positions or morph weights.
+fn solve_sources(
+    sources: &[Source<'_>],
+    names: &[String],
+    opts: &LibraryJobOptions,
+) -> Result<Library> {
     for (i, n) in names.iter().enumerate() {
         if names[..i].contains(n) {
             return Err(Error::option_error(
@@ -304,7 +402,7 @@ pub(super) fn solve(
             ));
         }
     }
-    let size = library_size(opts, anims, names)?;
+    let size = library_size(opts, sources, names)?;
     super::check_positive_mm("thickness_mm", opts.thickness_mm)?;
     if !(opts.resolution_mm.is_finite() && opts.resolution_mm >= 0.0) {
         return Err(Error::option_error(
@@ -312,14 +410,9 @@ pub(super) fn solve(
             "must be a number of millimetres >= 0",
         ));
     }
-    let part_inputs: Vec<PartInput<'_>> = anims
-        .iter()
-        .zip(setups(opts, anims, names)?)
-        .map(|(a, setup)| PartInput {
-            animation: a,
-            setup,
-        })
-        .collect();
+    let vertices: Vec<usize> = sources.iter().map(Source::vertex_count).collect();
+    let setups = setups(opts, &vertices, names)?;
+    let part_inputs: Vec<(Source<'_>, &PartSetup)> = sources.iter().copied().zip(&setups).collect();
     let lib_opts = LibraryOptions {
         size,
         method: opts.method,
@@ -327,7 +420,7 @@ pub(super) fn solve(
         print_height_mm: opts.print_height_mm,
         ..LibraryOptions::default()
     };
-    let mut lib = build_library(&part_inputs, &lib_opts)?;
+    let mut lib = build_sources(&part_inputs, &lib_opts)?;
     for (p, n) in lib.parts.iter_mut().zip(names) {
         p.name.clone_from(n);
     }

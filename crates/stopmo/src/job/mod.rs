@@ -23,7 +23,9 @@ mod text;
 pub use checks::check_positive_mm;
 pub use error::{Error, Result};
 pub use fixed_pieces::{is_library_piece, library_pieces, PiecesFolder};
-pub use library_job::{file_safe_name, library, library_memory, run};
+pub use library_job::{
+    file_safe_name, frames_memory, library, library_frames, library_memory, run,
+};
 pub use options::{
     default_clearance_mm, LibraryJobOptions, PieceCount, PrintFormat, RunOptions,
     SegmentJobOptions, CLEARANCE_PER_RESOLUTION, CLEARANCE_RANGE_MM, DEFAULT_MIN_FEATURE_MM,
@@ -34,8 +36,8 @@ pub use plates::Plate;
 pub use print::{piece_label, Piece, DEFAULT_RESOLUTION_MM};
 pub use printability::{PrintabilityReport, SolidPrintability, Thin, ThinSpot};
 pub use report::{
-    LibraryReport, OrderReport, PartPrintReport, PartReport, PieceReport, PlugReport, PrintReport,
-    PrintTime,
+    FramesForm, LibraryReport, OrderReport, PartPrintReport, PartReport, PieceReport, PlugReport,
+    PrintReport, PrintTime,
 };
 pub use result::{LibraryResult, Reconstruction};
 pub use segment_job::{

@@ -125,6 +125,36 @@ pub struct LibraryReport {
     /// Peak resident memory of the process up to the end of the job, in MiB (the `VmHWM` of
     /// `/proc/self/status`; `null` where the system does not tell).
     pub peak_memory_mib: Option<f64>,
+    /// How the parts' frames reached the solver: positions, or morph weights expanded only
+    /// where needed (`docs/stopmo-scale.md`).
+    pub frames_form: FramesForm,
+}
+
+/// How a library job was given its parts' frames.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FramesForm {
+    /// Positions of every frame.
+    Positions,
+    /// Morph weights on still nodes (every part).
+    MorphWeights,
+    /// Some parts as positions, some as morph weights.
+    Mixed,
+}
+
+impl FramesForm {
+    /// The form of `parts`.
+    pub(crate) fn of(parts: &[anim::MeshFrames]) -> FramesForm {
+        let morph = parts
+            .iter()
+            .filter(|p| matches!(p, anim::MeshFrames::Morph(_)))
+            .count();
+        match morph {
+            0 => FramesForm::Positions,
+            m if m == parts.len() => FramesForm::MorphWeights,
+            _ => FramesForm::Mixed,
+        }
+    }
 }
 
 /// Peak resident memory of this process so far in MiB (`VmHWM`, Linux); `None` elsewhere.
@@ -171,6 +201,7 @@ impl LibraryReport {
     pub(crate) fn new(lib: &Library, x: ReportInputs<'_>) -> LibraryReport {
         LibraryReport {
             input: None,
+            frames_form: FramesForm::Positions,
             method: lib.method,
             energy: lib.energy,
             lambda: lib.lambda,

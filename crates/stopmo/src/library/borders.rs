@@ -14,6 +14,7 @@ use glam::{DVec3, Vec3};
 
 use super::problem::PartProblem;
 use super::solver::PartSolution;
+use super::source::Source;
 use crate::segment::{open_border, Topology, Weld};
 
 /// Rings of vertices over which a piece blends from the frames' mean at the part's border
@@ -24,7 +25,7 @@ impl PartProblem<'_> {
     /// The vertices within [`BORDER_RINGS`] of the part's border and the weight of the
     /// frames' mean there (see [`PartProblem::confine_borders`]); once per part.
     pub(crate) fn border_weights(&self) -> Vec<(usize, f32)> {
-        border_weights(&self.anim.mesh.positions, &self.anim.mesh.triangles)
+        border_weights(&self.src.mesh().positions, &self.src.mesh().triangles)
             .into_iter()
             .enumerate()
             .filter(|(_, w)| *w > 0.0)
@@ -38,7 +39,6 @@ impl PartProblem<'_> {
     /// # Performance
     /// One pass over the frames for the vertices of `near`.
     pub(crate) fn confine_borders(&self, solution: &mut PartSolution, near: &[(usize, f32)]) {
-        let anim = self.anim;
         if near.is_empty() {
             return;
         }
@@ -46,21 +46,55 @@ impl PartProblem<'_> {
         // In f64: a still vertex's mean is then its position exactly (seams stay bit-equal).
         let mut sums = vec![DVec3::ZERO; pieces * near.len()];
         let mut counts = vec![0usize; pieces];
-        for (f, &label) in solution.labels.iter().enumerate() {
-            let k = label as usize;
-            if k < self.fixed || k >= pieces || f >= anim.frame_count() {
-                continue;
+        match self.src {
+            Source::Positions(anim) => {
+                for (f, &label) in solution.labels.iter().enumerate() {
+                    let k = label as usize;
+                    if k < self.fixed || k >= pieces || f >= anim.frame_count() {
+                        continue;
+                    }
+                    counts[k] += 1;
+                    let x = anim.frame(f);
+                    for (s, &(v, _)) in sums[k * near.len()..(k + 1) * near.len()]
+                        .iter_mut()
+                        .zip(near)
+                    {
+                        *s += x[v].as_dvec3();
+                    }
+                }
             }
-            counts[k] += 1;
-            let x = anim.frame(f);
-            for (s, &(v, _)) in sums[k * near.len()..(k + 1) * near.len()]
-                .iter_mut()
-                .zip(near)
-            {
-                *s += x[v].as_dvec3();
+            Source::Morph(anim) => {
+                // Σ_f (b + T w_f) = count · b + T Σ_f w_f: the frames' weights summed per piece.
+                let (nt, m) = (anim.target_count(), anim.vertex_count());
+                let mut wsum = vec![0.0f64; pieces * nt];
+                for (f, &label) in solution.labels.iter().enumerate() {
+                    let k = label as usize;
+                    if k < self.fixed || k >= pieces || f >= anim.frame_count() {
+                        continue;
+                    }
+                    counts[k] += 1;
+                    for (a, &w) in wsum[k * nt..(k + 1) * nt]
+                        .iter_mut()
+                        .zip(anim.frame_weights(f))
+                    {
+                        *a += f64::from(w);
+                    }
+                }
+                let (base, targets) = (anim.base(), anim.targets());
+                for k in 0..pieces {
+                    for (s, &(v, _)) in sums[k * near.len()..(k + 1) * near.len()]
+                        .iter_mut()
+                        .zip(near)
+                    {
+                        *s = base[v].as_dvec3() * counts[k] as f64;
+                        for (j, &w) in wsum[k * nt..(k + 1) * nt].iter().enumerate() {
+                            *s += targets[j * m + v].as_dvec3() * w;
+                        }
+                    }
+                }
             }
         }
-        let m = anim.vertex_count();
+        let m = self.src.vertex_count();
         for (k, piece) in solution.pieces.iter_mut().enumerate().skip(self.fixed) {
             if counts[k] == 0 || piece.len() != m {
                 continue;

@@ -13,6 +13,7 @@ use super::metrics::{evaluate, ErrorSummary, FrameErrors};
 use super::problem::{PartProblem, PartSetup};
 use super::size::{budget_search, max_error_search, CurvePoint};
 use super::solver::{PartSolution, SolveOptions};
+use super::source::Source;
 use super::subspace::SubspaceOptions;
 
 /// How many pieces each part gets.
@@ -116,10 +117,18 @@ pub struct Library {
 /// `height_mm` (falls back to the bounding-box diagonal for flat models, and to 1 for a
 /// single point).
 pub fn print_scale(anims: &[&MeshAnimation], height_mm: f64) -> f64 {
-    let bbox = anims
-        .iter()
-        .map(|a| a.bbox())
-        .fold(anim::Aabb::EMPTY, anim::Aabb::union);
+    scale_of(anims.iter().map(|a| a.bbox()), height_mm)
+}
+
+/// [`print_scale`] of parts given as positions or morph weights (the latter expanded in
+/// streamed blocks).
+pub(crate) fn print_scale_of(parts: &[Source<'_>], height_mm: f64) -> f64 {
+    scale_of(parts.iter().map(Source::bbox), height_mm)
+}
+
+/// [`print_scale`] of the parts' bounding boxes.
+fn scale_of(boxes: impl Iterator<Item = anim::Aabb>, height_mm: f64) -> f64 {
+    let bbox = boxes.fold(anim::Aabb::EMPTY, anim::Aabb::union);
     let h = f64::from(bbox.max.y - bbox.min.y);
     let extent = if h > 0.0 && h.is_finite() {
         h
@@ -141,15 +150,27 @@ pub fn print_scale(anims: &[&MeshAnimation], height_mm: f64) -> f64 {
 /// # Performance
 /// Parts are reduced once each; every solve is parallel over restarts.
 pub fn build_library(parts: &[PartInput<'_>], opts: &LibraryOptions) -> Result<Library> {
+    let sources: Vec<(Source<'_>, &PartSetup)> = parts
+        .iter()
+        .map(|p| (Source::Positions(p.animation), &p.setup))
+        .collect();
+    build_sources(&sources, opts)
+}
+
+/// [`build_library`] of parts given as positions or morph weights.
+pub(crate) fn build_sources(
+    parts: &[(Source<'_>, &PartSetup)],
+    opts: &LibraryOptions,
+) -> Result<Library> {
     let start = Instant::now();
     let first = parts.first().ok_or(LibraryError::NoParts)?;
-    let n = first.animation.frame_count();
-    for p in parts {
-        if p.animation.frame_count() != n {
+    let n = first.0.frame_count();
+    for (p, _) in parts {
+        if p.frame_count() != n {
             return Err(LibraryError::FrameCountMismatch {
-                part: p.animation.mesh.name.clone(),
+                part: p.mesh().name.clone(),
                 expected: n,
-                found: p.animation.frame_count(),
+                found: p.frame_count(),
             });
         }
     }
@@ -164,13 +185,8 @@ pub fn build_library(parts: &[PartInput<'_>], opts: &LibraryOptions) -> Result<L
     let problems = parts
         .iter()
         .enumerate()
-        .map(|(i, p)| {
-            PartProblem::new(
-                p.animation,
-                &p.setup,
-                &opts.subspace,
-                opts.solve.seed ^ i as u64,
-            )
+        .map(|(i, (src, setup))| {
+            PartProblem::of(*src, setup, &opts.subspace, opts.solve.seed ^ i as u64)
         })
         .collect::<Result<Vec<_>>>()?;
     let method_opts = match opts.method {
@@ -242,8 +258,8 @@ pub fn build_library(parts: &[PartInput<'_>], opts: &LibraryOptions) -> Result<L
             .map(|(s, c)| (s, c, None))
             .collect(),
     };
-    let anims: Vec<&MeshAnimation> = parts.iter().map(|p| p.animation).collect();
-    let mm = print_scale(&anims, opts.print_height_mm);
+    let sources: Vec<Source<'_>> = parts.iter().map(|p| p.0).collect();
+    let mm = print_scale_of(&sources, opts.print_height_mm);
     let results: Vec<PartResult> = solved
         .into_par_iter()
         .zip(problems.par_iter())

@@ -86,14 +86,24 @@ pub(crate) fn evaluate(
     labels: &[u32],
     lambda: f64,
 ) -> (f64, FrameErrors) {
-    let n = p.frames();
+    let (n, m) = (p.frames(), p.vertices());
     let mut start = vec![false; n];
     p.chains.iter().for_each(|c| start[c.start] = true);
     let w = p.weights.as_deref();
-    let per_frame: Vec<(f64, f64, f64, f64, f64, f64)> = (0..n)
-        .into_par_iter()
-        .map(|f| {
-            let x = p.anim.frame(f);
+    let mut per_frame: Vec<(f64, f64, f64, f64, f64, f64)> = Vec::with_capacity(n);
+    // The last frame of the previous block (morph weights are expanded block by block).
+    let mut last: Vec<Vec3> = Vec::new();
+    p.src.blocks(|f0, block| {
+        let frame = |f: usize| -> &[Vec3] {
+            if f >= f0 {
+                &block[(f - f0) * m..(f - f0 + 1) * m]
+            } else {
+                &last
+            }
+        };
+        let k = block.len() / m.max(1);
+        per_frame.par_extend((f0..f0 + k).into_par_iter().map(|f| {
+            let x = frame(f);
             let r = &pieces[labels[f] as usize];
             let (mut eu, mut pm, mut px) = (0.0, 0.0, 0.0f64);
             for (i, (a, b)) in x.iter().zip(r).enumerate() {
@@ -106,7 +116,7 @@ pub(crate) fn evaluate(
             }
             let (mut ev, mut vm, mut vx) = (0.0, 0.0, 0.0f64);
             if !start[f] {
-                let (xp, rp) = (p.anim.frame(f - 1), &pieces[labels[f - 1] as usize]);
+                let (xp, rp) = (frame(f - 1), &pieces[labels[f - 1] as usize]);
                 for i in 0..x.len() {
                     let dv = (x[i] - xp[i]).as_dvec3() - (r[i] - rp[i]).as_dvec3();
                     let sq = dv.length_squared();
@@ -118,8 +128,12 @@ pub(crate) fn evaluate(
             }
             let m = x.len().max(1) as f64;
             (eu, pm / m, px, ev, vm / m, vx)
-        })
-        .collect();
+        }));
+        if k > 0 {
+            last.clear();
+            last.extend_from_slice(&block[(k - 1) * m..]);
+        }
+    });
     let energy = per_frame.iter().map(|t| t.0 + 0.5 * lambda * t.3).sum();
     let errors = FrameErrors {
         position_mean: per_frame.iter().map(|t| t.1).collect(),

@@ -59,6 +59,7 @@ mod problem;
 mod regularize;
 mod size;
 mod solver;
+mod source;
 mod subspace;
 #[cfg(test)]
 mod test_shapes;
@@ -80,6 +81,7 @@ pub use borders::BORDER_RINGS;
 pub use build::{
     build_library, print_scale, Library, LibraryOptions, LibrarySize, Method, PartInput, PartResult,
 };
+pub(crate) use build::{build_sources, print_scale_of};
 pub use error::{LibraryError, Result};
 pub use fabricate::{
     check_solid, material, scaled, solidify, volume, MaterialEstimate, SolidCheck,
@@ -107,6 +109,7 @@ pub use solver::{
     PartSolution, SolveOptions, DEFAULT_LAMBDA, DEFAULT_MAX_ITERATIONS, DEFAULT_RESTARTS,
     DEFAULT_SEED, DEFAULT_TOLERANCE,
 };
+pub(crate) use source::Source;
 pub use subspace::{
     SubspaceOptions, DEFAULT_INITIAL_RANK, DEFAULT_MAX_RANK, DEFAULT_SUBSPACE_TOLERANCE,
 };

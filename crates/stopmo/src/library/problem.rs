@@ -2,12 +2,13 @@
 
 use std::ops::Range;
 
-use anim::MeshAnimation;
+use anim::{MeshAnimation, MorphAnimation};
 use glam::Vec3;
 use rayon::prelude::*;
 
 use super::error::{LibraryError, Result};
-use super::subspace::{reduce, Subspace, SubspaceOptions};
+use super::source::Source;
+use super::subspace::{gram_coords, reduce, Subspace, SubspaceOptions};
 
 /// Per-part inputs beyond the animation (all optional).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -28,7 +29,8 @@ pub struct PartSetup {
 #[derive(Debug, Clone)]
 pub struct PartProblem<'a> {
     pub(crate) name: String,
-    pub(crate) anim: &'a MeshAnimation,
+    /// The frames, as positions or morph weights.
+    pub(crate) src: Source<'a>,
     /// Saliency per vertex (`None` = uniform).
     pub(crate) weights: Option<Vec<f64>>,
     /// Fixed pieces, row-major `fixed × 3m` (model units).
@@ -84,12 +86,37 @@ impl<'a> PartProblem<'a> {
         subspace: &SubspaceOptions,
         seed: u64,
     ) -> Result<PartProblem<'a>> {
-        let name = anim.mesh.name.clone();
-        let m = anim.vertex_count();
+        PartProblem::of(Source::Positions(anim), setup, subspace, seed)
+    }
+
+    /// [`PartProblem::new`] for a morph-target clip given as weights: the reduction is exact
+    /// in K (+ fixed pieces) dimensions from the Gram matrix of the targets, and the clip is
+    /// never expanded into positions (see `docs/stopmo-scale.md`).
+    ///
+    /// # Errors
+    /// As [`PartProblem::new`].
+    pub fn morph(
+        anim: &'a MorphAnimation,
+        setup: &PartSetup,
+        subspace: &SubspaceOptions,
+        seed: u64,
+    ) -> Result<PartProblem<'a>> {
+        PartProblem::of(Source::Morph(anim), setup, subspace, seed)
+    }
+
+    /// [`PartProblem::new`] for either form of the frames.
+    pub(crate) fn of(
+        src: Source<'a>,
+        setup: &PartSetup,
+        subspace: &SubspaceOptions,
+        seed: u64,
+    ) -> Result<PartProblem<'a>> {
+        let name = src.mesh().name.clone();
+        let m = src.vertex_count();
         if m == 0 {
             return Err(LibraryError::EmptyPart { part: name });
         }
-        let n = anim.frame_count();
+        let n = src.frame_count();
         let weights = match &setup.saliency {
             None => None,
             Some(w) => {
@@ -128,44 +155,13 @@ impl<'a> PartProblem<'a> {
         }
         let chains = chains(n, &setup.cuts)?;
 
-        // Centred, saliency-scaled rows Z = [X; R_fixed] (x̄ = mean frame).
-        // Parallel over column blocks, each summed over the frames in order (the same sums
-        // as one sequential pass).
-        let mut mean = vec![0.0f64; 3 * m];
-        mean.par_chunks_mut(MEAN_BLOCK)
-            .enumerate()
-            .for_each(|(b, acc)| {
-                let (c0, w) = (b * MEAN_BLOCK, acc.len());
-                for f in anim.frames() {
-                    let x: &[f32] = bytemuck::cast_slice(f);
-                    for (a, &v) in acc.iter_mut().zip(&x[c0..c0 + w]) {
-                        *a += f64::from(v);
-                    }
-                }
-                acc.iter_mut().for_each(|v| *v /= n as f64);
-            });
         let scale: Vec<f64> = (0..3 * m)
             .map(|c| weights.as_ref().map_or(1.0, |w| w[c / 3].sqrt()))
             .collect();
-        let rows = n + setup.fixed.len();
-        // Rows of Z streamed straight from the frames (no second copy of the animation).
-        let fill = |r0: usize, out: &mut [f32]| {
-            out.par_chunks_mut(3 * m).enumerate().for_each(|(i, row)| {
-                let r = r0 + i;
-                if r < n {
-                    let frame: &[f32] = bytemuck::cast_slice(anim.frame(r));
-                    for (((o, &v), &mu), &s) in row.iter_mut().zip(frame).zip(&mean).zip(&scale) {
-                        *o = ((f64::from(v) - mu) * s) as f32;
-                    }
-                } else {
-                    let fixed = &fixed_rows[(r - n) * 3 * m..(r - n + 1) * 3 * m];
-                    for (c, o) in row.iter_mut().enumerate() {
-                        *o = ((fixed[c] - mean[c]) * scale[c]) as f32;
-                    }
-                }
-            });
+        let sub = match src {
+            Source::Positions(anim) => dense_coords(anim, &fixed_rows, &scale, subspace, seed)?,
+            Source::Morph(anim) => morph_coords(anim, &fixed_rows, &scale)?,
         };
-        let sub = reduce(&fill, rows, 3 * m, subspace, seed)?;
         let q = sub.dim;
         let row = |f: usize| &sub.coords[f * q..(f + 1) * q];
         let xx = (0..n).map(|f| row(f).iter().map(|v| v * v).sum()).collect();
@@ -181,7 +177,7 @@ impl<'a> PartProblem<'a> {
         }
         Ok(PartProblem {
             name,
-            anim,
+            src,
             weights,
             fixed_rows,
             fixed: setup.fixed.len(),
@@ -199,12 +195,12 @@ impl<'a> PartProblem<'a> {
 
     /// Number of frames.
     pub fn frames(&self) -> usize {
-        self.anim.frame_count()
+        self.src.frame_count()
     }
 
     /// Number of vertices.
     pub fn vertices(&self) -> usize {
-        self.anim.vertex_count()
+        self.src.vertex_count()
     }
 
     /// Number of fixed (pre-defined) pieces.
@@ -212,9 +208,12 @@ impl<'a> PartProblem<'a> {
         self.fixed
     }
 
-    /// The part's animation.
-    pub fn animation(&self) -> &'a MeshAnimation {
-        self.anim
+    /// The part's animation when its frames are positions (`None` for morph weights).
+    pub fn animation(&self) -> Option<&'a MeshAnimation> {
+        match self.src {
+            Source::Positions(a) => Some(a),
+            Source::Morph(_) => None,
+        }
     }
 
     /// Clips of the frame chain (split at the cuts).
@@ -241,6 +240,88 @@ impl<'a> PartProblem<'a> {
     pub(crate) fn fixed_coords(&self) -> &[f64] {
         &self.sub.coords[self.frames() * self.sub.dim..]
     }
+}
+
+/// Reduced coordinates of `Z = [X; R_fixed]` (centred on the mean frame, saliency-scaled by
+/// `scale` per coordinate) streamed from the positions (see [`reduce`]).
+fn dense_coords(
+    anim: &MeshAnimation,
+    fixed_rows: &[f64],
+    scale: &[f64],
+    subspace: &SubspaceOptions,
+    seed: u64,
+) -> Result<Subspace> {
+    let (n, m) = (anim.frame_count(), anim.vertex_count());
+    // Centred, saliency-scaled rows Z = [X; R_fixed] (x̄ = mean frame).
+    // Parallel over column blocks, each summed over the frames in order (the same sums
+    // as one sequential pass).
+    let mut mean = vec![0.0f64; 3 * m];
+    mean.par_chunks_mut(MEAN_BLOCK)
+        .enumerate()
+        .for_each(|(b, acc)| {
+            let (c0, w) = (b * MEAN_BLOCK, acc.len());
+            for f in anim.frames() {
+                let x: &[f32] = bytemuck::cast_slice(f);
+                for (a, &v) in acc.iter_mut().zip(&x[c0..c0 + w]) {
+                    *a += f64::from(v);
+                }
+            }
+            acc.iter_mut().for_each(|v| *v /= n as f64);
+        });
+    let rows = n + fixed_rows.len() / (3 * m);
+    // Rows of Z streamed straight from the frames (no second copy of the animation).
+    let fill = |r0: usize, out: &mut [f32]| {
+        out.par_chunks_mut(3 * m).enumerate().for_each(|(i, row)| {
+            let r = r0 + i;
+            if r < n {
+                let frame: &[f32] = bytemuck::cast_slice(anim.frame(r));
+                for (((o, &v), &mu), &s) in row.iter_mut().zip(frame).zip(&mean).zip(scale) {
+                    *o = ((f64::from(v) - mu) * s) as f32;
+                }
+            } else {
+                let fixed = &fixed_rows[(r - n) * 3 * m..(r - n + 1) * 3 * m];
+                for (c, o) in row.iter_mut().enumerate() {
+                    *o = ((fixed[c] - mean[c]) * scale[c]) as f32;
+                }
+            }
+        });
+    };
+    reduce(&fill, rows, 3 * m, subspace, seed)
+}
+
+/// Exact reduced coordinates of `Z` for a morph clip `x_f = b + T w_f`: with the basis
+/// `D = [T; R_fixed − b]` (saliency-scaled), a frame is `(w_f − w̄, 0) D` and fixed piece `j`
+/// is `(−w̄, e_j) D`, so `Z Zᵀ = C (D Dᵀ) Cᵀ` and `Y = C F` with `F Fᵀ = D Dᵀ` (a
+/// `(K + fixed)²` Gram matrix) has `Y Yᵀ = Z Zᵀ`: StopShop Eq. 10 is unchanged.
+fn morph_coords(anim: &MorphAnimation, fixed_rows: &[f64], scale: &[f64]) -> Result<Subspace> {
+    let (n, m, k) = (anim.frame_count(), anim.vertex_count(), anim.target_count());
+    let nf = fixed_rows.len() / (3 * m);
+    let t: &[f32] = bytemuck::cast_slice(anim.targets());
+    let b: &[f32] = bytemuck::cast_slice(anim.base());
+    let basis = |r: usize, c: usize| -> f64 {
+        let v = if r < k {
+            f64::from(t[r * 3 * m + c])
+        } else {
+            fixed_rows[(r - k) * 3 * m + c] - f64::from(b[c])
+        };
+        v * scale[c]
+    };
+    let mut wbar = vec![0.0f64; k];
+    for f in 0..n {
+        for (a, &w) in wbar.iter_mut().zip(anim.frame_weights(f)) {
+            *a += f64::from(w);
+        }
+    }
+    wbar.iter_mut().for_each(|v| *v /= n as f64);
+    let coefficient = |r: usize, j: usize| -> f64 {
+        match (r < n, j < k) {
+            (true, true) => f64::from(anim.frame_weights(r)[j]) - wbar[j],
+            (true, false) => 0.0,
+            (false, true) => -wbar[j],
+            (false, false) => f64::from(u8::from(r - n == j - k)),
+        }
+    };
+    gram_coords(k + nf, 3 * m, &basis, n + nf, &coefficient)
 }
 
 #[cfg(test)]

@@ -67,7 +67,7 @@ impl PartProblem<'_> {
         let lib = (0..pieces)
             .map(|k| {
                 let (a, b) = ((k * n).div_ceil(pieces), ((k + 1) * n).div_ceil(pieces));
-                self.anim.frame((a + b - 1) / 2).to_vec()
+                self.src.frame((a + b - 1) / 2).into_owned()
             })
             .collect::<Vec<_>>();
         let (energy, _) = super::metrics::evaluate(self, &lib, &labels, lambda);

@@ -216,6 +216,52 @@ pub(crate) fn reduce(
     }
 }
 
+/// Coordinates `Y = C F` of `rows` rows given as combinations `C` (`coefficient(row, j)`) of
+/// an `r × cols` basis `D` (`basis(j, col)`), where `F Fᵀ = D Dᵀ` (eigendecomposition of the
+/// `r × r` Gram matrix, which a Cholesky factor would not survive when the basis is
+/// dependent): `Y Yᵀ = (C D)(C D)ᵀ` exactly, in at most `r` dimensions.
+pub(crate) fn gram_coords(
+    r: usize,
+    cols: usize,
+    basis: &(dyn Fn(usize, usize) -> f64 + Sync),
+    rows: usize,
+    coefficient: &(dyn Fn(usize, usize) -> f64 + Sync),
+) -> Result<Subspace> {
+    if r == 0 {
+        return Ok(zero(rows));
+    }
+    let d = Mat::<f64>::from_fn(r, cols, basis);
+    let mut gram = Mat::<f64>::zeros(r, r);
+    matmul(
+        gram.as_mut(),
+        Accum::Replace,
+        d.as_ref(),
+        d.transpose(),
+        1.0,
+        par(),
+    );
+    if (0..r).all(|i| gram[(i, i)] <= 0.0) {
+        return Ok(zero(rows));
+    }
+    let (f, dim) = eigen_coords(gram.as_ref(), None)?;
+    let f = MatRef::from_row_major_slice(&f, r, dim);
+    let c = Mat::<f64>::from_fn(rows, r, coefficient);
+    let mut coords = vec![0.0; rows * dim];
+    matmul(
+        faer::MatMut::from_row_major_slice_mut(&mut coords, rows, dim),
+        Accum::Replace,
+        c.as_ref(),
+        f,
+        1.0,
+        par(),
+    );
+    Ok(Subspace {
+        dim,
+        coords,
+        captured: 1.0,
+    })
+}
+
 /// The reduction of all-zero rows: one zero coordinate each.
 fn zero(rows: usize) -> Subspace {
     Subspace {

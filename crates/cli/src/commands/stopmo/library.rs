@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anim::MeshAnimation;
+use anim::MeshFrames;
 use anyhow::{bail, Result};
 use clap::Args;
 
@@ -28,32 +28,33 @@ pub(crate) struct LibraryArgs {
 }
 
 /// The parts of the input: one per mesh object, named after it (file-safe; the file stem
-/// for an unnamed object).
-fn parts(path: &Path, args: &InputArgs) -> Result<Vec<MeshAnimation>> {
-    let sampled = tkio::open(path, &args.options())?;
-    if sampled.objects.is_empty() {
+/// for an unnamed object), as morph weights when the clip only morphs still objects
+/// (`tkio::open_frames`), else as positions.
+fn parts(path: &Path, args: &InputArgs) -> Result<Vec<MeshFrames>> {
+    let mut parts = tkio::open_frames(path, &args.options())?;
+    if parts.is_empty() {
         bail!("{}: the file has no mesh", path.display());
     }
     let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("part");
-    Ok(sampled
-        .objects
-        .into_iter()
-        .map(|o| {
-            let mut a = o.animation;
-            a.mesh.name = stopmo::file_safe_name(if o.name.is_empty() { stem } else { &o.name });
-            a
-        })
-        .collect())
+    for p in &mut parts {
+        let mesh = p.mesh_mut();
+        mesh.name = stopmo::file_safe_name(if mesh.name.is_empty() {
+            stem
+        } else {
+            &mesh.name
+        });
+    }
+    Ok(parts)
 }
 
 /// Runs `toonkit stopmo library`.
 pub(super) fn library(ctx: &Context, args: LibraryArgs) -> Result<()> {
     let anims = parts(&args.input, &args.input_args)?;
-    let names: Vec<String> = anims.iter().map(|a| a.mesh.name.clone()).collect();
+    let names: Vec<String> = anims.iter().map(|a| a.mesh().name.clone()).collect();
     let options = args.library.options(&names)?;
     let spinner = crate::progress::spinner("optimizing the library", ctx.json);
-    let mut result =
-        stopmo::library(&anims, &options).map_err(|e| args.library.context(e, &args.input))?;
+    let mut result = stopmo::library_frames(&anims, &options)
+        .map_err(|e| args.library.context(e, &args.input))?;
     spinner.finish_and_clear();
     drop(anims);
     result.report.input = Some(args.input.display().to_string());
