@@ -1,5 +1,6 @@
 //! Compact answers: a stroke answered as the skeleton's pose and a whole clip answered as
-//! 16-bit changes rebuild the core's positions within their stated bounds
+//! 16-bit changes (its multiples as the vertices they show) rebuild the core's positions within
+//! their stated bounds
 //! (docs/studio.md, "Whole clips").
 
 use serde_json::json;
@@ -163,4 +164,83 @@ async fn the_whole_clip_sent_as_changes_rebuilds_the_cores_body_within_its_bound
             dense.len()
         );
     }
+}
+
+#[tokio::test]
+async fn a_whole_clip_sends_the_multiples_shown_vertices_and_16_bit_line_indices() {
+    let dir = tempfile::tempdir().unwrap();
+    let app = app(dir.path());
+    let (_, input) = pack::read_f32(
+        &send_ok(&app, get("/api/scene?clip=Dance")).await,
+        "positions",
+    )
+    .unwrap();
+    // SMEAR Fig. 16: elongation, two past and one future copy, motion lines.
+    let toml = include_str!("../../../examples/smear/fig16_combined.toml");
+    let mut request = json!({"clip": "Dance", "toml": toml});
+    let dense = send_ok(&app, post("/api/smear/stylize", request.clone())).await;
+    request["changes"] = json!(true);
+    let sent = send_ok(&app, post("/api/smear/stylize", request)).await;
+    let (header, _) = pack::split(&sent).unwrap();
+    let frames = header["frames"].as_u64().unwrap() as usize;
+    let n = input.len() / 3 / frames;
+    let copies = header["copies"].as_array().unwrap();
+    assert!(!copies.is_empty());
+    let (mut shown, mut all) = (0, 0);
+    for (i, c) in copies.iter().enumerate() {
+        let v = c["vertices"].as_u64().unwrap() as usize;
+        let first = c["first_vertex"].as_u64().unwrap() as usize;
+        let triangles = read_u32(&sent, &format!("copy{i}.triangles"));
+        let (positions, alpha) = (
+            f32s(&dense, &format!("copy{i}.positions")),
+            f32s(&dense, &format!("copy{i}.alpha")),
+        );
+        assert!(pack::read_f32(&sent, &format!("copy{i}.positions")).is_none());
+        let mask = read_u32(&sent, &format!("copy{i}.shown"));
+        let xyz = f32s(&sent, &format!("copy{i}.shown_positions"));
+        let a = f32s(&sent, &format!("copy{i}.shown_alpha"));
+        // The page's rebuild: shown vertices as sent, the others at the input, transparent.
+        let words = v.div_ceil(32);
+        let mut k = 0;
+        let (mut p, mut q) = (vec![0.0f32; frames * v * 3], vec![0.0f32; frames * v]);
+        for f in 0..frames {
+            for x in 0..v {
+                let o = f * v + x;
+                if mask[f * words + x / 32] >> (x % 32) & 1 == 1 {
+                    p[3 * o..3 * o + 3].copy_from_slice(&xyz[3 * k..3 * k + 3]);
+                    q[o] = a[k];
+                    k += 1;
+                } else {
+                    let from = (f * n + first + x) * 3;
+                    p[3 * o..3 * o + 3].copy_from_slice(&input[from..from + 3]);
+                }
+            }
+        }
+        assert_eq!(k, a.len(), "copy {i}: every shown vertex is placed");
+        assert_eq!(q, alpha, "copy {i}: every opacity is the core's");
+        for f in 0..frames {
+            for t in triangles.chunks(3) {
+                if t.iter().any(|&x| alpha[f * v + x as usize] > 0.0) {
+                    for &x in t {
+                        let o = 3 * (f * v + x as usize);
+                        assert_eq!(p[o..o + 3], positions[o..o + 3], "copy {i} frame {f}");
+                    }
+                }
+            }
+        }
+        shown += k;
+        all += frames * v;
+    }
+    assert!(shown * 4 < all, "{shown} of {all} vertex-frames shown");
+    for i in 0..header["lines"].as_array().unwrap().len() {
+        let wide = read_u32(&dense, &format!("lines{i}.triangles"));
+        let narrow = pack::read_i16(&sent, &format!("lines{i}.triangles16")).unwrap();
+        assert_eq!(wide, narrow.iter().map(|&x| x as u32).collect::<Vec<_>>());
+    }
+    assert!(
+        sent.len() * 2 < dense.len(),
+        "{} of {} bytes",
+        sent.len(),
+        dense.len()
+    );
 }

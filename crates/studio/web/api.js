@@ -30,9 +30,16 @@ export function parsePack(buffer) {
   return { header, buffers, bytes: buffer.byteLength };
 }
 
-/** A packed response (POST when `body` is given); `signal` aborts it (an AbortController's). */
+/**
+ * A packed response (POST when `body` is given); `signal` aborts it (an AbortController's).
+ * `times`: when the request left, its headers and its last byte arrived (performance.now()).
+ */
 export async function getPack(url, body, signal) {
   const init = body === undefined ? { signal } : { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body), signal };
+  const sent = performance.now();
   const r = await check(await fetch(url, init));
-  return parsePack(await r.arrayBuffer());
+  const headers = performance.now();
+  const out = parsePack(await r.arrayBuffer());
+  out.times = { sent, headers, body: performance.now() };
+  return out;
 }

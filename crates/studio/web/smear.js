@@ -7,13 +7,17 @@ import { getJSON, getPack, postJSON } from './api.js';
 import { KEYABLE, keyable, isCurve, paramAt, setKey, deleteKey, drawKeys, styleParams } from './smear_keys.js';
 import { WeightPicker } from './smear_weights.js';
 import { smearSummary } from './report.js';
+import { ClipBody, ClipCopy } from './smear_clip.js';
 
 const $ = (id) => document.getElementById(id);
 const EMPTY_LINES = { positions: new Float32Array(0), triangles: new Uint32Array(0) };
 
 /** Motion-line set `i` of a stylize answer, per frame: [{positions, triangles}]. */
 function splitLines(buffers, i) {
-  const counts = buffers[`lines${i}.counts`], pos = buffers[`lines${i}.positions`], tri = buffers[`lines${i}.triangles`];
+  const counts = buffers[`lines${i}.counts`], pos = buffers[`lines${i}.positions`];
+  // 16-bit indices (a whole-clip answer's) are drawn as they came, as uint16.
+  const t16 = buffers[`lines${i}.triangles16`];
+  const tri = t16 ? new Uint16Array(t16.buffer, t16.byteOffset, t16.length) : buffers[`lines${i}.triangles`];
   const out = [];
   let v = 0, t = 0;
   for (let f = 0; f < counts.length / 2; f++) {
@@ -22,35 +26,6 @@ function splitLines(buffers, i) {
     v += nv; t += nt;
   }
   return out;
-}
-
-/**
- * The body of a whole-clip answer sent as changes (`body.changed` bits per frame and vertex,
- * then the moved vertices as `body.delta` × `body.step` from the input, or as
- * `body.positions`; crates/studio/src/api/changes.rs) rebuilt over the input clip: the
- * core's numbers within 1e-5 of the clip's diagonal (docs/studio.md), unmoved vertices exact.
- */
-export function expandChanges(buffers, input, first, frames) {
-  const n = input.vertices, words = Math.ceil(n / 32);
-  const body = input.positions.slice(first * n * 3, (first + frames) * n * 3);
-  const bits = buffers['body.changed'], exact = buffers['body.positions'];
-  const delta = buffers['body.delta'], steps = buffers['body.step'];
-  let k = 0;
-  for (let f = 0; f < frames; f++) {
-    const step = steps ? steps[f] : 0;
-    for (let w = 0; w < words; w++) {
-      let word = bits[f * words + w];
-      while (word) {
-        const b = 31 - Math.clz32(word & -word);
-        word &= word - 1;
-        const o = (f * n + w * 32 + b) * 3;
-        if (exact) { body[o] = exact[k]; body[o + 1] = exact[k + 1]; body[o + 2] = exact[k + 2]; }
-        else { body[o] += delta[k] * step; body[o + 1] += delta[k + 1] * step; body[o + 2] += delta[k + 2] * step; }
-        k += 3;
-      }
-    }
-  }
-  return body;
 }
 
 /** A row of the "all parameters" block: label, field, and ◇/✕ for a keyable number. */
@@ -128,7 +103,7 @@ export class SmearPanel {
     this.active = false;
     if (this.restCtl) { this.restCtl.abort(); this.restCtl = null; }
     this.gen = (this.gen || 0) + 1;
-    this.body = this.copies = this.lines = null;
+    this.clip = this.copies = this.lines = null;
     this.studio.view.clearEffects();
     this.studio.view.setOffsets(null);
     this.studio.view.setVertexColors(null);
@@ -142,7 +117,7 @@ export class SmearPanel {
       this.anim = await s.loadClip(s.file, s.clip);
       this.loadedKey = key;
       this.offsets = null;
-      this.body = this.copies = this.lines = null;
+      this.clip = this.copies = this.lines = null;
     }
     s.view.setAnimation({ ...this.anim });
     s.setTimeline(this.anim.frames, this.anim.fps);
@@ -323,7 +298,9 @@ export class SmearPanel {
       this.apply(r);
       const applied = performance.now();
       await s.view.rendered();
-      s.stats.smearAll.push({ ms: performance.now() - t0, server_ms: r.header.seconds * 1000, bytes: r.bytes, frames: r.header.frames, fetch_ms: fetched - t0, apply_ms: applied - fetched, draw_ms: performance.now() - applied });
+      // When the request left, its answer's headers and its last byte arrived (from t0).
+      const at = (t) => t - t0;
+      s.stats.smearAll.push({ ms: performance.now() - t0, server_ms: r.header.seconds * 1000, bytes: r.bytes, frames: r.header.frames, fetch_ms: fetched - t0, apply_ms: applied - fetched, draw_ms: performance.now() - applied, sent_ms: at(r.times.sent), headers_ms: at(r.times.headers), body_ms: at(r.times.body) });
       $('smear-report').textContent += `\nall ${r.header.frames} frames in ${(performance.now() - t0).toFixed(0)} ms (server ${(r.header.seconds * 1000).toFixed(0)} ms, ${(r.bytes / 1048576).toFixed(1)} MiB)\n` + smearSummary(r.header.report, r.header.frames, this.anim.height);
     } catch (e) {
       if (e.name !== 'AbortError' && gen === this.gen) s.showError(e.message);
@@ -357,33 +334,34 @@ export class SmearPanel {
   apply({ header, buffers }) {
     const s = this.studio;
     const total = header.clip_frames, k = header.first_frame, nf = header.frames;
-    const n3 = this.anim.vertices * 3;
-    if (buffers['body.changed']) buffers.body = expandChanges(buffers, this.anim, k, nf);
-    if (nf === total) this.body = buffers.body;
-    else {
-      if (!this.body || this.body.length !== total * n3) this.body = new Float32Array(this.anim.positions);
-      this.body.set(buffers.body, k * n3);
-    }
-    const same = this.copies && this.copies.length === header.copies.length && this.copies.every((c, i) => c.vertices === header.copies[i].vertices);
-    const copy = (c, i) => ({ vertices: c.vertices, triangles: buffers[`copy${i}.triangles`], positions: buffers[`copy${i}.positions`], alpha: buffers[`copy${i}.alpha`] });
-    let newCopies = !same || nf === total;
-    if (nf === total) this.copies = header.copies.map(copy);
-    else {
-      if (!same) this.copies = header.copies.map((c, i) => ({ ...copy(c, i), positions: new Float32Array(total * c.vertices * 3), alpha: new Float32Array(total * c.vertices) }));
-      header.copies.forEach((c, i) => {
-        this.copies[i].positions.set(buffers[`copy${i}.positions`], k * c.vertices * 3);
-        this.copies[i].alpha.set(buffers[`copy${i}.alpha`], k * c.vertices);
+    if (!this.clip || this.clip.input !== this.anim) this.clip = new ClipBody(this.anim);
+    if (buffers['body.changed']) this.clip.setChanges(k, nf, buffers);
+    else this.clip.setFrames(k, nf, buffers.body);
+    // The multiples: kept per copy (ClipCopy) while the style's copies stay the same.
+    const same = this.copies && this.copies.length === header.copies.length && this.copies.every((c, i) => c.vertices === header.copies[i].vertices && c.triangles.length === buffers[`copy${i}.triangles`].length);
+    if (!same) {
+      this.copies = header.copies.map((c, i) => {
+        const clip = new ClipCopy(this.anim, c.first_vertex, c.vertices);
+        return { vertices: c.vertices, frames: total, triangles: buffers[`copy${i}.triangles`], clip, frameAt: (f) => clip.frame(f) };
       });
     }
+    header.copies.forEach((c, i) => {
+      const shown = buffers[`copy${i}.shown`], clip = this.copies[i].clip;
+      if (shown) clip.setShown(k, nf, shown, buffers[`copy${i}.shown_positions`], buffers[`copy${i}.shown_alpha`]);
+      else clip.setFrames(k, nf, buffers[`copy${i}.positions`], buffers[`copy${i}.alpha`]);
+    });
     const sets = header.lines.map((_, i) => splitLines(buffers, i));
     const sameLines = this.lines && this.lines.length === sets.length && nf !== total;
     if (!sameLines) this.lines = sets.map((fr) => (fr.length === total ? fr : Array.from({ length: total }, () => EMPTY_LINES)));
     if (nf !== total) sets.forEach((fr, i) => fr.forEach((x, j) => { this.lines[i][k + j] = x; }));
-    s.view.setAnimation({ ...this.anim, positions: this.body });
-    if (newCopies) s.view.setCopies(this.copies);
+    const clip = this.clip;
+    s.view.setAnimation({ ...this.anim, positions: clip.positions, frameAt: (f) => clip.frame(f) });
+    if (!same) s.view.setCopies(this.copies);
     if (!sameLines) s.view.setLines(this.lines.map((frames) => ({ frames })));
-    s.view.setFrame(s.view.frame);
   }
+
+  /** Every frame's body (frames × vertices × 3) of the styles answered so far, or null. */
+  get body() { return this.clip ? this.clip.all() : null; }
 
   async showOffsets() {
     const s = this.studio;

@@ -42,7 +42,11 @@ export class Viewport {
     this.dirty = true;
   }
 
-  /** Shows an animation: {triangles: Uint32Array, positions: Float32Array, frames, vertices}. */
+  /**
+   * Shows an animation: {triangles: Uint32Array, positions: Float32Array, frames, vertices},
+   * optionally `frameAt(f)` giving frame f's positions (a clip rebuilt frame by frame as it is
+   * drawn) instead of reading them from `positions`.
+   */
   setAnimation(anim, { frame = true } = {}) {
     const reuse = this.mesh && !this.mesh.isSkinnedMesh && this.anim && this.anim.vertices === anim.vertices && this.anim.triangles === anim.triangles;
     this.anim = anim;
@@ -104,7 +108,8 @@ export class Viewport {
     const n = anim.vertices;
     const box = new THREE.Box3();
     const p = new THREE.Vector3();
-    for (let i = 0; i < n; i++) box.expandByPoint(p.fromArray(anim.positions, i * 3));
+    const first = anim.frameAt ? anim.frameAt(0) : anim.positions;
+    for (let i = 0; i < n; i++) box.expandByPoint(p.fromArray(first, i * 3));
     const c = box.getCenter(new THREE.Vector3());
     const r = box.getSize(new THREE.Vector3()).length() / 2 || 1;
     this.perspective.near = r / 100; this.perspective.far = r * 100;
@@ -143,7 +148,8 @@ export class Viewport {
     } else {
       const n = this.anim.vertices * 3;
       const pos = this.mesh.geometry.attributes.position;
-      pos.array.set(this.anim.positions.subarray(this.frame * n, (this.frame + 1) * n));
+      const a = this.anim;
+      pos.array.set(a.frameAt ? a.frameAt(this.frame) : a.positions.subarray(this.frame * n, (this.frame + 1) * n));
       pos.needsUpdate = true;
       this.mesh.geometry.computeVertexNormals();
       this.mesh.geometry.computeBoundingSphere();
@@ -185,7 +191,10 @@ export class Viewport {
     this.copies = []; this.lines = [];
   }
 
-  /** Multiples: [{positions (frames × v × 3), alpha (frames × v), triangles, vertices}]. */
+  /**
+   * Multiples: [{positions (frames × v × 3), alpha (frames × v), triangles, vertices}], or
+   * with `frameAt(f)` giving frame f's {positions, alpha} and `frames` instead.
+   */
   setCopies(copies) {
     for (const c of this.copies) { this.scene.remove(c.mesh); c.mesh.geometry.dispose(); c.mesh.material.dispose(); }
     this.copies = copies.map((c) => {
@@ -205,11 +214,12 @@ export class Viewport {
   }
 
   copyFrame(c) {
-    const n = c.vertices, f = Math.min(this.frame, c.positions.length / (n * 3) - 1);
+    const n = c.vertices, f = Math.min(this.frame, (c.frameAt ? c.frames : c.positions.length / (n * 3)) - 1);
     const g = c.mesh.geometry;
-    g.attributes.position.array.set(c.positions.subarray(f * n * 3, (f + 1) * n * 3));
+    const fr = c.frameAt ? c.frameAt(f) : { positions: c.positions.subarray(f * n * 3, (f + 1) * n * 3), alpha: c.alpha.subarray(f * n, (f + 1) * n) };
+    g.attributes.position.array.set(fr.positions);
     const col = g.attributes.color.array;
-    for (let i = 0; i < n; i++) { col[i * 4] = 0.8; col[i * 4 + 1] = 0.8; col[i * 4 + 2] = 0.8; col[i * 4 + 3] = c.alpha[f * n + i]; }
+    for (let i = 0; i < n; i++) { col[i * 4] = 0.8; col[i * 4 + 1] = 0.8; col[i * 4 + 2] = 0.8; col[i * 4 + 3] = fr.alpha[i]; }
     g.attributes.position.needsUpdate = true; g.attributes.color.needsUpdate = true;
     g.computeVertexNormals();
   }

@@ -82,7 +82,7 @@ pub(crate) fn pack_changes<'a>(
             })
             .collect();
         let mut delta = vec![0i16; total];
-        split_frames(&mut delta, &moved)
+        split_frames(&mut delta, moved.iter().map(|m| 3 * m.0))
             .into_par_iter()
             .for_each(|(f, out)| {
                 let step = steps[f];
@@ -98,7 +98,7 @@ pub(crate) fn pack_changes<'a>(
         pack.i16("body.delta", delta);
     } else {
         let mut positions = vec![0.0f32; total];
-        split_frames(&mut positions, &moved)
+        split_frames(&mut positions, moved.iter().map(|m| 3 * m.0))
             .into_par_iter()
             .for_each(|(f, out)| {
                 each_moved(&body(f), input(f), bits(f), |k, p, _| {
@@ -139,12 +139,15 @@ fn each_moved(
     });
 }
 
-/// `buffer` cut into every frame's slice (three values per moved vertex of `moved`).
-fn split_frames<'b, T>(buffer: &'b mut [T], moved: &[(usize, f32)]) -> Vec<(usize, &'b mut [T])> {
-    let mut out = Vec::with_capacity(moved.len());
+/// `buffer` cut into every frame's slice (`lengths`: the values of each frame in turn).
+pub(super) fn split_frames<T>(
+    buffer: &mut [T],
+    lengths: impl Iterator<Item = usize>,
+) -> Vec<(usize, &mut [T])> {
+    let mut out = Vec::new();
     let mut rest = buffer;
-    for (f, &(n, _)) in moved.iter().enumerate() {
-        let (head, tail) = std::mem::take(&mut rest).split_at_mut(3 * n);
+    for (f, n) in lengths.enumerate() {
+        let (head, tail) = std::mem::take(&mut rest).split_at_mut(n);
         out.push((f, head));
         rest = tail;
     }

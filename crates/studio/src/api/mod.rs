@@ -26,6 +26,7 @@ mod changes;
 mod loa_api;
 mod loa_skin;
 mod scene;
+mod shown;
 mod smear_api;
 mod stopmo_api;
 mod stopmo_library;

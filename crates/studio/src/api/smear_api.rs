@@ -16,6 +16,7 @@ use smear::{ElongatePreset, ElongateStyle, OffsetOptions, Style, WeightSource};
 
 use super::changes::pack_changes;
 use super::scene::ClipQuery;
+use super::shown::pack_shown;
 use super::{blocking, body};
 use crate::error::{ApiError, ApiResult};
 use crate::files::output_path;
@@ -197,7 +198,10 @@ fn stylized(
 /// `linesN.counts` (u32 per frame: vertices, triangles), `linesN.positions`,
 /// `linesN.triangles`, `linesN.alpha`. With `"changes": true` the body comes as
 /// `body.changed` and `body.step` + `body.delta` (or `body.positions`) instead
-/// ([`super::changes`]).
+/// ([`super::changes`]), each copy as `copyN.shown`, `copyN.shown_positions` and
+/// `copyN.shown_alpha` with its `first_vertex` in the input ([`super::shown`]), and the lines'
+/// triangles as `linesN.triangles16` (i16) when every frame's tubes have at most 32,767
+/// vertices.
 pub(crate) async fn stylize(
     State(studio): State<Arc<Studio>>,
     request: Result<Bytes, BytesRejection>,
@@ -219,12 +223,9 @@ pub(crate) async fn stylize(
             .collect();
         let bodies = &bodies;
         let vertices: usize = bodies.iter().map(|a| a.vertex_count()).sum();
-        let clip = if r.changes {
-            Some(studio.sampled(r.file, &r.clip)?)
-        } else {
-            None
-        };
-        match clip.as_ref().map(|c| c.merged()) {
+        let input = studio.sampled(r.file, &r.clip)?;
+        let clip = r.changes.then_some(&input);
+        match clip.map(|c| c.merged()) {
             Some(m) if m.vertex_count() == vertices => pack_changes(
                 &mut pack,
                 frames,
@@ -240,21 +241,56 @@ pub(crate) async fn stylize(
                 );
             }
         }
+        // Each multiple's object in the merged input (its first vertex, vertex count): whole
+        // clips by changes send the vertices a copy shows, the page puts the rest there.
+        let inputs: Option<Vec<(usize, usize)>> = {
+            let objects = &input.sampled.objects;
+            (objects.len() == s.objects.len()).then(|| {
+                objects
+                    .iter()
+                    .scan(0, |first, o| {
+                        let n = o.animation.vertex_count();
+                        *first += n;
+                        Some((*first - n, n))
+                    })
+                    .collect()
+            })
+        };
         let mut copies = Vec::new();
         let mut lines = Vec::new();
-        for o in &s.objects {
+        for (j, o) in s.objects.iter().enumerate() {
             for i in o.copies.clone() {
                 if let Some(anim::FlipbookPart::Animation { animation, colors }) =
                     s.flipbook.parts.get(i)
                 {
                     let n = copies.len();
-                    pack.shared(&format!("copy{n}.positions"), (s.clone(), i), |(s, i)| {
-                        copy_positions(s, *i)
-                    });
                     pack.u32(
                         &format!("copy{n}.triangles"),
                         animation.mesh.triangles.iter().flatten().copied(),
                     );
+                    let v = animation.vertex_count();
+                    let first = inputs
+                        .as_ref()
+                        .and_then(|x| x.get(j))
+                        .and_then(|&(first, count)| (count == v).then_some(first));
+                    match first {
+                        Some(first) if r.changes => {
+                            pack_shown(
+                                &mut pack,
+                                &format!("copy{n}"),
+                                (frames, v),
+                                &animation.mesh.triangles,
+                                |f| animation.frame(f),
+                                colors.as_deref(),
+                            );
+                            copies.push(json!({"name": animation.mesh.name, "vertices": v, "first_vertex": first}));
+                            continue;
+                        }
+                        _ => {}
+                    }
+                    pack.shared(&format!("copy{n}.positions"), (s.clone(), i), |(s, i)| {
+                        copy_positions(s, *i)
+                    });
                     let count = animation.positions().len();
                     match colors {
                         Some(c) => pack.f32(&format!("copy{n}.alpha"), c.iter().map(|c| c[3])),
@@ -262,9 +298,7 @@ pub(crate) async fn stylize(
                             pack.f32(&format!("copy{n}.alpha"), std::iter::repeat_n(1.0, count))
                         }
                     };
-                    copies.push(
-                        json!({"name": animation.mesh.name, "vertices": animation.vertex_count()}),
-                    );
+                    copies.push(json!({"name": animation.mesh.name, "vertices": v, "first_vertex": first}));
                 }
             }
             if let Some(anim::FlipbookPart::Frames { name, meshes, .. }) =
@@ -281,12 +315,13 @@ pub(crate) async fn stylize(
                     &format!("lines{n}.positions"),
                     meshes.iter().map(|m| coordinates(&m.positions)),
                 );
-                pack.u32(
-                    &format!("lines{n}.triangles"),
-                    meshes
-                        .iter()
-                        .flat_map(|m| m.triangles.iter().flatten().copied()),
-                );
+                let indices = meshes.iter().flat_map(|m| m.triangles.iter().flatten());
+                // A frame's tubes index at most a few thousand vertices: 16 bits when they fit.
+                if r.changes && meshes.iter().all(|m| m.positions.len() <= i16::MAX as usize) {
+                    pack.i16(&format!("lines{n}.triangles16"), indices.map(|&k| k as i16));
+                } else {
+                    pack.u32(&format!("lines{n}.triangles"), indices.copied());
+                }
                 pack.f32(
                     &format!("lines{n}.alpha"),
                     meshes.iter().flat_map(|m| match &m.colors {

@@ -1,0 +1,142 @@
+// The smear result of every clip frame as the page holds it: per clip one preallocated
+// frames × vertices buffer for the body and for each multiple, filled from the answers. A
+// whole-clip answer (crates/studio/src/api/changes.rs and shown.rs, docs/studio.md) is kept as
+// it came and a frame is rebuilt over the input only when it is drawn (or the whole body is
+// read): the answer is in the scene as soon as it has arrived, without laying 81 frames of the
+// body and of every multiple over the clip first.
+
+/** Per frame of a bit set (`words` u32 per frame): where its values start, `per` a bit. */
+function starts(bits, words, count, per) {
+  const out = new Uint32Array(count + 1);
+  let k = 0;
+  for (let f = 0; f < count; f++) {
+    out[f] = k;
+    for (let w = f * words, end = w + words; w < end; w++) {
+      let x = bits[w];
+      x -= (x >>> 1) & 0x55555555;
+      x = (x & 0x33333333) + ((x >>> 2) & 0x33333333);
+      k += (Math.imul((x + (x >>> 4)) & 0x0f0f0f0f, 0x01010101) >>> 24) * per;
+    }
+  }
+  out[count] = k;
+  return out;
+}
+
+/** Calls `visit(v, k)` for the `k`-th set bit `v` (from 0) of frame `j`'s words. */
+function eachSet(bits, words, j, visit) {
+  let k = 0;
+  for (let w = 0, base = j * words; w < words; w++) {
+    let word = bits[base + w];
+    while (word) {
+      const b = 31 - Math.clz32(word & -word);
+      word &= word - 1;
+      visit(w * 32 + b, k++);
+    }
+  }
+}
+
+/** The elongated body of every frame. */
+export class ClipBody {
+  /** `input`: the clip as `/api/scene` gave it ({positions, frames, vertices}). */
+  constructor(input) {
+    this.input = input;
+    this.n3 = input.vertices * 3;
+    this.words = Math.ceil(input.vertices / 32);
+    this.positions = new Float32Array(input.frames * this.n3);
+    // Per frame: 1 when `positions` holds it, else rebuilt from `changes` (or the input).
+    this.ready = new Uint8Array(input.frames);
+    this.changes = null;
+  }
+
+  /** Answer frames `first ..+ count` as float32 (`body`, frame-major). */
+  setFrames(first, count, body) {
+    this.positions.set(body, first * this.n3);
+    this.ready.fill(1, first, first + count);
+  }
+
+  /**
+   * A whole-clip answer of changes: `body.changed` bits, `body.step` + `body.delta` or
+   * `body.positions` for the moved vertices. Only where each frame's moved vertices start is
+   * worked out now (a popcount of the bits); the frames are rebuilt when asked for.
+   */
+  setChanges(first, count, buffers) {
+    const bits = buffers['body.changed'];
+    this.changes = { first, count, bits, starts: starts(bits, this.words, count, 3), exact: buffers['body.positions'], delta: buffers['body.delta'], steps: buffers['body.step'] };
+    this.ready.fill(0, first, first + count);
+  }
+
+  /**
+   * Clip frame `f`'s positions: the input's with the moved vertices set (the core's numbers
+   * within 1e-5 of the clip's diagonal, docs/studio.md; unmoved vertices exact).
+   */
+  frame(f) {
+    const n3 = this.n3, out = this.positions.subarray(f * n3, (f + 1) * n3);
+    if (this.ready[f]) return out;
+    out.set(this.input.positions.subarray(f * n3, (f + 1) * n3));
+    const c = this.changes, j = c ? f - c.first : -1;
+    if (c && j >= 0 && j < c.count) {
+      const { exact, delta } = c, step = c.steps ? c.steps[j] : 0, k0 = c.starts[j];
+      eachSet(c.bits, this.words, j, (v, i) => {
+        const o = v * 3, k = k0 + i * 3;
+        if (exact) { out[o] = exact[k]; out[o + 1] = exact[k + 1]; out[o + 2] = exact[k + 2]; }
+        else { out[o] += delta[k] * step; out[o + 1] += delta[k + 1] * step; out[o + 2] += delta[k + 2] * step; }
+      });
+    }
+    this.ready[f] = 1;
+    return out;
+  }
+
+  /** Every frame rebuilt: frames × vertices × 3. */
+  all() {
+    for (let f = 0; f < this.input.frames; f++) this.frame(f);
+    return this.positions;
+  }
+}
+
+/**
+ * One multiple of every frame: positions and opacities of a copy of the input's vertices
+ * `first ..+ vertices` (one object). A frame not answered is the input, transparent.
+ */
+export class ClipCopy {
+  constructor(input, first, vertices) {
+    Object.assign(this, { input, first, vertices, words: Math.ceil(vertices / 32) });
+    this.positions = new Float32Array(input.frames * vertices * 3);
+    this.alpha = new Float32Array(input.frames * vertices);
+    this.ready = new Uint8Array(input.frames);
+    this.shown = null;
+  }
+
+  /** Answer frames `first ..+ count` as float32 positions and opacities. */
+  setFrames(first, count, positions, alpha) {
+    this.positions.set(positions, first * this.vertices * 3);
+    this.alpha.set(alpha, first * this.vertices);
+    this.ready.fill(1, first, first + count);
+  }
+
+  /** A whole-clip answer of the shown vertices (`copyN.shown`, `.shown_positions`, `.shown_alpha`). */
+  setShown(first, count, bits, positions, alpha) {
+    this.shown = { first, count, bits, starts: starts(bits, this.words, count, 1), positions, alpha };
+    this.ready.fill(0, first, first + count);
+  }
+
+  /** Clip frame `f`: {positions, alpha}. */
+  frame(f) {
+    const n = this.vertices;
+    const out = { positions: this.positions.subarray(f * n * 3, (f + 1) * n * 3), alpha: this.alpha.subarray(f * n, (f + 1) * n) };
+    if (this.ready[f]) return out;
+    const from = (f * this.input.vertices + this.first) * 3;
+    out.positions.set(this.input.positions.subarray(from, from + n * 3));
+    out.alpha.fill(0);
+    const c = this.shown, j = c ? f - c.first : -1;
+    if (c && j >= 0 && j < c.count) {
+      const k0 = c.starts[j], p = c.positions, a = c.alpha, pos = out.positions, alpha = out.alpha;
+      eachSet(c.bits, this.words, j, (v, i) => {
+        const k = k0 + i;
+        pos[v * 3] = p[k * 3]; pos[v * 3 + 1] = p[k * 3 + 1]; pos[v * 3 + 2] = p[k * 3 + 2];
+        alpha[v] = a[k];
+      });
+    }
+    this.ready[f] = 1;
+    return out;
+  }
+}
