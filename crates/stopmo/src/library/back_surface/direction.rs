@@ -116,7 +116,7 @@ impl<'a> DiscSearch<'a> {
 /// apart along the surface (greedily in vertex order: a vertex farther than that from every
 /// earlier sample is one); every vertex takes the sums of the samples within
 /// `DISC_BLEND_SPACINGS` spacings, weighted `(1 − (g/r)²)²`, normalized. On the ICT face at
-/// σ = 17.5 mm this differs from the sum at every vertex by at most a few tenths of a degree
+/// σ = 17.5 mm this differs from the sum at every vertex by 0.18° on average, 1.8° at worst
 /// (README, "What printing costs").
 ///
 /// # Performance
