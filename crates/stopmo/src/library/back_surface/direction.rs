@@ -114,8 +114,9 @@ impl<'a> DiscSearch<'a> {
 ///
 /// The disc sums are exact at *samples*, vertices about `DISC_SAMPLE_SPACING_SIGMAS × sigma`
 /// apart along the surface (greedily in vertex order: a vertex farther than that from every
-/// earlier sample is one); every vertex takes the sums of the samples within
-/// `DISC_BLEND_SPACINGS` spacings, weighted `(1 − (g/r)²)²`, normalized. On the ICT face at
+/// earlier sample is one); every vertex fits a linear field to the sums of the samples within
+/// `DISC_BLEND_SPACINGS` spacings (least squares weighted `(1 − (g/r)²)²`) and takes its
+/// value at the vertex, normalized. On the ICT face at
 /// σ = 17.5 mm this differs from the sum at every vertex by 0.18° on average, 1.8° at worst
 /// (README, "What printing costs").
 ///
