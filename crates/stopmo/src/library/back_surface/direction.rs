@@ -9,7 +9,7 @@
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
-use glam::Vec3;
+use glam::{DMat4, DVec3, DVec4, Vec3};
 use rayon::prelude::*;
 
 use super::PartShell;
@@ -24,14 +24,105 @@ fn reached(g: f32, u: u32) -> Reverse<u64> {
     Reverse((u64::from(g.to_bits()) << 32) | u64::from(u))
 }
 
+/// Spacing of the vertices whose geodesic discs are summed exactly, in Gaussian widths: the
+/// disc average changes over σ, so sums a fraction of σ apart, blended, stand for the sums
+/// at every vertex (ICT face, σ = 17.5 mm: 1.5 mm apart, ~1,000 of ~10,000 vertices).
+const DISC_SAMPLE_SPACING_SIGMAS: f32 = 1.0 / 12.0;
+
+/// Radius of the blend of sample sums at a vertex, in sample spacings: every vertex has a
+/// sample within one spacing, so at least one weighs in.
+const DISC_BLEND_SPACINGS: f32 = 2.0;
+
+/// Ridge on the slope of the blend's linear fit, per squared blend radius: keeps the fit
+/// defined across the surface's normal (the samples lie on a surface) and where few
+/// samples weigh in.
+const BLEND_RIDGE: f32 = 0.01;
+
+/// Edges of `adj` in one array with their lengths over `front` (CSR: the edges of `u` are
+/// `edges[start[u]..start[u + 1]]`), the same f32 values a search would compute per visit.
+fn edge_lengths(front: &[Vec3], adj: &[Vec<u32>]) -> (Vec<usize>, Vec<(u32, f32)>) {
+    let mut start = Vec::with_capacity(front.len() + 1);
+    let mut edges: Vec<(u32, f32)> = Vec::new();
+    start.push(0);
+    for (u, around) in adj.iter().enumerate().take(front.len()) {
+        edges.extend(
+            around
+                .iter()
+                .map(|&w| (w, front[u].distance(front[w as usize]))),
+        );
+        start.push(edges.len());
+    }
+    (start, edges)
+}
+
+/// Bounded Dijkstra searches over one edge array, reusing their buffers between searches.
+struct DiscSearch<'a> {
+    start: &'a [usize],
+    edges: &'a [(u32, f32)],
+    dist: Vec<f32>,
+    touched: Vec<u32>,
+    heap: BinaryHeap<Reverse<u64>>,
+}
+
+impl<'a> DiscSearch<'a> {
+    fn new(start: &'a [usize], edges: &'a [(u32, f32)]) -> Self {
+        DiscSearch {
+            start,
+            edges,
+            dist: vec![f32::INFINITY; start.len().saturating_sub(1)],
+            touched: Vec::new(),
+            heap: BinaryHeap::new(),
+        }
+    }
+
+    /// Calls `visit(u, g)` for every vertex `u` within `radius` of `v` along edge paths, in
+    /// the order of `(g, u)`.
+    fn run(&mut self, v: usize, radius: f32, mut visit: impl FnMut(usize, f32)) {
+        let (dist, touched, heap) = (&mut self.dist, &mut self.touched, &mut self.heap);
+        dist[v] = 0.0;
+        touched.push(v as u32);
+        heap.push(reached(0.0, v as u32));
+        while let Some(Reverse(key)) = heap.pop() {
+            let (g, u) = (f32::from_bits((key >> 32) as u32), key as u32 as usize);
+            if g > dist[u] {
+                continue;
+            }
+            visit(u, g);
+            for &(w, length) in &self.edges[self.start[u]..self.start[u + 1]] {
+                let w = w as usize;
+                let gw = g + length;
+                if gw <= radius && gw < dist[w] {
+                    if dist[w] == f32::INFINITY {
+                        touched.push(w as u32);
+                    }
+                    dist[w] = gw;
+                    heap.push(reached(gw, w as u32));
+                }
+            }
+        }
+        for &u in touched.iter() {
+            dist[u as usize] = f32::INFINITY;
+        }
+        touched.clear();
+    }
+}
+
 /// Unit outward direction at every vertex of `front` (triangles `tris`, vertex adjacency
 /// `adj`): the area-weighted normals of the vertices within `DISC_SIGMAS × sigma` mm along
 /// the surface (shortest edge paths), weighted by a Gaussian of width `sigma` mm of that
 /// distance. `sigma` 0 gives the (area-weighted) vertex normals.
 ///
+/// The disc sums are exact at *samples*, vertices about `DISC_SAMPLE_SPACING_SIGMAS × sigma`
+/// apart along the surface (greedily in vertex order: a vertex farther than that from every
+/// earlier sample is one); every vertex fits a linear field to the sums of the samples within
+/// `DISC_BLEND_SPACINGS` spacings (least squares weighted `(1 − (g/r)²)²`) and takes its
+/// value at the vertex, normalized. On the ICT face at
+/// σ = 17.5 mm this differs from the sum at every vertex by 0.18° on average, 1.8° at worst
+/// (README, "What printing costs").
+///
 /// # Performance
-/// One bounded Dijkstra search per vertex (parallel); its cost grows with the number of
-/// vertices in the disc (ICT face parts, σ = 17.5 mm: under a second a part, release).
+/// One bounded Dijkstra search per sample (parallel) and a short one per sample for the
+/// blend: ~10× fewer disc searches than one per vertex on the ICT face.
 pub(super) fn smoothed_directions(
     front: &[Vec3],
     tris: &[[u32; 3]],
@@ -46,51 +137,92 @@ pub(super) fn smoothed_directions(
     }
     let radius = DISC_SIGMAS * sigma;
     let inv_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
-    // Edges in one array with their lengths (the same f32 values the search would compute
-    // per visit): every disc relaxes each edge inside it, n discs in all.
-    let mut start = Vec::with_capacity(n + 1);
-    let mut edges: Vec<(u32, f32)> = Vec::new();
-    start.push(0);
-    for (u, around) in adj.iter().enumerate().take(n) {
-        edges.extend(
-            around
-                .iter()
-                .map(|&w| (w, front[u].distance(front[w as usize]))),
-        );
-        start.push(edges.len());
+    let (start, edges) = edge_lengths(front, adj);
+    // Samples, and for every vertex the samples within the blend radius (index, distance).
+    let spacing = DISC_SAMPLE_SPACING_SIGMAS * sigma;
+    let blend = DISC_BLEND_SPACINGS * spacing;
+    let mut search = DiscSearch::new(&start, &edges);
+    let mut cover = vec![f32::INFINITY; n];
+    let mut near: Vec<Vec<(u32, f32)>> = vec![Vec::new(); n];
+    let mut samples: Vec<usize> = Vec::new();
+    for v in 0..n {
+        if cover[v] <= spacing {
+            continue;
+        }
+        let s = samples.len() as u32;
+        samples.push(v);
+        search.run(v, blend, |u, g| {
+            cover[u] = cover[u].min(g);
+            near[u].push((s, g));
+        });
     }
-    (0..n)
+    let sums: Vec<Vec3> = samples
+        .par_iter()
+        .map_init(
+            || DiscSearch::new(&start, &edges),
+            |search, &v| {
+                let mut sum = Vec3::ZERO;
+                search.run(v, radius, |u, g| {
+                    sum += area_normals[u] * (-g * g * inv_two_sigma2).exp();
+                });
+                sum
+            },
+        )
+        .collect();
+    let inv_blend2 = 1.0 / (blend * blend);
+    let ridge = f64::from(BLEND_RIDGE * blend * blend);
+    let out: Vec<Vec3> = (0..n)
+        .into_par_iter()
+        .map(|v| {
+            // Weighted least squares of a linear field through the samples' sums, taken at
+            // the vertex: a plain weighted mean would lean towards where the samples lie.
+            let at = front[v].as_dvec3();
+            let (mut a, mut b) = (DMat4::ZERO, [DVec3::ZERO; 4]);
+            for &(s, g) in &near[v] {
+                let t = 1.0 - g * g * inv_blend2;
+                let w = f64::from(t * t);
+                let d = front[samples[s as usize]].as_dvec3() - at;
+                let x = DVec4::new(1.0, d.x, d.y, d.z);
+                a += DMat4::from_cols(x * (w * x.x), x * (w * x.y), x * (w * x.z), x * (w * x.w));
+                let sum = sums[s as usize].as_dvec3() * w;
+                for k in 0..4 {
+                    b[k] += sum * x[k];
+                }
+            }
+            let weight = a.x_axis.x;
+            for k in 1..4 {
+                a.col_mut(k)[k] += ridge * weight;
+            }
+            let row =
+                if a.determinant().abs() > f64::EPSILON * weight.powi(4).max(f64::MIN_POSITIVE) {
+                    a.inverse().x_axis
+                } else {
+                    DVec4::new(1.0 / weight.max(f64::MIN_POSITIVE), 0.0, 0.0, 0.0)
+                };
+            let sum = (0..4).fold(DVec3::ZERO, |acc, k| acc + b[k] * row[k]);
+            sum.as_vec3().try_normalize().unwrap_or_else(|| own(v))
+        })
+        .collect();
+    out
+}
+
+/// [`smoothed_directions`] with the disc summed at every vertex (no samples).
+#[cfg(test)]
+fn exact_directions(front: &[Vec3], tris: &[[u32; 3]], adj: &[Vec<u32>], sigma: f32) -> Vec<Vec3> {
+    let area_normals = anim::area_normals(front, tris);
+    let inv_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
+    let (start, edges) = edge_lengths(front, adj);
+    (0..front.len())
         .into_par_iter()
         .map_init(
-            || (vec![f32::INFINITY; n], Vec::<u32>::new(), BinaryHeap::new()),
-            |(dist, touched, heap), v| {
+            || DiscSearch::new(&start, &edges),
+            |search, v| {
                 let mut sum = Vec3::ZERO;
-                dist[v] = 0.0;
-                touched.push(v as u32);
-                heap.push(reached(0.0, v as u32));
-                while let Some(Reverse(key)) = heap.pop() {
-                    let (g, u) = (f32::from_bits((key >> 32) as u32), key as u32 as usize);
-                    if g > dist[u] {
-                        continue;
-                    }
+                search.run(v, DISC_SIGMAS * sigma, |u, g| {
                     sum += area_normals[u] * (-g * g * inv_two_sigma2).exp();
-                    for &(w, length) in &edges[start[u]..start[u + 1]] {
-                        let w = w as usize;
-                        let gw = g + length;
-                        if gw <= radius && gw < dist[w] {
-                            if dist[w] == f32::INFINITY {
-                                touched.push(w as u32);
-                            }
-                            dist[w] = gw;
-                            heap.push(reached(gw, w as u32));
-                        }
-                    }
-                }
-                for &u in touched.iter() {
-                    dist[u as usize] = f32::INFINITY;
-                }
-                touched.clear();
-                sum.try_normalize().unwrap_or_else(|| own(v))
+                });
+                sum.try_normalize()
+                    .unwrap_or_else(|| area_normals[v].try_normalize().unwrap_or(Vec3::Z))
             },
         )
         .collect()
@@ -188,6 +320,20 @@ mod tests {
                 d(a).total_cmp(&d(b))
             })
             .unwrap_or(0)
+    }
+
+    #[test]
+    fn the_sampled_disc_directions_follow_the_disc_at_every_vertex() {
+        let (positions, tris, adj) = two_densities();
+        // σ = 12 mm: samples 1 mm apart, fewer than the vertices on the fine side.
+        let sampled = smoothed_directions(&positions, &tris, &adj, 12.0);
+        let exact = exact_directions(&positions, &tris, &adj, 12.0);
+        let worst = sampled
+            .iter()
+            .zip(&exact)
+            .map(|(a, b)| a.dot(*b).clamp(-1.0, 1.0).acos().to_degrees())
+            .fold(0.0f32, f32::max);
+        assert!(worst < 0.5, "worst {worst} degrees");
     }
 
     #[test]
