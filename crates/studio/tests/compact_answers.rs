@@ -21,6 +21,14 @@ fn f32s(bytes: &[u8], name: &str) -> Vec<f32> {
         .1
 }
 
+/// The robot's Dance clip as the page first receives it: its input frame's positions.
+async fn dance_input(app: &axum::Router) -> Vec<f32> {
+    f32s(
+        &send_ok(app, get("/api/scene?clip=Dance")).await,
+        "positions",
+    )
+}
+
 #[tokio::test]
 async fn a_stroke_answered_as_the_skeletons_pose_skins_to_the_cores_positions() {
     let dir = tempfile::tempdir().unwrap();
@@ -87,11 +95,7 @@ async fn a_stroke_answered_as_the_skeletons_pose_skins_to_the_cores_positions() 
 async fn the_whole_clip_sent_as_changes_rebuilds_the_cores_body_within_its_bound() {
     let dir = tempfile::tempdir().unwrap();
     let app = app(dir.path());
-    let (_, input) = pack::read_f32(
-        &send_ok(&app, get("/api/scene?clip=Dance")).await,
-        "positions",
-    )
-    .unwrap();
+    let input = dance_input(&app).await;
     // The bound of the 16-bit displacements: 1e-5 of the clip's bounding-box diagonal.
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     for (i, &x) in input.iter().enumerate() {
@@ -170,11 +174,7 @@ async fn the_whole_clip_sent_as_changes_rebuilds_the_cores_body_within_its_bound
 async fn a_whole_clip_sends_the_multiples_shown_vertices_and_16_bit_line_indices() {
     let dir = tempfile::tempdir().unwrap();
     let app = app(dir.path());
-    let (_, input) = pack::read_f32(
-        &send_ok(&app, get("/api/scene?clip=Dance")).await,
-        "positions",
-    )
-    .unwrap();
+    let input = dance_input(&app).await;
     // SMEAR Fig. 16: elongation, two past and one future copy, motion lines.
     let toml = include_str!("../../../examples/smear/fig16_combined.toml");
     let mut request = json!({"clip": "Dance", "toml": toml});
