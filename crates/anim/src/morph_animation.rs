@@ -136,6 +136,41 @@ impl MorphAnimation {
         }
     }
 
+    /// The weights averaged over the frames, `w̄` (summed in f64, then divided).
+    pub fn mean_weights(&self) -> Vec<f64> {
+        let (n, k) = (self.frame_count(), self.target_count());
+        let mut wbar = vec![0.0f64; k];
+        for f in 0..n {
+            for (a, &w) in wbar.iter_mut().zip(self.frame_weights(f)) {
+                *a += f64::from(w);
+            }
+        }
+        wbar.iter_mut().for_each(|v| *v /= n as f64);
+        wbar
+    }
+
+    /// The average frame `b + T w̄` as a one-frame animation with the clip's topology and
+    /// timing (positions summed in f64).
+    ///
+    /// # Errors
+    /// [`AnimError`] when the average is not finite.
+    pub fn average_frame(&self) -> Result<MeshAnimation> {
+        let m = self.vertex_count();
+        let wbar = self.mean_weights();
+        let average: Vec<Vec3> = (0..m)
+            .map(|v| {
+                let mut p = self.base[v].as_dvec3();
+                for (j, &w) in wbar.iter().enumerate() {
+                    p += self.targets[j * m + v].as_dvec3() * w;
+                }
+                p.as_vec3()
+            })
+            .collect();
+        let mut a = MeshAnimation::new(self.mesh.clone(), self.fps, average)?;
+        a.start_time = self.start_time;
+        Ok(a)
+    }
+
     /// The clip expanded into positions (every frame by [`MorphAnimation::frame_into`]).
     pub fn to_positions(&self) -> MeshAnimation {
         let m = self.vertex_count();

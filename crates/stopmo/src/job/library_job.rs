@@ -1,12 +1,15 @@
 //! The library job: size rule → StopShop Eq. 10 libraries and labels → printable pieces,
 //! assembly, shooting order, reconstruction, report; and `run` (segment, then library).
 
-use std::borrow::Borrow;
+use std::borrow::{Borrow, Cow};
 use std::time::Instant;
 
-use anim::{MeshAnimation, MeshFrames, MorphAnimation};
+use anim::{MeshAnimation, MeshFrames};
 
 use super::error::{Error, Result};
+use super::library_memory::{
+    check_memory, frames_memory, library_memory, LIBRARY_COPIES, MEMORY_HINT,
+};
 use super::options::{
     LibraryJobOptions, PieceCount, RunOptions, CLEARANCE_RANGE_MM, PLATE_SIDE_RANGE_MM,
     PRINTER_MINIMUM_RANGE_MM,
@@ -81,113 +84,19 @@ pub fn library_frames(parts: &[MeshFrames], opts: &LibraryJobOptions) -> Result<
     let lib = solve_sources(&sources, &names, opts)?;
     // Printing, sheets and the reconstruction read the topology, timing and average shape:
     // a morph clip stands in as its one average frame.
-    let stand_ins: Vec<Option<MeshAnimation>> = parts
+    let stand_ins: Vec<Cow<'_, MeshAnimation>> = parts
         .iter()
         .map(|p| match p {
-            MeshFrames::Positions(_) => Ok(None),
-            MeshFrames::Morph(m) => average_frame(m).map(Some),
+            MeshFrames::Positions(a) => Ok(Cow::Borrowed(a)),
+            MeshFrames::Morph(m) => Ok(Cow::Owned(m.average_frame()?)),
         })
         .collect::<Result<_>>()?;
-    let anims: Vec<&MeshAnimation> = parts
-        .iter()
-        .zip(&stand_ins)
-        .map(|(p, s)| match (p, s) {
-            (MeshFrames::Positions(a), _) => a,
-            (_, Some(s)) => s,
-            (MeshFrames::Morph(_), None) => unreachable!("a stand-in per morph clip"),
-        })
-        .collect();
+    let anims: Vec<&MeshAnimation> = stand_ins.iter().map(AsRef::as_ref).collect();
     let mut result = finish(lib, &anims, &names, opts, None, start)?;
     result.report.frames_form = FramesForm::of(parts);
     result.report.total_seconds = start.elapsed().as_secs_f64();
     result.report.peak_memory_mib = super::report::peak_memory_mib();
     Ok(result)
-}
-
-/// What [`library_frames`] holds: [`LIBRARY_COPIES`] copies of the parts given as positions,
-/// and for a morph clip its weights and targets (f32, twice again for the solver's f64
-/// copies) plus one expanded block and the reduced coordinates.
-pub fn frames_memory(parts: &[MeshFrames]) -> anim::budget::JobMemory {
-    let frames = parts.first().map_or(0, MeshFrames::frame_count);
-    let dense: usize = parts
-        .iter()
-        .filter(|p| matches!(p, MeshFrames::Positions(_)))
-        .map(MeshFrames::vertex_count)
-        .sum();
-    let floats: u64 = parts
-        .iter()
-        .filter_map(|p| match p {
-            MeshFrames::Morph(m) => {
-                let k = m.target_count() as u64 + 1;
-                Some(3 * k * (m.frame_count() as u64 + 3 * m.vertex_count() as u64))
-            }
-            MeshFrames::Positions(_) => None,
-        })
-        .sum();
-    memory(frames, dense, LIBRARY_COPIES)
-        .bytes("morph weights, targets and coordinates", 4 * floats)
-}
-
-/// A morph clip's average frame as a one-frame animation with its topology and timing:
-/// `b + T w̄`, the weights averaged in f64.
-fn average_frame(m: &MorphAnimation) -> Result<MeshAnimation> {
-    let (n, k, nv) = (m.frame_count(), m.target_count(), m.vertex_count());
-    let mut wbar = vec![0.0f64; k];
-    for f in 0..n {
-        for (a, &w) in wbar.iter_mut().zip(m.frame_weights(f)) {
-            *a += f64::from(w);
-        }
-    }
-    let (base, targets) = (m.base(), m.targets());
-    let average: Vec<anim::glam::Vec3> = (0..nv)
-        .map(|v| {
-            let mut p = base[v].as_dvec3();
-            for (j, &w) in wbar.iter().enumerate() {
-                p += targets[j * nv + v].as_dvec3() * (w / n as f64);
-            }
-            p.as_vec3()
-        })
-        .collect();
-    let mut a = MeshAnimation::new(m.mesh.clone(), m.fps, average).map_err(Error::from)?;
-    a.start_time = m.start_time;
-    Ok(a)
-}
-
-/// Copies of a part's positions a library build holds: the parts, and at most the solver's
-/// reduced coordinates (f64, twice an f32 copy, when a part is too small to be sketched).
-/// The frames are streamed into the sketch, the reconstruction is kept and written as pieces
-/// and labels (`reconstruction.pc2` streams frame by frame).
-const LIBRARY_COPIES: u64 = 3;
-
-/// What to lower when a library job is over the memory budget.
-const MEMORY_HINT: &str = "lower --fps or pick a shorter clip";
-
-/// What building a library of `parts` will hold ([`library`] checks it before the solver
-/// allocates; a server reserves it): [`LIBRARY_COPIES`] copies of the parts' frames.
-pub fn library_memory<A: Borrow<MeshAnimation>>(parts: &[A]) -> anim::budget::JobMemory {
-    let frames = parts.first().map_or(0, |a| a.borrow().frame_count());
-    let vertices = parts.iter().map(|a| a.borrow().vertex_count()).sum();
-    memory(frames, vertices, LIBRARY_COPIES)
-}
-
-/// `copies` copies of `frames` frames of parts of `vertices` vertices in all.
-fn memory(frames: usize, vertices: usize, copies: u64) -> anim::budget::JobMemory {
-    anim::budget::JobMemory::new().positions(
-        "copies of the clip (parts, solver)",
-        frames,
-        vertices,
-        copies,
-    )
-}
-
-/// Checks what building a library of parts of `vertices` vertices in all will hold (`copies`
-/// copies of their `frames` frames) against [`anim::budget::DEFAULT_MAX_JOB_BYTES`] before
-/// the solver allocates.
-fn check_memory(frames: usize, vertices: usize, copies: u64) -> Result<()> {
-    memory(frames, vertices, copies)
-        .check(MEMORY_HINT)
-        .map_err(anim::AnimError::from)?;
-    Ok(())
 }
 
 /// Segments `anim`, then builds the library of its parts (named after the parts, made

@@ -7,6 +7,7 @@ mod figure;
 mod files;
 mod fixed_pieces;
 mod library_job;
+mod library_memory;
 mod magnets;
 mod options;
 mod piece;
@@ -23,9 +24,8 @@ mod text;
 pub use checks::check_positive_mm;
 pub use error::{Error, Result};
 pub use fixed_pieces::{is_library_piece, library_pieces, PiecesFolder};
-pub use library_job::{
-    file_safe_name, frames_memory, library, library_frames, library_memory, run,
-};
+pub use library_job::{file_safe_name, library, library_frames, run};
+pub use library_memory::{frames_memory, library_memory};
 pub use options::{
     default_clearance_mm, LibraryJobOptions, PieceCount, PrintFormat, RunOptions,
     SegmentJobOptions, CLEARANCE_PER_RESOLUTION, CLEARANCE_RANGE_MM, DEFAULT_MIN_FEATURE_MM,

@@ -306,13 +306,7 @@ fn morph_coords(anim: &MorphAnimation, fixed_rows: &[f64], scale: &[f64]) -> Res
         };
         v * scale[c]
     };
-    let mut wbar = vec![0.0f64; k];
-    for f in 0..n {
-        for (a, &w) in wbar.iter_mut().zip(anim.frame_weights(f)) {
-            *a += f64::from(w);
-        }
-    }
-    wbar.iter_mut().for_each(|v| *v /= n as f64);
+    let wbar = anim.mean_weights();
     let coefficient = |r: usize, j: usize| -> f64 {
         match (r < n, j < k) {
             (true, true) => f64::from(anim.frame_weights(r)[j]) - wbar[j],
