@@ -273,32 +273,30 @@ pub(crate) async fn stylize(
                         .as_ref()
                         .and_then(|x| x.get(j))
                         .and_then(|&(first, count)| (count == v).then_some(first));
-                    match first {
-                        Some(first) if r.changes => {
-                            pack_shown(
-                                &mut pack,
-                                &format!("copy{n}"),
-                                (frames, v),
-                                &animation.mesh.triangles,
-                                |f| animation.frame(f),
-                                colors.as_deref(),
-                            );
-                            copies.push(json!({"name": animation.mesh.name, "vertices": v, "first_vertex": first}));
-                            continue;
-                        }
-                        _ => {}
+                    if first.is_some() && r.changes {
+                        pack_shown(
+                            &mut pack,
+                            &format!("copy{n}"),
+                            (frames, v),
+                            &animation.mesh.triangles,
+                            |f| animation.frame(f),
+                            colors.as_deref(),
+                        );
+                    } else {
+                        pack.shared(&format!("copy{n}.positions"), (s.clone(), i), |(s, i)| {
+                            copy_positions(s, *i)
+                        });
+                        let count = animation.positions().len();
+                        match colors {
+                            Some(c) => pack.f32(&format!("copy{n}.alpha"), c.iter().map(|c| c[3])),
+                            None => {
+                                pack.f32(&format!("copy{n}.alpha"), std::iter::repeat_n(1.0, count))
+                            }
+                        };
                     }
-                    pack.shared(&format!("copy{n}.positions"), (s.clone(), i), |(s, i)| {
-                        copy_positions(s, *i)
-                    });
-                    let count = animation.positions().len();
-                    match colors {
-                        Some(c) => pack.f32(&format!("copy{n}.alpha"), c.iter().map(|c| c[3])),
-                        None => {
-                            pack.f32(&format!("copy{n}.alpha"), std::iter::repeat_n(1.0, count))
-                        }
-                    };
-                    copies.push(json!({"name": animation.mesh.name, "vertices": v, "first_vertex": first}));
+                    copies.push(
+                        json!({"name": animation.mesh.name, "vertices": v, "first_vertex": first}),
+                    );
                 }
             }
             if let Some(anim::FlipbookPart::Frames { name, meshes, .. }) =
@@ -317,7 +315,11 @@ pub(crate) async fn stylize(
                 );
                 let indices = meshes.iter().flat_map(|m| m.triangles.iter().flatten());
                 // A frame's tubes index at most a few thousand vertices: 16 bits when they fit.
-                if r.changes && meshes.iter().all(|m| m.positions.len() <= i16::MAX as usize) {
+                if r.changes
+                    && meshes
+                        .iter()
+                        .all(|m| m.positions.len() <= i16::MAX as usize)
+                {
                     pack.i16(&format!("lines{n}.triangles16"), indices.map(|&k| k as i16));
                 } else {
                     pack.u32(&format!("lines{n}.triangles"), indices.copied());
