@@ -8,6 +8,8 @@ use anim::glam::Vec3;
 use anim::{Mesh, MeshFrames, MorphAnimation};
 use stopmo::{FramesForm, LibraryJobOptions, PieceCount};
 
+mod common;
+
 fn options(pieces: usize) -> LibraryJobOptions {
     LibraryJobOptions {
         pieces: PieceCount::Each(pieces),
@@ -28,15 +30,7 @@ fn dyadic_grid(side: usize, targets: usize, frames: usize) -> MorphAnimation {
             base.push(Vec3::new(x as f32, y as f32, 0.0) * 0.5);
         }
     }
-    let mut triangles = Vec::new();
-    for y in 0..side - 1 {
-        for x in 0..side - 1 {
-            let i = (y * side + x) as u32;
-            let s = side as u32;
-            triangles.push([i, i + 1, i + s + 1]);
-            triangles.push([i, i + s + 1, i + s]);
-        }
-    }
+    let triangles = common::grid_triangles(side);
     let m = base.len();
     // Each target bulges a patch of the grid (the rest stays still).
     let mut deltas = vec![Vec3::ZERO; targets * m];

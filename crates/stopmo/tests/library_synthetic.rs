@@ -8,6 +8,8 @@ use stopmo::library::{
     LibrarySize, Method, PartInput, PartProblem, PartSetup, SolveOptions, SubspaceOptions,
 };
 
+mod common;
+
 /// A `k × k` grid in the XY plane, counter-clockwise seen from +Z.
 fn grid(name: &str, k: usize) -> Mesh {
     let mut pos = Vec::new();
@@ -20,16 +22,7 @@ fn grid(name: &str, k: usize) -> Mesh {
             ));
         }
     }
-    let mut tris = Vec::new();
-    for j in 0..k - 1 {
-        for i in 0..k - 1 {
-            let v = (j * k + i) as u32;
-            let k = k as u32;
-            tris.push([v, v + 1, v + k + 1]);
-            tris.push([v, v + k + 1, v + k]);
-        }
-    }
-    Mesh::new(name, pos, tris)
+    Mesh::new(name, pos, common::grid_triangles(k))
 }
 
 /// A mouth: the lower half of the grid drops by `open(f)` (scaled by distance from the middle).

@@ -23,3 +23,18 @@ pub(crate) fn face(fps: f32) -> anim::MeshAnimation {
     .unwrap();
     s.objects.into_iter().next().unwrap().animation
 }
+
+/// The triangles of a `side × side` vertex grid numbered row by row, counter-clockwise seen
+/// from +Z when rows grow along +Y and columns along +X.
+pub(crate) fn grid_triangles(side: usize) -> Vec<[u32; 3]> {
+    let s = side as u32;
+    let mut triangles = Vec::new();
+    for y in 0..s.saturating_sub(1) {
+        for x in 0..s - 1 {
+            let i = y * s + x;
+            triangles.push([i, i + 1, i + s + 1]);
+            triangles.push([i, i + s + 1, i + s]);
+        }
+    }
+    triangles
+}
