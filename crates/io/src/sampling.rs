@@ -151,15 +151,18 @@ pub fn open(path: &Path, options: &OpenOptions) -> Result<SampledScene> {
 /// # Errors
 /// As [`open`].
 pub fn open_frames(path: &Path, options: &OpenOptions) -> Result<Vec<anim::MeshFrames>> {
-    if let Loaded::Scene(scene) = load(path, options)? {
-        let sample = sample_options(path, &scene, options)?;
-        if let Some(morphs) = anim::sample_morph(&scene, &sample).map_err(with_path(path))? {
-            return Ok(morphs.into_iter().map(anim::MeshFrames::Morph).collect());
+    match load(path, options)? {
+        Loaded::Scene(scene) => {
+            let sample = sample_options(path, &scene, options)?;
+            if let Some(morphs) = anim::sample_morph(&scene, &sample).map_err(with_path(path))? {
+                return Ok(morphs.into_iter().map(anim::MeshFrames::Morph).collect());
+            }
+            let sampled = anim::sample_owned(*scene, &sample).map_err(with_path(path))?;
+            Ok(positions(sampled))
         }
-        let sampled = anim::sample_owned(*scene, &sample).map_err(with_path(path))?;
-        return Ok(positions(sampled));
+        // A point cache or still mesh: sampled from what was loaded, not read again.
+        loaded => Ok(positions(sample(path, &loaded, options)?)),
     }
-    Ok(positions(open(path, options)?))
 }
 
 /// The objects' positions, each mesh named after its object.
