@@ -355,17 +355,20 @@ class _Pose:
             else:
                 m, idx, w = self._skinning(o, a, world)
             rests.append(rest)
-            indices.append(np.where(idx >= 0, idx + slots, -1))
+            indices.append(idx + slots if slots else idx)  # no -1 in them
             weights.append(w)
             matrices.append(m)
             slots += m.shape[1]
             self.ranges[o.name] = range(start, start + len(rest))
             start += len(rest)
         width = max(1, max(i.shape[1] for i in indices))
-        indices = [np.pad(i, [(0, 0), (0, width - i.shape[1])], constant_values=-1)
+        indices = [i if i.shape[1] == width else
+                   np.pad(i, [(0, 0), (0, width - i.shape[1])], constant_values=-1)
                    for i in indices]
-        weights = [np.pad(w, [(0, 0), (0, width - w.shape[1])]) for w in weights]
-        return (np.concatenate(rests), np.concatenate(indices), np.concatenate(weights),
+        weights = [w if w.shape[1] == width else np.pad(w, [(0, 0), (0, width - w.shape[1])])
+                   for w in weights]
+        # One mesh (the usual bake) hands its arrays over as they are: no copies.
+        return (_joined(rests), _joined(indices), _joined(weights),
                 _rows_y_up(np.concatenate(matrices, axis=1)).astype(np.float32))
 
     def _skinning(self, o, a, world):
@@ -395,6 +398,10 @@ class _Pose:
         # Every deforming bone is an influence of every vertex: the core drops the zero
         # weights and keeps the rest in bone order (no numpy pass to compact them).
         return matrices, np.broadcast_to(np.arange(len(deform)), dense.shape), dense
+
+
+def _joined(arrays):
+    return arrays[0] if len(arrays) == 1 else np.concatenate(arrays)
 
 
 def bake_range(scene):

@@ -11,6 +11,8 @@ file. Keys also hold the vertex count and the vertex group names, so a mesh swap
 the same address reads again.
 """
 
+import uuid
+
 import bpy
 from bpy.app.handlers import persistent
 import numpy as np
@@ -57,32 +59,22 @@ _STORED = "tk_weights_{}"
 def _read_nodes(context, objs):
     """The vertex groups of `objs` through Geometry Nodes (see the module's doc), by object
     name: a temporary modifier (the object's own modifiers off) whose float inputs read the
-    groups as attributes and whose outputs store them; the node group is two nodes and a link
-    per group. An object this cannot read (linked, not evaluated, a group name taken by an
-    attribute) is left out, for `_read`."""
+    groups as attributes and whose outputs store them (`_tree`). An object this cannot read
+    (linked, not evaluated, a group name taken by an attribute) is left out, for `_read`."""
     objs = [o for o in objs if len(o.vertex_groups) and o.library is None
             and not any(_STORED.format(i) in o.data.attributes or g.name in o.data.attributes
                         for i, g in enumerate(o.vertex_groups))]
     if not objs:
         return {}
-    slots = max(len(o.vertex_groups) for o in objs)
-    tree = bpy.data.node_groups.new(".toonkit weights", "GeometryNodeTree")
     added, muted, out = [], [], {}
     outside = _own_updates[0] == 0  # a read outside a bake: no edit of the mesh either
     _own_updates[0] += 1
     try:
-        face = tree.interface
-        face.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
-        face.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
-        ins, outs = [], []
-        for i in range(slots):
-            ins.append(face.new_socket(f"in {i}", in_out="INPUT",
-                                       socket_type="NodeSocketFloat").identifier)
-            outs.append(face.new_socket(f"out {i}", in_out="OUTPUT",
-                                        socket_type="NodeSocketFloat").identifier)
-        gin, gout = tree.nodes.new("NodeGroupInput"), tree.nodes.new("NodeGroupOutput")
-        for i in range(slots + 1):
-            tree.links.new(gin.outputs[i], gout.inputs[i])
+        tree = _tree(max(len(o.vertex_groups) for o in objs))
+        sockets = [i for i in tree.interface.items_tree
+                   if getattr(i, "socket_type", None) == "NodeSocketFloat"]
+        ins = [i.identifier for i in sockets if i.in_out == "INPUT"]
+        outs = [i.identifier for i in sockets if i.in_out == "OUTPUT"]
         for o in objs:
             muted += [m for m in o.modifiers if m.show_viewport]
             try:
@@ -107,11 +99,39 @@ def _read_nodes(context, objs):
             o.modifiers.remove(mod)
         for m in muted:
             m.show_viewport = True
-        bpy.data.node_groups.remove(tree)
         if outside:  # the updates of the restored modifiers are reported now, as ours
             context.evaluated_depsgraph_get()
         _own_updates[0] -= 1
     return out
+
+
+#: The node group `_read_nodes` uses, kept for the session: no object uses it once read, so
+#: a save leaves it out; a bake that needs more groups than it has builds it again.
+TREE = ".toonkit weights"
+_BUILD = uuid.uuid4().hex  # this extension's build: a reloaded one builds its own
+
+
+def _tree(slots):
+    """The node group of `_read_nodes` with at least `slots` float inputs, each linked to a
+    float output (two nodes and a link per group)."""
+    tree = bpy.data.node_groups.get(TREE)
+    if (tree is not None and tree.get("toonkit_build") == _BUILD
+            and tree.get("toonkit_slots", 0) >= slots):
+        return tree
+    if tree is not None:
+        bpy.data.node_groups.remove(tree)
+    tree = bpy.data.node_groups.new(TREE, "GeometryNodeTree")
+    face = tree.interface
+    face.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+    face.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    for i in range(slots):
+        face.new_socket(f"in {i}", in_out="INPUT", socket_type="NodeSocketFloat")
+        face.new_socket(f"out {i}", in_out="OUTPUT", socket_type="NodeSocketFloat")
+    gin, gout = tree.nodes.new("NodeGroupInput"), tree.nodes.new("NodeGroupOutput")
+    for i in range(slots + 1):
+        tree.links.new(gin.outputs[i], gout.inputs[i])
+    tree["toonkit_build"], tree["toonkit_slots"] = _BUILD, slots
+    return tree
 
 
 def _stored(obj, mesh):
