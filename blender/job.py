@@ -66,12 +66,6 @@ def bake_blocker(context):
     return None
 
 
-def _moves(s):
-    """Whether any vertex of the sample moves over its frames (no copy of the frames)."""
-    first = s.y_up[0]
-    return any(not np.array_equal(first, p) for p in s.y_up[1:])
-
-
 def _prepare(context, objects, settings):
     toonkit = _toonkit()
     shown = []
@@ -88,7 +82,7 @@ def _prepare(context, objects, settings):
         for o, hidden, vp in shown:
             o.hide_viewport = vp
             o.hide_set(hidden)
-    if not _moves(s) and s.camera is None:
+    if not s.moves() and s.camera is None:
         names = ", ".join(s.names[:3]) + (" …" if len(s.names) > 3 else "")
         raise JobError(f"{names}: does not move over frames {s.frame_start}-"
                        f"{s.frame_start + s.frame_count - 1}, nothing to smear; animate it "
@@ -97,7 +91,8 @@ def _prepare(context, objects, settings):
     try:
         scene = toonkit.Scene.from_arrays(positions, s.triangles, fps=s.fps, skin=skin,
                                           objects=s.objects, attributes=s.attributes,
-                                          rest=s.rest)
+                                          rest=s.rest,
+                                          skinning=s.skinning if positions is None else None)
         prepared = toonkit.smear.prepare(scene, smooth=settings.smooth)
     except (toonkit.ToonkitError, ValueError) as e:
         raise JobError(_one_line(e)) from e

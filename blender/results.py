@@ -11,6 +11,8 @@ attribute and the node group deletes the other frames. `tk_alpha` carries the op
 material (Attribute node).
 """
 
+import uuid
+
 import bpy
 import numpy as np
 
@@ -54,12 +56,33 @@ def _frame_attribute(n, prefix, text):
     return attr
 
 
+#: A copy of the node group kept for the session (docs/blender.md, "Speed"): an unbake
+#: removes the group, and a bake after it copies this one instead of building it again. No
+#: object uses it, so a save leaves it out.
+TEMPLATE = ".toonkit smear template"
+_BUILD = uuid.uuid4().hex  # this extension's build: a reloaded one builds its own template
+
+
 def node_group():
-    """The shared node group (made once per .blend)."""
+    """The shared node group (made once per .blend; copied from the session's template)."""
     g = bpy.data.node_groups.get(GROUP)
     if g is not None:
         return g
-    g = bpy.data.node_groups.new(GROUP, "GeometryNodeTree")
+    template = bpy.data.node_groups.get(TEMPLATE)
+    if template is None or template.get(ROLE) != _BUILD:
+        if template is not None:
+            bpy.data.node_groups.remove(template)
+        template = _build(TEMPLATE)
+        template[ROLE] = _BUILD
+    g = template.copy()
+    g.name = GROUP
+    del g[ROLE]
+    return g
+
+
+def _build(name):
+    """The node group (19 nodes, each node and link an API call that updates the tree)."""
+    g = bpy.data.node_groups.new(name, "GeometryNodeTree")
     g.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
     for name in ("Start", "End"):
         g.interface.new_socket(name, in_out="INPUT", socket_type="NodeSocketInt")

@@ -38,7 +38,6 @@ class Sample:
 
     names: list                 # original object names, in vertex order
     ranges: list                # vertex range of each object
-    y_up: np.ndarray            # (frames, vertices, 3) float32 C-contiguous, world turned Y-up
     triangles: np.ndarray       # (t, 3) int32
     frame_start: int
     fps: float
@@ -47,6 +46,10 @@ class Sample:
     bones: list = field(default_factory=list)
     camera: np.ndarray = None   # (frames, 4, 4) camera world matrices (camera-relative mode)
     rest: np.ndarray = None     # (vertices, 3) float32 world space at the rest pose
+    # `toonkit.skin`'s arguments when every mesh is pose-only: the core skins the clip
+    # straight into the scene it makes (`Scene.from_arrays(skinning=...)`, no copy).
+    skinning: tuple = None
+    _y_up: np.ndarray = field(default=None, repr=False)
     _world: np.ndarray = field(default=None, repr=False)
 
     @property
@@ -55,12 +58,33 @@ class Sample:
 
     @property
     def frame_count(self):
-        return len(self.y_up)
+        return len(self.skinning[3]) if self._y_up is None else len(self._y_up)
+
+    @property
+    def y_up(self):
+        """(frames, vertices, 3) float32 C-contiguous, the world turned Y-up (`to_y_up`);
+        skinned by the core on first use when only `skinning` is kept (the bake hands the
+        core `skinning` itself and never reads this)."""
+        if self._y_up is None:
+            import toonkit
+            self._y_up = toonkit.skin(*self.skinning)
+        return self._y_up
+
+    def moves(self):
+        """Whether any vertex moves over the frames (no copy of them). With `skinning`: a
+        vertex moves only when a matrix it is skinned with changes (the same matrices give
+        the same vertices, bit for bit)."""
+        if self._y_up is None:
+            _, indices, weights, matrices = self.skinning
+            used = matrices[:, np.unique(indices[(indices >= 0) & (weights > 0)])]
+            return any(not np.array_equal(used[0], m) for m in used[1:])
+        first = self._y_up[0]
+        return any(not np.array_equal(first, p) for p in self._y_up[1:])
 
     @property
     def positions(self):
         """(frames, vertices, 3) float32 in Blender's Z-up world: `y_up` turned back (exact),
-        made once on first use; the bake itself hands the core `y_up`."""
+        made once on first use (the bake never reads it)."""
         if self._world is None:
             self._world = np.ascontiguousarray(from_y_up(self.y_up))
         return self._world
@@ -246,13 +270,13 @@ def _rest_matrices(context, meshes):
         context.evaluated_depsgraph_get().update()
 
 
-def _rest_positions(meshes, ranges, matrices, y_up):
+def _rest_positions(meshes, ranges, matrices, result):
     """(vertices, 3) float32: each mesh's own vertices through its rest matrix, or its first
-    frame (of the Y-up `y_up`) when a modifier changed its vertex count."""
+    frame (of the sample `result`) when a modifier changed its vertex count."""
     rest = np.empty((ranges[-1].stop, 3), np.float32)
     for o, r in zip(meshes, ranges):
         if len(o.data.vertices) != len(r):
-            rest[r.start:r.stop] = from_y_up(y_up[0, r.start:r.stop])
+            rest[r.start:r.stop] = from_y_up(result.y_up[0, r.start:r.stop])
             continue
         co = _co(o).astype(np.float64)
         m = matrices[o.name]
@@ -312,12 +336,12 @@ class _Pose:
             self.arm_world[k, i] = _matrix(ev.matrix_world)
             ev.pose.bones.foreach_get("matrix", self.pose[i][k])
 
-    def skin(self, toonkit):
-        """Every frame's world vertices of the pose-only objects turned Y-up (`to_y_up`),
-        concatenated in their order: one `toonkit.skin` call, float32 (frames, vertices, 3),
-        the array the core reads. The turn is folded into the skinning matrices (a signed
-        permutation of their rows), so the vertices are `to_y_up` of the world's bit for bit
-        with no pass over them."""
+    def skinning(self):
+        """`toonkit.skin`'s arguments for every frame's world vertices of the pose-only
+        objects turned Y-up (`to_y_up`), concatenated in their order (float32 (frames,
+        vertices, 3), the array the core reads). The turn is folded into the skinning
+        matrices (a signed permutation of their rows), so the vertices are `to_y_up` of the
+        world's bit for bit with no pass over them."""
         rests, indices, weights, matrices = [], [], [], []
         self.ranges, start, slots = {}, 0, 0
         for i, o in enumerate(self.objects):
@@ -331,19 +355,21 @@ class _Pose:
             else:
                 m, idx, w = self._skinning(o, a, world)
             rests.append(rest)
-            indices.append(np.where(idx >= 0, idx + slots, -1))
+            indices.append(idx + slots if slots else idx)  # no -1 in them
             weights.append(w)
             matrices.append(m)
             slots += m.shape[1]
             self.ranges[o.name] = range(start, start + len(rest))
             start += len(rest)
-        width = max(i.shape[1] for i in indices)
-        indices = [np.pad(i, [(0, 0), (0, width - i.shape[1])], constant_values=-1)
+        width = max(1, max(i.shape[1] for i in indices))
+        indices = [i if i.shape[1] == width else
+                   np.pad(i, [(0, 0), (0, width - i.shape[1])], constant_values=-1)
                    for i in indices]
-        weights = [np.pad(w, [(0, 0), (0, width - w.shape[1])]) for w in weights]
-        return toonkit.skin(np.concatenate(rests), np.concatenate(indices),
-                            np.concatenate(weights),
-                            _rows_y_up(np.concatenate(matrices, axis=1)).astype(np.float32))
+        weights = [w if w.shape[1] == width else np.pad(w, [(0, 0), (0, width - w.shape[1])])
+                   for w in weights]
+        # One mesh (the usual bake) hands its arrays over as they are: no copies.
+        return (_joined(rests), _joined(indices), _joined(weights),
+                _rows_y_up(np.concatenate(matrices, axis=1)).astype(np.float32))
 
     def _skinning(self, o, a, world):
         """Per-frame skinning matrices of `o`'s deforming bones (world space: armature world ·
@@ -369,23 +395,13 @@ class _Pose:
             if g is not None:
                 np.maximum(g, 0.0, out=dense[:, j])
         dense[dense.sum(axis=1) <= ARMATURE_MIN_WEIGHT] = 0.0
-        indices, weights = _compact(dense)
-        return matrices, indices, weights
+        # Every deforming bone is an influence of every vertex: the core drops the zero
+        # weights and keeps the rest in bone order (no numpy pass to compact them).
+        return matrices, np.broadcast_to(np.arange(len(deform)), dense.shape), dense
 
 
-def _compact(dense):
-    """The nonzero entries of `dense` (vertices, bones) as per-vertex influences: bone indices
-    (-1 pads) and weights (vertices, k), k the most any vertex has, in bone order."""
-    rows, cols = np.nonzero(dense)
-    counts = np.bincount(rows, minlength=len(dense))
-    most = max(1, int(counts.max(initial=0)))
-    first = np.cumsum(counts) - counts
-    slot = np.arange(len(rows)) - first[rows]
-    indices = np.full((len(dense), most), -1, np.int64)
-    weights = np.zeros((len(dense), most), np.float32)
-    indices[rows, slot] = cols
-    weights[rows, slot] = dense[rows, cols]
-    return indices, weights
+def _joined(arrays):
+    return arrays[0] if len(arrays) == 1 else np.concatenate(arrays)
 
 
 def bake_range(scene):
@@ -421,7 +437,7 @@ def _sample(context, meshes, camera_relative, pose_only):
     joint_names, parents = _joint_order(armature) if armature else ([], [])
 
     frames = end - start + 1
-    groups = {o.name: weights.read(o, len(o.data.vertices)) for o in meshes}
+    groups = weights.read_all(context, meshes)
     posed = _readers_evaluated(meshes, [o for o in meshes
                                         if pose_only and pose_only_reason(o) is None])
     evaluated = [o for o in meshes if o not in posed]
@@ -467,12 +483,12 @@ def _sample(context, meshes, camera_relative, pose_only):
         ranges.append(range(offset, offset + c))
         all_tris.append(tris[o.name] + offset)
         offset += c
-    y_up = _positions(context, meshes, ranges, frames, pose, per_object)
     result = Sample(
-        names=[o.name for o in meshes], ranges=ranges, y_up=y_up,
+        names=[o.name for o in meshes], ranges=ranges,
         triangles=np.concatenate(all_tris).astype(np.int32), frame_start=start,
-        fps=scene.render.fps / scene.render.fps_base, bones=joint_names,
-        rest=_rest_positions(meshes, ranges, rest_matrices, y_up))
+        fps=scene.render.fps / scene.render.fps_base, bones=joint_names)
+    _positions(result, meshes, frames, pose, per_object)
+    result.rest = _rest_positions(meshes, ranges, rest_matrices, result)
     _skin_and_attributes(result, meshes, counts, groups, armature, parents,
                          rig.matrices() if rig is not None else None)
     if camera_relative:
@@ -535,23 +551,26 @@ class _Rig:
         return (self.world[:, None] @ pose.astype(np.float64)).astype(np.float32)
 
 
-def _positions(context, meshes, ranges, frames, pose, per_object):
-    """(frames, vertices, 3) float32 of `meshes` in order, turned Y-up: the core's skinned
-    array itself when every mesh is pose-only, else both paths' vertices in their ranges."""
+def _positions(result, meshes, frames, pose, per_object):
+    """The vertices of `meshes` in order, turned Y-up, into `result`: the skinning inputs
+    when every mesh is pose-only (the core skins them into its scene), else both paths'
+    vertices in their ranges of (frames, vertices, 3) float32."""
     import toonkit
 
-    skinned = pose.skin(toonkit) if pose is not None else None
-    if skinned is not None and len(pose.objects) == len(meshes):
-        return skinned
-    positions = np.empty((frames, ranges[-1].stop, 3), np.float32)
-    for o, r in zip(meshes, ranges):
+    skinning = pose.skinning() if pose is not None else None
+    if skinning is not None and len(pose.objects) == len(meshes):
+        result.skinning = skinning
+        return
+    skinned = toonkit.skin(*skinning) if skinning is not None else None
+    positions = np.empty((frames, result.ranges[-1].stop, 3), np.float32)
+    for o, r in zip(meshes, result.ranges):
         if o.name in per_object:
             for k, p in enumerate(per_object[o.name]):
                 positions[k, r.start:r.stop] = to_y_up(p)
         else:
             r0 = pose.ranges[o.name]
             positions[:, r.start:r.stop] = skinned[:, r0.start:r0.stop]
-    return positions
+    result._y_up = positions
 
 
 def _skin_and_attributes(result, meshes, counts, groups, armature, parents, matrices):
@@ -588,12 +607,13 @@ def _skin_and_attributes(result, meshes, counts, groups, armature, parents, matr
 
 def to_camera(sample):
     """Positions and joint matrices in the frame the core works in: the camera's with
-    camera-relative speed (SMEAR: camera space), else the Y-up world (`to_y_up`)."""
+    camera-relative speed (SMEAR: camera space), else the Y-up world (`to_y_up`). Positions
+    are None when the core is to skin them from `sample.skinning` (Y-up world only)."""
     if sample.camera is None:
         skin = None
         if sample.skin is not None:
             skin = dict(sample.skin, matrices=_rows_y_up(sample.skin["matrices"]))
-        return sample.y_up, skin
+        return (sample.y_up if sample.skinning is None else None), skin
     inv = affine_inverse(sample.camera)
     p = sample.positions.astype(np.float64)
     p = np.einsum("fij,fvj->fvi", inv[:, :3, :3], p) + inv[:, None, :3, 3]

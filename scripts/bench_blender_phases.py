@@ -40,15 +40,17 @@ def timed(label, f):
 
 
 def wrap(owner, name, label):
-    setattr(owner, name, timed(label, getattr(owner, name)))
+    if hasattr(owner, name):  # an older extension may not have it (A/B runs)
+        setattr(owner, name, timed(label, getattr(owner, name)))
 
 
 def instrument():
     import toonkit
     from bl_ext.user_default.toonkit import job, results, sample, weights
 
-    wrap(weights, "read", "sample: vertex weights (kept or read)")
-    wrap(weights, "_read", "sample: vertex weights read")
+    wrap(weights, "read_all", "sample: vertex weights (kept or read)")
+    wrap(weights, "_read_nodes", "sample: vertex weights read (Geometry Nodes)")
+    wrap(weights, "_read", "sample: vertex weights read (per vertex)")
     for name, label in (("sample", "sample (all of it)"),
                         ("_rest_matrices", "sample: rest pose matrices"),
                         ("_rest_positions", "sample: rest positions"),

@@ -391,6 +391,32 @@ def test_kept_weights_follow_every_edit_of_the_mesh():
     bpy.ops.toonkit.smear_unbake()
 
 
+def test_weights_through_geometry_nodes_equal_a_pass_over_the_vertices():
+    """The vertex weights a bake reads through a Geometry Nodes modifier (docs/blender.md,
+    "Speed") are the per-vertex pass's bit for bit on every test scene with vertex groups
+    (the robot's skinned hands and bone-named, shape-keyed head, CesiumMan, the chain rig
+    with shape keys), and the read leaves each mesh's modifiers as they were."""
+    from bl_ext.user_default.toonkit import weights
+
+    scenes = (("robot", lambda: imported("RobotExpressive.glb", "Dance")),
+              ("cesium_man", lambda: imported("CesiumMan.glb")),
+              ("chain", lambda: rig(20, 24, True)))
+    for name, scene in scenes:  # each one replaces the one before
+        meshes = [o for o in scene() if len(o.vertex_groups)]
+        check(bool(meshes), f"{name}: no mesh with vertex groups")
+        before = {o.name: [(m.name, m.show_viewport) for m in o.modifiers] for o in meshes}
+        read = weights._read_nodes(bpy.context, meshes)
+        check(sorted(read) == sorted(o.name for o in meshes), f"{name}: read {sorted(read)}")
+        for o in meshes:
+            want = weights._read(o, len(o.data.vertices))
+            check(list(read[o.name]) == list(want), f"{o.name}: groups {list(read[o.name])}")
+            for group, values in want.items():
+                np.testing.assert_array_equal(read[o.name][group], values,
+                                              err_msg=f"{o.name}: {group}")
+            after = [(m.name, m.show_viewport) for m in o.modifiers]
+            check(after == before[o.name], f"{o.name}: modifiers {after}")
+
+
 def test_object_without_animation_says_so():
     scene = empty_scene()
     bpy.ops.mesh.primitive_cube_add()
@@ -557,6 +583,7 @@ if __name__ == "__main__":
         test_scene_range_longer_than_the_keys_and_a_2000_frame_clip,
         test_live_restyle_writes_each_frame_when_the_scene_reaches_it,
         test_kept_weights_follow_every_edit_of_the_mesh,
+        test_weights_through_geometry_nodes_equal_a_pass_over_the_vertices,
         test_results_equal_the_cli_on_both_sampling_paths,
         test_tube_speed,
     ])

@@ -14,9 +14,32 @@ use crate::errors::{at, value_error};
 
 const SOURCE: &str = "<arrays>";
 
+/// The clip of `Scene.from_arrays`: frame-major points (`frames × vertices`).
+pub(crate) struct Clip {
+    /// Every frame's points, frame after frame.
+    pub(crate) points: Vec<Vec3>,
+    /// Number of frames.
+    pub(crate) frames: usize,
+    /// Number of vertices per frame.
+    pub(crate) vertices: usize,
+}
+
+impl Clip {
+    /// One copy of a host's `(frames, vertices, 3)` buffer (its shape ends in 3, so it casts
+    /// whole).
+    pub(crate) fn copied(positions: &ArrayIn<'_, f32>) -> PyResult<Clip> {
+        let s = shape(positions, "positions", &[None, None, Some(3)])?;
+        Ok(Clip {
+            points: bytemuck::cast_slice(&values(positions)).to_vec(),
+            frames: s[0],
+            vertices: s[1],
+        })
+    }
+}
+
 /// The sampled scene of `Scene.from_arrays`.
 pub(crate) fn sampled(
-    positions: &ArrayIn<'_, f32>,
+    clip: Clip,
     triangles: &ArrayIn<'_, i64>,
     fps: f32,
     skin: Option<&Bound<'_, PyDict>>,
@@ -29,15 +52,17 @@ pub(crate) fn sampled(
             "fps must be a positive number, got {fps}"
         )));
     }
-    let s = shape(positions, "positions", &[None, None, Some(3)])?;
-    let (frames, vertices) = (s[0], s[1]);
+    let Clip {
+        points,
+        frames,
+        vertices,
+    } = clip;
     if frames == 0 || vertices == 0 {
         return Err(value_error(format!(
-            "positions must have at least one frame and one vertex, got shape {s:?}"
+            "positions must have at least one frame and one vertex, got shape {:?}",
+            [frames, vertices, 3]
         )));
     }
-    // One copy of the host's buffer (its shape ends in 3, so it casts whole).
-    let points: Vec<Vec3> = bytemuck::cast_slice(&values(positions)).to_vec();
     let rest: Vec<Vec3> = match rest {
         Some(r) => {
             shape(r, "rest", &[Some(vertices), Some(3)])?;

@@ -135,6 +135,14 @@ impl From<PyErrLater> for PyErr {
     }
 }
 
+/// `Scene.from_arrays`' ``skinning``: the arguments of `toonkit.skin`.
+type Skinning<'py> = (
+    crate::arrays::ArrayIn<'py, f32>,
+    crate::arrays::ArrayIn<'py, i64>,
+    crate::arrays::ArrayIn<'py, f32>,
+    crate::arrays::ArrayIn<'py, f32>,
+);
+
 /// A clip name or index.
 #[derive(FromPyObject)]
 pub(crate) enum ClipArg {
@@ -205,22 +213,45 @@ impl Scene {
     ///
     /// Arrays are read in place when they are C-contiguous float32 (int for indices).
     ///
+    /// ``skinning`` (``(rest, indices, weights, matrices)``, the arguments of ``toonkit.skin``)
+    /// replaces ``positions`` (pass ``None``): the clip is skinned straight into the scene, with
+    /// no copy of it (docs/blender.md, "Speed"); ``positions`` then reads (a copy, made on
+    /// first read) the values ``toonkit.skin`` returns.
+    ///
     /// >>> s = toonkit.load("assets/characters/RobotExpressive.glb", clip="Dance")
     /// >>> t = toonkit.Scene.from_arrays(s.positions, s.triangles, fps=s.fps, skin=s.skin)
     /// >>> t.positions.shape == s.positions.shape
     /// True
     #[staticmethod]
-    #[pyo3(signature = (positions, triangles, fps=anim::DEFAULT_FPS, skin=None, objects=None, attributes=None, rest=None))]
-    fn from_arrays(
-        py: Python<'_>,
-        positions: crate::arrays::ArrayIn<'_, f32>,
+    #[pyo3(signature = (positions, triangles, fps=anim::DEFAULT_FPS, skin=None, objects=None, attributes=None, rest=None, skinning=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn from_arrays<'py>(
+        py: Python<'py>,
+        positions: Option<crate::arrays::ArrayIn<'py, f32>>,
         triangles: crate::arrays::ArrayIn<'_, i64>,
         fps: f32,
         skin: Option<&Bound<'_, PyDict>>,
         objects: Option<Vec<(String, Bound<'_, PyAny>)>>,
         attributes: Option<std::collections::BTreeMap<String, crate::arrays::ArrayIn<'_, f32>>>,
         rest: Option<crate::arrays::ArrayIn<'_, f32>>,
+        skinning: Option<Skinning<'py>>,
     ) -> PyResult<Scene> {
+        let clip = match (positions, skinning) {
+            (Some(p), None) => crate::from_arrays::Clip::copied(&p)?,
+            (None, Some((r, i, w, m))) => {
+                let (points, frames, vertices) = crate::skin_py::skinned(py, &r, &i, &w, &m)?;
+                crate::from_arrays::Clip {
+                    points,
+                    frames,
+                    vertices,
+                }
+            }
+            _ => {
+                return Err(value_error(
+                    "give the clip as positions or as skinning (positions=None), not both",
+                ))
+            }
+        };
         let attributes = attributes
             .unwrap_or_default()
             .into_iter()
@@ -241,7 +272,7 @@ impl Scene {
             })
             .transpose()?;
         let sampled = crate::from_arrays::sampled(
-            &positions,
+            clip,
             &triangles,
             fps,
             skin,

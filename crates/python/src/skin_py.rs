@@ -29,12 +29,25 @@ pub(crate) fn skin<'py>(
     weights: ArrayIn<'py, f32>,
     matrices: ArrayIn<'py, f32>,
 ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
-    let n = shape(&rest, "rest", &[None, Some(3)])?[0];
-    let k = shape(&indices, "indices", &[Some(n), None])?[1];
-    shape(&weights, "weights", &[Some(n), Some(k)])?;
-    let m = shape(&matrices, "matrices", &[None, None, Some(4), Some(4)])?;
+    let (data, frames, n) = skinned(py, &rest, &indices, &weights, &matrices)?;
+    output(py, &[frames, n, 3], bytemuck::cast_vec::<Vec3, f32>(data))
+}
+
+/// The skinned clip of `toonkit.skin` (and of `Scene.from_arrays(skinning=...)`, which keeps
+/// it as the scene's clip without a copy): frame-major points, the frame and vertex counts.
+pub(crate) fn skinned(
+    py: Python<'_>,
+    rest: &ArrayIn<'_, f32>,
+    indices: &ArrayIn<'_, i64>,
+    weights: &ArrayIn<'_, f32>,
+    matrices: &ArrayIn<'_, f32>,
+) -> PyResult<(Vec<Vec3>, usize, usize)> {
+    let n = shape(rest, "rest", &[None, Some(3)])?[0];
+    let k = shape(indices, "indices", &[Some(n), None])?[1];
+    shape(weights, "weights", &[Some(n), Some(k)])?;
+    let m = shape(matrices, "matrices", &[None, None, Some(4), Some(4)])?;
     let (frames, bones) = (m[0], m[1]);
-    let (idx, w) = (values(&indices), values(&weights));
+    let (idx, w) = (values(indices), values(weights));
     if let Some((i, &b)) = idx
         .iter()
         .enumerate()
@@ -55,24 +68,14 @@ pub(crate) fn skin<'py>(
                     .map(|(b, x)| (*b as u32, *x))
             },
         ));
-    let skinning: Vec<Mat4> = values(&matrices)
+    let skinning: Vec<Mat4> = values(matrices)
         .chunks_exact(16)
         .map(|m| Mat4::from_cols_slice(m).transpose())
         .collect();
-    let rest: Vec<Vec3> = values(&rest)
-        .chunks_exact(3)
-        .map(Vec3::from_slice)
-        .collect();
-    let mut data = vec![0.0f32; frames * n * 3];
-    py.detach(|| {
-        anim::skin_frames(
-            &influences,
-            bones,
-            &skinning,
-            &rest,
-            bytemuck::cast_slice_mut(&mut data),
-        )
-    })
-    .map_err(|e| anim_error("<arrays>", e))?;
-    output(py, &[frames, n, 3], data)
+    let rest: Vec<Vec3> = values(rest).chunks_exact(3).map(Vec3::from_slice).collect();
+    // Zeroed f32s (fresh pages from the allocator, no pass over them) seen as points.
+    let mut data: Vec<Vec3> = bytemuck::cast_vec(vec![0.0f32; frames * n * 3]);
+    py.detach(|| anim::skin_frames(&influences, bones, &skinning, &rest, &mut data))
+        .map_err(|e| anim_error("<arrays>", e))?;
+    Ok((data, frames, n))
 }

@@ -47,3 +47,42 @@ def test_bad_inputs_are_one_line_value_errors():
         toonkit.skin(rest, [[0], [1]], [[1.0, 2.0], [1.0, 1.0]], mats)
     with pytest.raises(ValueError, match="matrices must have shape"):
         toonkit.skin(rest, [[0], [1]], [[1.0], [1.0]], mats[..., :3])
+
+
+def test_a_scene_skinned_in_place_equals_one_from_the_skinned_array():
+    """`Scene.from_arrays(None, ..., skinning=...)` skins the clip straight into the scene
+    (the Blender bake's transfer without a copy, docs/blender.md "Speed"): the same clip,
+    size and offsets, bit for bit, as the array `toonkit.skin` returns handed over."""
+    rng = np.random.default_rng(3)
+    rest = rng.normal(size=(60, 3)).astype(np.float32)
+    indices = np.broadcast_to(np.arange(3), (60, 3))
+    weights = rng.uniform(0.0, 1.0, size=(60, 3)).astype(np.float32)
+    weights[::4, 1] = 0.0  # a zero weight is no influence
+    mats = np.stack([[rotation_z(0.2 * f * (b + 1), (0.3 * f, b, 0.0)) for b in range(3)]
+                     for f in range(12)]).astype(np.float32)
+    triangles = rng.integers(0, 60, size=(40, 3))
+    at_rest = rest + 1.0
+    copied = toonkit.Scene.from_arrays(toonkit.skin(rest, indices, weights, mats), triangles,
+                                       fps=30.0, objects=[("body", range(60))], rest=at_rest)
+    skinned = toonkit.Scene.from_arrays(None, triangles, fps=30.0,
+                                        objects=[("body", range(60))], rest=at_rest,
+                                        skinning=(rest, indices, weights, mats))
+    np.testing.assert_array_equal(skinned.positions, copied.positions)
+    assert skinned.size == copied.size and skinned.objects == copied.objects
+    a = np.asarray(toonkit.smear.prepare(copied).offsets)
+    b = np.asarray(toonkit.smear.prepare(skinned).offsets)
+    np.testing.assert_array_equal(a, b)
+
+
+def test_a_scene_takes_positions_or_skinning_not_both():
+    rest = np.zeros((3, 3), np.float32)
+    mats = np.tile(np.eye(4, dtype=np.float32), (2, 1, 1, 1))
+    skinning = (rest, [[0], [0], [0]], [[1.0], [1.0], [1.0]], mats)
+    with pytest.raises(ValueError, match="positions or as skinning"):
+        toonkit.Scene.from_arrays(np.zeros((2, 3, 3), np.float32), [[0, 1, 2]],
+                                  skinning=skinning)
+    with pytest.raises(ValueError, match="positions or as skinning"):
+        toonkit.Scene.from_arrays(None, [[0, 1, 2]])
+    with pytest.raises(ValueError, match=r"indices\[0, 0\] = 1"):
+        toonkit.Scene.from_arrays(None, [[0, 1, 2]],
+                                  skinning=(rest, [[1], [0], [0]], [[1.0]] * 3, mats))

@@ -16,13 +16,16 @@ class Scene:
 
     @staticmethod
     def from_arrays(
-        positions: npt.ArrayLike,
+        positions: Optional[npt.ArrayLike],
         triangles: npt.ArrayLike,
         fps: float = 24.0,
         skin: Optional[Mapping[str, Any]] = None,
         objects: Optional[Sequence[tuple[str, range]]] = None,
         attributes: Optional[Mapping[str, npt.ArrayLike]] = None,
         rest: Optional[npt.ArrayLike] = None,
+        skinning: Optional[
+            tuple[npt.ArrayLike, npt.ArrayLike, npt.ArrayLike, npt.ArrayLike]
+        ] = None,
     ) -> Scene: ...
     @property
     def positions(self) -> npt.NDArray[np.float32]: ...
