@@ -1,5 +1,6 @@
 //! Exact energy (StopShop Eq. 10) and per-frame position/velocity errors (Fig. 19).
 
+use anim::Aabb;
 use glam::Vec3;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -91,6 +92,9 @@ pub(crate) fn evaluate(
     p.chains.iter().for_each(|c| start[c.start] = true);
     let w = p.weights.as_deref();
     let mut per_frame: Vec<(f64, f64, f64, f64, f64, f64)> = Vec::with_capacity(n);
+    // The part's bounding box rides along the first evaluation (see `PartProblem::bbox`).
+    let want_bounds = p.bounds.get().is_none();
+    let mut bounds = Aabb::EMPTY;
     // The last frame of the previous block (morph weights are expanded block by block).
     let mut last: Vec<Vec3> = Vec::new();
     p.src.blocks(|f0, block| {
@@ -102,6 +106,13 @@ pub(crate) fn evaluate(
             }
         };
         let k = block.len() / m.max(1);
+        if want_bounds {
+            bounds = block
+                .par_chunks(m.max(1))
+                .map(Aabb::from_points)
+                .reduce(|| Aabb::EMPTY, Aabb::union)
+                .union(bounds);
+        }
         per_frame.par_extend((f0..f0 + k).into_par_iter().map(|f| {
             let x = frame(f);
             let r = &pieces[labels[f] as usize];
@@ -134,6 +145,10 @@ pub(crate) fn evaluate(
             last.extend_from_slice(&block[(k - 1) * m..]);
         }
     });
+    if want_bounds {
+        // Unions of minima and maxima: the same box as any other pass over the frames.
+        let _ = p.bounds.set(bounds);
+    }
     let energy = per_frame.iter().map(|t| t.0 + 0.5 * lambda * t.3).sum();
     let errors = FrameErrors {
         position_mean: per_frame.iter().map(|t| t.1).collect(),
