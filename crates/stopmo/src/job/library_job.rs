@@ -19,7 +19,7 @@ use super::print::{print_pieces, surface_pieces, PrintSettings};
 use super::report::{FramesForm, InputErrors, LibraryReport, ReportInputs};
 use super::result::{LibraryResult, Reconstruction};
 use super::segment_job::segment;
-use super::sheets::{assembly_sheets, catalogue_png};
+use super::sheets::{assembly_sheets, catalogue_png, piece_thumbnails};
 use crate::library::{
     build_sources, compare_frames, plan_plugs, print_scale_of, scaled, shooting_order,
     ErrorSummary, Library, LibraryOptions, LibrarySize, PartSetup, Plug, PlugOptions, Source,
@@ -386,9 +386,11 @@ pub(super) fn finish(
     };
     let mut printed = printed;
     let library_3mf = lay_out_plates(&mut printed, names, opts)?;
-    let catalogue = catalogue_png(&lib, anims)?;
+    let thumbnails = piece_thumbnails(&lib, anims)?;
+    let catalogue = catalogue_png(&lib, &thumbnails)?;
     let assembly = lib.assembly();
-    let sheets = assembly_sheets(&lib, anims, &assembly, &opts.cuts)?;
+    let sheets = assembly_sheets(&lib, anims, &assembly, &opts.cuts, &thumbnails)?;
+    drop(thumbnails);
     let order = shooting_order(&assembly);
     let reconstruction = anims
         .iter()

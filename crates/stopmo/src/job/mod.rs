@@ -15,6 +15,7 @@ mod plates;
 mod print;
 mod printability;
 mod report;
+mod resolution;
 mod result;
 mod segment_job;
 mod sheets;

@@ -16,10 +16,11 @@ pub use super::options::DEFAULT_RESOLUTION_MM;
 pub use super::piece::Piece;
 use super::printability::{measure_part, printability, PartGeometry};
 use super::report::{PartPrintReport, PieceReport, PrintReport, PrintTime};
+use super::resolution::below_resolution;
 use crate::library::{
-    add_plugs, build_shells, first_thinnest, material, piece_id, regularize,
-    self_intersecting_triangles, volume, Bitmap, Key, KeyOptions, Library, PartShell, ShellInput,
-    ShellOptions, DEFAULT_ID_RELIEF_MM,
+    add_plugs, build_shells, first_thinnest, material, regularize, self_intersecting_triangles,
+    volume, Bitmap, Key, KeyOptions, Library, PartShell, ShellInput, ShellOptions,
+    DEFAULT_ID_RELIEF_MM,
 };
 
 /// Resin layer height assumed by the print-time estimate (mm).
@@ -479,29 +480,6 @@ fn warn_below_resolution(
             close.join(", ")
         ));
     }
-}
-
-/// Pieces closer to a sibling than `resolution_mm` (largest vertex distance), and the
-/// smallest such distance of the part.
-fn below_resolution(name: &str, pieces_mm: &[Vec<Vec3>], resolution_mm: f64) -> (Vec<String>, f64) {
-    let n = pieces_mm.len();
-    let mut nearest = vec![f64::INFINITY; n];
-    for i in 0..n {
-        for j in i + 1..n {
-            let d = pieces_mm[i]
-                .iter()
-                .zip(&pieces_mm[j])
-                .map(|(x, y)| x.distance(*y))
-                .fold(0.0f32, f32::max) as f64;
-            nearest[i] = nearest[i].min(d);
-            nearest[j] = nearest[j].min(d);
-        }
-    }
-    let close = (0..n)
-        .filter(|&k| nearest[k] < resolution_mm)
-        .map(|k| piece_id(name, k, n))
-        .collect();
-    (close, nearest.iter().copied().fold(f64::INFINITY, f64::min))
 }
 
 /// Resin print time: plates by footprint (pieces laid on their smallest extent, 50 % margin),

@@ -32,22 +32,36 @@ fn thumbnail(
     )?)
 }
 
-/// `catalogue.png`: every piece rendered from the front with its embossed ID.
-pub(crate) fn catalogue_png(lib: &Library, anims: &[&MeshAnimation]) -> Result<Vec<u8>> {
-    let jobs: Vec<(usize, usize)> = lib
-        .parts
+/// Every piece rendered from the front in its part's colour, part by part: the catalogue's
+/// thumbnails before their IDs, and, for a one-part library, each shot's assembled face.
+pub(crate) fn piece_thumbnails(
+    lib: &Library,
+    anims: &[&MeshAnimation],
+) -> Result<Vec<Vec<render::Image>>> {
+    lib.parts
         .iter()
         .enumerate()
-        .flat_map(|(p, r)| (0..r.solution.pieces.len()).map(move |k| (p, k)))
+        .map(|(p, r)| {
+            r.solution
+                .pieces
+                .par_iter()
+                .map(|piece| thumbnail(piece, &anims[p].mesh.triangles, render::categorical(p)))
+                .collect::<Result<Vec<_>>>()
+        })
+        .collect()
+}
+
+/// `catalogue.png`: every piece's thumbnail ([`piece_thumbnails`]) with its embossed ID.
+pub(crate) fn catalogue_png(lib: &Library, thumbnails: &[Vec<render::Image>]) -> Result<Vec<u8>> {
+    let jobs: Vec<(usize, usize)> = thumbnails
+        .iter()
+        .enumerate()
+        .flat_map(|(p, t)| (0..t.len()).map(move |k| (p, k)))
         .collect();
     let images: Vec<render::Image> = jobs
         .par_iter()
-        .map(|&(p, k)| -> Result<render::Image> {
-            let mut img = thumbnail(
-                &lib.parts[p].solution.pieces[k],
-                &anims[p].mesh.triangles,
-                render::categorical(p),
-            )?;
+        .map(|&(p, k)| {
+            let mut img = thumbnails[p][k].clone();
             render::draw_text(
                 &mut img,
                 &piece_label(p, k),
@@ -57,9 +71,9 @@ pub(crate) fn catalogue_png(lib: &Library, anims: &[&MeshAnimation]) -> Result<V
                 [20, 20, 20, 255],
                 Some([255, 255, 255, 255]),
             );
-            Ok(img)
+            img
         })
-        .collect::<Result<_>>()?;
+        .collect();
     let columns = (images.len() as f64).sqrt().ceil().max(1.0) as usize;
     let widest = lib
         .parts
@@ -80,11 +94,14 @@ pub(crate) fn catalogue_png(lib: &Library, anims: &[&MeshAnimation]) -> Result<V
 }
 
 /// `assembly_shotNN.png`, one per shot (clips split at `cuts`), as (file name, PNG bytes).
+/// A one-part library's assembled face is its piece, drawn as the catalogue draws it (part
+/// 0's colour, the part's triangles), so its `thumbnails` are reused instead of rendered again.
 pub(crate) fn assembly_sheets(
     lib: &Library,
     anims: &[&MeshAnimation],
     assembly: &Assembly,
     cuts: &[usize],
+    thumbnails: &[Vec<render::Image>],
 ) -> Result<Vec<(String, Vec<u8>)>> {
     let frames = assembly.frames.len();
     let mut starts: Vec<usize> = std::iter::once(0)
@@ -102,6 +119,9 @@ pub(crate) fn assembly_sheets(
         let images: Vec<render::Image> = runs
             .par_iter()
             .map(|&f| -> Result<render::Image> {
+                if let ([sol], [pieces]) = (&lib.parts[..], thumbnails) {
+                    return Ok(pieces[sol.solution.labels[f] as usize].clone());
+                }
                 let mut positions = Vec::new();
                 let mut triangles = Vec::new();
                 for (p, a) in anims.iter().enumerate() {

@@ -258,22 +258,27 @@ pub(crate) fn build_sources(
             .map(|(s, c)| (s, c, None))
             .collect(),
     };
-    let sources: Vec<Source<'_>> = parts.iter().map(|p| p.0).collect();
-    let mm = print_scale_of(&sources, opts.print_height_mm);
-    let results: Vec<PartResult> = solved
+    // Errors first: their pass over the frames also gives the bounding boxes of the scale.
+    let solved: Vec<(PartSolution, Vec<CurvePoint>, FrameErrors)> = solved
         .into_par_iter()
         .zip(problems.par_iter())
         .map(|((solution, curve, errors), p)| {
             let errors =
                 errors.unwrap_or_else(|| evaluate(p, &solution.pieces, &solution.labels, lambda).1);
-            PartResult {
-                name: p.name.clone(),
-                errors_mm: errors.summary(mm),
-                errors,
-                solution,
-                curve,
-                vertices: p.vertices(),
-            }
+            (solution, curve, errors)
+        })
+        .collect();
+    let mm = scale_of(problems.iter().map(PartProblem::bbox), opts.print_height_mm);
+    let results: Vec<PartResult> = solved
+        .into_par_iter()
+        .zip(problems.par_iter())
+        .map(|((solution, curve, errors), p)| PartResult {
+            name: p.name.clone(),
+            errors_mm: errors.summary(mm),
+            errors,
+            solution,
+            curve,
+            vertices: p.vertices(),
         })
         .collect();
     let summary: Vec<(ErrorSummary, usize)> =

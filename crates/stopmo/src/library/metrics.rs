@@ -1,5 +1,6 @@
 //! Exact energy (StopShop Eq. 10) and per-frame position/velocity errors (Fig. 19).
 
+use anim::Aabb;
 use glam::Vec3;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -76,6 +77,9 @@ impl ErrorSummary {
     }
 }
 
+/// One frame's position energy, mean and max distance, velocity energy, mean and max.
+type FrameTerms = (f64, f64, f64, f64, f64, f64);
+
 /// Exact energy of StopShop Eq. 10 (saliency-weighted, model units²) and the per-frame errors.
 ///
 /// # Performance
@@ -90,7 +94,9 @@ pub(crate) fn evaluate(
     let mut start = vec![false; n];
     p.chains.iter().for_each(|c| start[c.start] = true);
     let w = p.weights.as_deref();
-    let mut per_frame: Vec<(f64, f64, f64, f64, f64, f64)> = Vec::with_capacity(n);
+    let mut per_frame: Vec<(FrameTerms, Aabb)> = Vec::with_capacity(n);
+    // The part's bounding box rides along the first evaluation (see `PartProblem::bbox`).
+    let want_bounds = p.bounds.get().is_none();
     // The last frame of the previous block (morph weights are expanded block by block).
     let mut last: Vec<Vec3> = Vec::new();
     p.src.blocks(|f0, block| {
@@ -106,7 +112,12 @@ pub(crate) fn evaluate(
             let x = frame(f);
             let r = &pieces[labels[f] as usize];
             let (mut eu, mut pm, mut px) = (0.0, 0.0, 0.0f64);
+            // In the distance loop, the box costs no extra pass over the frame.
+            let mut bb = Aabb::EMPTY;
             for (i, (a, b)) in x.iter().zip(r).enumerate() {
+                if want_bounds {
+                    bb.grow(*a);
+                }
                 let dv = (*a - *b).as_dvec3();
                 let sq = dv.length_squared();
                 eu += w.map_or(1.0, |w| w[i]) * sq;
@@ -127,13 +138,19 @@ pub(crate) fn evaluate(
                 }
             }
             let m = x.len().max(1) as f64;
-            (eu, pm / m, px, ev, vm / m, vx)
+            ((eu, pm / m, px, ev, vm / m, vx), bb)
         }));
         if k > 0 {
             last.clear();
             last.extend_from_slice(&block[(k - 1) * m..]);
         }
     });
+    if want_bounds {
+        // Unions of minima and maxima: the same box as any other pass over the frames.
+        let bounds = per_frame.iter().fold(Aabb::EMPTY, |b, t| b.union(t.1));
+        let _ = p.bounds.set(bounds);
+    }
+    let per_frame: Vec<FrameTerms> = per_frame.into_iter().map(|t| t.0).collect();
     let energy = per_frame.iter().map(|t| t.0 + 0.5 * lambda * t.3).sum();
     let errors = FrameErrors {
         position_mean: per_frame.iter().map(|t| t.1).collect(),

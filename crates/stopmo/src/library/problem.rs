@@ -1,8 +1,9 @@
 //! One part's optimization problem: validated inputs and reduced coordinates.
 
 use std::ops::Range;
+use std::sync::OnceLock;
 
-use anim::{MeshAnimation, MorphAnimation};
+use anim::{Aabb, MeshAnimation, MorphAnimation};
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -43,6 +44,9 @@ pub struct PartProblem<'a> {
     pub(crate) xx: Vec<f64>,
     /// ‖y_f − y_{f−1}‖² per frame (0 at chain starts).
     pub(crate) dxx: Vec<f64>,
+    /// Bounding box over all frames, kept by the first pass that reads every frame (an
+    /// energy evaluation) so that a morph clip is not expanded once more for it.
+    pub(crate) bounds: OnceLock<Aabb>,
 }
 
 /// Columns (coordinates) per parallel block of the mean frame: 32 KiB of `f64`.
@@ -185,6 +189,7 @@ impl<'a> PartProblem<'a> {
             sub,
             xx,
             dxx,
+            bounds: OnceLock::new(),
         })
     }
 
@@ -229,6 +234,12 @@ impl<'a> PartProblem<'a> {
     /// Dimension of the reduced coordinates.
     pub fn reduced_dimension(&self) -> usize {
         self.sub.dim
+    }
+
+    /// Bounding box of the part over all frames (expanded once for a morph clip, or kept
+    /// from an energy evaluation).
+    pub(crate) fn bbox(&self) -> Aabb {
+        *self.bounds.get_or_init(|| self.src.bbox())
     }
 
     /// Row-major `frames × dim` reduced coordinates of the frames.

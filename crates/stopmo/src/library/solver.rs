@@ -102,22 +102,25 @@ struct Run {
 }
 
 /// k-means++ (Arthur & Vassilvitskii 2007) over frames, fixed pieces counted as centres.
-/// Returns row-major `d × q` pieces.
-fn kmeans_pp(p: &PartProblem<'_>, d: usize, rng: &mut SplitMix64) -> Vec<f64> {
+/// Returns row-major `d × q` pieces. With `Par::Seq` (restarts already run in parallel) the
+/// distance updates stay on the calling thread; the values are the same either way.
+fn kmeans_pp(p: &PartProblem<'_>, d: usize, rng: &mut SplitMix64, par: Par) -> Vec<f64> {
     let (n, q, nf) = (p.frames(), p.sub.dim, p.fixed);
     let y = p.frame_coords();
     let mut lib = Vec::with_capacity(d * q);
     lib.extend_from_slice(p.fixed_coords());
     let mut dist = vec![f64::INFINITY; n];
-    let update = |dist: &mut [f64], c: &[f64]| {
-        dist.par_iter_mut().enumerate().for_each(|(f, dv)| {
-            let s: f64 = y[f * q..(f + 1) * q]
-                .iter()
-                .zip(c)
-                .map(|(a, b)| (a - b) * (a - b))
-                .sum();
-            *dv = dv.min(s);
-        });
+    let nearer = |(f, dv): (usize, &mut f64), c: &[f64]| {
+        let s: f64 = y[f * q..(f + 1) * q]
+            .iter()
+            .zip(c)
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum();
+        *dv = dv.min(s);
+    };
+    let update = |dist: &mut [f64], c: &[f64]| match par {
+        Par::Seq => dist.iter_mut().enumerate().for_each(|e| nearer(e, c)),
+        _ => dist.par_iter_mut().enumerate().for_each(|e| nearer(e, c)),
     };
     for k in 0..nf {
         update(&mut dist, &p.fixed_coords()[k * q..(k + 1) * q]);
@@ -232,7 +235,7 @@ fn run(
 ) -> Result<Run> {
     let (n, q, nf) = (prob.frames(), prob.sub.dim, prob.fixed);
     let mut rng = SplitMix64::new(opts.seed, restart as u64 + 1);
-    let mut lib = kmeans_pp(prob, d, &mut rng);
+    let mut lib = kmeans_pp(prob, d, &mut rng, par);
     let mut buf = LabelBuffers {
         p: Vec::new(),
         g: Vec::new(),
