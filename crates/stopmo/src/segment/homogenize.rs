@@ -23,7 +23,7 @@ use faer::sparse::linalg::cholesky::{
     SymmetricOrdering,
 };
 use faer::sparse::{SparseColMat, Triplet};
-use faer::{Accum, Conj, Mat, MatMut, Par, Side};
+use faer::{Accum, Conj, Mat, MatMut, MatRef, Par, Side};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -36,6 +36,14 @@ const RESPONSE_COST_RATIO: usize = 8;
 
 /// Default number of frames whose right-hand sides are solved together (one task).
 pub const DEFAULT_CHUNK_FRAMES: usize = 64;
+
+/// Frames whose seam displacements are multiplied by the dense response at once: a chunk's
+/// buffers are `(F + P) × 3 · RESPONSE_FRAMES` floats instead of `× 3 · chunk` (1.9 MB
+/// rather than 15 MB per thread on the face).
+const RESPONSE_FRAMES: usize = 8;
+
+/// Rows of the dense response multiplied at once (see [`Homogenizer::solve_chunk`]).
+const RESPONSE_ROWS: usize = 240;
 
 /// Measurements of one homogenization run.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
@@ -297,7 +305,8 @@ impl Homogenizer {
     /// frame (coincident duplicates included).
     ///
     /// # Performance
-    /// One pass over the frames; per chunk an `F × 3·chunk` dense buffer.
+    /// One pass over the frames; per chunk an `F × 3·chunk` dense buffer, or with the dense
+    /// response an `(F + P) × 3·RESPONSE_FRAMES` one.
     pub fn apply(&self, anim: &mut MeshAnimation) -> HomogenizeStats {
         let start = Instant::now();
         let m = anim.vertex_count();
@@ -355,29 +364,47 @@ impl Homogenizer {
         if m == 0 || nfr == 0 {
             return stats;
         }
-        let mut rhs = Mat::<f64>::zeros(nf, 3 * nfr);
+        let mut disp = vec![DVec3::ZERO; self.targets.len()];
         if let Some(response) = &self.response {
-            // d_F = R d_P for all frames of the chunk: one dense product.
+            // d_F = R d_P, [`RESPONSE_FRAMES`] frames at a time into buffers of this chunk:
+            // every column is the same product whatever the columns beside it, and the
+            // frames are visited in the same order, so the chunk's sums are unchanged.
+            let block = RESPONSE_FRAMES.min(nfr);
             let np = self.pinned.len();
-            let mut dp = Mat::<f64>::zeros(np, 3 * nfr);
-            for lf in 0..nfr {
-                let y = &frames[lf * m..(lf + 1) * m];
-                for (pl, &p) in self.pinned.iter().enumerate() {
-                    let d = self.pinned_displacement(p as usize, y);
-                    for k in 0..3 {
-                        dp[(pl, 3 * lf + k)] = d[k];
+            let mut rhs = Mat::<f64>::zeros(nf, 3 * block);
+            let mut dp = Mat::<f64>::zeros(np, 3 * block);
+            for y in frames.chunks_mut(m * block) {
+                let cols = 3 * (y.len() / m);
+                let mut dp = dp.as_mut().subcols_mut(0, cols);
+                for (lf, y) in y.chunks_exact(m).enumerate() {
+                    for (pl, &p) in self.pinned.iter().enumerate() {
+                        let d = self.pinned_displacement(p as usize, y);
+                        for k in 0..3 {
+                            dp[(pl, 3 * lf + k)] = d[k];
+                        }
                     }
                 }
+                let mut rhs = rhs.as_mut().subcols_mut(0, cols);
+                // By blocks of rows: the product packs the rows of R it multiplies into a
+                // buffer of the calling thread that lives as long as the thread (a worker of
+                // the global pool: for good), so whole R would stay resident once per thread
+                // (36 MB on the face); a block keeps it under 1 MB. Every entry is the same
+                // sum in the same order.
+                for r0 in (0..nf).step_by(RESPONSE_ROWS) {
+                    let rows = RESPONSE_ROWS.min(nf - r0);
+                    matmul(
+                        rhs.rb_mut().subrows_mut(r0, rows),
+                        Accum::Replace,
+                        response.as_ref().subrows(r0, rows),
+                        dp.as_ref(),
+                        1.0,
+                        Par::Seq,
+                    );
+                }
+                self.move_frames(y, m, rhs.as_ref(), &mut disp, &mut stats);
             }
-            matmul(
-                rhs.as_mut(),
-                Accum::Replace,
-                response.as_ref(),
-                dp.as_ref(),
-                1.0,
-                Par::Seq,
-            );
         } else {
+            let mut rhs = Mat::<f64>::zeros(nf, 3 * nfr);
             for lf in 0..nfr {
                 let y = &frames[lf * m..(lf + 1) * m];
                 for (pl, &p) in self.pinned.iter().enumerate() {
@@ -392,17 +419,30 @@ impl Homogenizer {
             if nf > 0 {
                 self.solve_in_place(rhs.as_mut());
             }
+            self.move_frames(frames, m, rhs.as_ref(), &mut disp, &mut stats);
         }
-        let nw = self.targets.len();
-        let mut disp = vec![DVec3::ZERO; nw];
-        for lf in 0..nfr {
-            let y = &mut frames[lf * m..(lf + 1) * m];
-            for w in 0..nw {
-                disp[w] = match (self.free_index[w], self.pinned_index[w]) {
+        stats
+    }
+
+    /// Moves `frames` (frame-major, `m` vertices each) by their solved free displacements
+    /// (`d_F`, three columns per frame) and their pinned ones, adding to `stats` as
+    /// [`Homogenizer::solve_chunk`] returns them; `disp` is scratch of one displacement per
+    /// welded vertex.
+    fn move_frames(
+        &self,
+        frames: &mut [Vec3],
+        m: usize,
+        d_free: MatRef<'_, f64>,
+        disp: &mut [DVec3],
+        stats: &mut [f64; 6],
+    ) {
+        for (lf, y) in frames.chunks_exact_mut(m).enumerate() {
+            for (w, d) in disp.iter_mut().enumerate() {
+                *d = match (self.free_index[w], self.pinned_index[w]) {
                     (Some(r), _) => DVec3::new(
-                        rhs[(r as usize, 3 * lf)],
-                        rhs[(r as usize, 3 * lf + 1)],
-                        rhs[(r as usize, 3 * lf + 2)],
+                        d_free[(r as usize, 3 * lf)],
+                        d_free[(r as usize, 3 * lf + 1)],
+                        d_free[(r as usize, 3 * lf + 2)],
                     ),
                     (None, Some(_)) => self.pinned_displacement(w, y),
                     (None, None) => DVec3::ZERO,
@@ -432,6 +472,5 @@ impl Homogenizer {
                 }
             }
         }
-        stats
     }
 }
