@@ -209,7 +209,12 @@ pub(crate) async fn stylize(
     let r: StyleRequest = body(request)?;
     blocking(move || {
         let start = Instant::now();
-        let (style, s, held) = stylized(&studio, &r, false)?;
+        let one = r.frames.is_some_and(|[a, b]| b == a + 1);
+        let (style, s, held) = if one {
+            studio.one_frame(|| stylized(&studio, &r, false))?
+        } else {
+            stylized(&studio, &r, false)?
+        };
         // Shared with the answer: the multiples are sent from the result, not copied.
         let s = Arc::new(s);
         let toml = style.to_toml_string().unwrap_or_default();
@@ -228,8 +233,8 @@ pub(crate) async fn stylize(
         match clip.map(|c| c.merged()) {
             Some(m) if m.vertex_count() == vertices => pack_changes(
                 &mut pack,
-                frames,
-                vertices,
+                (frames, vertices),
+                input.diagonal(s.first_frame..s.first_frame + frames),
                 |f| bodies.iter().map(|a| a.frame(f)).collect(),
                 |f| m.frame(s.first_frame + f),
             ),
