@@ -85,10 +85,6 @@ pub struct Studio {
     pub jobs: Jobs,
     /// The memory the requests running at once share ([`Studio::reserve`]).
     pub memory: Arc<MemoryPool>,
-    /// A thread of its own for one-frame restyles (the page's current frame): they run
-    /// beside a whole-clip restyle instead of queueing behind its tasks on rayon's shared
-    /// pool ([`Studio::one_frame`]).
-    one_frame: Option<rayon::ThreadPool>,
 }
 
 impl Studio {
@@ -105,21 +101,6 @@ impl Studio {
             stopmo: Mutex::default(),
             jobs: Jobs::default(),
             memory: MemoryPool::job_budget(),
-            one_frame: rayon::ThreadPoolBuilder::new()
-                .num_threads(1)
-                .thread_name(|_| "studio-one-frame".into())
-                .build()
-                .ok(),
-        }
-    }
-
-    /// Runs `work` (a restyle of one frame) on the studio's one-frame thread, so that it does
-    /// not wait for the tasks of a whole clip restyled meanwhile; here when that thread could
-    /// not be started.
-    pub fn one_frame<T: Send>(&self, work: impl FnOnce() -> T + Send) -> T {
-        match &self.one_frame {
-            Some(pool) => pool.install(work),
-            None => work(),
         }
     }
 

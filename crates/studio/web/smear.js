@@ -229,11 +229,10 @@ export class SmearPanel {
   }
 
   /**
-   * Restyles: the current frame (a one-frame answer, drawn at once) and every frame, asked
-   * for together (the server restyles the one frame on a thread of its own, beside the
-   * clip); the clip is laid in when it arrives, cancelled by the next change. Frames
-   * scrubbed to meanwhile are asked for one by one. While a first-frame request is in flight
-   * only the newest change waits.
+   * Restyles: the current frame (a one-frame answer, drawn at once), then every frame (asked
+   * for as soon as the current frame is answered, laid in when it arrives, cancelled by the
+   * next change); frames scrubbed to meanwhile are asked for one by one. While a first-frame
+   * request is in flight only the newest change waits.
    */
   async request(body, t0) {
     this.gen = (this.gen || 0) + 1;
@@ -249,14 +248,18 @@ export class SmearPanel {
     const f = s.frame;
     const gen = this.gen;
     this.fresh = null;
-    const ctl = new AbortController();
-    const rest = getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...body, changes: true }, ctl.signal);
-    rest.catch(() => {});
-    this.restCtl = ctl;
     try {
       const r = await getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...body, frames: [f, f + 1] });
       const fetched = performance.now();
       if (!this.pending) {
+        // The whole clip is asked for now, after the current frame's answer and before it is
+        // drawn: the small request does not wait behind the clip's tasks on the server's
+        // cores (docs/studio.md, "Figures"), and the server restyles the clip while the page
+        // draws the frame.
+        const ctl = new AbortController();
+        const rest = getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...body, changes: true }, ctl.signal);
+        rest.catch(() => {});
+        this.restCtl = ctl;
         $('style-error').textContent = '';
         s.showError('');
         this.style = r.header.style;
@@ -273,11 +276,9 @@ export class SmearPanel {
         const ms = performance.now() - t0;
         s.stats.smear.push({ ms, server_ms: r.header.seconds * 1000, bytes: r.bytes, fetch_ms: fetched - t0, apply_ms: applied - fetched, draw_ms: performance.now() - applied, render_ms: s.view.renderMs });
         $('smear-report').textContent = `frame ${f} restyled in ${ms.toFixed(0)} ms (server ${(r.header.seconds * 1000).toFixed(0)} ms, ${(r.bytes / 1024).toFixed(0)} KiB)`;
-        if (gen === this.gen) this.loadRest(gen, t0, rest, ctl);
+        this.loadRest(gen, t0, rest, ctl);
       }
     } catch (e) {
-      ctl.abort();
-      if (this.restCtl === ctl) this.restCtl = null;
       $('style-error').textContent = e.message;
       s.showError(e.message);
     } finally {

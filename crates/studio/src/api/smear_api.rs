@@ -209,12 +209,7 @@ pub(crate) async fn stylize(
     let r: StyleRequest = body(request)?;
     blocking(move || {
         let start = Instant::now();
-        let one = r.frames.is_some_and(|[a, b]| b == a + 1);
-        let (style, s, held) = if one {
-            studio.one_frame(|| stylized(&studio, &r, false))?
-        } else {
-            stylized(&studio, &r, false)?
-        };
+        let (style, s, held) = stylized(&studio, &r, false)?;
         // Shared with the answer: the multiples are sent from the result, not copied.
         let s = Arc::new(s);
         let toml = style.to_toml_string().unwrap_or_default();
