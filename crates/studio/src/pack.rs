@@ -139,13 +139,19 @@ impl Pack {
         self.entry(name, "u32", offset, count)
     }
 
-    /// Adds an int16 buffer made of `parts` one after the other (a frame each), handed over
-    /// without copying (zero-padded as [`Pack::i16`]).
+    /// Adds an int16 buffer made of `parts` one after the other (a frame each), copied as
+    /// bytes into one chunk (a chunk per frame made the answer slower to send and to read)
+    /// and zero-padded as [`Pack::i16`].
     pub fn i16_parts(&mut self, name: &str, parts: Vec<Vec<i16>>) -> &mut Pack {
         let offset = self.offset();
         let count: usize = parts.iter().map(Vec::len).sum();
+        self.data.reserve_exact(2 * count + 2);
         for part in parts {
-            self.owned(part);
+            if cfg!(target_endian = "little") {
+                self.data.extend_from_slice(bytemuck::cast_slice(&part));
+            } else {
+                part.into_iter().for_each(|v| v.extend_le(&mut self.data));
+            }
         }
         if count % 2 == 1 {
             self.data.extend_from_slice(&[0, 0]);
