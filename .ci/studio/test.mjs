@@ -140,7 +140,7 @@ try {
   console.log(`  of which: request until answer ${part('fetch_ms')} ms, buffers into the scene ${part('apply_ms')} ms, until the next render is done ${part('draw_ms')} ms (one render of the page ${part('render_ms')} ms: software GL)`);
   console.log(`latency smear slider → all 81 frames drawn: median ${median(latAll.map((l) => l.ms)).toFixed(1)} ms of ${latAll.length}, server median ${median(latAll.map((l) => l.server_ms)).toFixed(1)} ms, ${(median(latAll.map((l) => l.bytes)) / 1048576).toFixed(2)} MiB; target 50 ms`);
   const partAll = (k) => median(latAll.map((l) => l[k])).toFixed(1);
-  console.log(`  of which: request until answer ${partAll('fetch_ms')} ms, laid over the clip and into the scene ${partAll('apply_ms')} ms, until the next render is done ${partAll('draw_ms')} ms`);
+  console.log(`  of which: request left ${partAll('sent_ms')} ms, its headers ${partAll('headers_ms')} ms, answer ${partAll('fetch_ms')} ms, laid over the clip and into the scene ${partAll('apply_ms')} ms, until the next render is done ${partAll('draw_ms')} ms; drawn again ${latAll.filter((l) => l.redrawn).length} of ${latAll.length} times (the frame on screen already showed the new style)`);
   const whole = await page.evaluate(() => { const p = window.studio.panels.smear; return { body: p.body.length, frames: p.anim.frames, vertices: p.anim.vertices }; });
   // The quantized answer (crates/studio/src/api/changes.rs) against the core's float32 body.
   const quant = await page.evaluate(async () => {

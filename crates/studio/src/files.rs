@@ -1,9 +1,12 @@
 //! The files the studio was opened with (the only files it reads) and the output folder (the
 //! only place it writes).
 
+use std::ops::Range;
 use std::path::{Component, Path, PathBuf};
+use std::sync::OnceLock;
 
-use anim::{MeshAnimation, SampleOptions, SampledScene};
+use anim::{Aabb, MeshAnimation, SampleOptions, SampledScene};
+use rayon::prelude::*;
 use tkio::{LoadOptions, Loaded};
 
 use crate::error::{ApiError, ApiResult, StudioError};
@@ -121,6 +124,9 @@ pub struct Clip {
     pub sampled: SampledScene,
     /// The objects merged, when there are several.
     several: Option<MeshAnimation>,
+    /// Per frame the merged vertices' bounding box, worked out on first use (the bound of a
+    /// whole-clip answer of changes, docs/studio.md): not again for every restyle.
+    bounds: OnceLock<Vec<Aabb>>,
 }
 
 impl Clip {
@@ -131,7 +137,11 @@ impl Clip {
             1 => None,
             _ => Some(merged(label, &sampled)?),
         };
-        Ok(Clip { sampled, several })
+        Ok(Clip {
+            sampled,
+            several,
+            bounds: OnceLock::new(),
+        })
     }
 
     /// Every object's vertices as one cache, in object order.
@@ -152,6 +162,22 @@ impl Clip {
             Ok(Clip { mut sampled, .. }) => sampled.objects.swap_remove(0).animation,
             Err(shared) => shared.merged().clone(),
         }
+    }
+
+    /// The diagonal of the merged vertices' bounding box over clip frames `frames` (0 for
+    /// none); the boxes of the frames are found once per clip.
+    pub fn diagonal(&self, frames: Range<usize>) -> f32 {
+        let bounds = self.bounds.get_or_init(|| {
+            let m = self.merged();
+            (0..m.frame_count())
+                .into_par_iter()
+                .map(|f| Aabb::from_points(m.frame(f)))
+                .collect()
+        });
+        bounds
+            .get(frames)
+            .and_then(|b| b.iter().copied().reduce(Aabb::union))
+            .map_or(0.0, |b| b.diagonal())
     }
 
     /// The merged positions as float32 coordinates (for [`crate::pack::Pack::shared`]).

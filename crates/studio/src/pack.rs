@@ -139,6 +139,50 @@ impl Pack {
         self.entry(name, "u32", offset, count)
     }
 
+    /// Adds an int16 buffer made of `parts` one after the other (a frame each), copied as
+    /// bytes into one chunk (a chunk per frame made the answer slower to send and to read)
+    /// and zero-padded as [`Pack::i16`].
+    pub fn i16_parts(&mut self, name: &str, parts: Vec<Vec<i16>>) -> &mut Pack {
+        let offset = self.offset();
+        let count: usize = parts.iter().map(Vec::len).sum();
+        self.data.reserve_exact(2 * count + 2);
+        for part in parts {
+            if cfg!(target_endian = "little") {
+                self.data.extend_from_slice(bytemuck::cast_slice(&part));
+            } else {
+                part.into_iter().for_each(|v| v.extend_le(&mut self.data));
+            }
+        }
+        if count % 2 == 1 {
+            self.data.extend_from_slice(&[0, 0]);
+        }
+        self.entry(name, "i16", offset, count)
+    }
+
+    /// Adds a uint32 buffer handed over without copying.
+    pub fn u32_vec(&mut self, name: &str, values: Vec<u32>) -> &mut Pack {
+        let offset = self.offset();
+        let count = values.len();
+        self.owned(values);
+        self.entry(name, "u32", offset, count)
+    }
+
+    /// `values` as the next chunk of the data (their bytes, little-endian).
+    fn owned<T: bytemuck::Pod + Send + ToLeBytes>(&mut self, values: Vec<T>) {
+        if values.is_empty() {
+            return;
+        }
+        if cfg!(target_endian = "little") {
+            self.flush();
+            self.written += std::mem::size_of_val(&values[..]);
+            self.chunks.push(Bytes::from_owner(PodBytes(values)));
+        } else {
+            for v in values {
+                v.extend_le(&mut self.data);
+            }
+        }
+    }
+
     /// Adds an int16 buffer (zero-padded to a multiple of 4 bytes, so the buffers after it
     /// stay aligned for the page's typed arrays).
     pub fn i16(&mut self, name: &str, values: impl IntoIterator<Item = i16>) -> &mut Pack {
@@ -225,6 +269,32 @@ impl<T> AsRef<[u8]> for F32Bytes<T> {
     }
 }
 
+/// A vector's values as the bytes of a response chunk ([`Pack::i16_parts`], [`Pack::u32_vec`]).
+struct PodBytes<T>(Vec<T>);
+
+impl<T: bytemuck::Pod> AsRef<[u8]> for PodBytes<T> {
+    fn as_ref(&self) -> &[u8] {
+        bytemuck::cast_slice(&self.0)
+    }
+}
+
+/// A value written little-endian (the packs of a big-endian machine).
+trait ToLeBytes {
+    fn extend_le(self, out: &mut Vec<u8>);
+}
+
+impl ToLeBytes for i16 {
+    fn extend_le(self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self.to_le_bytes());
+    }
+}
+
+impl ToLeBytes for u32 {
+    fn extend_le(self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self.to_le_bytes());
+    }
+}
+
 /// Points as their x, y, z coordinates, without copying.
 pub fn coordinates(points: &[anim::glam::Vec3]) -> &[f32] {
     bytemuck::cast_slice(points)
@@ -293,6 +363,8 @@ mod tests {
         p.shared("held", held.clone(), |v| &v[..]);
         p.u32("after", [9]);
         p.i16("small", [-3, 7, 1]).u32("aligned", [5]);
+        p.i16_parts("parts", vec![vec![1, -2], vec![], vec![3]])
+            .u32_vec("words", vec![6, 7]);
         let bytes = p.finish(json!({"frames": 3}));
         let (header, pos) = read_f32(&bytes, "pos").unwrap();
         assert_eq!(pos, vec![1.5, -2.0]);
@@ -305,6 +377,9 @@ mod tests {
         assert_eq!(header["buffers"][6]["offset"], 56);
         assert_eq!(read_u32(&bytes, "aligned").unwrap(), vec![5]);
         assert_eq!(read_i16(&bytes, "small").unwrap(), vec![-3, 7, 1]);
+        assert_eq!(read_i16(&bytes, "parts").unwrap(), vec![1, -2, 3]);
+        assert_eq!(header["buffers"][8]["offset"], 68);
+        assert_eq!(read_u32(&bytes, "words").unwrap(), vec![6, 7]);
         assert_eq!(header["buffers"][1]["offset"], 12);
         let len = u32::from_le_bytes(bytes[..4].try_into().unwrap()) as usize;
         assert_eq!(len % 4, 0);

@@ -230,7 +230,7 @@ export class SmearPanel {
 
   /**
    * Restyles: the current frame (a one-frame answer, drawn at once), then every frame (asked
-   * for as soon as the current frame is answered, drawn when it arrives, cancelled by the
+   * for as soon as the current frame is answered, laid in when it arrives, cancelled by the
    * next change); frames scrubbed to meanwhile are asked for one by one. While a first-frame
    * request is in flight only the newest change waits.
    */
@@ -246,16 +246,16 @@ export class SmearPanel {
     this.inflight = true;
     const s = this.studio;
     const f = s.frame;
+    const gen = this.gen;
     this.fresh = null;
     try {
       const r = await getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...body, frames: [f, f + 1] });
       const fetched = performance.now();
       if (!this.pending) {
-        const gen = this.gen;
         // The whole clip is asked for now, after the current frame's answer and before it is
-        // drawn: the small request does not wait behind the clip's on the server's cores
-        // (asked for together, the current frame took twice as long on a loaded machine),
-        // and the server restyles the clip while the page draws the frame.
+        // drawn: the small request does not wait behind the clip's tasks on the server's
+        // cores (docs/studio.md, "Figures"), and the server restyles the clip while the page
+        // draws the frame.
         const ctl = new AbortController();
         const rest = getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...body, changes: true }, ctl.signal);
         rest.catch(() => {});
@@ -287,7 +287,12 @@ export class SmearPanel {
     }
   }
 
-  /** Every frame of the current style (the `rest` answer of `ctl`); a newer change aborts it. */
+  /**
+   * Every frame of the current style (the `rest` answer of `ctl`); a newer change aborts it.
+   * Called once the current frame's answer is drawn: the frames restyled exactly so far
+   * (`fresh`) are kept, and when the frame on screen is one of them nothing is drawn again
+   * (it already shows the new style); the clock stops when every frame is in the buffers.
+   */
   async loadRest(gen, t0, rest, ctl) {
     const s = this.studio;
     try {
@@ -295,12 +300,12 @@ export class SmearPanel {
       if (gen !== this.gen) return;
       const fetched = performance.now();
       this.restCtl = null;
-      this.apply(r);
+      const redrawn = this.apply(r, this.fresh);
       const applied = performance.now();
-      await s.view.rendered();
+      if (redrawn) await s.view.rendered();
       // When the request left, its answer's headers and its last byte arrived (from t0).
       const at = (t) => t - t0;
-      s.stats.smearAll.push({ ms: performance.now() - t0, server_ms: r.header.seconds * 1000, bytes: r.bytes, frames: r.header.frames, fetch_ms: fetched - t0, apply_ms: applied - fetched, draw_ms: performance.now() - applied, sent_ms: at(r.times.sent), headers_ms: at(r.times.headers), body_ms: at(r.times.body) });
+      s.stats.smearAll.push({ ms: performance.now() - t0, server_ms: r.header.seconds * 1000, bytes: r.bytes, frames: r.header.frames, fetch_ms: fetched - t0, apply_ms: applied - fetched, draw_ms: performance.now() - applied, redrawn, sent_ms: at(r.times.sent), headers_ms: at(r.times.headers), body_ms: at(r.times.body) });
       $('smear-report').textContent += `\nall ${r.header.frames} frames in ${(performance.now() - t0).toFixed(0)} ms (server ${(r.header.seconds * 1000).toFixed(0)} ms, ${(r.bytes / 1048576).toFixed(1)} MiB)\n` + smearSummary(r.header.report, r.header.frames, this.anim.height);
     } catch (e) {
       if (e.name !== 'AbortError' && gen === this.gen) s.showError(e.message);
@@ -327,15 +332,17 @@ export class SmearPanel {
   }
 
   /**
-   * Draws a stylize answer holding clip frames `first_frame ..+ frames`: written into the
-   * panel's whole-clip buffers (frames not answered yet keep the previous style; copies
-   * there are transparent until they arrive).
+   * Lays a stylize answer holding clip frames `first_frame ..+ frames` into the panel's
+   * whole-clip buffers (frames not answered yet keep the previous style; copies there are
+   * transparent until they arrive). `keep`: clip frames that already hold this style exactly
+   * (a one-frame answer's), left as they are. Returns whether the viewport was given the
+   * result to draw again (false when the frame it shows is kept and the meshes stay).
    */
-  apply({ header, buffers }) {
+  apply({ header, buffers }, keep = null) {
     const s = this.studio;
     const total = header.clip_frames, k = header.first_frame, nf = header.frames;
     if (!this.clip || this.clip.input !== this.anim) this.clip = new ClipBody(this.anim);
-    if (buffers['body.changed']) this.clip.setChanges(k, nf, buffers);
+    if (buffers['body.changed']) this.clip.setChanges(k, nf, buffers, keep);
     else this.clip.setFrames(k, nf, buffers.body);
     // The multiples: kept per copy (ClipCopy) while the style's copies stay the same.
     const same = this.copies && this.copies.length === header.copies.length && this.copies.every((c, i) => c.vertices === header.copies[i].vertices && c.triangles.length === buffers[`copy${i}.triangles`].length);
@@ -347,17 +354,21 @@ export class SmearPanel {
     }
     header.copies.forEach((c, i) => {
       const shown = buffers[`copy${i}.shown`], clip = this.copies[i].clip;
-      if (shown) clip.setShown(k, nf, shown, buffers[`copy${i}.shown_positions`], buffers[`copy${i}.shown_alpha`]);
+      if (shown) clip.setShown(k, nf, shown, buffers[`copy${i}.shown_positions`], buffers[`copy${i}.shown_alpha`], keep);
       else clip.setFrames(k, nf, buffers[`copy${i}.positions`], buffers[`copy${i}.alpha`]);
     });
+    // The motion lines: per set, one entry per clip frame, replaced in place (the viewport
+    // reads the same arrays) while the sets stay the same.
     const sets = header.lines.map((_, i) => splitLines(buffers, i));
-    const sameLines = this.lines && this.lines.length === sets.length && nf !== total;
-    if (!sameLines) this.lines = sets.map((fr) => (fr.length === total ? fr : Array.from({ length: total }, () => EMPTY_LINES)));
-    if (nf !== total) sets.forEach((fr, i) => fr.forEach((x, j) => { this.lines[i][k + j] = x; }));
-    const clip = this.clip;
-    s.view.setAnimation({ ...this.anim, positions: clip.positions, frameAt: (f) => clip.frame(f) });
-    if (!same) s.view.setCopies(this.copies);
-    if (!sameLines) s.view.setLines(this.lines.map((frames) => ({ frames })));
+    const sameLines = this.lines && this.lines.length === sets.length && this.lines.every((l) => l.length === total);
+    if (!sameLines) this.lines = sets.map(() => Array.from({ length: total }, () => EMPTY_LINES));
+    sets.forEach((fr, i) => fr.forEach((x, j) => { if (!keep || !keep.has(k + j)) this.lines[i][k + j] = x; }));
+    const clip = this.clip, view = s.view;
+    if (same && sameLines && keep && keep.has(view.frame) && view.anim && view.anim.clip === clip) return false;
+    view.setAnimation({ ...this.anim, positions: clip.positions, frameAt: (f) => clip.frame(f), clip });
+    if (!same) view.setCopies(this.copies);
+    if (!sameLines) view.setLines(this.lines.map((frames) => ({ frames })));
+    return true;
   }
 
   /** Every frame's body (frames × vertices × 3) of the styles answered so far, or null. */

@@ -35,6 +35,14 @@ function eachSet(bits, words, j, visit) {
   }
 }
 
+/**
+ * Frames `first ..+ count` to be rebuilt from a whole-clip answer, but for those in `keep`
+ * (a Set of clip frames that hold the same style's float32 answer already: exact, kept).
+ */
+function unready(ready, first, count, keep) {
+  for (let f = first; f < first + count; f++) if (!keep || !keep.has(f) || !ready[f]) ready[f] = 0;
+}
+
 /** The elongated body of every frame. */
 export class ClipBody {
   /** `input`: the clip as `/api/scene` gave it ({positions, frames, vertices}). */
@@ -56,13 +64,13 @@ export class ClipBody {
 
   /**
    * A whole-clip answer of changes: `body.changed` bits, `body.step` + `body.delta` or
-   * `body.positions` for the moved vertices. Only where each frame's moved vertices start is
+   * `body.positions` for the moved vertices (frames in `keep` stay as they are). Only where each frame's moved vertices start is
    * worked out now (a popcount of the bits); the frames are rebuilt when asked for.
    */
-  setChanges(first, count, buffers) {
+  setChanges(first, count, buffers, keep = null) {
     const bits = buffers['body.changed'];
     this.changes = { first, count, bits, starts: starts(bits, this.words, count, 3), exact: buffers['body.positions'], delta: buffers['body.delta'], steps: buffers['body.step'] };
-    this.ready.fill(0, first, first + count);
+    unready(this.ready, first, count, keep);
   }
 
   /**
@@ -114,9 +122,9 @@ export class ClipCopy {
   }
 
   /** A whole-clip answer of the shown vertices (`copyN.shown`, `.shown_positions`, `.shown_alpha`). */
-  setShown(first, count, bits, positions, alpha) {
+  setShown(first, count, bits, positions, alpha, keep = null) {
     this.shown = { first, count, bits, starts: starts(bits, this.words, count, 1), positions, alpha };
-    this.ready.fill(0, first, first + count);
+    unready(this.ready, first, count, keep);
   }
 
   /** Clip frame `f`: {positions, alpha}. */

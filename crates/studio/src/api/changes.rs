@@ -19,32 +19,30 @@ pub(crate) const MAX_QUANTIZATION_ERROR: f32 = 1e-5;
 /// `v / 32` set when vertex `v` moved), `body.step` (f32 per frame) and `body.delta` (i16 xyz
 /// of the moved vertices, frame-major, in vertex order: the position is the input's plus
 /// `delta × step`). When a frame's displacements are too large for 16 bits within
-/// [`MAX_QUANTIZATION_ERROR`] of the diagonal of the input's bounding box over the frames
-/// answered, `body.positions` (f32 xyz of the moved
+/// [`MAX_QUANTIZATION_ERROR`] of `diagonal` (the input's bounding box over the frames
+/// answered, [`crate::files::Clip::diagonal`]), `body.positions` (f32 xyz of the moved
 /// vertices) replaces `body.step` and `body.delta`. `body(f)` and `input(f)` are the merged
-/// vertices of frame `f` of the answer and of the input clip. Frames are compared and packed
-/// in parallel; only the answer's own buffers are allocated.
+/// vertices of frame `f` of the answer and of the input clip. Each frame is compared and
+/// quantized by one task while its vertices are in cache, frames in parallel; the answer's
+/// buffers are handed to the pack, not copied.
 pub(crate) fn pack_changes<'a>(
     pack: &mut Pack,
-    frames: usize,
-    vertices: usize,
+    (frames, vertices): (usize, usize),
+    diagonal: f32,
     body: impl Fn(usize) -> Vec<&'a [Vec3]> + Sync,
     input: impl Fn(usize) -> &'a [Vec3] + Sync,
 ) {
     let words = vertices.div_ceil(32);
+    let limit = 2.0 * f32::from(i16::MAX) * MAX_QUANTIZATION_ERROR * diagonal;
     let mut mask = vec![0u32; frames * words];
-    // Per frame: moved vertices, the largest displacement coordinate, the input's bounds.
-    let scan: Vec<(usize, f32, Vec3, Vec3)> = mask
+    // Per frame: its step (0 when it does not fit in 16 bits) and its moved vertices' deltas.
+    let quantized: Vec<(f32, Vec<i16>)> = mask
         .par_chunks_mut(words.max(1))
         .enumerate()
         .map(|(f, bits)| {
-            let before = input(f);
+            let (slices, before) = (body(f), input(f));
             let (mut count, mut largest) = (0, 0.0f32);
-            let (lo, hi) = before.iter().fold(
-                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-                |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-            );
-            each_vertex(&body(f), |v, p| {
+            each_vertex(&slices, |v, p| {
                 // Bit-exact: an unmoved vertex is drawn from the input itself.
                 match before.get(v) {
                     Some(q) if q.to_array() == p.to_array() => {}
@@ -56,49 +54,34 @@ pub(crate) fn pack_changes<'a>(
                     }
                 }
             });
-            (count, largest, lo, hi)
+            if largest > limit {
+                return (0.0, Vec::new());
+            }
+            let step = if largest > 0.0 {
+                largest / f32::from(i16::MAX)
+            } else {
+                1.0
+            };
+            let mut delta = Vec::with_capacity(3 * count);
+            each_moved(&slices, before, bits, |_, p, q| {
+                delta.extend(((p - q) / step).to_array().map(round_i16));
+            });
+            (step, delta)
         })
         .collect();
-    let (lo, hi) = scan.iter().fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(lo, hi), s| (lo.min(s.2), hi.max(s.3)),
-    );
-    let diagonal = if frames > 0 { (hi - lo).length() } else { 0.0 };
-    let moved: Vec<(usize, f32)> = scan.iter().map(|s| (s.0, s.1)).collect();
-    let limit = 2.0 * f32::from(i16::MAX) * MAX_QUANTIZATION_ERROR * diagonal;
-    let quantized = moved.iter().all(|&(_, d)| d <= limit);
-    let total = moved.iter().map(|&(n, _)| 3 * n).sum::<usize>();
-    // Each frame's moved vertices in its own slice of the answer's buffer, filled in parallel.
-    let bits = |f: usize| &mask[f * words..(f + 1) * words];
-    if quantized {
-        let steps: Vec<f32> = moved
-            .iter()
-            .map(|&(_, d)| {
-                if d > 0.0 {
-                    d / f32::from(i16::MAX)
-                } else {
-                    1.0
-                }
-            })
-            .collect();
-        let mut delta = vec![0i16; total];
-        split_frames(&mut delta, moved.iter().map(|m| 3 * m.0))
-            .into_par_iter()
-            .for_each(|(f, out)| {
-                let step = steps[f];
-                each_moved(&body(f), input(f), bits(f), |k, p, q| {
-                    let d = ((p - q) / step).round().to_array();
-                    for (o, x) in out[k..k + 3].iter_mut().zip(d) {
-                        *o = x as i16;
-                    }
-                });
-            });
-        pack.u32("body.changed", mask);
+    if quantized.iter().all(|(step, _)| *step > 0.0) {
+        let (steps, delta): (Vec<f32>, Vec<Vec<i16>>) = quantized.into_iter().unzip();
+        pack.u32_vec("body.changed", mask);
         pack.f32("body.step", steps);
-        pack.i16("body.delta", delta);
+        pack.i16_parts("body.delta", delta);
     } else {
-        let mut positions = vec![0.0f32; total];
-        split_frames(&mut positions, moved.iter().map(|m| 3 * m.0))
+        let counts: Vec<usize> = mask
+            .chunks(words.max(1))
+            .map(|w| w.iter().map(|x| x.count_ones() as usize).sum())
+            .collect();
+        let bits = |f: usize| &mask[f * words..(f + 1) * words];
+        let mut positions = vec![0.0f32; 3 * counts.iter().sum::<usize>()];
+        split_frames(&mut positions, counts.iter().map(|n| 3 * n))
             .into_par_iter()
             .for_each(|(f, out)| {
                 each_moved(&body(f), input(f), bits(f), |k, p, _| {
@@ -109,6 +92,14 @@ pub(crate) fn pack_changes<'a>(
         // Sent from the vector itself, not copied once more into the pack.
         pack.shared("body.positions", positions, |m| &m[..]);
     }
+}
+
+/// `x` (|x| ≤ 32,767) rounded to the nearest integer, ties to even, without a call into the
+/// C library: adding and taking away 1.5 × 2²³ leaves no bit for a fraction.
+#[inline]
+fn round_i16(x: f32) -> i16 {
+    const SHIFT: f32 = 12_582_912.0;
+    ((x + SHIFT) - SHIFT) as i16
 }
 
 /// Calls `visit(v, p)` for every vertex of a frame given as its objects' slices.

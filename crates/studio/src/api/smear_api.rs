@@ -228,8 +228,8 @@ pub(crate) async fn stylize(
         match clip.map(|c| c.merged()) {
             Some(m) if m.vertex_count() == vertices => pack_changes(
                 &mut pack,
-                frames,
-                vertices,
+                (frames, vertices),
+                input.diagonal(s.first_frame..s.first_frame + frames),
                 |f| bodies.iter().map(|a| a.frame(f)).collect(),
                 |f| m.frame(s.first_frame + f),
             ),
