@@ -150,7 +150,7 @@ impl Pack {
             if cfg!(target_endian = "little") {
                 self.data.extend_from_slice(bytemuck::cast_slice(&part));
             } else {
-                part.into_iter().for_each(|v| v.extend_le(&mut self.data));
+                self.data.extend(part.iter().flat_map(|v| v.to_le_bytes()));
             }
         }
         if count % 2 == 1 {
@@ -159,28 +159,18 @@ impl Pack {
         self.entry(name, "i16", offset, count)
     }
 
-    /// Adds a uint32 buffer handed over without copying.
+    /// Adds a uint32 buffer handed over without copying (copied as [`Pack::u32`] on a
+    /// big-endian machine).
     pub fn u32_vec(&mut self, name: &str, values: Vec<u32>) -> &mut Pack {
+        if cfg!(target_endian = "big") || values.is_empty() {
+            return self.u32(name, values);
+        }
         let offset = self.offset();
         let count = values.len();
-        self.owned(values);
+        self.flush();
+        self.written += 4 * count;
+        self.chunks.push(Bytes::from_owner(PodBytes(values)));
         self.entry(name, "u32", offset, count)
-    }
-
-    /// `values` as the next chunk of the data (their bytes, little-endian).
-    fn owned<T: bytemuck::Pod + Send + ToLeBytes>(&mut self, values: Vec<T>) {
-        if values.is_empty() {
-            return;
-        }
-        if cfg!(target_endian = "little") {
-            self.flush();
-            self.written += std::mem::size_of_val(&values[..]);
-            self.chunks.push(Bytes::from_owner(PodBytes(values)));
-        } else {
-            for v in values {
-                v.extend_le(&mut self.data);
-            }
-        }
     }
 
     /// Adds an int16 buffer (zero-padded to a multiple of 4 bytes, so the buffers after it
@@ -269,29 +259,12 @@ impl<T> AsRef<[u8]> for F32Bytes<T> {
     }
 }
 
-/// A vector's values as the bytes of a response chunk ([`Pack::i16_parts`], [`Pack::u32_vec`]).
+/// A vector's values as the bytes of a response chunk ([`Pack::u32_vec`]).
 struct PodBytes<T>(Vec<T>);
 
 impl<T: bytemuck::Pod> AsRef<[u8]> for PodBytes<T> {
     fn as_ref(&self) -> &[u8] {
         bytemuck::cast_slice(&self.0)
-    }
-}
-
-/// A value written little-endian (the packs of a big-endian machine).
-trait ToLeBytes {
-    fn extend_le(self, out: &mut Vec<u8>);
-}
-
-impl ToLeBytes for i16 {
-    fn extend_le(self, out: &mut Vec<u8>) {
-        out.extend_from_slice(&self.to_le_bytes());
-    }
-}
-
-impl ToLeBytes for u32 {
-    fn extend_le(self, out: &mut Vec<u8>) {
-        out.extend_from_slice(&self.to_le_bytes());
     }
 }
 
