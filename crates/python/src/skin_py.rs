@@ -47,6 +47,11 @@ pub(crate) fn skinned(
     shape(weights, "weights", &[Some(n), Some(k)])?;
     let m = shape(matrices, "matrices", &[None, None, Some(4), Some(4)])?;
     let (frames, bones) = (m[0], m[1]);
+    // The clip is frames × vertices whatever the inputs' sizes: checked before it is held.
+    anim::budget::JobMemory::new()
+        .positions("skinned clip", frames, n, 1)
+        .check("skin fewer frames or vertices")
+        .map_err(|e| anim_error("<arrays>", e.into()))?;
     let (idx, w) = (values(indices), values(weights));
     if let Some((i, &b)) = idx
         .iter()

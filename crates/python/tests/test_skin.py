@@ -86,3 +86,15 @@ def test_a_scene_takes_positions_or_skinning_not_both():
     with pytest.raises(ValueError, match=r"indices\[0, 0\] = 1"):
         toonkit.Scene.from_arrays(None, [[0, 1, 2]],
                                   skinning=(rest, [[1], [0], [0]], [[1.0]] * 3, mats))
+
+
+def test_a_clip_over_the_memory_budget_is_an_error_not_an_abort():
+    # 100,000 frames × 100,000 vertices (120 GB of positions) from inputs of a few MB.
+    n = 100_000
+    rest = np.zeros((n, 3), np.float32)
+    idx, w = np.zeros((n, 1), np.int64), np.ones((n, 1), np.float32)
+    mats = np.tile(np.eye(4, dtype=np.float32), (n, 1, 1, 1))
+    with pytest.raises(ValueError, match="skinned clip.*over the limit"):
+        toonkit.skin(rest, idx, w, mats)
+    with pytest.raises(ValueError, match="skinned clip.*over the limit"):
+        toonkit.Scene.from_arrays(None, [[0, 1, 2]], skinning=(rest, idx, w, mats))
