@@ -92,7 +92,7 @@ def _prepare(context, objects, settings):
         scene = toonkit.Scene.from_arrays(positions, s.triangles, fps=s.fps, skin=skin,
                                           objects=s.objects, attributes=s.attributes,
                                           rest=s.rest,
-                                          skinning=s.skinning if positions is None else None)
+                                          skinning=s.clip_skinning() if positions is None else None)
         prepared = toonkit.smear.prepare(scene, smooth=settings.smooth)
     except (toonkit.ToonkitError, ValueError) as e:
         raise JobError(_one_line(e)) from e

@@ -49,6 +49,9 @@ class Sample:
     # `toonkit.skin`'s arguments when every mesh is pose-only: the core skins the clip
     # straight into the scene it makes (`Scene.from_arrays(skinning=...)`, no copy).
     skinning: tuple = None
+    # The same clip already being skinned by the core while frames were read
+    # (`toonkit.SkinStream`): `clip_skinning` hands it over once.
+    stream: object = field(default=None, repr=False)
     _y_up: np.ndarray = field(default=None, repr=False)
     _world: np.ndarray = field(default=None, repr=False)
 
@@ -70,13 +73,23 @@ class Sample:
             self._y_up = toonkit.skin(*self.skinning)
         return self._y_up
 
+    def clip_skinning(self):
+        """`Scene.from_arrays`' `skinning`: the stream the frames were pushed to (once), else
+        `toonkit.skin`'s arguments."""
+        stream, self.stream = self.stream, None
+        return stream if stream is not None else self.skinning
+
     def moves(self):
         """Whether any vertex moves over the frames (no copy of them). With `skinning`: a
         vertex moves only when a matrix it is skinned with changes (the same matrices give
         the same vertices, bit for bit)."""
         if self._y_up is None:
             _, indices, weights, matrices = self.skinning
-            used = matrices[:, np.unique(indices[(indices >= 0) & (weights > 0)])]
+            if indices.strides[0] == 0:  # every vertex has the same slots (`_Pose`)
+                slots = indices[0][(indices[0] >= 0) & (weights > 0).any(axis=0)]
+            else:
+                slots = indices[(indices >= 0) & (weights > 0)]
+            used = matrices[:, np.unique(slots)]
             return any(not np.array_equal(used[0], m) for m in used[1:])
         first = self._y_up[0]
         return any(not np.array_equal(first, p) for p in self._y_up[1:])
@@ -288,7 +301,7 @@ class _Pose:
     """The pose-only objects of one sample: their rest vertices, and per frame the object and
     armature matrices and the bones' pose matrices (read by foreach_get)."""
 
-    def __init__(self, objects, frames, groups):
+    def __init__(self, objects, frames):
         self.objects = objects
         self.armatures = []
         self.armature_of = {o.name: armature_of(o, viewport=True) for o in objects}
@@ -302,13 +315,24 @@ class _Pose:
         self.arm_world = np.empty((frames, len(self.armatures), 4, 4), np.float64)
         self.pose = [np.empty((frames, len(a.pose.bones) * 16), np.float32)
                      for a in self.armatures]
-        self.groups = groups
         self.muted = []
+        self.early = False
+
+    def mute_early(self):
+        """When every mesh takes its triangles from its own corners (`_own_triangles`), the
+        Armature modifiers go off before the vertex weights are read: neither that read nor
+        the first frame then evaluates a deformed mesh Blender would skin for nothing."""
+        tris = {o.name: _own_triangles(o) for o in self.objects}
+        if all(t is not None for t in tris.values()):
+            self.tris, self.early = tris, True
+            self.mute()
 
     def first_frame(self, dg):
         """The evaluated meshes' triangles (a quad's diagonal and an n-gon's triangles follow
         its shape), then the Armature modifiers off: Blender evaluates the pose, not these
         meshes."""
+        if self.early:
+            return
         for o in self.objects:
             self.tris[o.name] = _triangles(o.evaluated_get(dg))
         self.mute()
@@ -336,29 +360,27 @@ class _Pose:
             self.arm_world[k, i] = _matrix(ev.matrix_world)
             ev.pose.bones.foreach_get("matrix", self.pose[i][k])
 
-    def skinning(self):
-        """`toonkit.skin`'s arguments for every frame's world vertices of the pose-only
-        objects turned Y-up (`to_y_up`), concatenated in their order (float32 (frames,
-        vertices, 3), the array the core reads). The turn is folded into the skinning
-        matrices (a signed permutation of their rows), so the vertices are `to_y_up` of the
-        world's bit for bit with no pass over them."""
-        rests, indices, weights, matrices = [], [], [], []
+    def start(self, groups, stream):
+        """Before the frames are read: every object's rest vertices and influences (from
+        its vertex `groups`), and with `stream` a `toonkit.SkinStream` that skins each chunk
+        of frames `read` completes while Blender evaluates the next ones."""
+        self.groups = groups
+        rests, indices, weights, self.parts = [], [], [], []
         self.ranges, start, slots = {}, 0, 0
         for i, o in enumerate(self.objects):
             rest = self.rest[o.name]
-            world = self.object_world[:, i]
             a = self.armature_of[o.name]
             if a is None:  # rigid: the object's matrix alone
-                m = world[:, None]
+                part = (i, None)
                 idx = np.zeros((len(rest), 1), np.int64)
                 w = np.ones((len(rest), 1), np.float32)
             else:
-                m, idx, w = self._skinning(o, a, world)
+                part, idx, w = self._influences(o, i, a)
             rests.append(rest)
             indices.append(idx + slots if slots else idx)  # no -1 in them
             weights.append(w)
-            matrices.append(m)
-            slots += m.shape[1]
+            self.parts.append(part)
+            slots += idx.shape[1]
             self.ranges[o.name] = range(start, start + len(rest))
             start += len(rest)
         width = max(1, max(i.shape[1] for i in indices))
@@ -368,36 +390,81 @@ class _Pose:
         weights = [w if w.shape[1] == width else np.pad(w, [(0, 0), (0, width - w.shape[1])])
                    for w in weights]
         # One mesh (the usual bake) hands its arrays over as they are: no copies.
-        return (_joined(rests), _joined(indices), _joined(weights),
-                _rows_y_up(np.concatenate(matrices, axis=1)).astype(np.float32))
+        self.inputs = (_joined(rests), _joined(indices), _joined(weights))
+        frames = len(self.object_world)
+        self.matrices = np.empty((frames, slots, 4, 4), np.float32)
+        self.done = 0
+        self.stream = None
+        if stream:
+            import toonkit
+            self.stream = toonkit.SkinStream(*self.inputs, frames=frames, bones=slots)
 
-    def _skinning(self, o, a, world):
-        """Per-frame skinning matrices of `o`'s deforming bones (world space: armature world ·
-        pose · bind⁻¹ · armature world⁻¹ · object world, as the Armature modifier maps object
-        space through the armature's) and the vertices' influences."""
+    def frames_read(self, count):
+        """The first `count` frames are read: the skinning matrices of each whole chunk of
+        `STREAM_CHUNK` frames (and of the last frames) are made, and pushed to the stream."""
+        frames = len(self.matrices)
+        if count - self.done < STREAM_CHUNK and count < frames:
+            return
+        f = slice(self.done, count)
+        chunk = _rows_y_up(np.concatenate([self._matrices(part, f) for part in self.parts],
+                                          axis=1)).astype(np.float32)
+        self.matrices[f] = chunk
+        if self.stream is not None:
+            self.stream.push(chunk)
+        self.done = count
+
+    def skinning(self):
+        """`toonkit.skin`'s arguments for every frame's world vertices of the pose-only
+        objects turned Y-up (`to_y_up`), concatenated in their order (float32 (frames,
+        vertices, 3), the array the core reads). The turn is folded into the skinning
+        matrices (a signed permutation of their rows), so the vertices are `to_y_up` of the
+        world's bit for bit with no pass over them."""
+        return (*self.inputs, self.matrices)
+
+    def _influences(self, o, i, a):
+        """What `_matrices` needs of `o` (deformed by the armature `a`), and the vertices'
+        influences: every deforming bone of every vertex, weights as the Armature modifier
+        normalizes them."""
         k = self.armatures.index(a)
         bones = a.data.bones
         pose_names = [pb.name for pb in a.pose.bones]
-        deform = [i for i, n in enumerate(pose_names) if bones[n].use_deform]
-        frames = len(world)
-        # foreach_get gives each 4x4 in Blender's column-major memory order.
-        pose = self.pose[k].reshape(frames, -1, 4, 4).transpose(0, 1, 3, 2)[:, deform]
-        bind_inv = affine_inverse(np.stack([_matrix(bones[pose_names[i]].matrix_local)
-                                           for i in deform]))
-        arm = self.arm_world[:, k]
-        to_arm = affine_inverse(arm) @ world
-        matrices = arm[:, None] @ pose.astype(np.float64) @ bind_inv[None] @ to_arm[:, None]
+        deform = [j for j, n in enumerate(pose_names) if bones[n].use_deform]
+        bind_inv = affine_inverse(np.stack([_matrix(bones[pose_names[j]].matrix_local)
+                                           for j in deform]))
         groups = self.groups[o.name]
         n = len(self.rest[o.name])
         dense = np.zeros((n, len(deform)), np.float32)
-        for j, i in enumerate(deform):
-            g = groups.get(pose_names[i])
+        for j, b in enumerate(deform):
+            g = groups.get(pose_names[b])
             if g is not None:
                 np.maximum(g, 0.0, out=dense[:, j])
         dense[dense.sum(axis=1) <= ARMATURE_MIN_WEIGHT] = 0.0
         # Every deforming bone is an influence of every vertex: the core drops the zero
         # weights and keeps the rest in bone order (no numpy pass to compact them).
-        return matrices, np.broadcast_to(np.arange(len(deform)), dense.shape), dense
+        return ((i, (k, deform, bind_inv)), np.broadcast_to(np.arange(len(deform)), dense.shape),
+                dense)
+
+    def _matrices(self, part, f):
+        """Skinning matrices of the frames `f` (a slice) of one object (`start`'s part):
+        its world matrix when rigid, else of each deforming bone, world space: armature
+        world · pose · bind⁻¹ · armature world⁻¹ · object world, as the Armature modifier
+        maps object space through the armature's."""
+        i, bones = part
+        world = self.object_world[f, i]
+        if bones is None:
+            return world[:, None]
+        k, deform, bind_inv = bones
+        frames = len(world)
+        # foreach_get gives each 4x4 in Blender's column-major memory order.
+        pose = self.pose[k][f].reshape(frames, -1, 4, 4).transpose(0, 1, 3, 2)[:, deform]
+        arm = self.arm_world[f, k]
+        to_arm = affine_inverse(arm) @ world
+        return arm[:, None] @ pose.astype(np.float64) @ bind_inv[None] @ to_arm[:, None]
+
+
+#: Frames per chunk of `_Pose.frames_read`: each chunk costs a few numpy calls on Blender's
+#: thread, and the core skins it on another while the next frames are read.
+STREAM_CHUNK = 8
 
 
 def _joined(arrays):
@@ -437,16 +504,21 @@ def _sample(context, meshes, camera_relative, pose_only):
     joint_names, parents = _joint_order(armature) if armature else ([], [])
 
     frames = end - start + 1
-    groups = weights.read_all(context, meshes)
     posed = _readers_evaluated(meshes, [o for o in meshes
                                         if pose_only and pose_only_reason(o) is None])
     evaluated = [o for o in meshes if o not in posed]
-    pose = _Pose(posed, frames, groups) if posed else None
+    pose = _Pose(posed, frames) if posed else None
     rig = _Rig(armature, joint_names, frames, pose) if armature is not None else None
     current = scene.frame_current, scene.frame_subframe
     per_object = {o.name: [] for o in evaluated}
     tris, cams = {}, []
     try:
+        if pose is not None:
+            pose.mute_early()
+        groups = weights.read_all(context, meshes)
+        if pose is not None:
+            # The core skins the frames as they are read when it is to make the clip.
+            pose.start(groups, stream=not evaluated and not camera_relative)
         for k in range(frames):
             scene.frame_set(start + k)
             if k == 0:
@@ -465,6 +537,7 @@ def _sample(context, meshes, camera_relative, pose_only):
                 per_object[o.name].append(p)
             if pose is not None:
                 pose.read(k, dg)
+                pose.frames_read(k + 1)
             if rig is not None:
                 rig.read(k, dg)
             if camera_relative:
@@ -559,7 +632,7 @@ def _positions(result, meshes, frames, pose, per_object):
 
     skinning = pose.skinning() if pose is not None else None
     if skinning is not None and len(pose.objects) == len(meshes):
-        result.skinning = skinning
+        result.skinning, result.stream = skinning, pose.stream
         return
     skinned = toonkit.skin(*skinning) if skinning is not None else None
     positions = np.empty((frames, result.ranges[-1].stop, 3), np.float32)

@@ -20,6 +20,7 @@ mod loa_py;
 mod progress;
 mod scene;
 mod skin_py;
+mod skin_stream;
 mod smear_job;
 mod smear_presets;
 mod smear_py;
@@ -37,6 +38,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::Scene>()?;
     m.add_function(wrap_pyfunction!(scene::load, m)?)?;
     m.add_function(wrap_pyfunction!(skin_py::skin, m)?)?;
+    m.add_class::<skin_stream::SkinStream>()?;
     m.add_function(wrap_pyfunction!(smear_py::offsets, m)?)?;
     m.add_class::<smear_job::Prepared>()?;
     m.add_class::<smear_job::Stylized>()?;

@@ -135,13 +135,20 @@ impl From<PyErrLater> for PyErr {
     }
 }
 
-/// `Scene.from_arrays`' ``skinning``: the arguments of `toonkit.skin`.
-type Skinning<'py> = (
-    crate::arrays::ArrayIn<'py, f32>,
-    crate::arrays::ArrayIn<'py, i64>,
-    crate::arrays::ArrayIn<'py, f32>,
-    crate::arrays::ArrayIn<'py, f32>,
-);
+/// `Scene.from_arrays`' ``skinning``: a `toonkit.SkinStream` fed every frame, or the
+/// arguments of `toonkit.skin`.
+#[derive(FromPyObject)]
+pub(crate) enum Skinning<'py> {
+    Stream(Bound<'py, crate::skin_stream::SkinStream>),
+    Arrays(
+        (
+            crate::arrays::ArrayIn<'py, f32>,
+            crate::arrays::ArrayIn<'py, i64>,
+            crate::arrays::ArrayIn<'py, f32>,
+            crate::arrays::ArrayIn<'py, f32>,
+        ),
+    ),
+}
 
 /// A clip name or index.
 #[derive(FromPyObject)]
@@ -213,10 +220,11 @@ impl Scene {
     ///
     /// Arrays are read in place when they are C-contiguous float32 (int for indices).
     ///
-    /// ``skinning`` (``(rest, indices, weights, matrices)``, the arguments of ``toonkit.skin``)
-    /// replaces ``positions`` (pass ``None``): the clip is skinned straight into the scene, with
-    /// no copy of it (docs/blender.md, "Speed"); ``positions`` then reads (a copy, made on
-    /// first read) the values ``toonkit.skin`` returns.
+    /// ``skinning`` (``(rest, indices, weights, matrices)``, the arguments of ``toonkit.skin``,
+    /// or a ``toonkit.SkinStream`` every frame was pushed to) replaces ``positions`` (pass
+    /// ``None``): the clip is skinned straight into the scene, with no copy of it
+    /// (docs/blender.md, "Speed"); ``positions`` then reads (a copy, made on first read) the
+    /// values ``toonkit.skin`` returns.
     ///
     /// >>> s = toonkit.load("assets/characters/RobotExpressive.glb", clip="Dance")
     /// >>> t = toonkit.Scene.from_arrays(s.positions, s.triangles, fps=s.fps, skin=s.skin)
@@ -238,8 +246,11 @@ impl Scene {
     ) -> PyResult<Scene> {
         let clip = match (positions, skinning) {
             (Some(p), None) => crate::from_arrays::Clip::copied(&p)?,
-            (None, Some((r, i, w, m))) => {
-                let (points, frames, vertices) = crate::skin_py::skinned(py, &r, &i, &w, &m)?;
+            (None, Some(skinning)) => {
+                let (points, frames, vertices) = match skinning {
+                    Skinning::Arrays((r, i, w, m)) => crate::skin_py::skinned(py, &r, &i, &w, &m)?,
+                    Skinning::Stream(s) => s.borrow_mut().finish(py)?,
+                };
                 crate::from_arrays::Clip {
                     points,
                     frames,

@@ -52,6 +52,26 @@ pub(crate) fn skinned(
         .positions("skinned clip", frames, n, 1)
         .check("skin fewer frames or vertices")
         .map_err(|e| anim_error("<arrays>", e.into()))?;
+    let influences = influences(indices, weights, n, bones)?;
+    let skinning = mat4s(matrices);
+    let rest: Vec<Vec3> = values(rest).chunks_exact(3).map(Vec3::from_slice).collect();
+    // Zeroed f32s (fresh pages from the allocator, no pass over them) seen as points.
+    let mut data: Vec<Vec3> = bytemuck::cast_vec(vec![0.0f32; frames * n * 3]);
+    py.detach(|| anim::skin_frames(&influences, bones, &skinning, &rest, &mut data))
+        .map_err(|e| anim_error("<arrays>", e))?;
+    Ok((data, frames, n))
+}
+
+/// The influences of `toonkit.skin` (``indices`` and ``weights``, ``(vertices, k)`` each, a
+/// bone index or -1 per slot), checked against `n` vertices and `bones` matrices per frame.
+pub(crate) fn influences(
+    indices: &ArrayIn<'_, i64>,
+    weights: &ArrayIn<'_, f32>,
+    n: usize,
+    bones: usize,
+) -> PyResult<VertexWeights> {
+    let k = shape(indices, "indices", &[Some(n), None])?[1];
+    shape(weights, "weights", &[Some(n), Some(k)])?;
     let (idx, w) = (values(indices), values(weights));
     if let Some((i, &b)) = idx
         .iter()
@@ -64,23 +84,23 @@ pub(crate) fn skinned(
             i % k.max(1)
         )));
     }
-    let influences =
-        VertexWeights::from_influences(idx.chunks(k.max(1)).zip(w.chunks(k.max(1))).take(n).map(
-            |(i, w)| {
+    Ok(VertexWeights::from_influences(
+        idx.chunks(k.max(1))
+            .zip(w.chunks(k.max(1)))
+            .take(n)
+            .map(|(i, w)| {
                 i.iter()
                     .zip(w)
                     .filter(|(b, _)| **b >= 0)
                     .map(|(b, x)| (*b as u32, *x))
-            },
-        ));
-    let skinning: Vec<Mat4> = values(matrices)
+            }),
+    ))
+}
+
+/// ``(..., 4, 4)`` row-major float32 matrices (translation in column 3) as glam's.
+pub(crate) fn mat4s(matrices: &ArrayIn<'_, f32>) -> Vec<Mat4> {
+    values(matrices)
         .chunks_exact(16)
         .map(|m| Mat4::from_cols_slice(m).transpose())
-        .collect();
-    let rest: Vec<Vec3> = values(rest).chunks_exact(3).map(Vec3::from_slice).collect();
-    // Zeroed f32s (fresh pages from the allocator, no pass over them) seen as points.
-    let mut data: Vec<Vec3> = bytemuck::cast_vec(vec![0.0f32; frames * n * 3]);
-    py.detach(|| anim::skin_frames(&influences, bones, &skinning, &rest, &mut data))
-        .map_err(|e| anim_error("<arrays>", e))?;
-    Ok((data, frames, n))
+        .collect()
 }

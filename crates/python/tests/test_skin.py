@@ -98,3 +98,51 @@ def test_a_clip_over_the_memory_budget_is_an_error_not_an_abort():
         toonkit.skin(rest, idx, w, mats)
     with pytest.raises(ValueError, match="skinned clip.*over the limit"):
         toonkit.Scene.from_arrays(None, [[0, 1, 2]], skinning=(rest, idx, w, mats))
+
+
+def test_a_skin_stream_fed_in_chunks_gives_the_clip_of_skin_bit_for_bit():
+    """`toonkit.SkinStream` (the Blender bake skins each chunk of frames while Blender reads
+    the next ones, docs/blender.md "Speed"): pushed in uneven chunks, the scene it makes holds
+    the clip `toonkit.skin` returns, bit for bit, and the same offsets."""
+    rng = np.random.default_rng(5)
+    rest = rng.normal(size=(70, 3)).astype(np.float32)
+    indices = np.broadcast_to(np.arange(3), (70, 3))
+    weights = rng.uniform(0.0, 1.0, size=(70, 3)).astype(np.float32)
+    weights[::5] = 0.0  # no influence: the vertex stays at rest
+    mats = np.stack([[rotation_z(0.15 * f * (b + 1), (0.2 * f, b, 0.1)) for b in range(3)]
+                     for f in range(13)]).astype(np.float32)
+    triangles = rng.integers(0, 70, size=(50, 3))
+    stream = toonkit.SkinStream(rest, indices, weights, frames=13, bones=3)
+    for a, b in ((0, 8), (8, 12), (12, 13)):
+        stream.push(mats[a:b])
+    streamed = toonkit.Scene.from_arrays(None, triangles, fps=24.0, skinning=stream)
+    at_once = toonkit.Scene.from_arrays(None, triangles, fps=24.0,
+                                        skinning=(rest, indices, weights, mats))
+    np.testing.assert_array_equal(streamed.positions, toonkit.skin(rest, indices, weights, mats))
+    np.testing.assert_array_equal(np.asarray(toonkit.smear.prepare(streamed).offsets),
+                                  np.asarray(toonkit.smear.prepare(at_once).offsets))
+
+
+def test_a_skin_stream_takes_exactly_its_frames_once():
+    rest = np.zeros((3, 3), np.float32)
+    idx, w = [[0], [0], [0]], [[1.0]] * 3
+    mats = np.tile(np.eye(4, dtype=np.float32), (2, 1, 1, 1))
+    stream = toonkit.SkinStream(rest, idx, w, frames=2, bones=1)
+    stream.push(mats[:1])
+    with pytest.raises(ValueError, match="got 1 of its 2 frames"):
+        toonkit.Scene.from_arrays(None, [[0, 1, 2]], skinning=stream)
+    stream = toonkit.SkinStream(rest, idx, w, frames=2, bones=1)
+    with pytest.raises(ValueError, match="takes 2 frames; 0 were pushed, 3 more"):
+        stream.push(np.tile(np.eye(4, dtype=np.float32), (3, 1, 1, 1)))
+    with pytest.raises(ValueError, match="matrices must have shape"):
+        stream.push(np.tile(np.eye(4, dtype=np.float32), (1, 2, 1, 1)))
+    stream.push(mats)
+    toonkit.Scene.from_arrays(None, [[0, 1, 2]], skinning=stream)
+    with pytest.raises(ValueError, match="already used"):
+        toonkit.Scene.from_arrays(None, [[0, 1, 2]], skinning=stream)
+    with pytest.raises(ValueError, match=r"indices\[0, 0\] = 1"):
+        toonkit.SkinStream(rest, [[1], [0], [0]], w, frames=2, bones=1)
+    n = 100_000  # 120 GB of positions: refused before anything is held
+    with pytest.raises(ValueError, match="skinned clip.*over the limit"):
+        toonkit.SkinStream(np.zeros((n, 3), np.float32), np.zeros((n, 1), np.int64),
+                           np.ones((n, 1), np.float32), frames=n, bones=1)

@@ -17,7 +17,8 @@ Errors are one line, as the CLI prints them: ``FileNotFoundError`` for a missing
 ``ValueError`` for a bad argument, :class:`ToonkitError` for anything else.
 """
 
-from ._native import Scene, ToonkitError, __version__, load, skin
+from ._native import Scene, SkinStream, ToonkitError, __version__, load, skin
 from . import loa, smear, stopmo
 
-__all__ = ["Scene", "ToonkitError", "load", "loa", "skin", "smear", "stopmo", "__version__"]
+__all__ = ["Scene", "SkinStream", "ToonkitError", "load", "loa", "skin", "smear", "stopmo",
+           "__version__"]

@@ -24,7 +24,7 @@ class Scene:
         attributes: Optional[Mapping[str, npt.ArrayLike]] = None,
         rest: Optional[npt.ArrayLike] = None,
         skinning: Optional[
-            tuple[npt.ArrayLike, npt.ArrayLike, npt.ArrayLike, npt.ArrayLike]
+            Union[tuple[npt.ArrayLike, npt.ArrayLike, npt.ArrayLike, npt.ArrayLike], SkinStream]
         ] = None,
     ) -> Scene: ...
     @property
@@ -53,6 +53,19 @@ def load(
     clip: Optional[Union[str, int]] = None,
     fps: float = 24.0,
 ) -> Scene: ...
+class SkinStream:
+    """``toonkit.skin`` fed a few frames at a time, skinning on a worker thread."""
+
+    def __init__(
+        self,
+        rest: npt.ArrayLike,
+        indices: npt.ArrayLike,
+        weights: npt.ArrayLike,
+        frames: int,
+        bones: int,
+    ) -> None: ...
+    def push(self, matrices: npt.ArrayLike) -> None: ...
+
 def skin(
     rest: npt.ArrayLike,
     indices: npt.ArrayLike,
