@@ -283,15 +283,16 @@ def _rest_matrices(context, meshes):
         context.evaluated_depsgraph_get().update()
 
 
-def _rest_positions(meshes, ranges, matrices, result):
-    """(vertices, 3) float32: each mesh's own vertices through its rest matrix, or its first
-    frame (of the sample `result`) when a modifier changed its vertex count."""
+def _rest_positions(meshes, ranges, matrices, result, own):
+    """(vertices, 3) float32: each mesh's own vertices (`own` by name when read already)
+    through its rest matrix, or its first frame (of the sample `result`) when a modifier
+    changed its vertex count."""
     rest = np.empty((ranges[-1].stop, 3), np.float32)
     for o, r in zip(meshes, ranges):
         if len(o.data.vertices) != len(r):
             rest[r.start:r.stop] = from_y_up(result.y_up[0, r.start:r.stop])
             continue
-        co = _co(o).astype(np.float64)
+        co = (own[o.name] if o.name in own else _co(o)).astype(np.float64)
         m = matrices[o.name]
         rest[r.start:r.stop] = co @ m[:3, :3].T + m[:3, 3]
     return rest
@@ -400,10 +401,11 @@ class _Pose:
             self.stream = toonkit.SkinStream(*self.inputs, frames=frames, bones=slots)
 
     def frames_read(self, count):
-        """The first `count` frames are read: the skinning matrices of each whole chunk of
-        `STREAM_CHUNK` frames (and of the last frames) are made, and pushed to the stream."""
+        """The first `count` frames are read: the skinning matrices of each whole chunk (a
+        `STREAM_CHUNKS`th of the frames, and the last frames) are made and pushed to the
+        stream."""
         frames = len(self.matrices)
-        if count - self.done < STREAM_CHUNK and count < frames:
+        if count - self.done < -(-frames // STREAM_CHUNKS) and count < frames:
             return
         f = slice(self.done, count)
         chunk = _rows_y_up(np.concatenate([self._matrices(part, f) for part in self.parts],
@@ -462,9 +464,10 @@ class _Pose:
         return arm[:, None] @ pose.astype(np.float64) @ bind_inv[None] @ to_arm[:, None]
 
 
-#: Frames per chunk of `_Pose.frames_read`: each chunk costs a few numpy calls on Blender's
-#: thread, and the core skins it on another while the next frames are read.
-STREAM_CHUNK = 8
+#: Chunks of frames `_Pose.frames_read` makes matrices for: each costs a few numpy calls on
+#: Blender's thread (~0.25 ms), and the core skins it on another while the next frames are
+#: read (the last one while the sample's other arrays are made).
+STREAM_CHUNKS = 4
 
 
 def _joined(arrays):
@@ -561,7 +564,8 @@ def _sample(context, meshes, camera_relative, pose_only):
         triangles=np.concatenate(all_tris).astype(np.int32), frame_start=start,
         fps=scene.render.fps / scene.render.fps_base, bones=joint_names)
     _positions(result, meshes, frames, pose, per_object)
-    result.rest = _rest_positions(meshes, ranges, rest_matrices, result)
+    result.rest = _rest_positions(meshes, ranges, rest_matrices, result,
+                                  pose.rest if pose is not None else {})
     _skin_and_attributes(result, meshes, counts, groups, armature, parents,
                          rig.matrices() if rig is not None else None)
     if camera_relative:

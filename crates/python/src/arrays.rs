@@ -4,7 +4,8 @@
 
 use numpy::ndarray::{ArrayD, IxDyn};
 use numpy::{
-    AllowTypeChange, Element, IntoPyArray, PyArrayDyn, PyArrayLikeDyn, PyUntypedArrayMethods,
+    AllowTypeChange, Element, IntoPyArray, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods,
+    PyUntypedArrayMethods,
 };
 use pyo3::prelude::*;
 
@@ -43,8 +44,19 @@ pub(crate) fn shape<T: Element>(
 pub(crate) fn values<'a, T: Element + Copy>(a: &'a ArrayIn<'_, T>) -> std::borrow::Cow<'a, [T]> {
     match a.as_slice() {
         Ok(s) => std::borrow::Cow::Borrowed(s),
-        Err(_) => std::borrow::Cow::Owned(a.as_array().iter().copied().collect()),
+        Err(_) => std::borrow::Cow::Owned(
+            c_order_copy(a).unwrap_or_else(|| a.as_array().iter().copied().collect()),
+        ),
     }
+}
+
+/// A strided array's values in C order through numpy's own copy: ~20× faster than
+/// ndarray's iterator over dynamic dimensions (a broadcast `(15002, 10)` index array took
+/// ~7 ms that way, docs/blender.md "Speed").
+fn c_order_copy<T: Element + Copy>(a: &ArrayIn<'_, T>) -> Option<Vec<T>> {
+    let copy = a.call_method0("copy").ok()?.cast_into::<PyArrayDyn<T>>().ok()?;
+    let copy = copy.try_readonly().ok()?;
+    copy.as_slice().ok().map(<[T]>::to_vec)
 }
 
 /// A numpy array of `shape` owning `data` (no copy).

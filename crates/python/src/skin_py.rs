@@ -1,6 +1,8 @@
 //! `toonkit.skin`: linear blend skinning of a whole clip from a host application's pose (its
 //! bone matrices per frame), through `anim::skin_frames`.
 
+use std::borrow::Cow;
+
 use anim::glam::{Mat4, Vec3};
 use anim::VertexWeights;
 use numpy::PyArrayDyn;
@@ -70,6 +72,21 @@ pub(crate) fn influences(
     n: usize,
     bones: usize,
 ) -> PyResult<VertexWeights> {
+    let (k, idx, w) = checked_influences(indices, weights, n, bones)?;
+    Ok(weights_of(&idx, &w, k, n))
+}
+
+/// Slots per vertex, indices and weights of `toonkit.skin`'s influences.
+pub(crate) type Influences<'a> = (usize, Cow<'a, [i64]>, Cow<'a, [f32]>);
+
+/// The slots per vertex and the values of `influences`' inputs, checked, for
+/// [`weights_of`] (on another thread, without the GIL).
+pub(crate) fn checked_influences<'a>(
+    indices: &'a ArrayIn<'_, i64>,
+    weights: &'a ArrayIn<'_, f32>,
+    n: usize,
+    bones: usize,
+) -> PyResult<Influences<'a>> {
     let k = shape(indices, "indices", &[Some(n), None])?[1];
     shape(weights, "weights", &[Some(n), Some(k)])?;
     let (idx, w) = (values(indices), values(weights));
@@ -84,16 +101,18 @@ pub(crate) fn influences(
             i % k.max(1)
         )));
     }
-    Ok(VertexWeights::from_influences(
-        idx.chunks(k.max(1))
-            .zip(w.chunks(k.max(1)))
-            .take(n)
-            .map(|(i, w)| {
-                i.iter()
-                    .zip(w)
-                    .filter(|(b, _)| **b >= 0)
-                    .map(|(b, x)| (*b as u32, *x))
-            }),
+    Ok((k, idx, w))
+}
+
+/// The influences of `n` vertices with `k` slots each (indices checked, -1 for none).
+pub(crate) fn weights_of(idx: &[i64], w: &[f32], k: usize, n: usize) -> VertexWeights {
+    VertexWeights::from_influences(idx.chunks(k.max(1)).zip(w.chunks(k.max(1))).take(n).map(
+        |(i, w)| {
+            i.iter()
+                .zip(w)
+                .filter(|(b, _)| **b >= 0)
+                .map(|(b, x)| (*b as u32, *x))
+        },
     ))
 }
 

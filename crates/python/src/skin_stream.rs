@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 
 use crate::arrays::{shape, values, ArrayIn};
 use crate::errors::{anim_error, value_error};
-use crate::skin_py::{influences, mat4s};
+use crate::skin_py::{checked_influences, mat4s, weights_of};
 
 /// What the worker returns: the skinned clip, frame-major.
 type Skinned = Result<Vec<Vec3>, AnimError>;
@@ -58,13 +58,13 @@ impl SkinStream {
             .positions("skinned clip", frames, n, 1)
             .check("skin fewer frames or vertices")
             .map_err(|e| anim_error("<arrays>", e.into()))?;
-        let weights = influences(&indices, &weights, n, bones)?;
-        let rest: Vec<Vec3> = values(&rest)
-            .chunks_exact(3)
-            .map(Vec3::from_slice)
-            .collect();
+        let (k, idx, w) = checked_influences(&indices, &weights, n, bones)?;
+        let (idx, w, rest) = (idx.into_owned(), w.into_owned(), values(&rest).into_owned());
         let (frames_in, received) = channel::<Vec<Mat4>>();
+        // The influences are built on the worker too: the caller goes on reading frames.
         let handle = std::thread::spawn(move || -> Skinned {
+            let weights = weights_of(&idx, &w, k, n);
+            let rest: Vec<Vec3> = rest.chunks_exact(3).map(Vec3::from_slice).collect();
             // Zeroed f32s (fresh pages, mapped by the frames' writes) seen as points.
             let mut clip: Vec<Vec3> = bytemuck::cast_vec(vec![0.0f32; frames * n * 3]);
             let mut done = 0;
