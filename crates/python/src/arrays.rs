@@ -54,7 +54,11 @@ pub(crate) fn values<'a, T: Element + Copy>(a: &'a ArrayIn<'_, T>) -> std::borro
 /// ndarray's iterator over dynamic dimensions (a broadcast `(15002, 10)` index array took
 /// ~7 ms that way, docs/blender.md "Speed").
 fn c_order_copy<T: Element + Copy>(a: &ArrayIn<'_, T>) -> Option<Vec<T>> {
-    let copy = a.call_method0("copy").ok()?.cast_into::<PyArrayDyn<T>>().ok()?;
+    let copy = a
+        .call_method0("copy")
+        .ok()?
+        .cast_into::<PyArrayDyn<T>>()
+        .ok()?;
     let copy = copy.try_readonly().ok()?;
     copy.as_slice().ok().map(<[T]>::to_vec)
 }

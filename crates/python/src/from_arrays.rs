@@ -287,12 +287,12 @@ fn add_skin(scene: &mut SampledScene, skin: &Bound<'_, PyDict>) -> PyResult<()> 
             .collect(),
     };
     let w = values(&weights);
+    // Each row's nonzero weights, read in place (no list per vertex).
     let influences = w.chunks_exact(joints).map(|row| {
         row.iter()
             .enumerate()
             .filter(|(_, x)| **x != 0.0)
             .map(|(k, &x)| (k as u32, x))
-            .collect::<Vec<_>>()
     });
     let skin = Skin {
         joints: (0..joints).collect(),
