@@ -398,7 +398,10 @@ class _Pose:
         self.stream = None
         if stream:
             import toonkit
-            self.stream = toonkit.SkinStream(*self.inputs, frames=frames, bones=slots)
+            try:
+                self.stream = toonkit.SkinStream(*self.inputs, frames=frames, bones=slots)
+            except ValueError as e:  # e.g. a clip over the job memory budget
+                raise SampleError(" ".join(str(e).split())) from e
 
     def frames_read(self, count):
         """The first `count` frames are read: the skinning matrices of each whole chunk (a
