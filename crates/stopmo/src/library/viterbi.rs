@@ -42,7 +42,7 @@ impl LabelInputs<'_> {
         self.xx[f] - 2.0 * self.p[f * self.d + k] + self.g[k * self.d + k]
     }
 
-    #[inline]
+    #[cfg(test)]
     fn delta(&self, f: usize, k: usize) -> f64 {
         self.p[f * self.d + k] - self.p[(f - 1) * self.d + k]
     }
@@ -76,10 +76,13 @@ impl LabelInputs<'_> {
 /// Reusable buffers of the label step.
 #[derive(Debug, Default, Clone)]
 pub(crate) struct ViterbiWork {
+    /// Per frame: `α_{f+1}` once the next frame is reached (what the backtrack needs), the
+    /// value function `V_f` on a chain's last frame.
     v: Vec<f64>,
-    alpha: Vec<f64>,
     m: Vec<f64>,
     lg: Vec<f64>,
+    /// Diagonal `G_kk`, contiguous so that the per-frame loops vectorize.
+    gd: Vec<f64>,
 }
 
 /// Lanes of the register-blocked min-plus sweep (4 AVX2 or 2 AVX-512 registers of f64).
@@ -167,8 +170,9 @@ pub(crate) fn label_step(
     let n = inp.xx.len();
     let half = 0.5 * inp.lambda;
     work.v.resize(n * d, 0.0);
-    work.alpha.resize(d, 0.0);
     work.m.resize(d, 0.0);
+    work.gd.clear();
+    work.gd.extend((0..d).map(|k| inp.g[k * d + k]));
     // λ·G, symmetrized so that forward sweep (rows) and backtrack (columns) agree exactly.
     work.lg.resize(d * d, 0.0);
     for a in 0..d {
@@ -176,62 +180,90 @@ pub(crate) fn label_step(
             work.lg[a * d + b] = 0.5 * inp.lambda * (inp.g[a * d + b] + inp.g[b * d + a]);
         }
     }
+    let gd = &work.gd[..];
     let mut total = 0.0;
     for ch in inp.chains {
         if ch.is_empty() {
             continue;
         }
-        for k in 0..d {
-            work.v[ch.start * d + k] = inp.unary(ch.start, k);
+        let (xs, ps) = (inp.xx[ch.start], &inp.p[ch.start * d..(ch.start + 1) * d]);
+        for ((v, &p), &g) in work.v[ch.start * d..(ch.start + 1) * d]
+            .iter_mut()
+            .zip(ps)
+            .zip(gd)
+        {
+            *v = xs - 2.0 * p + g;
         }
         for f in ch.start + 1..ch.end {
             let (prev, cur) = work.v.split_at_mut(f * d);
-            let prev = &prev[(f - 1) * d..];
-            for a in 0..d {
-                work.alpha[a] = prev[a] + half * (inp.g[a * d + a] + 2.0 * inp.delta(f, a));
+            // V_{f−1} becomes α_f in place: the backtrack reads it back bit for bit.
+            let alpha = &mut prev[(f - 1) * d..];
+            let cur = &mut cur[..d];
+            let (pp, pf) = (&inp.p[(f - 1) * d..f * d], &inp.p[f * d..(f + 1) * d]);
+            for (((al, &g), &a1), &a0) in alpha.iter_mut().zip(gd).zip(pf).zip(pp) {
+                *al += half * (g + 2.0 * (a1 - a0));
             }
             // m(b) = min_a (α_a − λ G_ab), swept row by row of λG (λ = 0: one minimum).
             if inp.lambda == 0.0 {
-                let flat = work.alpha.iter().copied().fold(f64::INFINITY, f64::min);
+                let flat = alpha.iter().copied().fold(f64::INFINITY, f64::min);
                 work.m.fill(flat);
             } else {
-                min_plus(&mut work.m, &work.alpha, &work.lg, d);
+                min_plus(&mut work.m, alpha, &work.lg, d);
             }
-            for b in 0..d {
-                cur[b] = inp.unary(f, b)
-                    + half * (inp.dxx[f] + inp.g[b * d + b] - 2.0 * inp.delta(f, b))
-                    + work.m[b];
+            let (xf, df) = (inp.xx[f], inp.dxx[f]);
+            for ((((c, &g), &b1), &b0), &mb) in cur.iter_mut().zip(gd).zip(pf).zip(pp).zip(&work.m)
+            {
+                *c = (xf - 2.0 * b1 + g) + half * (df + g - 2.0 * (b1 - b0)) + mb;
             }
         }
         // Backtrack: the last label minimizes V, each earlier one re-derives its argmin.
         let last = ch.end - 1;
-        let row = &work.v[last * d..(last + 1) * d];
-        let (mut best, mut arg) = (f64::INFINITY, 0usize);
-        for (k, &v) in row.iter().enumerate() {
-            if v < best {
-                (best, arg) = (v, k);
-            }
-        }
+        let (best, arg) = arg_min(&work.v[last * d..(last + 1) * d]);
         total += best;
         labels[last] = arg as u32;
         for f in (ch.start + 1..ch.end).rev() {
             let b = labels[f] as usize;
-            let prev = &work.v[(f - 1) * d..f * d];
-            let (mut best, mut arg) = (f64::INFINITY, 0usize);
-            for a in 0..d {
-                let v = prev[a] + half * (inp.g[a * d + a] + 2.0 * inp.delta(f, a))
-                    - work.lg[b * d + a];
-                if v < best {
-                    (best, arg) = (v, a);
-                }
+            let alpha = &work.v[(f - 1) * d..f * d];
+            for ((m, &al), &l) in work
+                .m
+                .iter_mut()
+                .zip(alpha)
+                .zip(&work.lg[b * d..(b + 1) * d])
+            {
+                *m = al - l;
             }
-            labels[f - 1] = arg as u32;
+            labels[f - 1] = arg_min(&work.m).1 as u32;
         }
         for f in ch.clone() {
             cost[f] = inp.unary(f, labels[f] as usize);
         }
     }
     total
+}
+
+/// The smallest value and its first index (+∞ and index 0 when every value is NaN or +∞),
+/// as a scan keeping the first strictly smaller value would give; the minimum is taken in
+/// lanes so that it vectorizes.
+fn arg_min(values: &[f64]) -> (f64, usize) {
+    const W: usize = 8;
+    let mut acc = [f64::INFINITY; W];
+    let chunks = values.chunks_exact(W);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for l in 0..W {
+            acc[l] = if c[l] < acc[l] { c[l] } else { acc[l] };
+        }
+    }
+    let mut best = f64::INFINITY;
+    for &v in acc.iter().chain(rest) {
+        best = if v < best { v } else { best };
+    }
+    let arg = if best < f64::INFINITY {
+        values.iter().position(|&v| v == best).unwrap_or(0)
+    } else {
+        0
+    };
+    (best, arg)
 }
 
 #[cfg(test)]
