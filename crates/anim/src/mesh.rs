@@ -32,6 +32,7 @@ impl Aabb {
     }
 
     /// Extends the box to contain `p` (ignored if not finite).
+    #[inline]
     pub fn grow(&mut self, p: Vec3) {
         if p.is_finite() {
             self.min = self.min.min(p);
