@@ -19,6 +19,11 @@ use axum::http::header;
 use axum::response::{IntoResponse, Response};
 use serde_json::{json, Map, Value};
 
+/// A chunk holding this many bytes is ended before a buffer written value by value: that
+/// buffer grows by doubling its chunk, and a grown chunk of earlier buffers would be copied
+/// and held twice (a 23 MB whole-clip answer reached 31 MB of blocks).
+const CHUNK_BYTES: usize = 1 << 20;
+
 /// Buffers collected for one binary response.
 #[derive(Debug, Default)]
 pub struct Pack {
@@ -56,6 +61,8 @@ impl Pack {
 
     /// Adds a float32 buffer.
     pub fn f32(&mut self, name: &str, values: impl IntoIterator<Item = f32>) -> &mut Pack {
+        let values = values.into_iter();
+        self.start_buffer(values.size_hint().0 * size_of::<f32>());
         let offset = self.offset();
         let mut count = 0usize;
         for v in values {
@@ -75,6 +82,7 @@ impl Pack {
         let offset = self.offset();
         let slices: Vec<&[f32]> = slices.into_iter().collect();
         // Reserved exactly: a growing buffer would hold its old and new block at once.
+        self.end_large_chunk();
         self.data
             .reserve_exact(4 * slices.iter().map(|s| s.len()).sum::<usize>());
         let mut count = 0usize;
@@ -119,6 +127,20 @@ impl Pack {
         self
     }
 
+    /// Before a buffer of at least `bytes`: ends a large chunk (its growth would copy the
+    /// buffers before), then reserves them.
+    fn start_buffer(&mut self, bytes: usize) {
+        self.end_large_chunk();
+        self.data.reserve(bytes);
+    }
+
+    /// Ends the chunk being written when it holds [`CHUNK_BYTES`] or more.
+    fn end_large_chunk(&mut self) {
+        if self.data.len() >= CHUNK_BYTES {
+            self.flush();
+        }
+    }
+
     /// Ends the chunk being written.
     fn flush(&mut self) {
         if !self.data.is_empty() {
@@ -130,6 +152,8 @@ impl Pack {
 
     /// Adds a uint32 buffer.
     pub fn u32(&mut self, name: &str, values: impl IntoIterator<Item = u32>) -> &mut Pack {
+        let values = values.into_iter();
+        self.start_buffer(values.size_hint().0 * size_of::<u32>());
         let offset = self.offset();
         let mut count = 0usize;
         for v in values {
@@ -145,6 +169,7 @@ impl Pack {
     pub fn i16_parts(&mut self, name: &str, parts: Vec<Vec<i16>>) -> &mut Pack {
         let offset = self.offset();
         let count: usize = parts.iter().map(Vec::len).sum();
+        self.end_large_chunk();
         self.data.reserve_exact(2 * count + 2);
         for part in parts {
             if cfg!(target_endian = "little") {
@@ -176,6 +201,8 @@ impl Pack {
     /// Adds an int16 buffer (zero-padded to a multiple of 4 bytes, so the buffers after it
     /// stay aligned for the page's typed arrays).
     pub fn i16(&mut self, name: &str, values: impl IntoIterator<Item = i16>) -> &mut Pack {
+        let values = values.into_iter();
+        self.start_buffer(values.size_hint().0 * size_of::<i16>());
         let offset = self.offset();
         let mut count = 0usize;
         for v in values {

@@ -244,3 +244,25 @@ async fn a_whole_clip_sends_the_multiples_shown_vertices_and_16_bit_line_indices
         dense.len()
     );
 }
+
+#[test]
+fn buffers_after_a_megabyte_chunk_read_back_at_their_offsets() {
+    // A whole clip's answer: megabytes of value-by-value buffers end their chunks (so the
+    // growth of one does not copy those before it); every buffer still reads back in place.
+    let big: Vec<f32> = (0..300_000).map(|i| i as f32 * 0.5).collect();
+    let words: Vec<u32> = (0..400_000).collect();
+    let mut p = pack::Pack::new();
+    p.f32("big", big.iter().copied())
+        .u32("words", words.iter().copied())
+        .i16("small", [-3, 7, 1])
+        .f32_slices("slices", [&big[..10], &big[10..20]])
+        .i16_parts("parts", vec![vec![1, -2], vec![3]])
+        .f32("alpha", big.iter().copied().filter(|v| *v > 1.0));
+    let bytes = p.finish(json!({}));
+    assert_eq!(f32s(&bytes, "big"), big);
+    assert_eq!(read_u32(&bytes, "words"), words);
+    assert_eq!(pack::read_i16(&bytes, "small").unwrap(), vec![-3, 7, 1]);
+    assert_eq!(f32s(&bytes, "slices"), big[..20].to_vec());
+    assert_eq!(pack::read_i16(&bytes, "parts").unwrap(), vec![1, -2, 3]);
+    assert_eq!(f32s(&bytes, "alpha"), big[3..].to_vec());
+}
