@@ -49,19 +49,29 @@ pub(crate) fn skinned(
     shape(weights, "weights", &[Some(n), Some(k)])?;
     let m = shape(matrices, "matrices", &[None, None, Some(4), Some(4)])?;
     let (frames, bones) = (m[0], m[1]);
-    // The clip is frames × vertices whatever the inputs' sizes: checked before it is held.
-    anim::budget::JobMemory::new()
-        .positions("skinned clip", frames, n, 1)
-        .check("skin fewer frames or vertices")
-        .map_err(|e| anim_error("<arrays>", e.into()))?;
+    check_clip(frames, n)?;
     let influences = influences(indices, weights, n, bones)?;
     let skinning = mat4s(matrices);
     let rest: Vec<Vec3> = values(rest).chunks_exact(3).map(Vec3::from_slice).collect();
-    // Zeroed f32s (fresh pages from the allocator, no pass over them) seen as points.
-    let mut data: Vec<Vec3> = bytemuck::cast_vec(vec![0.0f32; frames * n * 3]);
+    let mut data = zeroed_clip(frames, n);
     py.detach(|| anim::skin_frames(&influences, bones, &skinning, &rest, &mut data))
         .map_err(|e| anim_error("<arrays>", e))?;
     Ok((data, frames, n))
+}
+
+/// Checks a skinned clip of `frames` × `n` vertices against the job memory budget: the clip
+/// is that size whatever the inputs' sizes, so it is checked before it is held.
+pub(crate) fn check_clip(frames: usize, n: usize) -> PyResult<()> {
+    anim::budget::JobMemory::new()
+        .positions("skinned clip", frames, n, 1)
+        .check("skin fewer frames or vertices")
+        .map_err(|e| anim_error("<arrays>", e.into()))
+}
+
+/// A clip of `frames` × `n` points to skin into: zeroed f32s (fresh pages from the
+/// allocator, mapped by the frames' writes, no pass over them) seen as points.
+pub(crate) fn zeroed_clip(frames: usize, n: usize) -> Vec<Vec3> {
+    bytemuck::cast_vec(vec![0.0f32; frames * n * 3])
 }
 
 /// The influences of `toonkit.skin` (``indices`` and ``weights``, ``(vertices, k)`` each, a

@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 
 use crate::arrays::{shape, values, ArrayIn};
 use crate::errors::{anim_error, value_error};
-use crate::skin_py::{checked_influences, mat4s, weights_of};
+use crate::skin_py::{check_clip, checked_influences, mat4s, weights_of, zeroed_clip};
 
 /// What the worker returns: the skinned clip, frame-major.
 type Skinned = Result<Vec<Vec3>, AnimError>;
@@ -54,10 +54,7 @@ impl SkinStream {
         bones: usize,
     ) -> PyResult<SkinStream> {
         let n = shape(&rest, "rest", &[None, Some(3)])?[0];
-        anim::budget::JobMemory::new()
-            .positions("skinned clip", frames, n, 1)
-            .check("skin fewer frames or vertices")
-            .map_err(|e| anim_error("<arrays>", e.into()))?;
+        check_clip(frames, n)?;
         let (k, idx, w) = checked_influences(&indices, &weights, n, bones)?;
         let (idx, w, rest) = (idx.into_owned(), w.into_owned(), values(&rest).into_owned());
         let (frames_in, received) = channel::<Vec<Mat4>>();
@@ -65,8 +62,7 @@ impl SkinStream {
         let handle = std::thread::spawn(move || -> Skinned {
             let weights = weights_of(&idx, &w, k, n);
             let rest: Vec<Vec3> = rest.chunks_exact(3).map(Vec3::from_slice).collect();
-            // Zeroed f32s (fresh pages, mapped by the frames' writes) seen as points.
-            let mut clip: Vec<Vec3> = bytemuck::cast_vec(vec![0.0f32; frames * n * 3]);
+            let mut clip = zeroed_clip(frames, n);
             let mut done = 0;
             for m in received {
                 let k = m.len() / bones.max(1);
@@ -102,10 +98,7 @@ impl SkinStream {
                 self.frames, self.pushed
             )));
         }
-        let worker = self
-            .worker
-            .as_ref()
-            .ok_or_else(|| value_error("the skin stream was already used by Scene.from_arrays"))?;
+        let worker = self.worker.as_ref().ok_or_else(used)?;
         // A send fails only when the worker stopped on an error, which `finish` reports.
         let _ = worker.frames.send(mat4s(&matrices));
         self.pushed += k;
@@ -123,11 +116,7 @@ impl SkinStream {
                 self.pushed, self.frames
             )));
         }
-        let worker = self
-            .worker
-            .take()
-            .ok_or_else(|| value_error("the skin stream was already used by Scene.from_arrays"))?;
-        let Worker { frames, handle } = worker;
+        let Worker { frames, handle } = self.worker.take().ok_or_else(used)?;
         drop(frames);
         let clip = py
             .detach(|| handle.join())
@@ -135,4 +124,9 @@ impl SkinStream {
             .map_err(|e| anim_error("<arrays>", e))?;
         Ok((clip, self.frames, self.vertices))
     }
+}
+
+/// The error of a stream whose clip `Scene.from_arrays` already took.
+fn used() -> PyErr {
+    value_error("the skin stream was already used by Scene.from_arrays")
 }
