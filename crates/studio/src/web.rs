@@ -22,6 +22,7 @@ pub const PAGE: &[(&str, &str, &str)] = &[
     ),
     ("app.js", JS, include_str!("../web/app.js")),
     ("api.js", JS, include_str!("../web/api.js")),
+    ("pack_worker.js", JS, include_str!("../web/pack_worker.js")),
     ("viewport.js", JS, include_str!("../web/viewport.js")),
     ("smear.js", JS, include_str!("../web/smear.js")),
     ("smear_clip.js", JS, include_str!("../web/smear_clip.js")),

@@ -1,5 +1,6 @@
-//! The page comes from the binary alone: every module the page imports — our scripts and the
-//! vendored three.js — is embedded and served, with no npm install or source tree.
+//! The page comes from the binary alone: every module the page imports — our scripts, the
+//! workers they start and the vendored three.js — is embedded and served, with no npm
+//! install or source tree.
 
 use axum::http::{header, StatusCode};
 
@@ -26,6 +27,18 @@ fn imports(script: &str) -> Vec<String> {
         .collect()
 }
 
+/// The script URLs of `new Worker('...')` in a script.
+fn workers(script: &str) -> Vec<String> {
+    script
+        .split("new Worker(")
+        .skip(1)
+        .filter_map(|rest| {
+            let quote = rest.chars().next()?;
+            rest[1..].split(quote).next().map(str::to_string)
+        })
+        .collect()
+}
+
 /// The URL a specifier resolves to from `base` (an absolute URL path), with the page's
 /// import map (`three`, `three/addons/`).
 fn resolve(spec: &str, base: &str) -> String {
@@ -34,6 +47,9 @@ fn resolve(spec: &str, base: &str) -> String {
     }
     if let Some(rest) = spec.strip_prefix("three/addons/") {
         return format!("/vendor/three/examples/jsm/{rest}");
+    }
+    if spec.starts_with('/') {
+        return spec.into();
     }
     let dir = &base[..base.rfind('/').unwrap() + 1];
     let mut parts: Vec<&str> = dir.split('/').filter(|p| !p.is_empty()).collect();
@@ -64,11 +80,12 @@ async fn every_module_the_page_imports_is_served_from_the_binary() {
         let res = send(&app, get(&url)).await;
         assert_eq!(res.0, StatusCode::OK, "{url} is not served");
         let script = String::from_utf8(res.1).unwrap();
-        for spec in imports(&script) {
+        for spec in imports(&script).into_iter().chain(workers(&script)) {
             queue.push(resolve(&spec, &url));
         }
     }
     for needed in [
+        "/pack_worker.js",
         "/vendor/three/build/three.module.js",
         "/vendor/three/build/three.core.js",
         "/vendor/three/examples/jsm/controls/OrbitControls.js",

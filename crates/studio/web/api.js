@@ -43,3 +43,46 @@ export async function getPack(url, body, signal) {
   out.times = { sent, headers, body: performance.now() };
   return out;
 }
+
+// Whole-clip answers are fetched on a worker thread (pack_worker.js): their bytes keep
+// arriving while the page's thread is busy, e.g. waiting for a software-GL frame to be read
+// back (docs/studio.md, "Software GL"); the page gets them in one message, not copied.
+let worker = null, nextId = 0;
+const waiting = new Map();
+
+function packWorker() {
+  if (worker) return worker;
+  worker = new Worker('/pack_worker.js');
+  worker.onmessage = ({ data }) => {
+    const w = waiting.get(data.id);
+    if (!w) return;
+    waiting.delete(data.id);
+    if (data.error !== undefined) {
+      const e = new Error(data.error);
+      e.name = data.name || 'Error';
+      w.reject(e);
+      return;
+    }
+    const out = parsePack(data.buffer);
+    const o = performance.timeOrigin;
+    out.times = { sent: data.sent - o, headers: data.headers - o, body: data.body - o };
+    w.resolve(out);
+  };
+  return worker;
+}
+
+/** `getPack` on the worker thread: the same answer and `times`; `signal` aborts it. */
+export function getPackOffThread(url, body, signal) {
+  const w = packWorker(), id = ++nextId;
+  return new Promise((resolve, reject) => {
+    waiting.set(id, { resolve, reject });
+    if (signal) {
+      signal.addEventListener('abort', () => {
+        if (!waiting.delete(id)) return;
+        w.postMessage({ abort: id });
+        reject(new DOMException('the answer is no longer wanted', 'AbortError'));
+      }, { once: true });
+    }
+    w.postMessage({ id, url: new URL(url, location.href).href, body: body === undefined ? null : JSON.stringify(body) });
+  });
+}

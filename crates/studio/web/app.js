@@ -96,7 +96,7 @@ async function main() {
   const loop = (now) => {
     const dt = (now - last) / 1000; last = now;
     fpsFrames++; fpsTime += dt;
-    if (fpsTime > 0.5) { $('fps-label').textContent = `${Math.round(fpsFrames / fpsTime)} fps draw · ${studio.timeline.fps} fps clip`; fpsFrames = 0; fpsTime = 0; }
+    if (fpsTime > 0.5) { $('fps-label').textContent = `${Math.round(fpsFrames / fpsTime)} fps draw${view.software ? ' (software GL: plain shading)' : ''} · ${studio.timeline.fps} fps clip`; fpsFrames = 0; fpsTime = 0; }
     if (studio.playing) {
       acc += dt * studio.timeline.fps;
       if (acc >= 1) { const step = Math.floor(acc); acc -= step; setFrame((studio.frame + step) % studio.timeline.frames); }

@@ -3,7 +3,7 @@
 // weight-group picker (smear_weights.js), the TOML editor with inline errors, the offsets
 // view, exports. Every change restyles the prepared offsets on the server: the current frame
 // first, the whole clip right after its answer.
-import { getJSON, getPack, postJSON } from './api.js';
+import { getJSON, getPack, getPackOffThread, postJSON } from './api.js';
 import { KEYABLE, keyable, isCurve, paramAt, setKey, deleteKey, drawKeys, styleParams } from './smear_keys.js';
 import { WeightPicker } from './smear_weights.js';
 import { smearSummary } from './report.js';
@@ -257,7 +257,7 @@ export class SmearPanel {
         // cores (docs/studio.md, "Figures"), and the server restyles the clip while the page
         // draws the frame.
         const ctl = new AbortController();
-        const rest = getPack('/api/smear/stylize', { file: s.file, clip: s.clip, ...body, changes: true }, ctl.signal);
+        const rest = getPackOffThread('/api/smear/stylize', { file: s.file, clip: s.clip, ...body, changes: true }, ctl.signal);
         rest.catch(() => {});
         this.restCtl = ctl;
         $('style-error').textContent = '';

@@ -259,7 +259,7 @@ export class StopmoPanel {
     const g = new THREE.BufferGeometry();
     g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(header.vertices * 3), 3));
     g.setIndex(new THREE.BufferAttribute(buffers.triangles, 1));
-    const mesh = new THREE.Mesh(g, new THREE.MeshStandardMaterial({ color: 0xd9c7a3, roughness: 0.8, side: THREE.DoubleSide }));
+    const mesh = new THREE.Mesh(g, this.studio.view.surface({ color: 0xd9c7a3, roughness: 0.8, side: THREE.DoubleSide }));
     mesh.frustumCulled = false;
     // Beside the original: shifted by 1.15 × the face's width.
     const [lo, hi] = header.bbox;

@@ -6,10 +6,32 @@ import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 
 const BASE = new THREE.Color(0.78, 0.78, 0.8);
 
+/**
+ * Whether WebGL draws on the CPU (SwiftShader, llvmpipe: a machine or VM without a GPU).
+ * There a frame with 4× multisampling and physically based shading costs tens of
+ * milliseconds of both cores, the cores the server restyles on, so the viewport draws
+ * without multisampling and with diffuse shading instead (docs/studio.md, "Software GL").
+ */
+function softwareRenderer() {
+  const gl = document.createElement('canvas').getContext('webgl2');
+  if (!gl) return false;
+  const info = gl.getExtension('WEBGL_debug_renderer_info');
+  const name = String(gl.getParameter(info ? info.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
+  const lose = gl.getExtension('WEBGL_lose_context');
+  if (lose) lose.loseContext();
+  return /swiftshader|llvmpipe|softpipe|software/i.test(name);
+}
+
+/** A surface material: physically based on a GPU, diffuse on a software renderer. */
+function surface(software, { roughness, ...options }) {
+  return software ? new THREE.MeshLambertMaterial(options) : new THREE.MeshStandardMaterial({ roughness, ...options });
+}
+
 export class Viewport {
   constructor(canvas) {
     this.canvas = canvas;
-    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+    this.software = softwareRenderer();
+    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: !this.software, preserveDrawingBuffer: true });
     this.renderer.setPixelRatio(1);
     this.scene = new THREE.Scene();
     this.scene.background = new THREE.Color(0x33363b);
@@ -21,7 +43,7 @@ export class Viewport {
     this.ortho = new THREE.OrthographicCamera(-1, 1, 1, -1, -1000, 1000);
     this.camera = this.perspective;
     this.controls = new OrbitControls(this.perspective, canvas);
-    this.material = new THREE.MeshStandardMaterial({ color: 0xffffff, vertexColors: true, roughness: 0.7, side: THREE.DoubleSide });
+    this.material = surface(this.software, { color: 0xffffff, vertexColors: true, roughness: 0.7, side: THREE.DoubleSide });
     this.mesh = null;
     this.anim = null;
     this.frame = 0;
@@ -32,6 +54,9 @@ export class Viewport {
     this.resize();
     new ResizeObserver(() => this.resize()).observe(canvas);
   }
+
+  /** A surface material for this viewport's renderer ([`surface`]). */
+  surface(options) { return surface(this.software, options); }
 
   resize() {
     const w = this.canvas.clientWidth || 1, h = this.canvas.clientHeight || 1;
@@ -202,7 +227,7 @@ export class Viewport {
       g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(c.vertices * 3), 3));
       g.setAttribute('color', new THREE.BufferAttribute(new Float32Array(c.vertices * 4), 4));
       g.setIndex(new THREE.BufferAttribute(c.triangles, 1));
-      const m = new THREE.MeshStandardMaterial({ vertexColors: true, transparent: true, depthWrite: false, side: THREE.DoubleSide });
+      const m = surface(this.software, { vertexColors: true, roughness: 1, transparent: true, depthWrite: false, side: THREE.DoubleSide });
       const mesh = new THREE.Mesh(g, m);
       mesh.frustumCulled = false;
       this.scene.add(mesh);
