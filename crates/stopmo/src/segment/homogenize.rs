@@ -45,6 +45,12 @@ const RESPONSE_FRAMES: usize = 8;
 /// Rows of the dense response multiplied at once (see [`Homogenizer::solve_chunk`]).
 const RESPONSE_ROWS: usize = 240;
 
+/// Frames whose right-hand sides are back-substituted at once without the dense response:
+/// the buffer and faer's solve scratch are `F × 3 · SOLVE_FRAMES` floats each (3.4 MB on the
+/// face) rather than `F × 3 · chunk` (13.6 MB each, allocated per chunk on every worker,
+/// whose freed blocks stayed in the allocator's per-thread arenas: docs/studio.md, "Memory").
+const SOLVE_FRAMES: usize = 16;
+
 /// Measurements of one homogenization run.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
 pub struct HomogenizeStats {
@@ -273,12 +279,23 @@ impl Homogenizer {
 
     /// Solves `Q_FF X = B` in place (sequential; callers parallelize over columns).
     fn solve_in_place(&self, rhs: MatMut<'_, f64>) {
-        let llt = LltRef::new(&self.symbolic, &self.values);
-        let mut mem = MemBuffer::new(
+        let mut mem = self.solve_scratch(rhs.ncols());
+        self.solve_in_place_with(rhs, &mut mem);
+    }
+
+    /// faer's scratch for solving up to `columns` right-hand sides at once.
+    fn solve_scratch(&self, columns: usize) -> MemBuffer {
+        MemBuffer::new(
             self.symbolic
-                .solve_in_place_scratch::<f64>(rhs.ncols(), Par::Seq),
-        );
-        llt.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, MemStack::new(&mut mem));
+                .solve_in_place_scratch::<f64>(columns, Par::Seq),
+        )
+    }
+
+    /// [`Homogenizer::solve_in_place`] with the caller's scratch (from
+    /// [`Homogenizer::solve_scratch`] for at least `rhs.ncols()` columns).
+    fn solve_in_place_with(&self, rhs: MatMut<'_, f64>, mem: &mut MemBuffer) {
+        let llt = LltRef::new(&self.symbolic, &self.values);
+        llt.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, MemStack::new(mem));
     }
 
     /// Solves `Q_FF X = B` with the columns split across two threads (`rayon::join`).
@@ -298,24 +315,30 @@ impl Homogenizer {
     }
 
     /// Deforms every frame of `anim` in place (StopShop Eqs. 4–9), in parallel over chunks of
-    /// [`DEFAULT_CHUNK_FRAMES`] frames; each chunk is one multi-column back-substitution
-    /// with `Par::Seq`.
+    /// [`DEFAULT_CHUNK_FRAMES`] frames; each chunk is solved by multi-column
+    /// back-substitutions (or dense products) of a few frames at a time with `Par::Seq`.
     ///
     /// After the call, every pinned vertex holds exactly its average position in every
     /// frame (coincident duplicates included).
     ///
     /// # Performance
-    /// One pass over the frames; per chunk an `F × 3·chunk` dense buffer, or with the dense
-    /// response an `(F + P) × 3·RESPONSE_FRAMES` one.
+    /// One pass over the frames; per worker task an `F × 3·SOLVE_FRAMES` dense buffer and
+    /// faer's solve scratch of the same size, or with the dense response an
+    /// `(F + P) × 3·RESPONSE_FRAMES` buffer, reused for every chunk of the task.
     pub fn apply(&self, anim: &mut MeshAnimation) -> HomogenizeStats {
         let start = Instant::now();
         let m = anim.vertex_count();
         let chunk = DEFAULT_CHUNK_FRAMES;
         let nf = self.free_count();
+        // One set of buffers per worker task, reused for every chunk it solves.
+        let block = self.block_frames().min(anim.frame_count()).max(1);
         let partials: Vec<[f64; 6]> = anim
             .positions_mut()
             .par_chunks_mut((m * chunk).max(1))
-            .map(|frames| self.solve_chunk(frames, m, nf))
+            .map_init(
+                || self.chunk_scratch(block),
+                |scratch, frames| self.solve_chunk(frames, m, scratch),
+            )
             .collect();
         let frames = anim.frame_count().max(1) as f64;
         let mut s = [0.0f64; 6];
@@ -357,25 +380,45 @@ impl Homogenizer {
         }
     }
 
+    /// Frames solved at once within a chunk.
+    fn block_frames(&self) -> usize {
+        if self.response.is_some() {
+            RESPONSE_FRAMES
+        } else {
+            SOLVE_FRAMES
+        }
+    }
+
+    /// Buffers for solving `block` frames at once (see [`ChunkScratch`]).
+    fn chunk_scratch(&self, block: usize) -> ChunkScratch {
+        let (nf, np) = (self.free_count(), self.pinned.len());
+        let dense = self.response.is_some();
+        ChunkScratch {
+            d_free: Mat::zeros(nf, 3 * block),
+            d_pinned: Mat::zeros(if dense { np } else { 0 }, 3 * block),
+            disp: vec![DVec3::ZERO; self.targets.len()],
+            solve: self.solve_scratch(if dense || nf == 0 { 0 } else { 3 * block }),
+            block,
+        }
+    }
+
     /// Solves the frames of one chunk; returns [Σ|d|, max|d|, Σ|d_F|, max|d_F|, max grad, n_F].
-    fn solve_chunk(&self, frames: &mut [Vec3], m: usize, nf: usize) -> [f64; 6] {
+    fn solve_chunk(&self, frames: &mut [Vec3], m: usize, s: &mut ChunkScratch) -> [f64; 6] {
+        let nf = self.free_count();
         let nfr = frames.len() / m.max(1);
         let mut stats = [0.0f64; 6];
         if m == 0 || nfr == 0 {
             return stats;
         }
-        let mut disp = vec![DVec3::ZERO; self.targets.len()];
-        if let Some(response) = &self.response {
-            // d_F = R d_P, [`RESPONSE_FRAMES`] frames at a time into buffers of this chunk:
-            // every column is the same product whatever the columns beside it, and the
-            // frames are visited in the same order, so the chunk's sums are unchanged.
-            let block = RESPONSE_FRAMES.min(nfr);
-            let np = self.pinned.len();
-            let mut rhs = Mat::<f64>::zeros(nf, 3 * block);
-            let mut dp = Mat::<f64>::zeros(np, 3 * block);
-            for y in frames.chunks_mut(m * block) {
-                let cols = 3 * (y.len() / m);
-                let mut dp = dp.as_mut().subcols_mut(0, cols);
+        // [`ChunkScratch::block`] frames at a time: every column is the same solve or
+        // product whatever the columns beside it, and the frames are visited in the same
+        // order, so the chunk's sums are unchanged.
+        for y in frames.chunks_mut(m * s.block) {
+            let cols = 3 * (y.len() / m);
+            let mut rhs = s.d_free.as_mut().subcols_mut(0, cols);
+            if let Some(response) = &self.response {
+                // d_F = R d_P.
+                let mut dp = s.d_pinned.as_mut().subcols_mut(0, cols);
                 for (lf, y) in y.chunks_exact(m).enumerate() {
                     for (pl, &p) in self.pinned.iter().enumerate() {
                         let d = self.pinned_displacement(p as usize, y);
@@ -384,7 +427,6 @@ impl Homogenizer {
                         }
                     }
                 }
-                let mut rhs = rhs.as_mut().subcols_mut(0, cols);
                 // By blocks of rows: the product packs the rows of R it multiplies into a
                 // buffer of the calling thread that lives as long as the thread (a worker of
                 // the global pool: for good), so whole R would stay resident once per thread
@@ -401,25 +443,24 @@ impl Homogenizer {
                         Par::Seq,
                     );
                 }
-                self.move_frames(y, m, rhs.as_ref(), &mut disp, &mut stats);
-            }
-        } else {
-            let mut rhs = Mat::<f64>::zeros(nf, 3 * nfr);
-            for lf in 0..nfr {
-                let y = &frames[lf * m..(lf + 1) * m];
-                for (pl, &p) in self.pinned.iter().enumerate() {
-                    let d = self.pinned_displacement(p as usize, y);
-                    for (r, q) in self.qfp.row(pl) {
-                        for k in 0..3 {
-                            rhs[(r as usize, 3 * lf + k)] -= q * d[k];
+            } else {
+                // Q_FF d_F = −Q_FP d_P.
+                rhs.fill(0.0);
+                for (lf, y) in y.chunks_exact(m).enumerate() {
+                    for (pl, &p) in self.pinned.iter().enumerate() {
+                        let d = self.pinned_displacement(p as usize, y);
+                        for (r, q) in self.qfp.row(pl) {
+                            for k in 0..3 {
+                                rhs[(r as usize, 3 * lf + k)] -= q * d[k];
+                            }
                         }
                     }
                 }
+                if nf > 0 {
+                    self.solve_in_place_with(rhs.rb_mut(), &mut s.solve);
+                }
             }
-            if nf > 0 {
-                self.solve_in_place(rhs.as_mut());
-            }
-            self.move_frames(frames, m, rhs.as_ref(), &mut disp, &mut stats);
+            self.move_frames(y, m, rhs.as_ref(), &mut s.disp, &mut stats);
         }
         stats
     }
@@ -473,4 +514,18 @@ impl Homogenizer {
             }
         }
     }
+}
+
+/// Buffers of one worker task of [`Homogenizer::apply`], reused for every chunk it solves.
+struct ChunkScratch {
+    /// Free displacements (or right-hand sides), three columns per frame.
+    d_free: Mat<f64>,
+    /// Pinned displacements, three columns per frame (with the dense response only).
+    d_pinned: Mat<f64>,
+    /// One displacement per welded vertex.
+    disp: Vec<DVec3>,
+    /// faer's solve scratch (without the dense response only).
+    solve: MemBuffer,
+    /// Frames solved at once.
+    block: usize,
 }
