@@ -66,8 +66,8 @@ def bake_blocker(context):
     return None
 
 
-def _prepare(context, objects, settings):
-    toonkit = _toonkit()
+def _sample(context, objects, settings):
+    """The sample of `objects` (see `sample.sample`); raises JobError when nothing moves."""
     shown = []
     try:
         for o in objects:  # hidden originals (a re-bake) must be evaluated
@@ -87,16 +87,38 @@ def _prepare(context, objects, settings):
         raise JobError(f"{names}: does not move over frames {s.frame_start}-"
                        f"{s.frame_start + s.frame_count - 1}, nothing to smear; animate it "
                        "or set the scene range to where it moves")
+    return s
+
+
+def _solve(s, settings, started=False):
+    """The core's scene of the sample `s` and its prepared offsets; `started`: a
+    `toonkit.smear.Preparing` solving them on a thread of its own (`_result` waits)."""
+    toonkit = _toonkit()
     positions, skin = sample.to_camera(s)
     try:
         scene = toonkit.Scene.from_arrays(positions, s.triangles, fps=s.fps, skin=skin,
                                           objects=s.objects, attributes=s.attributes,
                                           rest=s.rest,
                                           skinning=s.clip_skinning() if positions is None else None)
-        prepared = toonkit.smear.prepare(scene, smooth=settings.smooth)
+        if started:
+            return toonkit.smear.start_prepare(scene, smooth=settings.smooth)
+        return toonkit.smear.prepare(scene, smooth=settings.smooth)
     except (toonkit.ToonkitError, ValueError) as e:
         raise JobError(_one_line(e)) from e
-    return s, prepared
+
+
+def _result(preparing):
+    """The offsets `_solve(..., started=True)` started to prepare."""
+    toonkit = _toonkit()
+    try:
+        return preparing.result()
+    except (toonkit.ToonkitError, ValueError) as e:
+        raise JobError(_one_line(e)) from e
+
+
+def _prepare(context, objects, settings):
+    s = _sample(context, objects, settings)
+    return s, _solve(s, settings)
 
 
 def _stylize(s, prepared, style, frames=None):
@@ -198,9 +220,9 @@ def _write(s, look, frames=None):
             results.write_frames(mesh, start, positions, alpha, frames)
 
 
-def _show(scene, s, look):
-    """Creates or updates the result objects of `look` (elongation, copies, lines) and
-    writes its frames."""
+def _bodies(scene, s):
+    """The elongated body of each sampled object by source name, made when missing (its
+    mesh a copy of the original's evaluated mesh), over the sample's frames."""
     import bpy
 
     start, end = s.frame_start, s.frame_start + s.frame_count - 1
@@ -215,6 +237,14 @@ def _show(scene, s, look):
             body = results.make_body(scene, original, mesh, start, end)
             bodies[name] = body
         results.set_range(body, start, end)
+    return bodies
+
+
+def _show(scene, s, look):
+    """Creates or updates the result objects of `look` (elongation, copies, lines) and
+    writes its frames."""
+    start, end = s.frame_start, s.frame_start + s.frame_count - 1
+    bodies = _bodies(scene, s)
 
     wanted = {}
     for c in look.multiples:
@@ -274,10 +304,25 @@ def bake(context, objects):
     bake): the frame on screen at once, the others as `_show_lazily` says. Nothing in the
     scene changes when this raises."""
     scene, settings = context.scene, context.scene.toonkit_smear
-    s, prepared = _prepare(context, objects, settings)
+    s = _sample(context, objects, settings)
     wanted = _settings_style(s, settings)
-    look, lazy = _stylize_lazily(scene, s, prepared, wanted, True)
-    if is_baked(scene):
+    fresh = not is_baked(scene)
+    preparing = _solve(s, settings, started=True)
+    if fresh:
+        # Made while the core solves the offsets (docs/blender.md, "Speed"); removed again
+        # when the core or the style fails (hiding an original deselects it).
+        picked = [o for o in objects if o.select_get()]
+        _bodies(scene, s)
+    try:
+        prepared = _result(preparing)
+        look, lazy = _stylize_lazily(scene, s, prepared, wanted, True)
+    except JobError:
+        if fresh:
+            results.remove_all(scene)
+            for o in picked:
+                o.select_set(True)
+        raise
+    if not fresh:
         results.remove_all(scene)
     _CACHE[scene.name] = (s, prepared)
     _show_lazily(scene, s, look, wanted, lazy)

@@ -66,6 +66,8 @@ def instrument():
     wrap(toonkit.smear, "prepare", "toonkit.smear.prepare (core offsets)")
     wrap(job, "_stylize", "toonkit.smear.stylize (frame on screen)")
     wrap(job, "_show", "result objects + write-back")
+    wrap(job, "_bodies", "result bodies (first: while the core prepares)")
+    wrap(job, "_result", "waiting for the prepared offsets")
     wrap(results, "node_group", "result: node group")
     wrap(results, "write_frames", "result: write frames")
     from_arrays = timed("Scene.from_arrays (transfer)", toonkit.Scene.from_arrays)

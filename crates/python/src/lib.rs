@@ -44,6 +44,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<smear_job::Stylized>()?;
     m.add_class::<smear_stream::Stream>()?;
     m.add_function(wrap_pyfunction!(smear_job::prepare, m)?)?;
+    m.add_class::<smear_job::Preparing>()?;
+    m.add_function(wrap_pyfunction!(smear_job::start_prepare, m)?)?;
     m.add_function(wrap_pyfunction!(smear_job::stylize, m)?)?;
     m.add_function(wrap_pyfunction!(smear_presets::presets, m)?)?;
     m.add_function(wrap_pyfunction!(smear_presets::parameters, m)?)?;

@@ -3,6 +3,9 @@
 
 use std::path::PathBuf;
 use std::sync::Arc;
+use std::thread::JoinHandle;
+
+use anim::SampledScene;
 
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
@@ -71,6 +74,66 @@ impl Prepared {
     }
 }
 
+/// What `toonkit.smear.prepare` runs: the scene (shared, not copied), the options and the
+/// collider scenes, checked on the caller's thread.
+struct PrepareJob {
+    sampled: Arc<SampledScene>,
+    options: PrepareOptions,
+    colliders: Vec<Arc<SampledScene>>,
+    source: String,
+}
+
+impl PrepareJob {
+    fn new(
+        scene: &Bound<'_, Scene>,
+        smooth: usize,
+        whole_body: bool,
+        prune: Vec<String>,
+        camera: Option<CameraArg>,
+        options_json: Option<&str>,
+        causal: bool,
+        revolve: Vec<String>,
+        collider_scenes: Vec<Bound<'_, Scene>>,
+    ) -> PyResult<PrepareJob> {
+        let scene = scene.get();
+        scene.merged_check()?;
+        let mut options: PrepareOptions = match options_json {
+            Some(j) => {
+                serde_json::from_str(j).map_err(|e| value_error(format!("prepare options: {e}")))?
+            }
+            None => PrepareOptions::default(),
+        };
+        options.offsets = offset_options(smooth, whole_body, prune, camera, (causal, revolve));
+        let mut colliders = Vec::with_capacity(collider_scenes.len());
+        for c in &collider_scenes {
+            let c = c.get();
+            if c.sampled.objects.is_empty() {
+                return Err(value_error(format!(
+                    "{}: the collider has no mesh",
+                    c.source
+                )));
+            }
+            colliders.push(c.sampled.clone());
+        }
+        Ok(PrepareJob {
+            sampled: scene.sampled.clone(),
+            options,
+            colliders,
+            source: scene.source.clone(),
+        })
+    }
+
+    /// `smear::prepare`, every collider scene's objects added (no GIL needed).
+    fn run(self) -> smear::Result<smear::Prepared> {
+        // The clip is shared with the `Scene`, not copied.
+        let mut p = smear::prepare(self.sampled, &self.options)?;
+        for o in self.colliders.iter().flat_map(|c| &c.objects) {
+            p.add_collider(smear::Collider::from_animation(&o.animation));
+        }
+        Ok(p)
+    }
+}
+
 /// The native half of `toonkit.smear.prepare`; `options_json` holds the other
 /// `PrepareOptions` fields (`weights`, `merge`, `colliders`) as JSON; every object of the
 /// `collider_scenes` becomes a collider mesh (issue #22).
@@ -89,42 +152,86 @@ pub(crate) fn prepare(
     revolve: Vec<String>,
     collider_scenes: Vec<Bound<'_, Scene>>,
 ) -> PyResult<Prepared> {
-    let scene = scene.get();
-    scene.merged_check()?;
-    let mut options: PrepareOptions = match options_json {
-        Some(j) => {
-            serde_json::from_str(j).map_err(|e| value_error(format!("prepare options: {e}")))?
-        }
-        None => PrepareOptions::default(),
-    };
-    options.offsets = offset_options(smooth, whole_body, prune, camera, (causal, revolve));
+    let job = PrepareJob::new(
+        scene,
+        smooth,
+        whole_body,
+        prune,
+        camera,
+        options_json,
+        causal,
+        revolve,
+        collider_scenes,
+    )?;
     report(py, progress.as_ref(), "prepare", 0.0)?;
-    let mut colliders = Vec::with_capacity(collider_scenes.len());
-    for c in &collider_scenes {
-        let c = c.get();
-        if c.sampled.objects.is_empty() {
-            return Err(value_error(format!(
-                "{}: the collider has no mesh",
-                c.source
-            )));
-        }
-        colliders.push(c.sampled.clone());
-    }
-    let sampled = scene.sampled.clone();
+    let source = job.source.clone();
     let prepared = py
-        .detach(move || {
-            // The clip is shared with the `Scene`, not copied.
-            let mut p = smear::prepare(sampled, &options)?;
-            for o in colliders.iter().flat_map(|c| &c.objects) {
-                p.add_collider(smear::Collider::from_animation(&o.animation));
-            }
-            Ok(p)
-        })
-        .map_err(|e| smear_error(&scene.source, e))?;
+        .detach(move || job.run())
+        .map_err(|e| smear_error(&source, e))?;
     report(py, progress.as_ref(), "prepare", 1.0)?;
     Ok(Prepared {
         prepared: Arc::new(prepared),
-        source: scene.source.clone(),
+        source,
+    })
+}
+
+/// ``toonkit.smear.prepare`` running on a thread of its own (``toonkit.smear.start_prepare``):
+/// the caller goes on (a host builds its result objects meanwhile, docs/blender.md "Speed")
+/// and ``result()`` waits for the same ``Prepared`` ``prepare`` returns, or raises its error.
+#[pyclass(module = "toonkit.smear", name = "Preparing")]
+pub(crate) struct Preparing {
+    handle: Option<JoinHandle<smear::Result<smear::Prepared>>>,
+    source: String,
+}
+
+#[pymethods]
+impl Preparing {
+    /// Waits for the offsets: the ``Prepared`` (once), or ``prepare``'s error.
+    fn result(&mut self, py: Python<'_>) -> PyResult<Prepared> {
+        let handle = self.handle.take().ok_or_else(|| {
+            value_error("the prepared offsets were already taken by an earlier result()")
+        })?;
+        let prepared = py
+            .detach(|| handle.join())
+            .map_err(|_| value_error("the prepare thread panicked"))?
+            .map_err(|e| smear_error(&self.source, e))?;
+        Ok(Prepared {
+            prepared: Arc::new(prepared),
+            source: self.source.clone(),
+        })
+    }
+}
+
+/// The native half of `toonkit.smear.start_prepare`: `smear_prepare`'s arguments (but
+/// `progress`), checked here, the solve started on a thread of its own.
+#[pyfunction(name = "smear_start_prepare")]
+#[pyo3(signature = (scene, smooth=smear::DEFAULT_SMOOTH, whole_body=false, prune=Vec::new(), camera=None, options_json=None, causal=false, revolve=Vec::new(), collider_scenes=Vec::new()))]
+pub(crate) fn start_prepare(
+    scene: &Bound<'_, Scene>,
+    smooth: usize,
+    whole_body: bool,
+    prune: Vec<String>,
+    camera: Option<CameraArg>,
+    options_json: Option<&str>,
+    causal: bool,
+    revolve: Vec<String>,
+    collider_scenes: Vec<Bound<'_, Scene>>,
+) -> PyResult<Preparing> {
+    let job = PrepareJob::new(
+        scene,
+        smooth,
+        whole_body,
+        prune,
+        camera,
+        options_json,
+        causal,
+        revolve,
+        collider_scenes,
+    )?;
+    let source = job.source.clone();
+    Ok(Preparing {
+        handle: Some(std::thread::spawn(move || job.run())),
+        source,
     })
 }
 

@@ -111,6 +111,30 @@ def test_prepared_offsets_equal_offsets(robot, prepared):
     assert [o["name"] for o in prepared.report["objects"]] == [n for n, _ in robot.objects]
 
 
+def test_started_prepare_gives_what_prepare_gives_and_its_errors(robot, prepared):
+    preparing = toonkit.smear.start_prepare(robot)
+    ticks = 0
+    started = toonkit.smear.start_prepare(robot, whole_body=True, merge="all")
+    while ticks < 3:  # the caller goes on meanwhile
+        ticks += 1
+        time.sleep(0.001)
+    ready = preparing.result()
+    np.testing.assert_array_equal(ready.offsets, prepared.offsets)
+    look = toonkit.smear.stylize(ready, STRETCH)
+    np.testing.assert_array_equal(look.elongated, toonkit.smear.stylize(prepared, STRETCH).elongated)
+    whole = toonkit.smear.prepare(robot, whole_body=True, merge="all")
+    np.testing.assert_array_equal(started.result().offsets, whole.offsets)
+    with pytest.raises(ValueError, match="already taken"):
+        preparing.result()
+    # The solve's errors are raised by result(), with prepare's message.
+    with pytest.raises(ValueError) as expected:
+        toonkit.smear.prepare(robot, prune=["Tail"])
+    failing = toonkit.smear.start_prepare(robot, prune=["Tail"])
+    with pytest.raises(ValueError) as e:
+        failing.result()
+    assert str(e.value) == str(expected.value)
+
+
 def test_style_file_saves_what_the_cli_writes(robot, prepared, tmp_path):
     style = example("smear/fig11b_linear.toml")
     cli = tmp_path / "cli.glb"

@@ -116,6 +116,11 @@ class Prepared:
     def report(self) -> dict[str, Any]: ...
     def report_json(self) -> str: ...
 
+class Preparing:
+    """prepare running on a thread of its own."""
+
+    def result(self) -> Prepared: ...
+
 class Stream:
     def __init__(self, triangles: Any, vertices: int, options_json: Optional[str] = None) -> None: ...
     def push(self, positions: Any) -> npt.NDArray[np.float32]: ...
@@ -152,6 +157,17 @@ def smear_prepare(
     revolve: Sequence[str] = ...,
     collider_scenes: Sequence[Scene] = ...,
 ) -> Prepared: ...
+def smear_start_prepare(
+    scene: Scene,
+    smooth: int = 2,
+    whole_body: bool = False,
+    prune: Sequence[str] = ...,
+    camera: Optional[Union[str, int]] = None,
+    options_json: Optional[str] = None,
+    causal: bool = False,
+    revolve: Sequence[str] = ...,
+    collider_scenes: Sequence[Scene] = ...,
+) -> Preparing: ...
 def smear_stylize(
     prepared: Prepared,
     style_json: Optional[str] = None,

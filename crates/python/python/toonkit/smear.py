@@ -22,10 +22,11 @@ from typing import Any, Callable, Iterable, Mapping, Optional, Tuple, Union
 import numpy as np
 
 from . import _native
-from ._native import Prepared, Stream, Stylized
+from ._native import Prepared, Preparing, Stream, Stylized
 
 __all__ = [
     "Prepared",
+    "Preparing",
     "Stream",
     "Stylized",
     "offsets",
@@ -34,6 +35,7 @@ __all__ = [
     "presets",
     "prepare",
     "save_style",
+    "start_prepare",
     "stream",
     "style_toml",
     "stylize",
@@ -157,6 +159,57 @@ def prepare(
     >>> prepared.offsets.shape == scene.positions.shape[:2]
     True
     """
+    options, scenes = _prepare_options(weights, merge, colliders)
+    return _native.smear_prepare(
+        scene,
+        int(smooth),
+        bool(whole_body),
+        _prune_list(prune),
+        camera,
+        options,
+        progress,
+        bool(causal),
+        _prune_list(revolve),
+        scenes,
+    )
+
+
+def start_prepare(
+    scene: "_native.Scene",
+    smooth: int = 2,
+    whole_body: bool = False,
+    prune: Iterable[str] = (),
+    camera: Optional[Union[str, int]] = None,
+    weights: Optional[Mapping[str, Any]] = None,
+    merge: Optional[str] = None,
+    causal: bool = False,
+    revolve: Iterable[str] = (),
+    colliders: Iterable[Union[str, "_native.Scene"]] = (),
+) -> Preparing:
+    """:func:`prepare` (the same options but ``progress``) on a thread of its own: returns at
+    once, and ``result()`` waits for the :class:`Prepared` :func:`prepare` gives, or raises
+    its error. A host does other work meanwhile (Blender builds its result objects).
+
+    >>> preparing = toonkit.smear.start_prepare(scene, smooth=2)
+    >>> prepared = preparing.result()
+    """
+    options, scenes = _prepare_options(weights, merge, colliders)
+    return _native.smear_start_prepare(
+        scene,
+        int(smooth),
+        bool(whole_body),
+        _prune_list(prune),
+        camera,
+        options,
+        bool(causal),
+        _prune_list(revolve),
+        scenes,
+    )
+
+
+def _prepare_options(weights, merge, colliders):
+    """`prepare`'s `weights`, `merge` and collider names as the native options JSON (None
+    when unset), and its collider scenes."""
     extra = {}
     if weights is not None:
         extra["weights"] = dict(weights)
@@ -167,18 +220,7 @@ def prepare(
     scenes = [c for c in colliders if not isinstance(c, str)]
     if names:
         extra["colliders"] = names
-    return _native.smear_prepare(
-        scene,
-        int(smooth),
-        bool(whole_body),
-        _prune_list(prune),
-        camera,
-        json.dumps(extra) if extra else None,
-        progress,
-        bool(causal),
-        _prune_list(revolve),
-        scenes,
-    )
+    return (json.dumps(extra) if extra else None), scenes
 
 
 def stream(

@@ -6,7 +6,7 @@ from typing import Any, Callable, Iterable, Mapping, Optional, Union
 import numpy as np
 import numpy.typing as npt
 
-from ._native import Prepared as Prepared, Scene, Stream as Stream, Stylized as Stylized
+from ._native import Prepared as Prepared, Preparing as Preparing, Scene, Stream as Stream, Stylized as Stylized
 
 def offsets(
     scene: Scene,
@@ -31,6 +31,18 @@ def prepare(
     revolve: Iterable[str] = (),
     colliders: Iterable[Union[str, Scene]] = (),
 ) -> Prepared: ...
+def start_prepare(
+    scene: Scene,
+    smooth: int = 2,
+    whole_body: bool = False,
+    prune: Iterable[str] = (),
+    camera: Optional[Union[str, int]] = None,
+    weights: Optional[Mapping[str, Any]] = None,
+    merge: Optional[str] = None,
+    causal: bool = False,
+    revolve: Iterable[str] = (),
+    colliders: Iterable[Union[str, Scene]] = (),
+) -> Preparing: ...
 def stream(
     triangles: Any,
     vertices: int,
