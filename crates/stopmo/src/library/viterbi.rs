@@ -421,6 +421,9 @@ mod tests {
         best
     }
 
+    /// A min-plus sweep: `m`, `alpha`, `lg`, `d` as [`min_plus`] takes them.
+    type Sweep = fn(&mut [f64], &[f64], &[f64], usize);
+
     /// The naive double loop, with the sweep's `min` (the first of equal values is kept).
     fn naive_min_plus(alpha: &[f64], lg: &[f64], d: usize, b: usize) -> f64 {
         (0..d)
@@ -455,7 +458,7 @@ mod tests {
             };
             let alpha: Vec<f64> = (0..d).map(|_| value()).collect();
             let lg: Vec<f64> = (0..d * d).map(|_| value()).collect();
-            let mut paths: Vec<(&str, fn(&mut [f64], &[f64], &[f64], usize))> =
+            let mut paths: Vec<(&str, Sweep)> =
                 vec![("dispatched", min_plus), ("portable", min_plus_portable)];
             #[cfg(target_arch = "x86_64")]
             if d >= avx512::LANES && avx512::available() {
