@@ -35,13 +35,23 @@ export function parsePack(buffer) {
  * `times`: when the request left, its headers and its last byte arrived (performance.now()).
  */
 export async function getPack(url, body, signal) {
+  const { buffer, times } = await fetchPack(url, body, signal);
+  const out = parsePack(buffer);
+  out.times = times;
+  return out;
+}
+
+/**
+ * The bytes of a packed response, unparsed (POST when `body` is given), and when the request
+ * left, its headers and its last byte arrived (`performance.now()` of the calling thread).
+ */
+export async function fetchPack(url, body, signal) {
   const init = body === undefined ? { signal } : { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body), signal };
   const sent = performance.now();
   const r = await check(await fetch(url, init));
   const headers = performance.now();
-  const out = parsePack(await r.arrayBuffer());
-  out.times = { sent, headers, body: performance.now() };
-  return out;
+  const buffer = await r.arrayBuffer();
+  return { buffer, times: { sent, headers, body: performance.now() } };
 }
 
 // Whole-clip answers are fetched on a worker thread (pack_worker.js): their bytes keep
@@ -52,7 +62,7 @@ const waiting = new Map();
 
 function packWorker() {
   if (worker) return worker;
-  worker = new Worker('/pack_worker.js');
+  worker = new Worker('/pack_worker.js', { type: 'module' });
   worker.onmessage = ({ data }) => {
     const w = waiting.get(data.id);
     if (!w) return;
@@ -63,9 +73,9 @@ function packWorker() {
       w.reject(e);
       return;
     }
-    const out = parsePack(data.buffer);
-    const o = performance.timeOrigin;
-    out.times = { sent: data.sent - o, headers: data.headers - o, body: data.body - o };
+    // The worker's clock starts at its own origin: its times, moved to the page's.
+    const out = parsePack(data.buffer), shift = data.origin - performance.timeOrigin, t = data.times;
+    out.times = { sent: t.sent + shift, headers: t.headers + shift, body: t.body + shift };
     w.resolve(out);
   };
   return worker;
@@ -83,6 +93,6 @@ export function getPackOffThread(url, body, signal) {
         reject(new DOMException('the answer is no longer wanted', 'AbortError'));
       }, { once: true });
     }
-    w.postMessage({ id, url: new URL(url, location.href).href, body: body === undefined ? null : JSON.stringify(body) });
+    w.postMessage({ id, url: new URL(url, location.href).href, body });
   });
 }
