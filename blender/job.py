@@ -90,9 +90,9 @@ def _sample(context, objects, settings):
     return s
 
 
-def _solve(s, settings, started=False):
-    """The core's scene of the sample `s` and its prepared offsets; `started`: a
-    `toonkit.smear.Preparing` solving them on a thread of its own (`_result` waits)."""
+def _start(s, settings):
+    """The core's scene of the sample `s`, its offsets being prepared on a thread of their
+    own: a `toonkit.smear.Preparing` (`_result` waits for it)."""
     toonkit = _toonkit()
     positions, skin = sample.to_camera(s)
     try:
@@ -100,15 +100,13 @@ def _solve(s, settings, started=False):
                                           objects=s.objects, attributes=s.attributes,
                                           rest=s.rest,
                                           skinning=s.clip_skinning() if positions is None else None)
-        if started:
-            return toonkit.smear.start_prepare(scene, smooth=settings.smooth)
-        return toonkit.smear.prepare(scene, smooth=settings.smooth)
+        return toonkit.smear.start_prepare(scene, smooth=settings.smooth)
     except (toonkit.ToonkitError, ValueError) as e:
         raise JobError(_one_line(e)) from e
 
 
 def _result(preparing):
-    """The offsets `_solve(..., started=True)` started to prepare."""
+    """The offsets `_start` started to prepare."""
     toonkit = _toonkit()
     try:
         return preparing.result()
@@ -118,7 +116,7 @@ def _result(preparing):
 
 def _prepare(context, objects, settings):
     s = _sample(context, objects, settings)
-    return s, _solve(s, settings)
+    return s, _result(_start(s, settings))
 
 
 def _stylize(s, prepared, style, frames=None):
@@ -307,7 +305,7 @@ def bake(context, objects):
     s = _sample(context, objects, settings)
     wanted = _settings_style(s, settings)
     fresh = not is_baked(scene)
-    preparing = _solve(s, settings, started=True)
+    preparing = _start(s, settings)
     if fresh:
         # Made while the core solves the offsets (docs/blender.md, "Speed"); removed again
         # when the core or the style fails (hiding an original deselects it).
