@@ -22,11 +22,6 @@ function softwareRenderer() {
   return /swiftshader|llvmpipe|softpipe|software/i.test(name);
 }
 
-/** A surface material: physically based on a GPU, diffuse on a software renderer. */
-function surface(software, { roughness, ...options }) {
-  return software ? new THREE.MeshLambertMaterial(options) : new THREE.MeshStandardMaterial({ roughness, ...options });
-}
-
 export class Viewport {
   constructor(canvas) {
     this.canvas = canvas;
@@ -43,7 +38,7 @@ export class Viewport {
     this.ortho = new THREE.OrthographicCamera(-1, 1, 1, -1, -1000, 1000);
     this.camera = this.perspective;
     this.controls = new OrbitControls(this.perspective, canvas);
-    this.material = surface(this.software, { color: 0xffffff, vertexColors: true, roughness: 0.7, side: THREE.DoubleSide });
+    this.material = this.surface({ color: 0xffffff, vertexColors: true, roughness: 0.7, side: THREE.DoubleSide });
     this.mesh = null;
     this.anim = null;
     this.frame = 0;
@@ -55,8 +50,10 @@ export class Viewport {
     new ResizeObserver(() => this.resize()).observe(canvas);
   }
 
-  /** A surface material for this viewport's renderer ([`surface`]). */
-  surface(options) { return surface(this.software, options); }
+  /** A surface material: physically based on a GPU, diffuse on a software renderer. */
+  surface({ roughness, ...options }) {
+    return this.software ? new THREE.MeshLambertMaterial(options) : new THREE.MeshStandardMaterial({ roughness, ...options });
+  }
 
   resize() {
     const w = this.canvas.clientWidth || 1, h = this.canvas.clientHeight || 1;
@@ -227,7 +224,7 @@ export class Viewport {
       g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(c.vertices * 3), 3));
       g.setAttribute('color', new THREE.BufferAttribute(new Float32Array(c.vertices * 4), 4));
       g.setIndex(new THREE.BufferAttribute(c.triangles, 1));
-      const m = surface(this.software, { vertexColors: true, roughness: 1, transparent: true, depthWrite: false, side: THREE.DoubleSide });
+      const m = this.surface({ vertexColors: true, roughness: 1, transparent: true, depthWrite: false, side: THREE.DoubleSide });
       const mesh = new THREE.Mesh(g, m);
       mesh.frustumCulled = false;
       this.scene.add(mesh);
