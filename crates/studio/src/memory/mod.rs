@@ -4,7 +4,14 @@
 //! ([`anim::budget::JobMemory`], the estimate the tool crate checks) from one pool the size
 //! of the job budget before it starts, and gives it back when done ([`Reservation`] is
 //! dropped on success, error or panic). When the pool cannot hold it, the request waits a
-//! short bounded time for others to finish, then is answered 503 ("busy, retry").
+//! short bounded time for others to finish, then is answered 503 ("busy, retry"). Once the
+//! pool has been idle a moment after a large job, the memory freed is given back to the
+//! system ([`IDLE_BEFORE_GIVING_BACK`]).
+
+mod give_back;
+
+use give_back::GiveBack;
+pub use give_back::{GIVE_BACK_AFTER_BYTES, IDLE_BEFORE_GIVING_BACK};
 
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::{Duration, Instant};
@@ -25,6 +32,7 @@ pub struct MemoryPool {
     wait: Duration,
     reserved: Mutex<u64>,
     released: Condvar,
+    give_back: GiveBack,
 }
 
 /// Bytes reserved from a [`MemoryPool`] until dropped.
@@ -38,11 +46,18 @@ pub struct Reservation {
 impl MemoryPool {
     /// A pool of `capacity` bytes; a request waits at most `wait` for room.
     pub fn new(capacity: u64, wait: Duration) -> Arc<MemoryPool> {
+        MemoryPool::giving_back_after(capacity, wait, IDLE_BEFORE_GIVING_BACK)
+    }
+
+    /// [`MemoryPool::new`] giving freed memory back after `idle` without reservations
+    /// instead of [`IDLE_BEFORE_GIVING_BACK`].
+    pub fn giving_back_after(capacity: u64, wait: Duration, idle: Duration) -> Arc<MemoryPool> {
         Arc::new(MemoryPool {
             capacity,
             wait,
             reserved: Mutex::new(0),
             released: Condvar::new(),
+            give_back: GiveBack::new(idle),
         })
     }
 
@@ -60,6 +75,11 @@ impl MemoryPool {
     /// Bytes reserved now.
     pub fn reserved(&self) -> u64 {
         *lock(&self.reserved)
+    }
+
+    /// How many times the pool gave freed memory back to the system.
+    pub fn times_given_back(&self) -> u64 {
+        self.give_back.count()
     }
 
     /// Reserves `memory` for the job of `label` (blocking at most the pool's wait).
@@ -112,9 +132,14 @@ impl Reservation {
 
 impl Drop for Reservation {
     fn drop(&mut self) {
-        let mut reserved = lock(&self.pool.reserved);
-        *reserved = reserved.saturating_sub(self.bytes);
-        self.pool.released.notify_all();
+        let idle = {
+            let mut reserved = lock(&self.pool.reserved);
+            *reserved = reserved.saturating_sub(self.bytes);
+            self.pool.released.notify_all();
+            *reserved == 0
+        };
+        // Outside the lock on `reserved`: the give-back thread reads it under its own.
+        self.pool.give_back.released(&self.pool, self.bytes, idle);
     }
 }
 
@@ -163,6 +188,44 @@ mod tests {
         drop(first);
         assert_eq!(waiter.join().unwrap().unwrap(), 100);
         assert_eq!(pool.reserved(), 0);
+    }
+
+    /// Waits up to 5 s for the pool to have given memory back `times` times.
+    fn given_back(pool: &MemoryPool, times: u64) -> bool {
+        let end = Instant::now() + Duration::from_secs(5);
+        while pool.times_given_back() < times && Instant::now() < end {
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        pool.times_given_back() >= times
+    }
+
+    #[test]
+    fn freed_memory_goes_back_once_the_pool_is_idle_after_a_large_job() {
+        let idle = Duration::from_millis(30);
+        let pool = MemoryPool::giving_back_after(1 << 40, Duration::ZERO, idle);
+        // A small job frees too little to matter.
+        drop(
+            pool.reserve("slider", &job(GIVE_BACK_AFTER_BYTES - 1))
+                .unwrap(),
+        );
+        std::thread::sleep(idle * 4);
+        assert_eq!(pool.times_given_back(), 0);
+        // A large job ends while another runs: nothing until the pool is idle.
+        let running = pool.reserve("running", &job(10)).unwrap();
+        drop(pool.reserve("large", &job(GIVE_BACK_AFTER_BYTES)).unwrap());
+        std::thread::sleep(idle * 4);
+        assert_eq!(pool.times_given_back(), 0);
+        drop(running);
+        assert!(given_back(&pool, 1), "not given back once idle");
+        // Once: nothing large ended since.
+        drop(pool.reserve("slider", &job(10)).unwrap());
+        std::thread::sleep(idle * 4);
+        assert_eq!(pool.times_given_back(), 1);
+        drop(pool.reserve("large", &job(GIVE_BACK_AFTER_BYTES)).unwrap());
+        assert!(
+            given_back(&pool, 2),
+            "not given back after the second large job"
+        );
     }
 
     #[test]
