@@ -53,14 +53,16 @@ impl GiveBack {
         }
     }
 
-    /// A reservation of `bytes` ended, leaving the pool `idle` (nothing reserved) or not.
-    pub(super) fn released(&self, pool: &Arc<MemoryPool>, bytes: u64, idle: bool) {
-        let mut s = lock(&self.schedule);
+    /// A reservation of `bytes` from `pool` ended, leaving it `idle` (nothing reserved) or
+    /// not.
+    pub(super) fn released(pool: &Arc<MemoryPool>, bytes: u64, idle: bool) {
+        let g = &pool.give_back;
+        let mut s = lock(&g.schedule);
         s.owed |= bytes >= GIVE_BACK_AFTER_BYTES;
         if !(s.owed && idle) {
             return;
         }
-        s.due = Some(Instant::now() + self.idle);
+        s.due = Some(Instant::now() + g.idle);
         if !s.started {
             s.started = true;
             let pool = Arc::downgrade(pool);
@@ -70,7 +72,7 @@ impl GiveBack {
             // Without a thread the memory stays with the allocator, as before.
             s.started = thread.is_ok();
         }
-        self.wake.notify_all();
+        g.wake.notify_all();
     }
 
     /// How many times memory was given back.

@@ -139,7 +139,7 @@ impl Drop for Reservation {
             *reserved == 0
         };
         // Outside the lock on `reserved`: the give-back thread reads it under its own.
-        self.pool.give_back.released(&self.pool, self.bytes, idle);
+        GiveBack::released(&self.pool, self.bytes, idle);
     }
 }
 
