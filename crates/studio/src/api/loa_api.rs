@@ -21,7 +21,7 @@ use serde::Deserialize;
 use serde_json::{json, Value};
 
 use super::loa_skin::Binding;
-use super::{blocking, body};
+use super::{blocking, body, on_core_pool};
 use crate::error::{ApiError, ApiResult};
 use crate::files::{merged, output_path};
 use crate::pack::{coordinates, Pack};
@@ -183,7 +183,7 @@ pub(crate) async fn animate(
         options.wobbles = r.wobbles.clone();
         // The line first (the job's first half), so the sampled motion's memory is reserved
         // before the solve.
-        let line = loa::line(&keys, &options).map_err(|e| {
+        let line = on_core_pool(|| loa::line(&keys, &options)).map_err(|e| {
             let over = matches!(e, loa::LoaError::OverBudget(_));
             ApiError::refused(format!("line: {e}"), over)
         })?;
@@ -219,28 +219,11 @@ pub(crate) async fn animate(
             canvas: Some([r.width, r.height]),
             ..Default::default()
         };
-        let done = job::animate_character(scene, &prepared.character, line, &options)
-            .map_err(|e| {
-            let over = e.over_budget();
-            ApiError::refused(format!("{label}: {e}"), over)
-        })?;
-        let (out, motion, line) = (&done.scene, &done.motion, &done.line);
-        let clip = out
-            .find_clip(loa::animate::CLIP_NAME)
-            .map_err(|e| ApiError::internal(e.to_string()))?;
-        let sampled = anim::sample(
-            out,
-            &anim::SampleOptions {
-                fps: fps as f32,
-                clip: Some(clip),
-                meshes: Vec::new(),
-            },
-        )
-        .map_err(|e| {
-            let over = matches!(e, anim::AnimError::OverBudget(_));
-            ApiError::refused(format!("{label}: {e}"), over)
-        })?;
-        let m = merged(label, &sampled)?;
+        let character = &prepared.character;
+        let want_pose = r.skin.is_some();
+        let motion = on_core_pool(|| follow(scene, character, line, &options, fps, label, want_pose))?;
+        let Motion { done, merged: m, pose } = motion;
+        let (motion, line) = (&done.motion, &done.line);
         let animate_seconds = start.elapsed().as_secs_f64() - line_seconds;
 
         let frames = &line.animation.frames;
@@ -254,13 +237,7 @@ pub(crate) async fn animate(
                 .flat_map(|f| f.chain.joints().into_iter().flat_map(|p| [p.x as f32, p.y as f32])),
         );
         pack.u32("triangles", m.mesh.triangles.iter().flatten().copied());
-        let m = Arc::new(m);
         let motion_frames = m.frame_count();
-        let pose = r
-            .skin
-            .as_ref()
-            .and_then(|_| Binding::new(out, &sampled))
-            .and_then(|b| b.pose(&sampled, &m).map(|w| (b, w)));
         let mut skin = Value::Null;
         let shown = match (r.frame, pose) {
             // The skeleton's pose for every frame; the binding when the page lacks it.
@@ -325,6 +302,59 @@ pub(crate) async fn animate(
         Ok(pack.response(header))
     })
     .await
+}
+
+/// The motion of a stroke: the core's result, the character's meshes merged over every
+/// motion frame, and the skeleton's pose per frame with its binding when the page asked for
+/// it and skinning reproduces the merged meshes ([`Binding::pose`]).
+struct Motion {
+    done: job::SceneMotion,
+    merged: Arc<anim::MeshAnimation>,
+    pose: Option<(Binding, Vec<f32>)>,
+}
+
+/// The character of `scene` following `line` (`loa::animate`), sampled at `fps` and merged,
+/// with the pose when `want_pose`: the stroke's computation, which takes no lock and waits on
+/// nothing (it runs on the core's pool, [`on_core_pool`]).
+fn follow(
+    scene: &anim::Scene,
+    character: &Character,
+    line: loa::Line,
+    options: &job::SceneOptions,
+    fps: f64,
+    label: &str,
+    want_pose: bool,
+) -> ApiResult<Motion> {
+    let done = job::animate_character(scene, character, line, options).map_err(|e| {
+        let over = e.over_budget();
+        ApiError::refused(format!("{label}: {e}"), over)
+    })?;
+    let out = &done.scene;
+    let clip = out
+        .find_clip(loa::animate::CLIP_NAME)
+        .map_err(|e| ApiError::internal(e.to_string()))?;
+    let sampled = anim::sample(
+        out,
+        &anim::SampleOptions {
+            fps: fps as f32,
+            clip: Some(clip),
+            meshes: Vec::new(),
+        },
+    )
+    .map_err(|e| {
+        let over = matches!(e, anim::AnimError::OverBudget(_));
+        ApiError::refused(format!("{label}: {e}"), over)
+    })?;
+    let m = merged(label, &sampled)?;
+    let pose = want_pose
+        .then(|| Binding::new(out, &sampled))
+        .flatten()
+        .and_then(|b| b.pose(&sampled, &m).map(|w| (b, w)));
+    Ok(Motion {
+        done,
+        merged: Arc::new(m),
+        pose,
+    })
 }
 
 /// `GET /api/loa/motion?version=`: buffer `positions` (f32, every motion frame × vertices × 3)

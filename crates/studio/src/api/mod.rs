@@ -93,6 +93,15 @@ where
         .map_err(|_| ApiError::internal("the request stopped on an internal error"))?
 }
 
+/// Runs `work` as a task of the core's thread pool (rayon's) and waits for it: its parallel
+/// loops then split on the worker running it, instead of each being handed over from this
+/// thread and waited for (a stroke's solver runs one per iteration, hundreds in all;
+/// docs/studio.md, "Figures"). `work` must take no lock and wait on nothing: the pool may run
+/// it on a worker that suspended another request's loop, which would then wait for it.
+pub(crate) fn on_core_pool<R: Send>(work: impl FnOnce() -> R + Send) -> R {
+    rayon::scope(|_| work())
+}
+
 /// `GET /api/jobs/{id}`.
 async fn job(State(studio): State<Arc<Studio>>, Path(id): Path<u64>) -> ApiResult<Json<JobStatus>> {
     studio
@@ -108,5 +117,27 @@ async fn cancel(State(studio): State<Arc<Studio>>, Path(id): Path<u64>) -> ApiRe
         Ok(Json(serde_json::json!({ "cancelled": id })))
     } else {
         Err(ApiError::not_found(format!("job {id}: no such job")))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::on_core_pool;
+    use rayon::prelude::*;
+
+    #[test]
+    fn a_request_computes_on_the_core_pool_and_its_loops_split_there() {
+        // From an outside thread (the server's blocking pool), as a request runs.
+        let (inside, sum) = std::thread::spawn(|| {
+            on_core_pool(|| {
+                let inside = rayon::current_thread_index().is_some();
+                let sum: u64 = (0..10_000u64).into_par_iter().map(|x| x * x).sum();
+                (inside, sum)
+            })
+        })
+        .join()
+        .unwrap();
+        assert!(inside, "the work ran outside rayon's pool");
+        assert_eq!(sum, (0..10_000u64).map(|x| x * x).sum::<u64>());
     }
 }

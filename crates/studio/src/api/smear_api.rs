@@ -17,7 +17,7 @@ use smear::{ElongatePreset, ElongateStyle, OffsetOptions, Style, WeightSource};
 use super::changes::pack_changes;
 use super::scene::ClipQuery;
 use super::shown::pack_shown;
-use super::{blocking, body};
+use super::{blocking, body, on_core_pool};
 use crate::error::{ApiError, ApiResult};
 use crate::files::output_path;
 use crate::memory::Reservation;
@@ -187,7 +187,7 @@ fn stylized(
     };
     let memory = smear::stylize_memory(&p, &style, frames.clone()).map_err(refused)?;
     let held = studio.reserve(r.file, &memory)?;
-    let s = smear::stylize_frames(&p, &style, frames).map_err(refused)?;
+    let s = on_core_pool(|| smear::stylize_frames(&p, &style, frames)).map_err(refused)?;
     Ok((style, s, held))
 }
 
@@ -226,13 +226,20 @@ pub(crate) async fn stylize(
         let input = studio.sampled(r.file, &r.clip)?;
         let clip = r.changes.then_some(&input);
         match clip.map(|c| c.merged()) {
-            Some(m) if m.vertex_count() == vertices => pack_changes(
-                &mut pack,
-                (frames, vertices),
-                input.diagonal(s.first_frame..s.first_frame + frames),
-                |f| bodies.iter().map(|a| a.frame(f)).collect(),
-                |f| m.frame(s.first_frame + f),
-            ),
+            Some(m) if m.vertex_count() == vertices => {
+                // Found once per clip (it may wait for another request finding it): before
+                // the pool's task, which must not wait.
+                let diagonal = input.diagonal(s.first_frame..s.first_frame + frames);
+                on_core_pool(|| {
+                    pack_changes(
+                        &mut pack,
+                        (frames, vertices),
+                        diagonal,
+                        |f| bodies.iter().map(|a| a.frame(f)).collect(),
+                        |f| m.frame(s.first_frame + f),
+                    )
+                })
+            }
             _ => {
                 pack.f32_slices(
                     "body",
