@@ -101,6 +101,21 @@ try {
   const height = before.length / 4 / width;
   const centred = x0 < width / 2 && x1 > width / 2 && y0 < height / 2 && y1 > height / 2;
   check('the viewport shows the character (three.js embedded in the binary)', lit > 2000 && centred, `${lit} pixels differ from the background, in x ${x0}–${x1}, y ${y0}–${y1} of ${width}×${height}`);
+  // The viewport's own vertex normals (web/normals.js, per frame shown) against three.js's
+  // computeVertexNormals on the same geometry: the same float32 values.
+  const normals = await page.evaluate(async () => {
+    const { computeVertexNormals } = await import('/normals.js');
+    const g = window.studio.view.mesh.geometry;
+    const ours = g.clone(), theirs = g.clone();
+    computeVertexNormals(ours);
+    theirs.deleteAttribute('normal');
+    theirs.computeVertexNormals();
+    const a = ours.attributes.normal.array, b = theirs.attributes.normal.array;
+    let differ = 0;
+    for (let i = 0; i < a.length; i++) if (!Object.is(a[i], b[i])) differ++;
+    return { values: a.length, differ, vertices: g.attributes.position.count };
+  });
+  check('the viewport\'s vertex normals equal three.js computeVertexNormals bit for bit', normals.values === normals.vertices * 3 && normals.values > 0 && normals.differ === 0, JSON.stringify(normals));
 
   // β max slider: pixels change; latency slider → geometry drawn.
   const setSlider = (v) => page.evaluate((v) => {

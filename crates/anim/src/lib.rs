@@ -50,7 +50,8 @@ pub use mesh_animation::{MeshAnimation, DEFAULT_FPS};
 pub use morph_animation::{MeshFrames, MorphAnimation};
 pub use rng::{mix, SplitMix64};
 pub use sample::{
-    rest_transform, sample, sample_morph, sample_owned, MeshObject, SampleOptions, SampledScene,
+    rest_transform, sample, sample_morph, sample_node_world, sample_owned, MeshObject,
+    SampleOptions, SampledScene,
 };
 pub use scene::{MorphTarget, Node, Scene, SceneCamera, SceneMesh, SkinDef};
 pub use skeleton::{bones, Bone, Joint, SkeletalAnimation, Skeleton};

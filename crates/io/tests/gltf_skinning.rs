@@ -172,3 +172,26 @@ fn influence_counts_that_differ_are_an_error() {
         );
     }
 }
+
+#[test]
+fn node_world_alone_is_the_sampled_scenes_bit_for_bit() {
+    // What the studio sends a renderer that skins the meshes itself: the node matrices of a
+    // clip, without sampling any vertex, must be the ones a full sampling computes.
+    for (file, clip) in [
+        ("characters/RobotExpressive.glb", 0),
+        ("characters/RobotExpressive.glb", 5),
+        ("characters/CesiumMan.glb", 0),
+    ] {
+        let scene = tkio::gltf::read(std::path::Path::new(&data(file))).unwrap();
+        let options = SampleOptions {
+            fps: 24.0,
+            clip: Some(clip),
+            meshes: Vec::new(),
+        };
+        let full = sample(&scene, &options).unwrap();
+        let (frames, world) = anim::sample_node_world(&scene, &options).unwrap();
+        assert_eq!(frames, full.frame_count, "{file} clip {clip}");
+        assert!(!world.is_empty());
+        assert_eq!(world, full.node_world, "{file} clip {clip}");
+    }
+}

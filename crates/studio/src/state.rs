@@ -27,8 +27,8 @@ pub struct LoaSession {
     /// clip (LoA Section 4).
     pub done: loa::job::SceneMotion,
     /// The character's meshes merged, every motion frame (`GET /api/loa/motion`), shared
-    /// with the answers that send it.
-    pub merged: Arc<anim::MeshAnimation>,
+    /// with the answers that send it; sampled on first use when the answer sent the pose.
+    pub merged: std::sync::OnceLock<Arc<anim::MeshAnimation>>,
     /// Counts the animate requests: a page asking for the motion of an older one is refused.
     pub version: u64,
 }
@@ -49,6 +49,10 @@ pub struct LoaCharacter {
     pub camera: loa::animate::ActionCamera,
     /// Vertices of the file's meshes (as `anim::sample` counts them).
     pub vertices: usize,
+    /// The skin binding, once a stroke's motion showed that skinning it with the pose
+    /// reproduces the core's positions (`api::loa_skin`): later strokes send the pose
+    /// without sampling every vertex again.
+    pub(crate) skin: std::sync::OnceLock<Arc<crate::api::CheckedSkin>>,
 }
 
 /// The last segmentation of the stopmo panel, its size curve and the library built from it

@@ -24,6 +24,7 @@ pub const PAGE: &[(&str, &str, &str)] = &[
     ("api.js", JS, include_str!("../web/api.js")),
     ("pack_worker.js", JS, include_str!("../web/pack_worker.js")),
     ("viewport.js", JS, include_str!("../web/viewport.js")),
+    ("normals.js", JS, include_str!("../web/normals.js")),
     ("smear.js", JS, include_str!("../web/smear.js")),
     ("smear_clip.js", JS, include_str!("../web/smear_clip.js")),
     ("smear_keys.js", JS, include_str!("../web/smear_keys.js")),

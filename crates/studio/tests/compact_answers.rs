@@ -29,6 +29,61 @@ async fn dance_input(app: &axum::Router) -> Vec<f32> {
     )
 }
 
+/// A character's skin binding as an answer sends it once (`skin.*`).
+struct SkinBinding {
+    rest: Vec<f32>,
+    weight: Vec<f32>,
+    inverse: Vec<f32>,
+    index: Vec<u32>,
+    node: Vec<u32>,
+}
+
+impl SkinBinding {
+    fn read(answer: &[u8]) -> SkinBinding {
+        SkinBinding {
+            rest: f32s(answer, "skin.rest"),
+            weight: f32s(answer, "skin.weight"),
+            inverse: f32s(answer, "skin.inverse"),
+            index: read_u32(answer, "skin.index"),
+            node: read_u32(answer, "skin.node"),
+        }
+    }
+
+    /// The largest distance between linear blend skinning with the pose `world` (frames ×
+    /// `nodes` matrices), as the page's renderer does it, and the core's positions.
+    fn worst_error(&self, world: &[f32], nodes: usize, core: &[f32]) -> f32 {
+        let vertices = self.rest.len() / 3;
+        let frames = world.len() / (nodes * 16);
+        assert_eq!(core.len(), frames * vertices * 3);
+        let mat = |s: &[f32]| anim::glam::Mat4::from_cols_slice(s);
+        let mut worst = 0.0f32;
+        for f in 0..frames {
+            for v in 0..vertices {
+                let p = anim::glam::Vec3::from_slice(&self.rest[v * 3..v * 3 + 3]).extend(1.0);
+                let mut acc = anim::glam::Vec4::ZERO;
+                for k in 0..4 {
+                    let e = self.index[v * 4 + k] as usize;
+                    let n = self.node[e] as usize;
+                    let m = mat(&world[(f * nodes + n) * 16..][..16])
+                        * mat(&self.inverse[e * 16..][..16]);
+                    acc += m * p * self.weight[v * 4 + k];
+                }
+                let q = anim::glam::Vec3::from_slice(&core[(f * vertices + v) * 3..][..3]);
+                worst = worst.max((acc.truncate() - q).length());
+            }
+        }
+        worst
+    }
+}
+
+/// The core's positions of the animate answer `version` (`GET /api/loa/motion`).
+async fn core_motion(app: &axum::Router, version: u64) -> Vec<f32> {
+    f32s(
+        &send_ok(app, get(&format!("/api/loa/motion?version={version}"))).await,
+        "positions",
+    )
+}
+
 #[tokio::test]
 async fn a_stroke_answered_as_the_skeletons_pose_skins_to_the_cores_positions() {
     let dir = tempfile::tempdir().unwrap();
@@ -43,52 +98,58 @@ async fn a_stroke_answered_as_the_skeletons_pose_skins_to_the_cores_positions() 
         m["vertices"].as_u64().unwrap() as usize,
     );
     let nodes = m["skin"]["nodes"].as_u64().unwrap() as usize;
+    assert_eq!(
+        m["sampled_vertices"], true,
+        "the first stroke checks the binding"
+    );
     assert!(pack::read_f32(&answer, "positions").is_none());
     let world = f32s(&answer, "skin.world");
     assert_eq!(world.len(), frames * nodes * 16);
-    let (rest, weight, inverse) = (
-        f32s(&answer, "skin.rest"),
-        f32s(&answer, "skin.weight"),
-        f32s(&answer, "skin.inverse"),
+    let binding = SkinBinding::read(&answer);
+    assert_eq!(
+        (binding.rest.len(), binding.index.len()),
+        (vertices * 3, vertices * 4)
     );
-    let (index, node) = (
-        read_u32(&answer, "skin.index"),
-        read_u32(&answer, "skin.node"),
-    );
-    assert_eq!((rest.len(), index.len()), (vertices * 3, vertices * 4));
-    // Linear blend skinning of the binding with the pose, as the page's renderer does it.
     let version = header["version"].as_u64().unwrap();
-    let core = f32s(
-        &send_ok(&app, get(&format!("/api/loa/motion?version={version}"))).await,
-        "positions",
-    );
-    let mat = |s: &[f32]| anim::glam::Mat4::from_cols_slice(s);
-    let mut worst = 0.0f32;
-    for f in 0..frames {
-        for v in 0..vertices {
-            let p = anim::glam::Vec3::from_slice(&rest[v * 3..v * 3 + 3]).extend(1.0);
-            let mut acc = anim::glam::Vec4::ZERO;
-            for k in 0..4 {
-                let e = index[v * 4 + k] as usize;
-                let n = node[e] as usize;
-                let m = mat(&world[(f * nodes + n) * 16..][..16]) * mat(&inverse[e * 16..][..16]);
-                acc += m * p * weight[v * 4 + k];
-            }
-            let q = anim::glam::Vec3::from_slice(&core[(f * vertices + v) * 3..][..3]);
-            worst = worst.max((acc.truncate() - q).length());
-        }
-    }
+    let worst = binding.worst_error(&world, nodes, &core_motion(&app, version).await);
     assert!(
         worst < 1e-4,
         "the pose skins {worst} off the core's positions"
     );
-    // The binding is sent once: a page holding it gets the pose alone.
+    // The binding is sent once: a page holding it gets the pose alone. The character's
+    // binding is checked now, so another stroke's motion is posed without sampling every
+    // vertex; its positions, sampled when asked for, are still the pose's skinning.
     let mut again = request;
     again["skin"] = m["skin"]["id"].clone();
+    for k in again["keystrokes"].as_array_mut().unwrap() {
+        for p in k["points"].as_array_mut().unwrap() {
+            p[0] = json!(p[0].as_f64().unwrap() + 40.0);
+        }
+    }
     let answer = send_ok(&app, post("/api/loa/animate", again)).await;
+    let (header, _) = pack::split(&answer).unwrap();
     assert!(pack::read_f32(&answer, "skin.rest").is_none());
-    assert_eq!(f32s(&answer, "skin.world").len(), frames * nodes * 16);
     assert!(answer.len() < 300_000, "{} bytes", answer.len());
+    let m2 = &header["motion"];
+    assert_eq!(m2["skin"]["id"], m["skin"]["id"]);
+    assert_eq!(
+        m2["sampled_vertices"], false,
+        "the checked binding was not used"
+    );
+    assert_eq!(m2["vertices"].as_u64().unwrap() as usize, vertices);
+    let frames2 = m2["frames"].as_u64().unwrap() as usize;
+    let world2 = f32s(&answer, "skin.world");
+    assert_eq!(world2.len(), frames2 * nodes * 16);
+    assert_ne!(world2, world, "another stroke, the same motion");
+    let version2 = header["version"].as_u64().unwrap();
+    let core2 = core_motion(&app, version2).await;
+    let worst = binding.worst_error(&world2, nodes, &core2);
+    assert!(
+        worst < 1e-4,
+        "the second stroke's pose skins {worst} off the core's positions"
+    );
+    // Asked again, the same positions (sampled once).
+    assert_eq!(core_motion(&app, version2).await, core2);
 }
 
 #[tokio::test]

@@ -6,6 +6,7 @@
 import * as THREE from 'three';
 import { getJSON, getPack, postJSON } from './api.js';
 import { segmentSummary } from './report.js';
+import { computeVertexNormals } from './normals.js';
 
 const $ = (id) => document.getElementById(id);
 
@@ -301,7 +302,7 @@ export class StopmoPanel {
       pos.array.set(pieces.subarray(from, from + n * 3), at[i]);
     });
     pos.needsUpdate = true;
-    mesh.geometry.computeVertexNormals();
+    computeVertexNormals(mesh.geometry);
     this.ids = header.frame_ids[f];
     $('stopmo-ids').textContent = `frame ${f} pieces: ${this.ids.join(' · ')}`;
     this.studio.view.dirty = true;

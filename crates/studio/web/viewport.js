@@ -3,6 +3,7 @@
 // an orbit camera, and an orthographic action camera for drawing lines of action.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { computeVertexNormals } from './normals.js';
 
 const BASE = new THREE.Color(0.78, 0.78, 0.8);
 
@@ -107,7 +108,7 @@ export class Viewport {
       g.setAttribute('skinIndex', new THREE.BufferAttribute(Uint16Array.from(b.index), 4));
       g.setAttribute('skinWeight', new THREE.BufferAttribute(b.weight, 4));
       g.setIndex(new THREE.BufferAttribute(skinned.triangles, 1));
-      g.computeVertexNormals();
+      computeVertexNormals(g);
       // One bone per node of the pose, its world matrix set from the answer (not from a
       // scene graph); the palette repeats a bone under each mesh's inverse bind matrix.
       this.bones = Array.from({ length: skinned.nodes }, () => {
@@ -173,7 +174,7 @@ export class Viewport {
       const a = this.anim;
       pos.array.set(a.frameAt ? a.frameAt(this.frame) : a.positions.subarray(this.frame * n, (this.frame + 1) * n));
       pos.needsUpdate = true;
-      this.mesh.geometry.computeVertexNormals();
+      computeVertexNormals(this.mesh.geometry);
       this.mesh.geometry.computeBoundingSphere();
     }
     this.updateColors();
@@ -243,7 +244,7 @@ export class Viewport {
     const col = g.attributes.color.array;
     for (let i = 0; i < n; i++) { col[i * 4] = 0.8; col[i * 4 + 1] = 0.8; col[i * 4 + 2] = 0.8; col[i * 4 + 3] = fr.alpha[i]; }
     g.attributes.position.needsUpdate = true; g.attributes.color.needsUpdate = true;
-    g.computeVertexNormals();
+    computeVertexNormals(g);
   }
 
   /** Motion lines: [{frames: [{positions, triangles}]}] — one mesh per clip frame. */

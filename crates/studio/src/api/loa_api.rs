@@ -20,7 +20,7 @@ use loa::job;
 use serde::Deserialize;
 use serde_json::{json, Value};
 
-use super::loa_skin::Binding;
+use super::loa_skin::{Binding, CheckedSkin};
 use super::{blocking, body, on_core_pool};
 use crate::error::{ApiError, ApiResult};
 use crate::files::{merged, output_path};
@@ -56,6 +56,7 @@ fn character(studio: &Studio, file: usize, fps: f64) -> ApiResult<Arc<LoaCharact
         camera: ActionCamera::front_fitted(lo, hi),
         vertices: scene.meshes.iter().map(|m| m.mesh.vertex_count()).sum(),
         character,
+        skin: std::sync::OnceLock::new(),
     });
     lock(&studio.characters).insert(file, prepared.clone());
     Ok(prepared)
@@ -219,10 +220,18 @@ pub(crate) async fn animate(
             canvas: Some([r.width, r.height]),
             ..Default::default()
         };
-        let character = &prepared.character;
-        let want_pose = r.skin.is_some();
-        let motion = on_core_pool(|| follow(scene, character, line, &options, fps, label, want_pose))?;
-        let Motion { done, merged: m, pose } = motion;
+        // The pose serves a whole-motion answer to a page that skins (a one-frame answer
+        // sends that frame's positions).
+        let want_pose = r.skin.is_some() && r.frame.is_none();
+        let motion = on_core_pool(|| follow(scene, &prepared, line, &options, want_pose))?;
+        let Motion {
+            done,
+            merged,
+            pose,
+            frames: motion_frames,
+            vertices,
+            triangles,
+        } = motion;
         let (motion, line) = (&done.motion, &done.line);
         let animate_seconds = start.elapsed().as_secs_f64() - line_seconds;
 
@@ -236,12 +245,12 @@ pub(crate) async fn animate(
                 .iter()
                 .flat_map(|f| f.chain.joints().into_iter().flat_map(|p| [p.x as f32, p.y as f32])),
         );
-        pack.u32("triangles", m.mesh.triangles.iter().flatten().copied());
-        let motion_frames = m.frame_count();
+        pack.u32("triangles", triangles.iter().flatten().copied());
         let mut skin = Value::Null;
-        let shown = match (r.frame, pose) {
+        let shown = match (r.frame, pose, &merged) {
             // The skeleton's pose for every frame; the binding when the page lacks it.
-            (None, Some((binding, world))) => {
+            (None, Some((checked, world)), _) => {
+                let binding = &checked.binding;
                 if r.skin.as_deref() != Some(binding.id.as_str()) {
                     binding.pack(&mut pack);
                 }
@@ -249,17 +258,19 @@ pub(crate) async fn animate(
                 skin = json!({"id": binding.id, "nodes": binding.node_count()});
                 0..motion_frames
             }
-            (Some(f), _) => {
+            (Some(f), _, Some(m)) => {
                 let k = (f - motion.first_frame).clamp(0, motion_frames.max(1) as i64 - 1) as usize;
                 pack.f32_slices("positions", [coordinates(m.frame(k))]);
                 k..k + 1
             }
             // The whole motion in this answer: sent from the session's copy, not another.
-            (None, None) => {
+            (None, None, Some(m)) => {
                 pack.shared("positions", m.clone(), |m| coordinates(m.positions()));
                 0..motion_frames
             }
+            _ => return Err(ApiError::internal("the motion was neither sampled nor posed")),
         };
+        let sampled_vertices = merged.is_some();
         let mut session = lock(&studio.loa);
         let version = session.as_ref().map_or(1, |s| s.version + 1);
         let rep = &motion.report;
@@ -272,12 +283,15 @@ pub(crate) async fn animate(
             },
             "motion": {
                 "first_frame": motion.first_frame,
-                "frames": m.frame_count(),
-                "vertices": m.vertex_count(),
+                "frames": motion_frames,
+                "vertices": vertices,
                 "fps": motion.fps,
                 "positions_first": shown.start,
                 "positions_frames": shown.len(),
                 "skin": skin,
+                // Whether every vertex was sampled for this answer (not when the character's
+                // binding was checked by an earlier stroke and the pose is sent).
+                "sampled_vertices": sampled_vertices,
             },
             "version": version,
             "warnings": line.warnings,
@@ -295,7 +309,7 @@ pub(crate) async fn animate(
             file: r.file,
             keys,
             keys_json: keys_json.to_string(),
-            merged: m,
+            merged: merged.map(std::sync::OnceLock::from).unwrap_or_default(),
             version,
             done,
         });
@@ -304,56 +318,91 @@ pub(crate) async fn animate(
     .await
 }
 
-/// The motion of a stroke: the core's result, the character's meshes merged over every
-/// motion frame, and the skeleton's pose per frame with its binding when the page asked for
-/// it and skinning reproduces the merged meshes ([`Binding::pose`]).
+/// The motion of a stroke: the core's result, its frame and vertex counts and triangles,
+/// the character's meshes merged over every motion frame (unless the pose is sent: sampled
+/// on first use then), and the skeleton's pose per frame with the checked binding when the
+/// page asked for it and skinning reproduces the merged meshes ([`Binding::pose`]).
 struct Motion {
     done: job::SceneMotion,
-    merged: Arc<anim::MeshAnimation>,
-    pose: Option<(Binding, Vec<f32>)>,
+    merged: Option<Arc<anim::MeshAnimation>>,
+    pose: Option<(Arc<CheckedSkin>, Vec<f32>)>,
+    frames: usize,
+    vertices: usize,
+    triangles: Arc<Vec<[u32; 3]>>,
 }
 
-/// The character of `scene` following `line` (`loa::animate`), sampled at `fps` and merged,
-/// with the pose when `want_pose`: the stroke's computation, which takes no lock and waits on
-/// nothing (it runs on the core's pool, [`on_core_pool`]).
+/// The character of `scene` following `line` (`loa::animate`), sampled at the line's frame
+/// rate ([`motion_sampling`]): as the pose alone when `want_pose` and the character's binding was checked before, else every
+/// vertex merged, with the pose when `want_pose` and skinning reproduces it (the binding is
+/// then kept as checked). The stroke's computation: it takes no lock and waits on nothing
+/// (it runs on the core's pool, [`on_core_pool`]).
 fn follow(
     scene: &anim::Scene,
-    character: &Character,
+    prepared: &LoaCharacter,
     line: loa::Line,
     options: &job::SceneOptions,
-    fps: f64,
-    label: &str,
     want_pose: bool,
 ) -> ApiResult<Motion> {
-    let done = job::animate_character(scene, character, line, options).map_err(|e| {
+    let label = &prepared.label;
+    let refused = |e: anim::AnimError| {
+        let over = matches!(e, anim::AnimError::OverBudget(_));
+        ApiError::refused(format!("{label}: {e}"), over)
+    };
+    let done = job::animate_character(scene, &prepared.character, line, options).map_err(|e| {
         let over = e.over_budget();
         ApiError::refused(format!("{label}: {e}"), over)
     })?;
     let out = &done.scene;
-    let clip = out
-        .find_clip(loa::animate::CLIP_NAME)
-        .map_err(|e| ApiError::internal(e.to_string()))?;
-    let sampled = anim::sample(
-        out,
-        &anim::SampleOptions {
-            fps: fps as f32,
-            clip: Some(clip),
-            meshes: Vec::new(),
-        },
-    )
-    .map_err(|e| {
-        let over = matches!(e, anim::AnimError::OverBudget(_));
-        ApiError::refused(format!("{label}: {e}"), over)
-    })?;
+    let sampling = motion_sampling(&done)?;
+    if let Some(checked) = prepared.skin.get().filter(|_| want_pose) {
+        let (frames, node_world) = anim::sample_node_world(out, &sampling).map_err(refused)?;
+        if let Some(world) = checked.binding.world(&node_world, frames) {
+            return Ok(Motion {
+                done,
+                merged: None,
+                pose: Some((checked.clone(), world)),
+                frames,
+                vertices: checked.binding.vertex_count(),
+                triangles: checked.triangles.clone(),
+            });
+        }
+    }
+    let sampled = anim::sample(out, &sampling).map_err(refused)?;
     let m = merged(label, &sampled)?;
     let pose = want_pose
         .then(|| Binding::new(out, &sampled))
         .flatten()
-        .and_then(|b| b.pose(&sampled, &m).map(|w| (b, w)));
+        .and_then(|b| b.pose(&sampled, &m).map(|w| (b, w)))
+        .map(|(binding, world)| {
+            let checked = Arc::new(CheckedSkin {
+                binding,
+                triangles: Arc::new(m.mesh.triangles.clone()),
+            });
+            // Another stroke may have checked it meanwhile: either is the same binding.
+            let _ = prepared.skin.set(checked.clone());
+            (checked, world)
+        });
     Ok(Motion {
+        frames: m.frame_count(),
+        vertices: m.vertex_count(),
+        triangles: Arc::new(m.mesh.triangles.clone()),
         done,
-        merged: Arc::new(m),
+        merged: Some(Arc::new(m)),
         pose,
+    })
+}
+
+/// How the motion's clip is sampled: the synthesized clip of `done`'s scene at the line's
+/// frame rate, every mesh.
+fn motion_sampling(done: &job::SceneMotion) -> ApiResult<anim::SampleOptions> {
+    let clip = done
+        .scene
+        .find_clip(loa::animate::CLIP_NAME)
+        .map_err(|e| ApiError::internal(e.to_string()))?;
+    Ok(anim::SampleOptions {
+        fps: done.motion.fps as f32,
+        clip: Some(clip),
+        meshes: Vec::new(),
     })
 }
 
@@ -364,23 +413,64 @@ pub(crate) async fn motion(
     Query(q): Query<MotionQuery>,
 ) -> ApiResult<Response> {
     blocking(move || {
+        // The memory of sampling the motion, when the answer sent the pose, is reserved
+        // before the session is locked again (a stroke holding memory waits for that lock).
+        let sampling = {
+            let guard = lock(&studio.loa);
+            let s = current(&guard, q.version)?;
+            let vertices = s
+                .done
+                .scene
+                .meshes
+                .iter()
+                .map(|m| m.mesh.vertex_count())
+                .sum();
+            s.merged
+                .get()
+                .is_none()
+                .then(|| (s.file, s.done.motion.frames(), vertices))
+        };
+        let _held = match sampling {
+            Some((file, frames, vertices)) => {
+                Some(studio.reserve(file, &anim::SampledScene::merged_memory(frames, vertices))?)
+            }
+            None => None,
+        };
         let guard = lock(&studio.loa);
-        let s = guard
-            .as_ref()
-            .ok_or_else(|| ApiError::conflict("no line yet: draw keystrokes first"))?;
-        if s.version != q.version {
-            return Err(ApiError::conflict(format!(
-                "motion {} was replaced by motion {}",
-                q.version, s.version
-            )));
-        }
+        let s = current(&guard, q.version)?;
+        let merged = match s.merged.get() {
+            Some(m) => m.clone(),
+            // The answer sent the pose: the core's positions are sampled now, once.
+            None => {
+                let label = studio.file(s.file)?.label();
+                let sampled =
+                    anim::sample(&s.done.scene, &motion_sampling(&s.done)?).map_err(|e| {
+                        let over = matches!(e, anim::AnimError::OverBudget(_));
+                        ApiError::refused(format!("{label}: {e}"), over)
+                    })?;
+                let m = Arc::new(merged(&label, &sampled)?);
+                s.merged.get_or_init(|| m).clone()
+            }
+        };
         let mut pack = Pack::new();
-        pack.shared("positions", s.merged.clone(), |m| {
-            coordinates(m.positions())
-        });
+        pack.shared("positions", merged, |m| coordinates(m.positions()));
         Ok(pack.response(json!({ "version": s.version })))
     })
     .await
+}
+
+/// The session of the animate answer `version`: none yet or a newer one → 409.
+fn current(session: &Option<LoaSession>, version: u64) -> ApiResult<&LoaSession> {
+    let s = session
+        .as_ref()
+        .ok_or_else(|| ApiError::conflict("no line yet: draw keystrokes first"))?;
+    if s.version != version {
+        return Err(ApiError::conflict(format!(
+            "motion {version} was replaced by motion {}",
+            s.version
+        )));
+    }
+    Ok(s)
 }
 
 /// `GET /api/loa/line`: the last line in the CLI's JSON layout (`toonkit loa line -o x.json`).

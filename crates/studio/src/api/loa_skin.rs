@@ -114,26 +114,36 @@ impl Binding {
         })
     }
 
-    /// The world matrices of [`Binding::nodes`] for every frame of `sampled` (frame-major,
-    /// column-major 4 × 4), when skinning with them reproduces `merged` within
-    /// [`MAX_SKINNING_ERROR`] of its diagonal on every frame (a morph target or another
-    /// deformation the pose does not carry: `None`).
-    pub(crate) fn pose(&self, sampled: &SampledScene, merged: &MeshAnimation) -> Option<Vec<f32>> {
-        let frames = merged.frame_count();
-        let all = sampled.node_world.len() / frames.max(1);
-        if self.rest.len() != merged.vertex_count() || all * frames != sampled.node_world.len() {
+    /// The world matrices of [`Binding::nodes`] for every frame of `node_world` (every
+    /// scene node per frame, frame-major, as `anim` samples them), frame-major, column-major
+    /// 4 × 4; `None` when `node_world` does not hold `frames` whole frames or lacks a node.
+    pub(crate) fn world(&self, node_world: &[Mat4], frames: usize) -> Option<Vec<f32>> {
+        let all = node_world.len() / frames.max(1);
+        if frames == 0 || all * frames != node_world.len() {
             return None;
         }
         let mut world = Vec::with_capacity(frames * self.nodes.len() * 16);
         for f in 0..frames {
             for n in &self.nodes {
                 let m = match n {
-                    Some(n) => *sampled.node_world.get(f * all + n)?,
+                    Some(n) => (*n < all).then(|| node_world[f * all + n])?,
                     None => Mat4::IDENTITY,
                 };
                 world.extend_from_slice(&m.to_cols_array());
             }
         }
+        Some(world)
+    }
+
+    /// [`Binding::world`] of `sampled`'s frames, when skinning with it reproduces `merged`
+    /// within [`MAX_SKINNING_ERROR`] of its diagonal on every frame (a morph target or
+    /// another deformation the pose does not carry: `None`).
+    pub(crate) fn pose(&self, sampled: &SampledScene, merged: &MeshAnimation) -> Option<Vec<f32>> {
+        let frames = merged.frame_count();
+        if self.rest.len() != merged.vertex_count() {
+            return None;
+        }
+        let world = self.world(&sampled.node_world, frames)?;
         let bounds = merged.bbox();
         let tolerance = MAX_SKINNING_ERROR * (bounds.max - bounds.min).length();
         let exact = (0..frames).into_par_iter().all(|f| {
@@ -179,6 +189,25 @@ impl Binding {
     pub(crate) fn node_count(&self) -> usize {
         self.nodes.len()
     }
+
+    /// Vertices of the merged meshes it skins.
+    pub(crate) fn vertex_count(&self) -> usize {
+        self.rest.len()
+    }
+}
+
+/// A character's binding once [`Binding::pose`] found that skinning reproduces the core's
+/// positions, with the merged meshes' triangles. What makes the check pass — every mesh
+/// skinned by node matrices alone, at most [`MAX_INFLUENCES`] influences, no morph target
+/// away from its rest weight — belongs to the file, not to a pose: a line-of-action motion
+/// keys only the skeleton's nodes (`loa::animate::CLIP_NAME`), so the character's later
+/// motions are sent as the pose without sampling and checking every vertex again.
+#[derive(Debug)]
+pub(crate) struct CheckedSkin {
+    /// The binding.
+    pub(crate) binding: Binding,
+    /// The merged meshes' triangles (the answers' `triangles`).
+    pub(crate) triangles: std::sync::Arc<Vec<[u32; 3]>>,
 }
 
 /// FNV-1a of `bytes` (names a binding; not a security measure).

@@ -31,6 +31,8 @@ mod smear_api;
 mod stopmo_api;
 mod stopmo_library;
 
+pub(crate) use loa_skin::CheckedSkin;
+
 use std::sync::Arc;
 
 use axum::body::Bytes;
