@@ -35,6 +35,7 @@ pub mod error;
 pub mod files;
 pub mod guard;
 pub mod jobs;
+mod loa_skin;
 mod lock;
 pub mod memory;
 pub mod pack;

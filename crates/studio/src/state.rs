@@ -50,9 +50,9 @@ pub struct LoaCharacter {
     /// Vertices of the file's meshes (as `anim::sample` counts them).
     pub vertices: usize,
     /// The skin binding, once a stroke's motion showed that skinning it with the pose
-    /// reproduces the core's positions (`api::loa_skin`): later strokes send the pose
+    /// reproduces the core's positions (`loa_skin`): later strokes send the pose
     /// without sampling every vertex again.
-    pub(crate) skin: std::sync::OnceLock<Arc<crate::api::CheckedSkin>>,
+    pub(crate) skin: std::sync::OnceLock<Arc<crate::loa_skin::CheckedSkin>>,
 }
 
 /// The last segmentation of the stopmo panel, its size curve and the library built from it

@@ -90,7 +90,7 @@ export class Viewport {
 
   /**
    * Shows a motion the renderer skins (three.js SkinnedMesh, linear blend skinning):
-   * {triangles, binding: {rest, index, weight, node, inverse} (crates/studio/src/api/loa_skin.rs),
+   * {triangles, binding: {rest, index, weight, node, inverse} (crates/studio/src/loa_skin.rs),
    * world (frames × nodes × 16, column-major), nodes, frames, vertices}. The mesh and its
    * buffers stay on the GPU while the binding and triangles are the same: a new motion
    * uploads only the bone matrices of the frame shown.

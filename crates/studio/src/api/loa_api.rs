@@ -20,10 +20,10 @@ use loa::job;
 use serde::Deserialize;
 use serde_json::{json, Value};
 
-use super::loa_skin::{Binding, CheckedSkin};
 use super::{blocking, body, on_core_pool};
 use crate::error::{ApiError, ApiResult};
 use crate::files::{merged, output_path};
+use crate::loa_skin::{Binding, CheckedSkin};
 use crate::pack::{coordinates, Pack};
 use crate::state::{lock, LoaCharacter, LoaSession, Studio};
 

@@ -24,14 +24,11 @@
 
 mod changes;
 mod loa_api;
-mod loa_skin;
 mod scene;
 mod shown;
 mod smear_api;
 mod stopmo_api;
 mod stopmo_library;
-
-pub(crate) use loa_skin::CheckedSkin;
 
 use std::sync::Arc;
 

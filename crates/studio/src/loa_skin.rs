@@ -3,8 +3,9 @@
 //! glTF viewer does), from a binding sent once per character (rest positions, up to four
 //! influences per vertex over a palette of node × inverse bind) and, per answer, the world
 //! matrices of the palette's nodes for every motion frame (a few hundred KB instead of MBs).
-//! The motion is checked against the core's skinned positions before it is sent this way
-//! (docs/studio.md, "Whole clips").
+//! A character's motion is checked against the core's skinned positions before it is first
+//! sent this way; the binding is then kept as checked for the file's later motions
+//! ([`CheckedSkin`]; docs/studio.md, "Loa: the skeleton's pose, skinned by the renderer").
 
 use anim::glam::{Mat4, Vec3, Vec4};
 use anim::{MeshAnimation, SampledScene, Scene};
