@@ -344,10 +344,7 @@ fn follow(
     want_pose: bool,
 ) -> ApiResult<Motion> {
     let label = &prepared.label;
-    let refused = |e: anim::AnimError| {
-        let over = matches!(e, anim::AnimError::OverBudget(_));
-        ApiError::refused(format!("{label}: {e}"), over)
-    };
+    let refused = |e| sampling_refused(label, e);
     let done = job::animate_character(scene, &prepared.character, line, options).map_err(|e| {
         let over = e.over_budget();
         ApiError::refused(format!("{label}: {e}"), over)
@@ -369,6 +366,7 @@ fn follow(
     }
     let sampled = anim::sample(out, &sampling).map_err(refused)?;
     let m = merged(label, &sampled)?;
+    let triangles = Arc::new(m.mesh.triangles.clone());
     let pose = want_pose
         .then(|| Binding::new(out, &sampled))
         .flatten()
@@ -376,7 +374,7 @@ fn follow(
         .map(|(binding, world)| {
             let checked = Arc::new(CheckedSkin {
                 binding,
-                triangles: Arc::new(m.mesh.triangles.clone()),
+                triangles: triangles.clone(),
             });
             // Another stroke may have checked it meanwhile: either is the same binding.
             let _ = prepared.skin.set(checked.clone());
@@ -385,11 +383,17 @@ fn follow(
     Ok(Motion {
         frames: m.frame_count(),
         vertices: m.vertex_count(),
-        triangles: Arc::new(m.mesh.triangles.clone()),
+        triangles,
         done,
         merged: Some(Arc::new(m)),
         pose,
     })
+}
+
+/// A sampling error of `label`'s motion: 413 when over a budget, else 400.
+fn sampling_refused(label: &str, e: anim::AnimError) -> ApiError {
+    let over = matches!(e, anim::AnimError::OverBudget(_));
+    ApiError::refused(format!("{label}: {e}"), over)
 }
 
 /// How the motion's clip is sampled: the synthesized clip of `done`'s scene at the line's
@@ -443,11 +447,8 @@ pub(crate) async fn motion(
             // The answer sent the pose: the core's positions are sampled now, once.
             None => {
                 let label = studio.file(s.file)?.label();
-                let sampled =
-                    anim::sample(&s.done.scene, &motion_sampling(&s.done)?).map_err(|e| {
-                        let over = matches!(e, anim::AnimError::OverBudget(_));
-                        ApiError::refused(format!("{label}: {e}"), over)
-                    })?;
+                let sampled = anim::sample(&s.done.scene, &motion_sampling(&s.done)?)
+                    .map_err(|e| sampling_refused(&label, e))?;
                 let m = Arc::new(merged(&label, &sampled)?);
                 s.merged.get_or_init(|| m).clone()
             }
