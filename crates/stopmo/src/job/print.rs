@@ -193,6 +193,8 @@ pub(crate) fn print_pieces(
             },
             s,
         ));
+        // The ID sits at the same place on every piece of the part.
+        let id_frame = shell.id_frame(&id_keys);
         let made: Vec<Made> = (0..pieces_mm.len())
             .into_par_iter()
             .map(|k| -> Result<Made> {
@@ -202,13 +204,12 @@ pub(crate) fn print_pieces(
                 } else {
                     Bitmap::default()
                 };
-                let solid = shell.solid_with_id(
+                let solid = shell.solid_with_id_at(
                     &pieces_mm[k],
                     &surface.name,
                     &id,
-                    pixel,
-                    DEFAULT_ID_RELIEF_MM,
-                    &id_keys,
+                    (pixel, DEFAULT_ID_RELIEF_MM),
+                    id_frame,
                 )?;
                 // Measured on what is written (keys and ID included), not assumed: a
                 // coordinate beyond the exact test's range counts every triangle.
@@ -216,7 +217,9 @@ pub(crate) fn print_pieces(
                     self_intersecting_triangles(&m.positions, &m.triangles)
                         .map_or(m.triangles.len(), |t| t.len())
                 };
-                let built = count(&solid);
+                let built = shell
+                    .solid_crossings(&solid)
+                    .unwrap_or(solid.triangles.len());
                 let surface_crossing = if built > 0 {
                     shell.surface_crossings(&pieces_mm[k])
                 } else {

@@ -2,6 +2,8 @@
 
 use std::collections::HashMap;
 
+use rustc_hash::FxHashMap;
+
 use anim::Mesh;
 use glam::Vec3;
 use serde::Serialize;
@@ -195,8 +197,12 @@ impl SolidCheck {
 }
 
 /// Counts the defects that keep a triangle mesh from being a closed, oriented 2-manifold.
+///
+/// # Performance
+/// Two hash maps keyed by vertex pairs, with a fast non-cryptographic hash (the keys are the
+/// mesh's own indices): every printed piece is checked.
 pub fn check_solid(mesh: &Mesh) -> SolidCheck {
-    let mut edges: HashMap<(u32, u32), (usize, usize)> = HashMap::new();
+    let mut edges: FxHashMap<(u32, u32), (usize, usize)> = FxHashMap::default();
     for t in &mesh.triangles {
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
@@ -223,7 +229,7 @@ pub fn check_solid(mesh: &Mesh) -> SolidCheck {
         }
     }
     // Vertex fans: the triangles around v, linked through shared edges, must form one cycle.
-    let mut next: HashMap<(u32, u32), u32> = HashMap::new(); // (v, a) -> b for triangle v→a→b
+    let mut next: FxHashMap<(u32, u32), u32> = FxHashMap::default(); // (v, a) -> b for v→a→b
     let mut fan = vec![0usize; mesh.positions.len()];
     for t in &mesh.triangles {
         for k in 0..3 {

@@ -260,13 +260,23 @@ impl<'a> TriangleGrid<'a> {
     /// nearest distance d. Folding a minimum over many points with the running minimum as
     /// `limit` (as [`PartShell::min_wall`](super::PartShell::min_wall) does) keeps every query
     /// after the first to a few rings.
+    ///
+    /// A triangle whose box is farther than `limit` is not measured at all: over a thick
+    /// wall most queries find nothing below it, and answer after box tests alone.
     pub fn distance_below(&self, p: Vec3, limit: f64) -> f64 {
-        self.nearest_below(p, limit).0
+        self.nearest_within(p, limit, true).0
     }
 
     /// [`TriangleGrid::distance_below`] and the nearest triangle (`None` when none was
-    /// found below `limit`).
+    /// found below `limit`). Above `limit`, what is returned is the nearest of the
+    /// triangles measured on the way (callers weigh such near misses).
     pub(crate) fn nearest_below(&self, p: Vec3, limit: f64) -> (f64, Option<u32>) {
+        self.nearest_within(p, limit, false)
+    }
+
+    /// [`TriangleGrid::nearest_below`]; with `cut`, triangles whose boxes are farther than
+    /// `limit` are skipped too (the answer below `limit` is the same).
+    fn nearest_within(&self, p: Vec3, limit: f64, cut: bool) -> (f64, Option<u32>) {
         if self.triangles.is_empty() {
             return (f64::INFINITY, None);
         }
@@ -285,7 +295,8 @@ impl<'a> TriangleGrid<'a> {
             for &t in list {
                 let (lo, hi) = self.boxes[t as usize];
                 let gap = (lo - p).max(p - hi).max(Vec3::ZERO).length();
-                if f64::from(gap) > best.0 + f64::from(slack) {
+                let reach = if cut { best.0.min(limit) } else { best.0 };
+                if f64::from(gap) > reach + f64::from(slack) {
                     continue;
                 }
                 let [a, b, c] = self.triangles[t as usize].map(|v| self.positions[v as usize]);

@@ -313,6 +313,23 @@ impl PartShell {
         relief_mm: f64,
         keys: &[Key],
     ) -> Result<anim::Mesh> {
+        self.solid_with_id_at(piece, name, id, (pixel_mm, relief_mm), self.id_frame(keys))
+    }
+
+    /// [`PartShell::solid_with_id`] with the ID's centre and reading frame given
+    /// ([`PartShell::id_frame`] of the keys, the same for every piece of the part: found
+    /// once), and its pixel width and relief as `(pixel_mm, relief_mm)`.
+    ///
+    /// # Errors
+    /// As [`PartShell::solid_with_id`].
+    pub fn solid_with_id_at(
+        &self,
+        piece: &[Vec3],
+        name: &str,
+        id: &Bitmap,
+        (pixel_mm, relief_mm): (f64, f64),
+        (c, u, w): (Vec3, Vec3, Vec3),
+    ) -> Result<anim::Mesh> {
         if !(pixel_mm.is_finite() && pixel_mm > 0.0 && relief_mm.is_finite() && relief_mm >= 0.0) {
             return Err(LibraryError::InvalidParameter(format!(
                 "ID pixel must be > 0 and relief >= 0 mm, got {pixel_mm} and {relief_mm}"
@@ -320,7 +337,6 @@ impl PartShell {
         }
         let mut shell = self.clone();
         if id.width > 0 && id.height > 0 && relief_mm > 0.0 {
-            let (c, u, w) = self.id_frame(keys);
             let px = pixel_mm as f32;
             let (half_w, half_h) = (id.width as f32 * px / 2.0, id.height as f32 * px / 2.0);
             let relief = relief_mm as f32;
@@ -337,7 +353,7 @@ impl PartShell {
     }
 
     /// Centre and reading frame (right, up) of the ID on the back surface, seen from behind.
-    pub(crate) fn id_frame(&self, keys: &[Key]) -> (Vec3, Vec3, Vec3) {
+    pub fn id_frame(&self, keys: &[Key]) -> (Vec3, Vec3, Vec3) {
         let back = self.back();
         let from_boundary = distances(back, &self.boundary_points());
         let centres: Vec<Vec3> = keys.iter().map(|k| Vec3::from_array(k.center)).collect();

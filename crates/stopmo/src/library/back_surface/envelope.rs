@@ -3,6 +3,8 @@
 //! direction, so a back surface that leaves the wall under the nose tip does not pass through
 //! the nostrils behind it, nor one under a lip through the mouth corner.
 
+use std::ops::Range;
+
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -12,16 +14,21 @@ use crate::library::nearest::floor_i32;
 /// beyond it, whatever its direction.
 const CELLS_PER_LATERAL: f32 = 2.0;
 
+/// Points a column test handles at once: 16 `f32` lanes (one AVX-512 or two AVX2 registers).
+const LANES: usize = 16;
+
 /// Every front point of every piece binned in a uniform grid, each cell's points stored
-/// contiguously (cell-major), for the column queries of [`envelope_limits`].
+/// contiguously (cell-major) and by coordinate (`x`, `y`, `z` apart, so that the column
+/// test runs over many points per instruction), for the column queries of
+/// [`envelope_limits`].
 struct PointGrid {
     lo: Vec3,
     cell: f32,
     dims: [i32; 3],
-    /// Start of every cell's points in `points` (cell `x + dims[0]·(y + dims[1]·z)`), plus
-    /// the end.
+    /// Start of every cell's points (cell `x + dims[0]·(y + dims[1]·z)`), plus the end.
     start: Vec<u32>,
-    points: Vec<Vec3>,
+    /// The points' coordinates, in cell order.
+    xyz: [Vec<f32>; 3],
 }
 
 impl PointGrid {
@@ -55,7 +62,7 @@ impl PointGrid {
             cell,
             dims,
             start: Vec::new(),
-            points: Vec::new(),
+            xyz: [Vec::new(), Vec::new(), Vec::new()],
         };
         let cells = dims.iter().map(|&d| d as usize).product::<usize>();
         let mut count = vec![0u32; cells + 1];
@@ -66,12 +73,15 @@ impl PointGrid {
             count[i + 1] += count[i];
         }
         let mut next = count.clone();
-        grid.points = vec![Vec3::ZERO; count[cells] as usize];
+        let mut xyz = [0; 3].map(|_| vec![0.0; count[cells] as usize]);
         for p in all() {
             let slot = &mut next[grid.index(p)];
-            grid.points[*slot as usize] = p;
+            for (axis, value) in xyz.iter_mut().zip(p.to_array()) {
+                axis[*slot as usize] = value;
+            }
             *slot += 1;
         }
+        grid.xyz = xyz;
         grid.start = count;
         grid
     }
@@ -87,16 +97,73 @@ impl PointGrid {
         (x + self.dims[0] * (y + self.dims[1] * z)) as usize
     }
 
-    /// The points of every cell that meets the box `lo..=hi`.
-    fn in_box(&self, lo: Vec3, hi: Vec3) -> impl Iterator<Item = &[Vec3]> + '_ {
+    /// The points of every cell that meets the box `lo..=hi`, as ranges of indices (one per
+    /// row of cells along x).
+    fn in_box(&self, lo: Vec3, hi: Vec3) -> impl Iterator<Item = Range<usize>> + '_ {
         let (a, b) = (self.coords(lo), self.coords(hi));
         (a[2]..=b[2]).flat_map(move |z| {
             (a[1]..=b[1]).map(move |y| {
                 let row = self.dims[0] * (y + self.dims[1] * z);
                 let (s, e) = ((row + a[0]) as usize, (row + b[0]) as usize + 1);
-                &self.points[self.start[s] as usize..self.start[e] as usize]
+                self.start[s] as usize..self.start[e] as usize
             })
         })
+    }
+}
+
+/// One column: its centre `c`, unit direction `d`, how deep (`reach`) and how far up and
+/// sideways (`lateral`) it goes.
+#[derive(Clone, Copy)]
+struct Column {
+    c: Vec3,
+    d: Vec3,
+    reach: f32,
+    lateral: f32,
+}
+
+impl Column {
+    /// The smallest `q·d` of `lowest` and the points `q` (coordinates `x`, `y`, `z`) inside
+    /// the column.
+    ///
+    /// Every point goes through the same operations in the same order as glam's `Vec3`
+    /// (`e = q − c`, `h = e·d`, `|e − d h|²`, `q·d`), lane by lane, so the minimum is the one
+    /// a point-by-point loop over `Vec3`s finds.
+    #[inline]
+    fn lowest(&self, x: &[f32], y: &[f32], z: &[f32], lowest: f32) -> f32 {
+        let mut acc = [lowest; LANES];
+        let (xs, ys, zs) = (
+            x.chunks_exact(LANES),
+            y.chunks_exact(LANES),
+            z.chunks_exact(LANES),
+        );
+        let tail = (xs.remainder(), ys.remainder(), zs.remainder());
+        for ((x, y), z) in xs.zip(ys).zip(zs) {
+            for l in 0..LANES {
+                acc[l] = self.lower(acc[l], x[l], y[l], z[l]);
+            }
+        }
+        let mut lowest = acc.into_iter().fold(f32::INFINITY, f32::min);
+        for ((&x, &y), &z) in tail.0.iter().zip(tail.1).zip(tail.2) {
+            lowest = self.lower(lowest, x, y, z);
+        }
+        lowest
+    }
+
+    /// `lowest`, or `q·d` when the point `q = (x, y, z)` is inside the column and lower.
+    #[inline(always)]
+    fn lower(&self, lowest: f32, x: f32, y: f32, z: f32) -> f32 {
+        let (c, d) = (self.c, self.d);
+        let (ex, ey, ez) = (x - c.x, y - c.y, z - c.z);
+        let h = ex * d.x + ey * d.y + ez * d.z;
+        let (sx, sy, sz) = (ex - d.x * h, ey - d.y * h, ez - d.z * h);
+        let side = sx * sx + sy * sy + sz * sz;
+        let inside = !(h < -self.reach || h > self.lateral) && side <= self.lateral * self.lateral;
+        let q = x * d.x + y * d.y + z * d.z;
+        if inside {
+            lowest.min(q)
+        } else {
+            lowest
+        }
     }
 }
 
@@ -108,7 +175,8 @@ impl PointGrid {
 /// # Performance
 /// The points of all pieces in one flat grid of cells half a column radius wide; each
 /// vertex reads the cells of its column's bounding box only (a minimum: which cells are
-/// read does not change it, as long as they hold the whole column).
+/// read does not change it, as long as they hold the whole column), [`LANES`] points at a
+/// time.
 pub(super) fn envelope_limits(
     average: &[Vec3],
     fronts: &[Vec<Vec3>],
@@ -128,17 +196,15 @@ pub(super) fn envelope_limits(
             // (`d` unit): its box, with a margin for rounding.
             let (deep, high) = (c - d * reach, c + d * lateral);
             let pad = Vec3::splat(lateral * 1.01 + 1e-3);
-            for list in grid.in_box(deep.min(high) - pad, deep.max(high) + pad) {
-                for &q in list {
-                    let e = q - c;
-                    let h = e.dot(d);
-                    if h < -reach || h > lateral {
-                        continue;
-                    }
-                    if (e - d * h).length_squared() <= lateral * lateral {
-                        lowest = lowest.min(q.dot(d));
-                    }
-                }
+            let column = Column {
+                c,
+                d,
+                reach,
+                lateral,
+            };
+            let [x, y, z] = &grid.xyz;
+            for r in grid.in_box(deep.min(high) - pad, deep.max(high) + pad) {
+                lowest = column.lowest(&x[r.clone()], &y[r.clone()], &z[r], lowest);
             }
             lowest - wall
         })

@@ -5,10 +5,8 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::{front_positions, PartShell};
-use crate::library::intersect::{
-    intersecting_pairs, intersecting_pairs_touching, self_intersecting_triangles,
-};
+use super::{front_positions, position_key, PartShell};
+use crate::library::intersect::{intersecting_pairs_touching, self_intersecting_triangles};
 use crate::library::nearest::TriangleGrid;
 
 /// Where a shell's wall is thinnest ([`PartShell::thinnest_wall`]).
@@ -58,12 +56,15 @@ impl PartShell {
     pub fn thinnest_wall(&self, pieces: &[&[Vec3]]) -> Option<ThinnestWall> {
         let grid = TriangleGrid::new(&self.back, &self.triangles);
         let (first, rest) = pieces.split_first()?;
-        let (head, _) = self.thinnest_in(&grid, 0, first, f64::INFINITY, None);
+        let (head, _) = self.thinnest_in(&grid, 0, &self.front(first), f64::INFINITY, None);
         let limit = head.map_or(f64::INFINITY, |t| t.mm);
         let tail: Vec<Option<ThinnestWall>> = rest
             .par_iter()
             .enumerate()
-            .map(|(k, piece)| self.thinnest_in(&grid, k + 1, piece, limit, None).0)
+            .map(|(k, piece)| {
+                let front = self.front(piece);
+                self.thinnest_in(&grid, k + 1, &front, limit, None).0
+            })
             .collect();
         first_thinnest(std::iter::once(head).chain(tail))
     }
@@ -81,16 +82,19 @@ impl PartShell {
         let Some((first, rest)) = pieces.split_first() else {
             return Vec::new();
         };
-        let (head, at) = self.thinnest_in(&grid, 0, first, f64::INFINITY, None);
+        let (head, at) = self.thinnest_in(&grid, 0, &self.front(first), f64::INFINITY, None);
         let tail: Vec<Option<ThinnestWall>> = rest
             .par_iter()
             .enumerate()
-            .map(|(k, piece)| self.thinnest_in(&grid, k + 1, piece, f64::INFINITY, at).0)
+            .map(|(k, piece)| {
+                let front = self.front(piece);
+                self.thinnest_in(&grid, k + 1, &front, f64::INFINITY, at).0
+            })
             .collect();
         std::iter::once(head).chain(tail).collect()
     }
 
-    /// The first front vertex of `piece` (index `k`) closest to the back surface (`grid`), if
+    /// The first vertex of the front of piece `k` closest to the back surface (`grid`), if
     /// closer than `limit`, and its index. With `seed`, that vertex is measured first and
     /// bounds the others' queries to just above its distance: which vertex is the first
     /// thinnest does not change (only queries that cannot win are cut short).
@@ -98,11 +102,10 @@ impl PartShell {
         &self,
         grid: &TriangleGrid<'_>,
         k: usize,
-        piece: &[Vec3],
+        front: &[Vec3],
         limit: f64,
         seed: Option<usize>,
     ) -> (Option<ThinnestWall>, Option<usize>) {
-        let front = self.front(piece);
         let mut limit = limit;
         if let Some(&p) = seed.and_then(|v| front.get(v)) {
             let d = grid.distance_below(p, limit);
@@ -154,56 +157,107 @@ impl PartShell {
     /// over the pieces.
     ///
     /// # Performance
-    /// The pieces share the back, the walls and every front vertex they agree on (the seams):
-    /// the pairs among triangles that are the same in every solid are tested once, and each
-    /// piece's solid only tests the pairs touching a triangle of its own.
+    /// The crossings among front triangles do not depend on the back: for the part's own
+    /// pieces (fronts equal bit for bit to those the shell was laid out with) they were found
+    /// once, for every direction field and repair round, and only the pairs touching the
+    /// back are tested here.
     pub(super) fn crossings(&self, pieces: &[&[Vec3]]) -> (Vec<u32>, usize) {
-        let n = self.back.len();
-        let tris = self.solid_topology();
         let fronts: Vec<Vec<Vec3>> = pieces.par_iter().map(|p| self.front(p)).collect();
+        let bits = |f: &[Vec3]| f.iter().map(|&p| position_key(p)).collect::<Vec<_>>();
+        let known = fronts.len() == self.front_crossings.fronts.len()
+            && fronts
+                .iter()
+                .zip(&self.front_crossings.fronts)
+                .all(|(a, b)| bits(a) == bits(b));
+        if known {
+            return self.crossings_with(&self.front_crossings);
+        }
+        let fixed = FrontCrossings::new(
+            fronts,
+            self.solid_topology(),
+            self.triangles.len(),
+            self.back.len(),
+        );
+        self.crossings_with(&fixed)
+    }
+
+    /// How many triangles of `solid` cross another one ([`self_intersecting_triangles`]'s
+    /// count; `None` when a coordinate is beyond the exact test's range), for a solid of this
+    /// shell: a piece's front over its back (displaced, an ID raised on it).
+    ///
+    /// # Performance
+    /// When the solid's front is one the shell was laid out with (bit for bit) and its
+    /// triangles are the shell's solid's, the front's own crossings are known: only the
+    /// pairs touching the back are tested. Any other mesh is tested whole.
+    pub fn solid_crossings(&self, solid: &anim::Mesh) -> Option<usize> {
+        let fixed = &self.front_crossings;
+        let n = self.back.len();
+        let front = solid.positions.get(..n);
+        let known = front.and_then(|front| {
+            fixed.fronts.iter().position(|f| {
+                f.len() == n
+                    && f.iter()
+                        .zip(front)
+                        .all(|(a, b)| position_key(*a) == position_key(*b))
+            })
+        });
+        let (Some(k), true) = (known, solid.triangles == fixed.tris) else {
+            return self_intersecting_triangles(&solid.positions, &solid.triangles)
+                .map(|t| t.len());
+        };
+        let own = intersecting_pairs_touching(&solid.positions, &fixed.tris, &fixed.kinds, BACK)?;
+        let mut hits: Vec<u32> = own
+            .into_iter()
+            .chain(fixed.front_pairs[k].as_ref()?.iter().copied())
+            .flat_map(|(i, j)| [i, j])
+            .collect();
+        hits.sort_unstable();
+        hits.dedup();
+        Some(hits.len())
+    }
+
+    /// [`PartShell::crossings`] of the pieces `fixed` was made from, with the back as it is
+    /// now: only the pairs with a triangle on the back (the back and the walls) are tested,
+    /// the front's own crossings are `fixed`'s.
+    ///
+    /// # Performance
+    /// The pairs among triangles that are the same in every solid are tested once, and each
+    /// piece's solid only tests the pairs touching a triangle of its own.
+    pub(super) fn crossings_with(&self, fixed: &FrontCrossings) -> (Vec<u32>, usize) {
+        let n = self.back.len();
+        let FrontCrossings {
+            fronts,
+            same,
+            tris,
+            kinds,
+            front_pairs,
+        } = fixed;
         let Some(first) = fronts.first() else {
             return (Vec::new(), 0);
         };
-        // Solid vertices (fronts, then the back) at the same place in every piece.
-        let bits = |p: Vec3| p.to_array().map(f32::to_bits);
-        let same: Vec<bool> = (0..n)
-            .map(|v| fronts.iter().all(|f| bits(f[v]) == bits(first[v])))
-            .chain(std::iter::repeat_n(true, n))
-            .collect();
-        let varying: Vec<bool> = tris
-            .iter()
-            .map(|t| t.iter().any(|&v| !same[v as usize]))
-            .collect();
-        let shared_ids: Vec<u32> = (0..tris.len() as u32)
-            .filter(|&t| !varying[t as usize])
-            .collect();
-        let shared_tris: Vec<[u32; 3]> = shared_ids.iter().map(|&t| tris[t as usize]).collect();
-        // Vertices only varying triangles use are never read there.
-        let shared_positions: Vec<Vec3> = first
-            .iter()
-            .zip(&same)
-            .map(|(&p, &s)| if s { p } else { Vec3::ZERO })
-            .chain(self.back.iter().copied())
-            .collect();
-        let shared_pairs: Vec<(u32, u32)> = intersecting_pairs(&shared_positions, &shared_tris)
-            .unwrap_or_default()
-            .into_iter()
-            .map(|(i, j)| (shared_ids[i as usize], shared_ids[j as usize]))
-            .collect();
+        let positions_of = |front: &[Vec3]| {
+            let mut positions = front.to_vec();
+            positions.extend_from_slice(&self.back);
+            positions
+        };
+        let mut same_solid = same.clone();
+        same_solid.resize(2 * n, true);
+        let shared_back = shared_pairs(&positions_of(first), &same_solid, tris, kinds, BACK);
         let per_piece: Vec<(Vec<u32>, usize)> = fronts
             .par_iter()
-            .map(|front| {
-                let mut positions = front.clone();
-                positions.extend_from_slice(&self.back);
-                let mut hits: Vec<u32> =
-                    match intersecting_pairs_touching(&positions, &tris, &varying) {
-                        Some(own) => own
-                            .into_iter()
-                            .chain(shared_pairs.iter().copied())
-                            .flat_map(|(i, j)| [i, j])
-                            .collect(),
-                        None => Vec::new(),
-                    };
+            .zip(front_pairs)
+            .map(|(front, front_pairs)| {
+                let positions = positions_of(front);
+                let own = intersecting_pairs_touching(&positions, tris, kinds, VARYING | BACK);
+                let mut hits: Vec<u32> = match (own, front_pairs) {
+                    (Some(own), Some(front_pairs)) => own
+                        .into_iter()
+                        .chain(shared_back.iter().copied())
+                        .chain(front_pairs.iter().copied())
+                        .flat_map(|(i, j)| [i, j])
+                        .collect(),
+                    _ => Vec::new(),
+                };
                 hits.sort_unstable();
                 hits.dedup();
                 let vertices = hits
@@ -219,4 +273,114 @@ impl PartShell {
         out.dedup();
         (out, count)
     }
+}
+
+/// A solid triangle with a vertex that differs between the pieces.
+const VARYING: u8 = 1;
+/// A solid triangle with a vertex on the back (the back's and the walls').
+const BACK: u8 = 2;
+
+/// The crossings of a part's pieces that do not depend on the back: each piece's front,
+/// which solid triangles differ between pieces or touch the back, and the crossing pairs
+/// among each piece's front triangles.
+#[derive(Debug, Default)]
+pub(super) struct FrontCrossings {
+    /// Every piece's front (shell vertices).
+    fronts: Vec<Vec<Vec3>>,
+    /// Per shell vertex: whether the front is at the same place in every piece.
+    same: Vec<bool>,
+    /// The solid's triangles ([`PartShell::solid_topology`]).
+    tris: Vec<[u32; 3]>,
+    /// [`VARYING`] and [`BACK`] flags per solid triangle.
+    kinds: Vec<u8>,
+    /// Per piece: the crossing pairs among front triangles (`None` when a coordinate is
+    /// beyond the exact test's range).
+    front_pairs: Vec<Option<Vec<(u32, u32)>>>,
+}
+
+impl FrontCrossings {
+    /// Finds the crossings among the front triangles of every piece's solid.
+    ///
+    /// # Arguments
+    /// * `fronts` — every piece's front over the `n` shell vertices;
+    /// * `tris` — the solid's triangles ([`PartShell::solid_topology`]), whose first
+    ///   `front_count` are the front's (over front vertices only).
+    ///
+    /// # Performance
+    /// The pieces share every front vertex they agree on (the seams): the pairs among front
+    /// triangles that are the same in every piece are tested once, and each piece's front
+    /// only tests the pairs touching a triangle of its own.
+    pub(super) fn new(
+        fronts: Vec<Vec<Vec3>>,
+        tris: Vec<[u32; 3]>,
+        front_count: usize,
+        n: usize,
+    ) -> FrontCrossings {
+        let Some(first) = fronts.first() else {
+            return FrontCrossings {
+                tris,
+                ..FrontCrossings::default()
+            };
+        };
+        // Front vertices at the same place in every piece.
+        let same: Vec<bool> = (0..n)
+            .map(|v| {
+                fronts
+                    .iter()
+                    .all(|f| position_key(f[v]) == position_key(first[v]))
+            })
+            .collect();
+        let kinds: Vec<u8> = tris
+            .iter()
+            .map(|t| {
+                let varying = t.iter().any(|&v| (v as usize) < n && !same[v as usize]);
+                let back = t.iter().any(|&v| v as usize >= n);
+                (u8::from(varying) * VARYING) | (u8::from(back) * BACK)
+            })
+            .collect();
+        let (front_tris, front_kinds) = (&tris[..front_count], &kinds[..front_count]);
+        let shared = shared_pairs(first, &same, front_tris, front_kinds, 0);
+        let front_pairs = fronts
+            .par_iter()
+            .map(|front| {
+                let own = intersecting_pairs_touching(front, front_tris, front_kinds, VARYING)?;
+                Some(own.into_iter().chain(shared.iter().copied()).collect())
+            })
+            .collect();
+        FrontCrossings {
+            fronts,
+            same,
+            tris,
+            kinds,
+            front_pairs,
+        }
+    }
+}
+
+/// The crossing pairs (ids in `tris`) among the triangles of `tris` that are not
+/// [`VARYING`] and carry the bits `need` between them, over `positions` (where only the
+/// vertices that are the same in every piece, `same`, are read).
+fn shared_pairs(
+    positions: &[Vec3],
+    same: &[bool],
+    tris: &[[u32; 3]],
+    kinds: &[u8],
+    need: u8,
+) -> Vec<(u32, u32)> {
+    let ids: Vec<u32> = (0..tris.len() as u32)
+        .filter(|&t| kinds[t as usize] & VARYING == 0)
+        .collect();
+    let sub: Vec<[u32; 3]> = ids.iter().map(|&t| tris[t as usize]).collect();
+    let sub_kinds: Vec<u8> = ids.iter().map(|&t| kinds[t as usize]).collect();
+    // Vertices only varying triangles use are never read there.
+    let positions: Vec<Vec3> = positions
+        .iter()
+        .zip(same)
+        .map(|(&p, &s)| if s { p } else { Vec3::ZERO })
+        .collect();
+    intersecting_pairs_touching(&positions, &sub, &sub_kinds, need)
+        .unwrap_or_default()
+        .into_iter()
+        .map(|(i, j)| (ids[i as usize], ids[j as usize]))
+        .collect()
 }

@@ -97,6 +97,8 @@ pub struct PartShell {
     untangle_step_mm: f32,
     /// The part's pieces' fronts, untangled once (shared with the other direction field's shell).
     fronts: Arc<topology::Fronts>,
+    /// The crossings among those fronts' own triangles, found once (shared likewise).
+    front_crossings: Arc<measure::FrontCrossings>,
     /// Measurements.
     pub stats: ShellStats,
 }
@@ -117,6 +119,19 @@ fn front_positions(source: &[u32], caps: &[Vec<u32>], piece: &[Vec3]) -> Vec<Vec
         out.push(c);
     }
     out
+}
+
+/// Triangles of a solid over `m` front vertices (shell vertex `v`) and the back (`v + m`):
+/// the front's `triangles`, the back's reversed, then two wall triangles per `boundary` edge.
+fn solid_topology(triangles: &[[u32; 3]], boundary: &[(u32, u32)], m: usize) -> Vec<[u32; 3]> {
+    let m = m as u32;
+    let mut tris = triangles.to_vec();
+    tris.extend(triangles.iter().map(|t| [t[0] + m, t[2] + m, t[1] + m]));
+    for &(a, b) in boundary {
+        tris.push([b, a, a + m]);
+        tris.push([b, a + m, b + m]);
+    }
+    tris
 }
 
 /// Exact key of a position (welding, seam matching): its bits.
@@ -209,24 +224,49 @@ impl PartShell {
             opts.cap_fraction,
             untangle::step_for_height(opts.model_height_mm),
         )?;
+        // The fronts' own crossings, whatever the back. A shell's front adds its nudge (zero
+        // until the shells are resolved against each other), so these do too.
+        let n = frame.topo.front.len();
+        let front_crossings = Arc::new(measure::FrontCrossings::new(
+            frame
+                .fronts
+                .untangled
+                .iter()
+                .map(|f| f.iter().map(|&p| p + Vec3::ZERO).collect())
+                .collect(),
+            solid_topology(&frame.topo.triangles, &frame.topo.boundary, n),
+            frame.topo.triangles.len(),
+            n,
+        ));
         // Inward direction field (see `DirectionField`); the frame is shared by both fields.
         let (front, tris, adj) = (&frame.topo.front, &frame.topo.triangles, &frame.adj);
         let rings = |radius_mm| direction::edge_ring_directions(front, tris, adj, radius_mm);
         let disc =
             |sigma_mm: f64| direction::smoothed_directions(front, tris, adj, sigma_mm as f32);
         match opts.direction {
-            DirectionField::EdgeRings { radius_mm } => {
-                Ok(Self::along(&frame, rings(radius_mm), pieces, opts, shared))
-            }
-            DirectionField::Geodesic { sigma_mm } => {
-                Ok(Self::along(&frame, disc(sigma_mm), pieces, opts, shared))
-            }
+            DirectionField::EdgeRings { radius_mm } => Ok(Self::along(
+                &frame,
+                &front_crossings,
+                rings(radius_mm),
+                pieces,
+                opts,
+                shared,
+            )),
+            DirectionField::Geodesic { sigma_mm } => Ok(Self::along(
+                &frame,
+                &front_crossings,
+                disc(sigma_mm),
+                pieces,
+                opts,
+                shared,
+            )),
             DirectionField::Best => {
                 let scale = opts.model_height_mm / DEFAULT_PRINT_HEIGHT_MM;
                 let (a, b) = rayon::join(
                     || {
                         Self::along(
                             &frame,
+                            &front_crossings,
                             rings(DEFAULT_EDGE_RING_RADIUS_MM * scale),
                             pieces,
                             opts,
@@ -236,6 +276,7 @@ impl PartShell {
                     || {
                         Self::along(
                             &frame,
+                            &front_crossings,
                             disc(DEFAULT_NORMAL_SMOOTHING_MM * scale),
                             pieces,
                             opts,
@@ -252,6 +293,7 @@ impl PartShell {
     /// envelope, the shared seam points, the smoothing and the repair of [`PartShell::new_sharing`].
     fn along(
         frame: &topology::PartFrame,
+        front_crossings: &Arc<measure::FrontCrossings>,
         normals: Vec<Vec3>,
         pieces: &[&[Vec3]],
         opts: &ShellOptions,
@@ -372,6 +414,7 @@ impl PartShell {
             nudge: vec![Vec3::ZERO; n],
             untangle_step_mm: *untangle_step_mm,
             fronts: Arc::clone(fronts),
+            front_crossings: Arc::clone(front_crossings),
             stats: ShellStats::default(),
         };
         shell.repair(front, &fixed, pieces, opts, &enforce, &along_loop);
@@ -451,18 +494,7 @@ impl PartShell {
     /// Triangles of every piece's solid over the front (shell vertex `v`) and the back
     /// (`v + back.len()`): front, back reversed, then two wall triangles per boundary edge.
     fn solid_topology(&self) -> Vec<[u32; 3]> {
-        let m = self.back.len() as u32;
-        let mut tris = self.triangles.clone();
-        tris.extend(
-            self.triangles
-                .iter()
-                .map(|t| [t[0] + m, t[2] + m, t[1] + m]),
-        );
-        for &(a, b) in &self.boundary {
-            tris.push([b, a, a + m]);
-            tris.push([b, a + m, b + m]);
-        }
-        tris
+        solid_topology(&self.triangles, &self.boundary, self.back.len())
     }
 
     fn solid_unchecked(&self, piece: &[Vec3], name: &str) -> Mesh {

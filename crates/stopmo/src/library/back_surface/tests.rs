@@ -91,3 +91,74 @@ fn a_piece_of_the_part_is_untangled_once_and_another_on_demand() {
     assert!(shell.fronts.find(&laid(&other)).is_none());
     assert_eq!(shell.front(&other), untangled_again(&other));
 }
+
+/// The crossings as the exact test finds them in each piece's whole solid: the shell
+/// vertices of the crossing triangles and how many cross, summed over the pieces.
+fn crossings_of_whole_solids(shell: &PartShell, pieces: &[&[Vec3]]) -> (Vec<u32>, usize) {
+    let n = shell.back.len() as u32;
+    let (mut vertices, mut count) = (Vec::new(), 0);
+    for piece in pieces {
+        let solid = shell.solid_unchecked(piece, "piece");
+        let hits = crate::library::self_intersecting_triangles(&solid.positions, &solid.triangles)
+            .expect("coordinates in range");
+        count += hits.len();
+        vertices.extend(
+            hits.iter()
+                .flat_map(|&t| solid.triangles[t as usize].map(|v| v % n)),
+        );
+    }
+    vertices.sort_unstable();
+    vertices.dedup();
+    (vertices, count)
+}
+
+#[test]
+fn crossings_with_the_fronts_found_once_are_those_of_the_whole_solids() {
+    // Three pieces of the saddle (two agree on most vertices, one lifted everywhere), then a
+    // back pushed through the front in a patch and a piece the shell was not built with:
+    // the split test (front pairs found once, back pairs each time) must count exactly
+    // what testing every solid whole counts.
+    let (mesh, avg) = saddle();
+    let lifted: Vec<Vec3> = avg.iter().map(|p| *p + Vec3::Z * 0.2).collect();
+    let dented: Vec<Vec3> = avg
+        .iter()
+        .map(|p| {
+            if p.x.abs() < 3.0 && p.y.abs() < 3.0 {
+                *p - Vec3::Z * 0.3
+            } else {
+                *p
+            }
+        })
+        .collect();
+    let pieces: [&[Vec3]; 3] = [&avg, &lifted, &dented];
+    let mut shell = PartShell::new(&mesh, &avg, &pieces, &ShellOptions::default()).expect("shell");
+    assert_eq!(
+        shell.crossings(&pieces),
+        crossings_of_whole_solids(&shell, &pieces)
+    );
+    for v in 0..shell.back.len() {
+        let p = shell.back[v];
+        if p.x.abs() < 4.0 && p.y.abs() < 2.0 {
+            shell.back[v] += shell.normals[v] * 4.0;
+        }
+    }
+    let whole = crossings_of_whole_solids(&shell, &pieces);
+    assert!(whole.1 > 0, "the pushed back crosses the front");
+    assert_eq!(shell.crossings(&pieces), whole);
+    for piece in pieces {
+        let solid = shell.solid_unchecked(piece, "piece");
+        let count = crate::library::self_intersecting_triangles(&solid.positions, &solid.triangles)
+            .map(|t| t.len());
+        assert_eq!(shell.solid_crossings(&solid), count);
+    }
+    let other: Vec<Vec3> = dented.iter().map(|p| *p + Vec3::Z * 0.01).collect();
+    let others: [&[Vec3]; 2] = [&avg, &other];
+    assert_eq!(
+        shell.crossings(&others),
+        crossings_of_whole_solids(&shell, &others)
+    );
+    let solid = shell.solid_unchecked(&other, "other");
+    let count = crate::library::self_intersecting_triangles(&solid.positions, &solid.triangles)
+        .map(|t| t.len());
+    assert_eq!(shell.solid_crossings(&solid), count);
+}

@@ -386,30 +386,34 @@ pub fn intersecting_pairs(positions: &[Vec3], tris: &[[u32; 3]]) -> Option<Vec<(
     pairs_touching(positions, tris, None)
 }
 
-/// [`intersecting_pairs`] restricted to the pairs with at least one triangle marked in
-/// `varying` (and the degenerate triangles among the marked ones): with the pairs of the
-/// unmarked triangles among themselves, found once, it gives [`intersecting_pairs`] of
-/// meshes that share those triangles (a part's pieces on one back surface).
+/// [`intersecting_pairs`] restricted to the pairs that, between them, carry every bit of
+/// `need` in `kinds` (one byte of flags per triangle; a degenerate triangle `t` counts when
+/// `kinds[t]` alone carries them): the pairs touching a triangle marked varying (one bit) give,
+/// with the pairs among the unmarked triangles found once, [`intersecting_pairs`] of meshes
+/// that share those triangles (a part's pieces on one back surface); two bits split the pairs
+/// further (those that also touch the back, which alone moves while a back is repaired).
 ///
 /// # Returns
-/// Sorted pairs; `None` as for [`intersecting_pairs`], or when `varying` does not have one
-/// flag per triangle.
+/// Sorted pairs; `None` as for [`intersecting_pairs`], or when `kinds` does not have one
+/// byte per triangle.
 pub(crate) fn intersecting_pairs_touching(
     positions: &[Vec3],
     tris: &[[u32; 3]],
-    varying: &[bool],
+    kinds: &[u8],
+    need: u8,
 ) -> Option<Vec<(u32, u32)>> {
-    if varying.len() != tris.len() {
+    if kinds.len() != tris.len() {
         return None;
     }
-    pairs_touching(positions, tris, Some(varying))
+    pairs_touching(positions, tris, Some((kinds, need)))
 }
 
-/// The pairs of [`intersecting_pairs`]; with `varying`, only those touching a marked triangle.
+/// The pairs of [`intersecting_pairs`]; with `filter` (`kinds`, `need`), only those that
+/// carry every bit of `need` between them.
 fn pairs_touching(
     positions: &[Vec3],
     tris: &[[u32; 3]],
-    varying: Option<&[bool]>,
+    filter: Option<(&[u8], u8)>,
 ) -> Option<Vec<(u32, u32)>> {
     if positions
         .iter()
@@ -423,7 +427,9 @@ fn pairs_touching(
     if tris.is_empty() {
         return Some(Vec::new());
     }
-    let marked = |t: u32| varying.is_none_or(|m| m[t as usize]);
+    let (kinds, need) = filter.unwrap_or((&[], 0));
+    let kind = |t: u32| kinds.get(t as usize).copied().unwrap_or(0);
+    let wanted = |bits: u8| bits & need == need;
     let snapped: Vec<P> = positions.iter().map(|&p| snap(p)).collect();
     // Cells of about twice the mean triangle size limit the exact tests to nearby pairs.
     let grid = TriangleGrid::new(positions, tris);
@@ -431,7 +437,7 @@ fn pairs_touching(
     let degenerate: Vec<u32> = tris
         .iter()
         .enumerate()
-        .filter(|&(t, _)| marked(t as u32))
+        .filter(|&(t, _)| wanted(kind(t as u32)))
         .filter(|(_, t)| {
             let [a, b, c] = t.map(|v| snapped[v as usize]);
             let (u, v) = (sub(b, a), sub(c, a));
@@ -444,10 +450,15 @@ fn pairs_touching(
         .par_iter()
         .flat_map_iter(|(cell_key, list)| {
             let mut out = Vec::new();
+            // A cell whose triangles do not carry `need` between them has no pair to test
+            // (a fine front's crowded cells while only the back moves).
+            if !wanted(list.iter().fold(0, |bits, &t| bits | kind(t))) {
+                return out;
+            }
             for (x, &i) in list.iter().enumerate() {
-                let marked_i = marked(i);
+                let kind_i = kind(i);
                 for &j in &list[x + 1..] {
-                    if !marked_i && !marked(j) {
+                    if !wanted(kind_i | kind(j)) {
                         continue;
                     }
                     let (bi, bj) = (boxes[i as usize], boxes[j as usize]);

@@ -82,6 +82,7 @@ fn marked_and_unmarked_pairs_make_up_all_pairs() {
     let all = intersecting_pairs(&p, &t).unwrap();
     assert!(all.len() > 20, "{} pairs", all.len());
     let varying: Vec<bool> = (0..t.len()).map(|i| i % 3 == 0 || i > 150).collect();
+    let kinds: Vec<u8> = varying.iter().map(|&v| u8::from(v)).collect();
     let unmarked: Vec<u32> = (0..t.len() as u32)
         .filter(|&i| !varying[i as usize])
         .collect();
@@ -90,12 +91,12 @@ fn marked_and_unmarked_pairs_make_up_all_pairs() {
         .unwrap()
         .into_iter()
         .map(|(i, j)| (unmarked[i as usize], unmarked[j as usize]))
-        .chain(intersecting_pairs_touching(&p, &t, &varying).unwrap())
+        .chain(intersecting_pairs_touching(&p, &t, &kinds, 1).unwrap())
         .collect();
     parts.sort_unstable();
     parts.dedup();
     assert_eq!(parts, all);
-    assert!(intersecting_pairs_touching(&p, &t, &varying[1..]).is_none());
+    assert!(intersecting_pairs_touching(&p, &t, &kinds[1..], 1).is_none());
 }
 
 /// The `f64` filters never change a sign: random points, points nudged a grid step off a
