@@ -168,3 +168,28 @@ fn skinned_character_is_read_as_positions() {
     let result = stopmo::library_frames(&frames, &options(3)).expect("library");
     assert_eq!(result.report.frames_form, FramesForm::Positions);
 }
+
+/// A clip with at least as many morph targets as frames (what `stopmo segment` writes: one
+/// target per frame) is read as positions: the weight form would hold as much and cost
+/// more. The bundled face has 55 targets: 30 frames are read as positions, 60 as weights.
+#[test]
+fn as_many_targets_as_frames_are_read_as_positions() {
+    let path = testdata::asset("face/ict-face-talk.glb");
+    let read = |fps: f32| {
+        let open = tkio::OpenOptions {
+            fps: Some(fps),
+            ..tkio::OpenOptions::default()
+        };
+        tkio::open_frames(&path, &open).expect("open as frames")
+    };
+    let few = read(0.5);
+    assert_eq!(few.len(), 1);
+    let MeshFrames::Positions(a) = &few[0] else {
+        panic!("55 targets over 30 frames are read as weights");
+    };
+    assert_eq!(a.frame_count(), 30);
+    let MeshFrames::Morph(m) = &read(1.0)[0] else {
+        panic!("55 targets over 60 frames are read as positions");
+    };
+    assert_eq!(m.frame_count(), 60);
+}

@@ -10,7 +10,10 @@ use crate::{MorphAnimation, Result, Scene};
 
 /// The selected mesh objects of a clip of `scene` as morph weights, in the order of
 /// [`sample`](super::sample)'s objects; `None` when one of them is skinned or its node
-/// moves (then only positions describe it), or when the mesh filter matches nothing.
+/// moves (then only positions describe it), when one has at least as many morph targets as
+/// the clip has frames (a flipbook of targets, one per frame: its positions are no larger,
+/// and the weight form's products over the targets would cost more than the frames
+/// themselves), or when the mesh filter matches nothing.
 ///
 /// # Errors
 /// As [`sample`](super::sample): an invalid scene, frame rate or clip.
@@ -62,6 +65,9 @@ pub fn sample_morph(scene: &Scene, options: &SampleOptions) -> Result<Option<Vec
         }
         let sm = &scene.meshes[scene.nodes[n].mesh.expect("mesh node")];
         let k = sm.morph_targets.len();
+        if k >= frames {
+            return Ok(None);
+        }
         let base: Vec<Vec3> = sm
             .mesh
             .positions
