@@ -172,13 +172,9 @@ impl PartShell {
         if known {
             return self.crossings_with(&self.front_crossings);
         }
-        let fixed = FrontCrossings::new(
-            fronts,
-            self.solid_topology(),
-            self.triangles.len(),
-            self.back.len(),
-        );
-        self.crossings_with(&fixed)
+        // Measured once: the front's pairs are not worth finding apart.
+        let whole = FrontCrossings::unsplit(fronts, self.solid_topology(), self.back.len());
+        self.crossings_with(&whole)
     }
 
     /// How many triangles of `solid` cross another one ([`self_intersecting_triangles`]'s
@@ -201,14 +197,18 @@ impl PartShell {
                         .all(|(a, b)| position_key(*a) == position_key(*b))
             })
         });
-        let (Some(k), true) = (known, solid.triangles == fixed.tris) else {
+        let (Some(k), true, Some(front_pairs)) = (
+            known,
+            solid.triangles == fixed.tris,
+            fixed.front_pairs.as_ref(),
+        ) else {
             return self_intersecting_triangles(&solid.positions, &solid.triangles)
                 .map(|t| t.len());
         };
         let own = intersecting_pairs_touching(&solid.positions, &fixed.tris, &fixed.kinds, BACK)?;
         let mut hits: Vec<u32> = own
             .into_iter()
-            .chain(fixed.front_pairs[k].as_ref()?.iter().copied())
+            .chain(front_pairs[k].as_ref()?.iter().copied())
             .flat_map(|(i, j)| [i, j])
             .collect();
         hits.sort_unstable();
@@ -217,8 +217,8 @@ impl PartShell {
     }
 
     /// [`PartShell::crossings`] of the pieces `fixed` was made from, with the back as it is
-    /// now: only the pairs with a triangle on the back (the back and the walls) are tested,
-    /// the front's own crossings are `fixed`'s.
+    /// now: when `fixed` holds the front's own crossings, only the pairs with a triangle on
+    /// the back (the back and the walls) are tested; otherwise every pair.
     ///
     /// # Performance
     /// The pairs among triangles that are the same in every solid are tested once, and each
@@ -242,17 +242,26 @@ impl PartShell {
         };
         let mut same_solid = same.clone();
         same_solid.resize(2 * n, true);
-        let shared_back = shared_pairs(&positions_of(first), &same_solid, tris, kinds, BACK);
+        // With the front's pairs known, the pairs left are those touching the back.
+        let (shared_need, own_need) = match front_pairs {
+            Some(_) => (BACK, VARYING | BACK),
+            None => (0, VARYING),
+        };
+        let shared = shared_pairs(&positions_of(first), &same_solid, tris, kinds, shared_need);
         let per_piece: Vec<(Vec<u32>, usize)> = fronts
             .par_iter()
-            .zip(front_pairs)
-            .map(|(front, front_pairs)| {
+            .enumerate()
+            .map(|(k, front)| {
                 let positions = positions_of(front);
-                let own = intersecting_pairs_touching(&positions, tris, kinds, VARYING | BACK);
+                let own = intersecting_pairs_touching(&positions, tris, kinds, own_need);
+                let front_pairs = match front_pairs {
+                    Some(pairs) => pairs[k].as_deref(),
+                    None => Some(&[][..]),
+                };
                 let mut hits: Vec<u32> = match (own, front_pairs) {
                     (Some(own), Some(front_pairs)) => own
                         .into_iter()
-                        .chain(shared_back.iter().copied())
+                        .chain(shared.iter().copied())
                         .chain(front_pairs.iter().copied())
                         .flat_map(|(i, j)| [i, j])
                         .collect(),
@@ -294,9 +303,13 @@ pub(super) struct FrontCrossings {
     /// [`VARYING`] and [`BACK`] flags per solid triangle.
     kinds: Vec<u8>,
     /// Per piece: the crossing pairs among front triangles (`None` when a coordinate is
-    /// beyond the exact test's range).
-    front_pairs: Vec<Option<Vec<(u32, u32)>>>,
+    /// beyond the exact test's range); `None` for all when they were not found apart
+    /// ([`FrontCrossings::unsplit`]).
+    front_pairs: Option<Vec<Option<Pairs>>>,
 }
+
+/// Crossing pairs of triangles `(i, j)`, `i ≤ j`.
+type Pairs = Vec<(u32, u32)>;
 
 impl FrontCrossings {
     /// Finds the crossings among the front triangles of every piece's solid.
@@ -316,6 +329,33 @@ impl FrontCrossings {
         front_count: usize,
         n: usize,
     ) -> FrontCrossings {
+        let mut fixed = FrontCrossings::unsplit(fronts, tris, n);
+        let FrontCrossings {
+            fronts,
+            same,
+            tris,
+            kinds,
+            ..
+        } = &fixed;
+        let Some(first) = fronts.first() else {
+            return fixed;
+        };
+        let (front_tris, front_kinds) = (&tris[..front_count], &kinds[..front_count]);
+        let shared = shared_pairs(first, same, front_tris, front_kinds, 0);
+        let front_pairs = fronts
+            .par_iter()
+            .map(|front| {
+                let own = intersecting_pairs_touching(front, front_tris, front_kinds, VARYING)?;
+                Some(own.into_iter().chain(shared.iter().copied()).collect())
+            })
+            .collect();
+        fixed.front_pairs = Some(front_pairs);
+        fixed
+    }
+
+    /// The pieces' fronts and the flags of the solid's triangles, without the front's own
+    /// crossings: [`PartShell::crossings_with`] then tests every pair (each shared one once).
+    pub(super) fn unsplit(fronts: Vec<Vec<Vec3>>, tris: Vec<[u32; 3]>, n: usize) -> FrontCrossings {
         let Some(first) = fronts.first() else {
             return FrontCrossings {
                 tris,
@@ -338,21 +378,12 @@ impl FrontCrossings {
                 (u8::from(varying) * VARYING) | (u8::from(back) * BACK)
             })
             .collect();
-        let (front_tris, front_kinds) = (&tris[..front_count], &kinds[..front_count]);
-        let shared = shared_pairs(first, &same, front_tris, front_kinds, 0);
-        let front_pairs = fronts
-            .par_iter()
-            .map(|front| {
-                let own = intersecting_pairs_touching(front, front_tris, front_kinds, VARYING)?;
-                Some(own.into_iter().chain(shared.iter().copied()).collect())
-            })
-            .collect();
         FrontCrossings {
             fronts,
             same,
             tris,
             kinds,
-            front_pairs,
+            front_pairs: None,
         }
     }
 }
