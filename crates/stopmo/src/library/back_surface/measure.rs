@@ -163,12 +163,11 @@ impl PartShell {
     /// back are tested here.
     pub(super) fn crossings(&self, pieces: &[&[Vec3]]) -> (Vec<u32>, usize) {
         let fronts: Vec<Vec<Vec3>> = pieces.par_iter().map(|p| self.front(p)).collect();
-        let bits = |f: &[Vec3]| f.iter().map(|&p| position_key(p)).collect::<Vec<_>>();
         let known = fronts.len() == self.front_crossings.fronts.len()
             && fronts
                 .iter()
                 .zip(&self.front_crossings.fronts)
-                .all(|(a, b)| bits(a) == bits(b));
+                .all(|(a, b)| same_bits(a, b));
         if known {
             return self.crossings_with(&self.front_crossings);
         }
@@ -189,14 +188,7 @@ impl PartShell {
         let fixed = &self.front_crossings;
         let n = self.back.len();
         let front = solid.positions.get(..n);
-        let known = front.and_then(|front| {
-            fixed.fronts.iter().position(|f| {
-                f.len() == n
-                    && f.iter()
-                        .zip(front)
-                        .all(|(a, b)| position_key(*a) == position_key(*b))
-            })
-        });
+        let known = front.and_then(|front| fixed.fronts.iter().position(|f| same_bits(f, front)));
         let (Some(k), true, Some(front_pairs)) = (
             known,
             solid.triangles == fixed.tris,
@@ -282,6 +274,14 @@ impl PartShell {
         out.dedup();
         (out, count)
     }
+}
+
+/// Whether two fronts are the same positions bit for bit.
+fn same_bits(a: &[Vec3], b: &[Vec3]) -> bool {
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(&p, &q)| position_key(p) == position_key(q))
 }
 
 /// A solid triangle with a vertex that differs between the pieces.
