@@ -109,36 +109,14 @@ pub(crate) fn evaluate(
         };
         let k = block.len() / m.max(1);
         per_frame.par_extend((f0..f0 + k).into_par_iter().map(|f| {
-            let x = frame(f);
-            let r = &pieces[labels[f] as usize];
-            let (mut eu, mut pm, mut px) = (0.0, 0.0, 0.0f64);
-            // In the distance loop, the box costs no extra pass over the frame.
-            let mut bb = Aabb::EMPTY;
-            for (i, (a, b)) in x.iter().zip(r).enumerate() {
-                if want_bounds {
-                    bb.grow(*a);
-                }
-                let dv = (*a - *b).as_dvec3();
-                let sq = dv.length_squared();
-                eu += w.map_or(1.0, |w| w[i]) * sq;
-                let dist = sq.sqrt();
-                pm += dist;
-                px = px.max(dist);
-            }
-            let (mut ev, mut vm, mut vx) = (0.0, 0.0, 0.0f64);
-            if !start[f] {
-                let (xp, rp) = (frame(f - 1), &pieces[labels[f - 1] as usize]);
-                for i in 0..x.len() {
-                    let dv = (x[i] - xp[i]).as_dvec3() - (r[i] - rp[i]).as_dvec3();
-                    let sq = dv.length_squared();
-                    ev += w.map_or(1.0, |w| w[i]) * sq;
-                    let dist = sq.sqrt();
-                    vm += dist;
-                    vx = vx.max(dist);
-                }
-            }
-            let m = x.len().max(1) as f64;
-            ((eu, pm / m, px, ev, vm / m, vx), bb)
+            let previous = (!start[f]).then(|| (frame(f - 1), &pieces[labels[f - 1] as usize][..]));
+            frame_terms(
+                frame(f),
+                &pieces[labels[f] as usize],
+                previous,
+                w,
+                want_bounds,
+            )
         }));
         if k > 0 {
             last.clear();
@@ -160,6 +138,79 @@ pub(crate) fn evaluate(
         has_velocity: start.iter().map(|s| !s).collect(),
     };
     (energy, errors)
+}
+
+/// One frame's [`FrameTerms`] and, with `want_bounds`, the bounding box of its vertices:
+/// `x` the frame, `r` its piece, `previous` the previous frame and its piece (none at a
+/// clip's first frame), `w` the saliency weights.
+///
+/// The distances of a chunk of vertices are found first (their square roots are
+/// independent, so they vectorize), then added in vertex order, both terms in one loop
+/// (their sums are independent chains of additions): every sum is the same sequence of f64
+/// additions as a loop over single vertices, so the energy and errors do not depend on the
+/// chunk size.
+fn frame_terms(
+    x: &[Vec3],
+    r: &[Vec3],
+    previous: Option<(&[Vec3], &[Vec3])>,
+    w: Option<&[f64]>,
+    want_bounds: bool,
+) -> (FrameTerms, Aabb) {
+    const CHUNK: usize = 16;
+    let (mut eu, mut pm, mut px) = (0.0, 0.0, 0.0f64);
+    let (mut ev, mut vm, mut vx) = (0.0, 0.0, 0.0f64);
+    // In the distance loop, the box costs no extra pass over the frame.
+    let mut bb = Aabb::EMPTY;
+    let (mut sq, mut dist) = ([0.0f64; CHUNK], [0.0f64; CHUNK]);
+    let (mut vsq, mut vdist) = ([0.0f64; CHUNK], [0.0f64; CHUNK]);
+    let n = x.len().min(r.len());
+    let mut i0 = 0;
+    while i0 < n {
+        let len = CHUNK.min(n - i0);
+        let (xc, rc) = (&x[i0..i0 + len], &r[i0..i0 + len]);
+        for l in 0..len {
+            let s = length_squared((xc[l] - rc[l]).as_dvec3());
+            sq[l] = s;
+            dist[l] = s.sqrt();
+        }
+        if want_bounds {
+            xc.iter().for_each(|&a| bb.grow(a));
+        }
+        let wc = w.map(|w| &w[i0..i0 + len]);
+        if let Some((xp, rp)) = previous {
+            let (xpc, rpc) = (&xp[i0..i0 + len], &rp[i0..i0 + len]);
+            for l in 0..len {
+                let dv = (xc[l] - xpc[l]).as_dvec3() - (rc[l] - rpc[l]).as_dvec3();
+                let s = length_squared(dv);
+                vsq[l] = s;
+                vdist[l] = s.sqrt();
+            }
+            for l in 0..len {
+                let wl = wc.map_or(1.0, |w| w[l]);
+                eu += wl * sq[l];
+                pm += dist[l];
+                px = px.max(dist[l]);
+                ev += wl * vsq[l];
+                vm += vdist[l];
+                vx = vx.max(vdist[l]);
+            }
+        } else {
+            for l in 0..len {
+                eu += wc.map_or(1.0, |w| w[l]) * sq[l];
+                pm += dist[l];
+                px = px.max(dist[l]);
+            }
+        }
+        i0 += len;
+    }
+    let m = x.len().max(1) as f64;
+    ((eu, pm / m, px, ev, vm / m, vx), bb)
+}
+
+/// `‖v‖²` summed as glam's `DVec3::length_squared` sums it (x, then y, then z).
+#[inline(always)]
+fn length_squared(v: glam::DVec3) -> f64 {
+    v.x * v.x + v.y * v.y + v.z * v.z
 }
 
 impl PartProblem<'_> {

@@ -6,7 +6,9 @@
 //! coordinate descent: the library step solves the normal equations of StopShop Eq. 10 (derived in
 //! the `update` module; the printed StopShop Eq. 13 has typos) and the label step is solved *exactly*
 //! by dynamic programming along the frame chain (cuts split it), never worse than the paper's
-//! α-expansion. k-means++ seeding, random restarts in parallel, fixed or partially fixed
+//! α-expansion (with 64 pieces or more the first steps search each frame's nearest pieces
+//! only, and a restart ends only where an exact step finds nothing better:
+//! docs/stopmo-scale.md, "Candidate label steps"). k-means++ seeding, random restarts in parallel, fixed or partially fixed
 //! libraries, saliency weights, empty-piece repair. Library sizes are given per part, found
 //! for a maximum frame error (Fig. 16), or distributed from a total budget; baselines
 //! ([`Method::KMeans`] = λ 0, [`Method::Uniform`] temporal sampling) report the same errors
@@ -46,6 +48,7 @@ mod assembly;
 mod back_surface;
 mod borders;
 mod build;
+mod candidates;
 mod error;
 mod fabricate;
 mod input_errors;

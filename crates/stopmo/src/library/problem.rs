@@ -247,6 +247,19 @@ impl<'a> PartProblem<'a> {
         &self.sub.coords[..self.frames() * self.sub.dim]
     }
 
+    /// The frames' reduced coordinates transposed (`dim × frames`, row-major).
+    pub(crate) fn frame_coords_transposed(&self) -> Vec<f64> {
+        let (n, q) = (self.frames(), self.sub.dim);
+        let y = self.frame_coords();
+        let mut t = vec![0.0; n * q];
+        for (f, row) in y.chunks_exact(q.max(1)).enumerate() {
+            for (c, &v) in row.iter().enumerate() {
+                t[c * n + f] = v;
+            }
+        }
+        t
+    }
+
     /// Row-major `fixed × dim` reduced coordinates of the fixed pieces.
     pub(crate) fn fixed_coords(&self) -> &[f64] {
         &self.sub.coords[self.frames() * self.sub.dim..]

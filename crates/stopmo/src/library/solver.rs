@@ -5,6 +5,7 @@ use faer::{Accum, MatMut, MatRef, Par};
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::candidates::{candidate_label_step, CandidateInputs, CandidateWork, MIN_PIECES};
 use super::error::{LibraryError, Result};
 use super::metrics::evaluate;
 use super::problem::PartProblem;
@@ -96,6 +97,9 @@ pub struct PartSolution {
 /// One restart's state in reduced coordinates.
 struct Run {
     labels: Vec<u32>,
+    /// The library of the last label step (reduced coordinates).
+    #[cfg_attr(not(test), allow(dead_code))]
+    lib: Vec<f64>,
     energy: f64,
     iterations: usize,
     history: Vec<f64>,
@@ -104,7 +108,13 @@ struct Run {
 /// k-means++ (Arthur & Vassilvitskii 2007) over frames, fixed pieces counted as centres.
 /// Returns row-major `d × q` pieces. With `Par::Seq` (restarts already run in parallel) the
 /// distance updates stay on the calling thread; the values are the same either way.
-fn kmeans_pp(p: &PartProblem<'_>, d: usize, rng: &mut SplitMix64, par: Par) -> Vec<f64> {
+fn kmeans_pp(
+    p: &PartProblem<'_>,
+    d: usize,
+    rng: &mut SplitMix64,
+    par: Par,
+    yt: &[f64],
+) -> Vec<f64> {
     let (n, q, nf) = (p.frames(), p.sub.dim, p.fixed);
     let y = p.frame_coords();
     let mut lib = Vec::with_capacity(d * q);
@@ -118,8 +128,22 @@ fn kmeans_pp(p: &PartProblem<'_>, d: usize, rng: &mut SplitMix64, par: Par) -> V
             .sum();
         *dv = dv.min(s);
     };
-    let update = |dist: &mut [f64], c: &[f64]| match par {
-        Par::Seq => dist.iter_mut().enumerate().for_each(|e| nearer(e, c)),
+    // On one thread, frames side by side over the transposed coordinates: each frame's sum
+    // still adds its coordinates in order (the same value as `nearer`), several frames per
+    // instruction.
+    let mut sums = vec![0.0; if matches!(par, Par::Seq) { n } else { 0 }];
+    let mut update = |dist: &mut [f64], c: &[f64]| match par {
+        Par::Seq => {
+            sums.fill(0.0);
+            for (row, &cc) in yt.chunks_exact(n).zip(c) {
+                for (s, &a) in sums.iter_mut().zip(row) {
+                    *s += (a - cc) * (a - cc);
+                }
+            }
+            for (dv, &s) in dist.iter_mut().zip(&sums) {
+                *dv = dv.min(s);
+            }
+        }
         _ => dist.par_iter_mut().enumerate().for_each(|e| nearer(e, c)),
     };
     for k in 0..nf {
@@ -175,13 +199,25 @@ pub(crate) fn repair_empty(labels: &mut [u32], cost: &[f64], fixed: usize, d: us
     }
 }
 
+#[derive(Default)]
 struct LabelBuffers {
     p: Vec<f64>,
     g: Vec<f64>,
     cost: Vec<f64>,
     work: ViterbiWork,
+    candidates: CandidateWork,
 }
 
+/// Which label step an iteration runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Step {
+    /// Over each frame's candidate pieces (`keep`: the current labels among them).
+    Candidates { keep: bool },
+    /// The exact dynamic programming over all pieces.
+    Exact,
+}
+
+#[allow(clippy::too_many_arguments)]
 fn label(
     prob: &PartProblem<'_>,
     lib: &[f64],
@@ -190,21 +226,12 @@ fn label(
     par: Par,
     buf: &mut LabelBuffers,
     labels: &mut [u32],
+    step: Step,
 ) -> f64 {
     let (n, q) = (prob.frames(), prob.sub.dim);
     let y = MatRef::from_row_major_slice(prob.frame_coords(), n, q);
     let r = MatRef::from_row_major_slice(lib, d, q);
-    buf.p.resize(n * d, 0.0);
     buf.g.resize(d * d, 0.0);
-    // One GEMM per iteration: X Rᵀ gives both ‖x − r‖² and Δx·r.
-    matmul(
-        MatMut::from_row_major_slice_mut(&mut buf.p, n, d),
-        Accum::Replace,
-        y,
-        r.transpose(),
-        1.0,
-        par,
-    );
     matmul(
         MatMut::from_row_major_slice_mut(&mut buf.g, d, d),
         Accum::Replace,
@@ -214,6 +241,31 @@ fn label(
         par,
     );
     buf.cost.resize(n, 0.0);
+    if let Step::Candidates { keep } = step {
+        let inp = CandidateInputs {
+            y: prob.frame_coords(),
+            r: lib,
+            q,
+            g: &buf.g,
+            xx: &prob.xx,
+            dxx: &prob.dxx,
+            chains: &prob.chains,
+            lambda,
+            d,
+        };
+        let e = candidate_label_step(&inp, labels, keep, &mut buf.cost, &mut buf.candidates);
+        return e;
+    }
+    buf.p.resize(n * d, 0.0);
+    // One GEMM per iteration: X Rᵀ gives both ‖x − r‖² and Δx·r.
+    matmul(
+        MatMut::from_row_major_slice_mut(&mut buf.p, n, d),
+        Accum::Replace,
+        y,
+        r.transpose(),
+        1.0,
+        par,
+    );
     let inp = LabelInputs {
         p: &buf.p,
         g: &buf.g,
@@ -226,25 +278,40 @@ fn label(
     label_step(&inp, labels, &mut buf.cost, &mut buf.work)
 }
 
+/// One restart; `yt` holds the frames' reduced coordinates transposed (`q × n`) for the
+/// seeding on one thread (empty otherwise).
 fn run(
     prob: &PartProblem<'_>,
     d: usize,
     opts: &SolveOptions,
     restart: usize,
     par: Par,
+    yt: &[f64],
 ) -> Result<Run> {
     let (n, q, nf) = (prob.frames(), prob.sub.dim, prob.fixed);
     let mut rng = SplitMix64::new(opts.seed, restart as u64 + 1);
-    let mut lib = kmeans_pp(prob, d, &mut rng, par);
-    let mut buf = LabelBuffers {
-        p: Vec::new(),
-        g: Vec::new(),
-        cost: Vec::new(),
-        work: ViterbiWork::default(),
-    };
+    let mut lib = kmeans_pp(prob, d, &mut rng, par, yt);
+    let mut buf = LabelBuffers::default();
     let mut labels = vec![0u32; n];
     let mut prev = vec![0u32; n];
-    let mut energy = label(prob, &lib, d, opts.lambda, par, &mut buf, &mut labels);
+    // Many pieces: candidate label steps while they improve, then exact ones
+    // (docs/stopmo-scale.md, "Candidate label steps").
+    let mut candidates = d >= MIN_PIECES && opts.lambda > 0.0;
+    let first = if candidates {
+        Step::Candidates { keep: false }
+    } else {
+        Step::Exact
+    };
+    let mut energy = label(
+        prob,
+        &lib,
+        d,
+        opts.lambda,
+        par,
+        &mut buf,
+        &mut labels,
+        first,
+    );
     let mut history = vec![energy];
     let mut iterations = 0;
     while d > nf && iterations < opts.max_iterations {
@@ -262,17 +329,37 @@ fn run(
         );
         lib = solve_pieces(&a, b, d, q, nf, prob.fixed_coords())?;
         iterations += 1;
-        prev.copy_from_slice(&labels);
-        let e = label(prob, &lib, d, opts.lambda, par, &mut buf, &mut labels);
-        history.push(e);
-        let stalled = energy - e <= opts.tolerance * energy.abs();
-        energy = e;
-        if prev == labels || stalled {
-            break;
+        let mut step = if candidates {
+            Step::Candidates { keep: true }
+        } else {
+            Step::Exact
+        };
+        loop {
+            prev.copy_from_slice(&labels);
+            let e = label(prob, &lib, d, opts.lambda, par, &mut buf, &mut labels, step);
+            history.push(e);
+            let stalled = energy - e <= opts.tolerance * energy.abs();
+            energy = e;
+            if !(prev == labels || stalled) {
+                break;
+            }
+            if step == Step::Exact {
+                return Ok(Run {
+                    labels,
+                    lib,
+                    energy,
+                    iterations,
+                    history,
+                });
+            }
+            // The candidate steps have settled: the same library, the exact step next.
+            candidates = false;
+            step = Step::Exact;
         }
     }
     Ok(Run {
         labels,
+        lib,
         energy,
         iterations,
         history,
@@ -433,9 +520,13 @@ impl PartProblem<'_> {
         } else {
             Par::rayon(rayon::current_num_threads().max(1))
         };
+        let yt = match par {
+            Par::Seq => self.frame_coords_transposed(),
+            _ => Vec::new(),
+        };
         let runs: Vec<Result<Run>> = (0..opts.restarts)
             .into_par_iter()
-            .map(|r| run(self, d, opts, r, par))
+            .map(|r| run(self, d, opts, r, par, &yt))
             .collect();
         let mut best: Option<Run> = None;
         for r in runs {
@@ -477,6 +568,74 @@ impl PartProblem<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::library::{PartSetup, SubspaceOptions};
+    use anim::{Mesh, MeshAnimation};
+
+    /// A wobbling strip: `frames` frames of a smooth random motion (cuts at `cuts`).
+    fn strip(frames: usize, seed: u64) -> MeshAnimation {
+        let m = 12;
+        let mesh = Mesh::new(
+            "strip",
+            (0..m).map(|i| Vec3::new(i as f32, 0.0, 0.0)).collect(),
+            (0..m as u32 - 2).map(|i| [i, i + 1, i + 2]).collect(),
+        );
+        let mut rng = SplitMix64::new(seed, 5);
+        let phase: Vec<f32> = (0..3 * m).map(|_| 6.0 * rng.next_f64() as f32).collect();
+        let positions = (0..frames)
+            .flat_map(|f| {
+                let t = f as f32 * 0.05;
+                let phase = &phase;
+                (0..m).map(move |i| {
+                    let w = |k: usize| (t * (1.0 + k as f32 * 0.37) + phase[3 * i + k]).sin();
+                    Vec3::new(i as f32 + 0.3 * w(0), w(1), 0.5 * w(2))
+                })
+            })
+            .collect();
+        MeshAnimation::new(mesh, 24.0, positions).expect("strip")
+    }
+
+    /// With many pieces the restarts start with candidate label steps; each ends where an
+    /// exact label step over its last library finds nothing better, with an energy that
+    /// never rose from step to step.
+    #[test]
+    fn candidate_steps_end_at_an_exact_label_step() {
+        let anim = strip(600, 3);
+        let setup = PartSetup {
+            cuts: vec![250],
+            ..PartSetup::default()
+        };
+        let prob = PartProblem::new(&anim, &setup, &SubspaceOptions::default(), 1).expect("part");
+        let d = MIN_PIECES + 6;
+        let opts = SolveOptions::default();
+        for restart in 0..3 {
+            let yt = prob.frame_coords_transposed();
+            let run = run(&prob, d, &opts, restart, Par::Seq, &yt).expect("run");
+            for w in run.history.windows(2) {
+                assert!(
+                    w[1] <= w[0] * (1.0 + 1e-12),
+                    "energy rose: {:?}",
+                    run.history
+                );
+            }
+            let mut buf = LabelBuffers::default();
+            let mut labels = vec![0u32; prob.frames()];
+            let exact = label(
+                &prob,
+                &run.lib,
+                d,
+                opts.lambda,
+                Par::Seq,
+                &mut buf,
+                &mut labels,
+                Step::Exact,
+            );
+            assert!(
+                exact >= run.energy * (1.0 - 1e-9) && exact <= run.energy * (1.0 + 1e-9),
+                "restart {restart}: exact step {exact}, run ended at {}",
+                run.energy
+            );
+        }
+    }
 
     #[test]
     fn repair_fills_every_free_piece() {

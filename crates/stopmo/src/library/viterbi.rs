@@ -359,19 +359,25 @@ fn arg_min(values: &[f64]) -> (f64, usize) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use anim::SplitMix64;
 
-    struct Case {
-        p: Vec<f64>,
-        g: Vec<f64>,
-        xx: Vec<f64>,
-        dxx: Vec<f64>,
+    /// Gram matrices of random frames and pieces.
+    pub(crate) struct Case {
+        /// Frames, `n × dim`.
+        pub(crate) x: Vec<f64>,
+        /// Pieces, `d × dim`.
+        pub(crate) r: Vec<f64>,
+        pub(crate) dim: usize,
+        pub(crate) p: Vec<f64>,
+        pub(crate) g: Vec<f64>,
+        pub(crate) xx: Vec<f64>,
+        pub(crate) dxx: Vec<f64>,
     }
 
     /// Random frames and pieces in `dim` dimensions, with their Gram matrices.
-    fn case(n: usize, d: usize, dim: usize, seed: u64) -> Case {
+    pub(crate) fn case(n: usize, d: usize, dim: usize, seed: u64) -> Case {
         let mut rng = SplitMix64::new(seed, 9);
         let x: Vec<f64> = (0..n * dim).map(|_| rng.normal()).collect();
         let r: Vec<f64> = (0..d * dim).map(|_| rng.normal()).collect();
@@ -403,7 +409,15 @@ mod tests {
                 dot(&dv, &dv)
             })
             .collect();
-        Case { p, g, xx, dxx }
+        Case {
+            x,
+            r,
+            dim,
+            p,
+            g,
+            xx,
+            dxx,
+        }
     }
 
     fn brute_force(inp: &LabelInputs<'_>, n: usize) -> f64 {

@@ -1,0 +1,449 @@
+//! The label step over a few candidate pieces per frame: the early iterations of block
+//! coordinate descent with many pieces (docs/stopmo-scale.md, "Candidate label steps").
+//!
+//! The exact label step ([`super::viterbi`]) sweeps all `pieces²` transitions per frame. While
+//! the library is still moving, most of that sweep only confirms what the unary term already
+//! says, so these steps run the same dynamic programming over each frame's
+//! [`CANDIDATES`] nearest pieces (StopShop Eq. 15) plus the current labels of the frame and its
+//! two neighbours. The current labeling is one of the paths searched, so a step never raises
+//! StopShop Eq. 10, and block coordinate descent keeps its monotone energy. Once these steps
+//! stop improving, the solver goes on with exact steps until those stop too: a restart ends
+//! where an exact label step finds nothing better, as before.
+
+use std::ops::Range;
+
+use faer::linalg::matmul::matmul;
+use faer::{Accum, MatMut, MatRef, Par};
+
+/// Nearest pieces (by unary cost) taken per frame, besides the current labels.
+pub(crate) const CANDIDATES: usize = 8;
+/// Library size from which the solver starts with candidate steps: below it the exact sweep
+/// is cheap (and results stay those of exact steps only).
+pub(crate) const MIN_PIECES: usize = 64;
+/// Candidates per frame at most: the nearest ones and the labels of `f − 1`, `f`, `f + 1`.
+const STRIDE: usize = CANDIDATES + 3;
+
+/// Frames whose inner products with the pieces are computed at once (one small GEMM whose
+/// result stays in cache while the frames' candidates are picked).
+const BLOCK: usize = 64;
+
+/// Inputs of [`candidate_label_step`]; all matrices row-major.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct CandidateInputs<'a> {
+    /// `n × q` frame coordinates.
+    pub y: &'a [f64],
+    /// `d × q` piece coordinates.
+    pub r: &'a [f64],
+    /// Coordinates per frame and piece.
+    pub q: usize,
+    /// The rest as the exact step takes it ([`super::viterbi::LabelInputs`]): `G = R Rᵀ`,
+    pub g: &'a [f64],
+    /// the frame norms `‖x_f‖²`,
+    pub xx: &'a [f64],
+    /// the norms of the frame differences (chain starts aside),
+    pub dxx: &'a [f64],
+    /// the clips,
+    pub chains: &'a [Range<usize>],
+    /// λ
+    pub lambda: f64,
+    /// and the number of pieces.
+    pub d: usize,
+}
+
+/// Reusable buffers of [`candidate_label_step`].
+#[derive(Debug, Default, Clone)]
+pub(crate) struct CandidateWork {
+    /// Candidates of each frame, ascending (`STRIDE` slots per frame).
+    pieces: Vec<u32>,
+    /// How many slots of each frame are used.
+    count: Vec<u8>,
+    /// `x_f · r_b` per candidate `b` of frame `f`.
+    here: Vec<f64>,
+    /// `x_{f−1} · r_b` per candidate `b` of frame `f`.
+    before: Vec<f64>,
+    /// `x_f · r_a` per candidate `a` of frame `f − 1`.
+    after: Vec<f64>,
+    /// Value function `V_f` per candidate.
+    v: Vec<f64>,
+    /// Slot of the best predecessor per candidate.
+    back: Vec<u8>,
+    /// `α` of the previous frame's candidates.
+    alpha: Vec<f64>,
+    /// Diagonal `G_kk`, contiguous.
+    gd: Vec<f64>,
+    /// Symmetrized `λG`, as the exact step forms it.
+    lg: Vec<f64>,
+    /// A block of rows of `X Rᵀ`, and the row before it.
+    rows: Vec<f64>,
+    /// One frame's unary costs less `‖x_f‖²`.
+    keys: Vec<f64>,
+    /// Pieces whose key is within a bound, and their keys.
+    below: Vec<(f64, u32)>,
+}
+
+/// The label step restricted to each frame's candidates.
+///
+/// `labels` holds the current labeling on entry when `keep_current` is set (its labels join
+/// the candidates, so the result's energy is at most the current one), and the new labeling
+/// on return; `cost` receives each frame's unary cost as in [`super::viterbi::label_step`].
+/// Returns the new labeling's energy (StopShop Eq. 10). With `CANDIDATES ≥ pieces` this is
+/// the exact step.
+///
+/// # Performance
+/// `O(n · q · pieces)` for the inner products, in blocks of frames that stay in cache (the
+/// `n × pieces` matrix is never stored), `O(n · pieces)` to pick the candidates,
+/// `O(n · STRIDE²)` for the dynamic programming; no allocation once `work` is warm.
+pub(crate) fn candidate_label_step(
+    inp: &CandidateInputs<'_>,
+    labels: &mut [u32],
+    keep_current: bool,
+    cost: &mut [f64],
+    work: &mut CandidateWork,
+) -> f64 {
+    let (d, n) = (inp.d, inp.xx.len());
+    work.pieces.resize(n * STRIDE, 0);
+    work.count.resize(n, 0);
+    work.here.resize(n * STRIDE, 0.0);
+    work.before.resize(n * STRIDE, 0.0);
+    work.after.resize(n * STRIDE, 0.0);
+    work.v.resize(n * STRIDE, 0.0);
+    work.back.resize(n * STRIDE, 0);
+    work.alpha.resize(STRIDE, 0.0);
+    work.gd.clear();
+    work.gd.extend((0..d).map(|k| inp.g[k * d + k]));
+    work.lg.resize(d * d, 0.0);
+    for a in 0..d {
+        for b in 0..d {
+            work.lg[a * d + b] = 0.5 * inp.lambda * (inp.g[a * d + b] + inp.g[b * d + a]);
+        }
+    }
+    work.keys.resize(d, 0.0);
+    work.rows.resize((BLOCK + 1) * d, 0.0);
+    let mut total = 0.0;
+    for ch in inp.chains {
+        if ch.is_empty() {
+            continue;
+        }
+        pick_candidates(inp, ch, labels, keep_current, work);
+        total += chain_dp(inp, ch, labels, cost, work);
+    }
+    total
+}
+
+/// Picks every frame of chain `ch`'s candidates and the inner products the dynamic
+/// programming needs, a block of frames at a time.
+fn pick_candidates(
+    inp: &CandidateInputs<'_>,
+    ch: &Range<usize>,
+    labels: &[u32],
+    keep_current: bool,
+    work: &mut CandidateWork,
+) {
+    let (d, q) = (inp.d, inp.q);
+    let r = MatRef::from_row_major_slice(inp.r, d, q);
+    let mut f0 = ch.start;
+    while f0 < ch.end {
+        let k = BLOCK.min(ch.end - f0);
+        // Row 0 holds the frame before the block (the last row of the previous block).
+        if f0 > ch.start {
+            work.rows.copy_within(BLOCK * d..(BLOCK + 1) * d, 0);
+        }
+        matmul(
+            MatMut::from_row_major_slice_mut(&mut work.rows[d..(k + 1) * d], k, d),
+            Accum::Replace,
+            MatRef::from_row_major_slice(&inp.y[f0 * q..(f0 + k) * q], k, q),
+            r.transpose(),
+            1.0,
+            Par::Seq,
+        );
+        for f in f0..f0 + k {
+            let row = f - f0 + 1;
+            frame_candidates(inp, ch, f, row, labels, keep_current, work);
+        }
+        f0 += k;
+    }
+}
+
+/// Frame `f`'s candidates, whose inner products are row `row` of `work.rows` (the previous
+/// frame's are the row before).
+fn frame_candidates(
+    inp: &CandidateInputs<'_>,
+    ch: &Range<usize>,
+    f: usize,
+    row: usize,
+    labels: &[u32],
+    keep_current: bool,
+    work: &mut CandidateWork,
+) {
+    let d = inp.d;
+    let pf = &work.rows[row * d..(row + 1) * d];
+    // ‖x_f‖² is the same for every piece: the order is that of the unary cost.
+    for ((k, &g), &p) in work.keys.iter_mut().zip(&work.gd).zip(pf) {
+        *k = g - 2.0 * p;
+    }
+    let slots = &mut work.pieces[f * STRIDE..(f + 1) * STRIDE];
+    // The previous step's candidates bound the new nearest ones (when they were at least
+    // as many distinct pieces, their largest key is no smaller than the k-th).
+    let kept = if keep_current {
+        work.count[f] as usize
+    } else {
+        0
+    };
+    let bound = (kept >= CANDIDATES.min(d))
+        .then(|| {
+            slots[..kept]
+                .iter()
+                .map(|&b| work.keys[b as usize])
+                .fold(f64::NEG_INFINITY, f64::max)
+        })
+        .filter(|t| !t.is_nan());
+    let mut c = nearest(&work.keys, bound, &mut work.below, &mut slots[..CANDIDATES]);
+    if keep_current {
+        let around = f.saturating_sub(1).max(ch.start)..(f + 2).min(ch.end);
+        for l in labels[around].iter().copied() {
+            if !slots[..c].contains(&l) {
+                slots[c] = l;
+                c += 1;
+            }
+        }
+    }
+    slots[..c].sort_unstable();
+    work.count[f] = c as u8;
+    let at = f * STRIDE;
+    for (j, &b) in slots[..c].iter().enumerate() {
+        work.here[at + j] = pf[b as usize];
+    }
+    if f > ch.start {
+        let pp = &work.rows[(row - 1) * d..row * d];
+        for (j, &b) in slots[..c].iter().enumerate() {
+            work.before[at + j] = pp[b as usize];
+        }
+        let prev = (f - 1) * STRIDE;
+        for i in 0..work.count[f - 1] as usize {
+            work.after[at + i] = pf[work.pieces[prev + i] as usize];
+        }
+    }
+}
+
+/// The dynamic programming over chain `ch`'s candidates; writes its labels and unary costs
+/// and returns its energy.
+fn chain_dp(
+    inp: &CandidateInputs<'_>,
+    ch: &Range<usize>,
+    labels: &mut [u32],
+    cost: &mut [f64],
+    work: &mut CandidateWork,
+) -> f64 {
+    let d = inp.d;
+    let half = 0.5 * inp.lambda;
+    let gd = &work.gd[..];
+    for f in ch.clone() {
+        let (xf, at) = (inp.xx[f], f * STRIDE);
+        let cf = work.count[f] as usize;
+        if f == ch.start {
+            for j in 0..cf {
+                let b = work.pieces[at + j] as usize;
+                work.v[at + j] = xf - 2.0 * work.here[at + j] + gd[b];
+            }
+            continue;
+        }
+        let prev = (f - 1) * STRIDE;
+        let cp = work.count[f - 1] as usize;
+        // α of the previous frame's candidates, as the exact step forms it.
+        for i in 0..cp {
+            let a = work.pieces[prev + i] as usize;
+            work.alpha[i] = work.v[prev + i]
+                + half * (gd[a] + 2.0 * (work.after[at + i] - work.here[prev + i]));
+        }
+        let df = inp.dxx[f];
+        for j in 0..cf {
+            let b = work.pieces[at + j] as usize;
+            // λG is symmetrized: row b holds column b.
+            let lg = &work.lg[b * d..(b + 1) * d];
+            let (mut best, mut arg) = (f64::INFINITY, 0);
+            for i in 0..cp {
+                let v = work.alpha[i] - lg[work.pieces[prev + i] as usize];
+                if v < best {
+                    (best, arg) = (v, i);
+                }
+            }
+            let (gb, pb) = (gd[b], work.here[at + j]);
+            work.v[at + j] =
+                (xf - 2.0 * pb + gb) + half * (df + gb - 2.0 * (pb - work.before[at + j])) + best;
+            work.back[at + j] = arg as u8;
+        }
+    }
+    let last = ch.end - 1;
+    let (mut best, mut slot) = (f64::INFINITY, 0);
+    for j in 0..work.count[last] as usize {
+        let v = work.v[last * STRIDE + j];
+        if v < best {
+            (best, slot) = (v, j);
+        }
+    }
+    for f in ch.clone().rev() {
+        let at = f * STRIDE + slot;
+        let b = work.pieces[at];
+        labels[f] = b;
+        cost[f] = inp.xx[f] - 2.0 * work.here[at] + gd[b as usize];
+        slot = work.back[at] as usize;
+    }
+    best
+}
+
+/// Writes the pieces of the `out.len()` smallest `keys` into `out`, smallest first (ties to
+/// the lower piece), and returns how many there are (`min(out.len(), pieces)`, fewer when
+/// keys are NaN, at least 1). With a `bound` no smaller than the `out.len()`-th smallest key,
+/// only the keys up to it are sorted; the result is the same.
+fn nearest(
+    keys: &[f64],
+    bound: Option<f64>,
+    below: &mut Vec<(f64, u32)>,
+    out: &mut [u32],
+) -> usize {
+    let k = out.len();
+    if let Some(t) = bound {
+        below.clear();
+        below.extend(
+            keys.iter()
+                .enumerate()
+                .filter(|&(_, &key)| key <= t)
+                .map(|(b, &key)| (key, b as u32)),
+        );
+        if below.len() >= k {
+            // Stable, and ±0 equal as `<` has them: equal keys keep the lower piece first.
+            below.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap_or(std::cmp::Ordering::Equal));
+            for (o, &(_, b)) in out.iter_mut().zip(below.iter()) {
+                *o = b;
+            }
+            return k;
+        }
+    }
+    let mut best = [f64::INFINITY; CANDIDATES];
+    let best = &mut best[..k];
+    let mut c = 0;
+    for (b, &key) in keys.iter().enumerate() {
+        // NaN keys are never candidates (nor are keys no better than the k-th).
+        if key.is_nan() || (c == k && key >= best[k - 1]) {
+            continue;
+        }
+        let mut i = c.min(k - 1);
+        while i > 0 && key < best[i - 1] {
+            best[i] = best[i - 1];
+            out[i] = out[i - 1];
+            i -= 1;
+        }
+        best[i] = key;
+        out[i] = b as u32;
+        c = (c + 1).min(k);
+    }
+    if c == 0 {
+        out[0] = 0;
+        c = 1;
+    }
+    c
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::viterbi::tests::{case, Case};
+    use super::super::viterbi::{label_step, LabelInputs, ViterbiWork};
+    use super::*;
+
+    fn inputs<'a>(
+        c: &'a Case,
+        chains: &'a [Range<usize>],
+        d: usize,
+        lambda: f64,
+    ) -> (LabelInputs<'a>, CandidateInputs<'a>) {
+        let exact = LabelInputs {
+            p: &c.p,
+            g: &c.g,
+            xx: &c.xx,
+            dxx: &c.dxx,
+            chains,
+            lambda,
+            d,
+        };
+        let ours = CandidateInputs {
+            y: &c.x,
+            r: &c.r,
+            q: c.dim,
+            g: &c.g,
+            xx: &c.xx,
+            dxx: &c.dxx,
+            chains,
+            lambda,
+            d,
+        };
+        (exact, ours)
+    }
+
+    /// With at least as many candidates as pieces the step is the exact one, over chains
+    /// longer than a block of frames.
+    #[test]
+    fn all_pieces_as_candidates_is_the_exact_step() {
+        for (seed, (n, d, lambda)) in [(140, 3, 2.0), (200, 8, 0.7), (70, 5, 10.0)]
+            .into_iter()
+            .enumerate()
+        {
+            let c = case(n, d, 4, seed as u64);
+            for chains in [
+                std::iter::once(0..n).collect::<Vec<_>>(),
+                vec![0..7, 7..n - 1, n - 1..n],
+            ] {
+                let (exact_inp, inp) = inputs(&c, &chains, d, lambda);
+                let (mut exact, mut ours) = (vec![0u32; n], vec![0u32; n]);
+                let (mut ce, mut co) = (vec![0.0; n], vec![0.0; n]);
+                let e = label_step(&exact_inp, &mut exact, &mut ce, &mut ViterbiWork::default());
+                let mut work = CandidateWork::default();
+                let o = candidate_label_step(&inp, &mut ours, false, &mut co, &mut work);
+                assert!((e - o).abs() <= 1e-9 * e.abs(), "seed {seed}: {e} vs {o}");
+                assert_eq!(exact, ours, "seed {seed}");
+                // Searched again from its own labels (the bounded pick), the same.
+                let again = candidate_label_step(&inp, &mut ours, true, &mut co, &mut work);
+                assert_eq!(exact, ours, "seed {seed}");
+                assert!((e - again).abs() <= 1e-9 * e.abs());
+            }
+        }
+    }
+
+    /// Many pieces: the step's energy is its labeling's, never above the current labeling's
+    /// (which it searches), and never below the exact optimum.
+    #[test]
+    fn candidate_steps_never_raise_the_energy() {
+        let (n, d, lambda) = (300, 90, 2.0);
+        let c = case(n, d, 6, 7);
+        let chains = vec![0..120, 120..n];
+        let (exact_inp, inp) = inputs(&c, &chains, d, lambda);
+        let mut exact = vec![0u32; n];
+        let optimum = label_step(
+            &exact_inp,
+            &mut exact,
+            &mut vec![0.0; n],
+            &mut ViterbiWork::default(),
+        );
+        let mut rng = anim::SplitMix64::new(3, 1);
+        let mut labels: Vec<u32> = (0..n).map(|_| rng.below(d) as u32).collect();
+        let mut work = CandidateWork::default();
+        let mut before = exact_inp.energy(&labels);
+        for step in 0..3 {
+            let e = candidate_label_step(&inp, &mut labels, step > 0, &mut vec![0.0; n], &mut work);
+            let again = exact_inp.energy(&labels);
+            assert!((again - e).abs() <= 1e-9 * e.abs(), "{again} vs {e}");
+            if step > 0 {
+                assert!(e <= before * (1.0 + 1e-12), "{e} after {before}");
+            }
+            assert!(
+                e >= optimum * (1.0 - 1e-12),
+                "{e} below the optimum {optimum}"
+            );
+            before = e;
+        }
+        // The exact optimum is a fixed point: searched again with its own labels, kept.
+        let mut kept = exact.clone();
+        let e = candidate_label_step(&inp, &mut kept, true, &mut vec![0.0; n], &mut work);
+        assert!((e - optimum).abs() <= 1e-9 * optimum.abs());
+        assert_eq!(kept, exact);
+    }
+}
