@@ -149,6 +149,8 @@ pub(crate) fn evaluate(
 /// (their sums are independent chains of additions): every sum is the same sequence of f64
 /// additions as a loop over single vertices, so the energy and errors do not depend on the
 /// chunk size.
+// Not inlined: its own symbol in profiles (docs/stopmo-scale.md measures it).
+#[inline(never)]
 fn frame_terms(
     x: &[Vec3],
     r: &[Vec3],
