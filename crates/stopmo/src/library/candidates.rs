@@ -15,6 +15,8 @@ use std::ops::Range;
 use faer::linalg::matmul::matmul;
 use faer::{Accum, MatMut, MatRef, Par};
 
+use super::viterbi::ChainTerms;
+
 /// Nearest pieces (by unary cost) taken per frame, besides the current labels.
 pub(crate) const CANDIDATES: usize = 8;
 /// Library size from which the solver starts with candidate steps: below it the exact sweep
@@ -36,18 +38,8 @@ pub(crate) struct CandidateInputs<'a> {
     pub r: &'a [f64],
     /// Coordinates per frame and piece.
     pub q: usize,
-    /// The rest as the exact step takes it ([`super::viterbi::LabelInputs`]): `G = R Rᵀ`,
-    pub g: &'a [f64],
-    /// the frame norms `‖x_f‖²`,
-    pub xx: &'a [f64],
-    /// the norms of the frame differences (chain starts aside),
-    pub dxx: &'a [f64],
-    /// the clips,
-    pub chains: &'a [Range<usize>],
-    /// λ
-    pub lambda: f64,
-    /// and the number of pieces.
-    pub d: usize,
+    /// Everything else, as the exact step takes it.
+    pub terms: ChainTerms<'a>,
 }
 
 /// Reusable buffers of [`candidate_label_step`].
@@ -100,7 +92,7 @@ pub(crate) fn candidate_label_step(
     cost: &mut [f64],
     work: &mut CandidateWork,
 ) -> f64 {
-    let (d, n) = (inp.d, inp.xx.len());
+    let (d, n) = (inp.terms.d, inp.terms.xx.len());
     work.pieces.resize(n * STRIDE, 0);
     work.count.resize(n, 0);
     work.here.resize(n * STRIDE, 0.0);
@@ -109,18 +101,11 @@ pub(crate) fn candidate_label_step(
     work.v.resize(n * STRIDE, 0.0);
     work.back.resize(n * STRIDE, 0);
     work.alpha.resize(STRIDE, 0.0);
-    work.gd.clear();
-    work.gd.extend((0..d).map(|k| inp.g[k * d + k]));
-    work.lg.resize(d * d, 0.0);
-    for a in 0..d {
-        for b in 0..d {
-            work.lg[a * d + b] = 0.5 * inp.lambda * (inp.g[a * d + b] + inp.g[b * d + a]);
-        }
-    }
+    inp.terms.gram_parts(&mut work.gd, &mut work.lg);
     work.keys.resize(d, 0.0);
     work.rows.resize((BLOCK + 1) * d, 0.0);
     let mut total = 0.0;
-    for ch in inp.chains {
+    for ch in inp.terms.chains {
         if ch.is_empty() {
             continue;
         }
@@ -139,7 +124,7 @@ fn pick_candidates(
     keep_current: bool,
     work: &mut CandidateWork,
 ) {
-    let (d, q) = (inp.d, inp.q);
+    let (d, q) = (inp.terms.d, inp.q);
     let r = MatRef::from_row_major_slice(inp.r, d, q);
     let mut f0 = ch.start;
     while f0 < ch.end {
@@ -175,7 +160,7 @@ fn frame_candidates(
     keep_current: bool,
     work: &mut CandidateWork,
 ) {
-    let d = inp.d;
+    let d = inp.terms.d;
     let pf = &work.rows[row * d..(row + 1) * d];
     // ‖x_f‖² is the same for every piece: the order is that of the unary cost.
     for ((k, &g), &p) in work.keys.iter_mut().zip(&work.gd).zip(pf) {
@@ -234,11 +219,11 @@ fn chain_dp(
     cost: &mut [f64],
     work: &mut CandidateWork,
 ) -> f64 {
-    let d = inp.d;
-    let half = 0.5 * inp.lambda;
+    let d = inp.terms.d;
+    let half = 0.5 * inp.terms.lambda;
     let gd = &work.gd[..];
     for f in ch.clone() {
-        let (xf, at) = (inp.xx[f], f * STRIDE);
+        let (xf, at) = (inp.terms.xx[f], f * STRIDE);
         let cf = work.count[f] as usize;
         if f == ch.start {
             for j in 0..cf {
@@ -255,7 +240,7 @@ fn chain_dp(
             work.alpha[i] = work.v[prev + i]
                 + half * (gd[a] + 2.0 * (work.after[at + i] - work.here[prev + i]));
         }
-        let df = inp.dxx[f];
+        let df = inp.terms.dxx[f];
         for j in 0..cf {
             let b = work.pieces[at + j] as usize;
             // λG is symmetrized: row b holds column b.
@@ -285,7 +270,7 @@ fn chain_dp(
         let at = f * STRIDE + slot;
         let b = work.pieces[at];
         labels[f] = b;
-        cost[f] = inp.xx[f] - 2.0 * work.here[at] + gd[b as usize];
+        cost[f] = inp.terms.xx[f] - 2.0 * work.here[at] + gd[b as usize];
         slot = work.back[at] as usize;
     }
     best
@@ -356,8 +341,7 @@ mod tests {
         d: usize,
         lambda: f64,
     ) -> (LabelInputs<'a>, CandidateInputs<'a>) {
-        let exact = LabelInputs {
-            p: &c.p,
+        let terms = ChainTerms {
             g: &c.g,
             xx: &c.xx,
             dxx: &c.dxx,
@@ -365,16 +349,12 @@ mod tests {
             lambda,
             d,
         };
+        let exact = LabelInputs { p: &c.p, terms };
         let ours = CandidateInputs {
             y: &c.x,
             r: &c.r,
             q: c.dim,
-            g: &c.g,
-            xx: &c.xx,
-            dxx: &c.dxx,
-            chains,
-            lambda,
-            d,
+            terms,
         };
         (exact, ours)
     }

@@ -53,6 +53,7 @@ mod error;
 mod fabricate;
 mod input_errors;
 mod intersect;
+mod kmeans_pp;
 mod magnet;
 mod metrics;
 mod nearest;

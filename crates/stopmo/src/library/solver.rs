@@ -7,11 +7,12 @@ use rayon::prelude::*;
 
 use super::candidates::{candidate_label_step, CandidateInputs, CandidateWork, MIN_PIECES};
 use super::error::{LibraryError, Result};
+use super::kmeans_pp::kmeans_pp;
 use super::metrics::evaluate;
 use super::problem::PartProblem;
 use super::source::Source;
 use super::update::{right_hand_side, solve_pieces, system_matrix, Dense, Positions};
-use super::viterbi::{label_step, LabelInputs, ViterbiWork};
+use super::viterbi::{label_step, ChainTerms, LabelInputs, ViterbiWork};
 use anim::{MorphAnimation, SplitMix64};
 
 /// Velocity weight λ of StopShop Eq. 10 (the paper's results use 2).
@@ -105,73 +106,6 @@ struct Run {
     history: Vec<f64>,
 }
 
-/// k-means++ (Arthur & Vassilvitskii 2007) over frames, fixed pieces counted as centres.
-/// Returns row-major `d × q` pieces. With `Par::Seq` (restarts already run in parallel) the
-/// distance updates stay on the calling thread; the values are the same either way.
-fn kmeans_pp(
-    p: &PartProblem<'_>,
-    d: usize,
-    rng: &mut SplitMix64,
-    par: Par,
-    yt: &[f64],
-) -> Vec<f64> {
-    let (n, q, nf) = (p.frames(), p.sub.dim, p.fixed);
-    let y = p.frame_coords();
-    let mut lib = Vec::with_capacity(d * q);
-    lib.extend_from_slice(p.fixed_coords());
-    let mut dist = vec![f64::INFINITY; n];
-    let nearer = |(f, dv): (usize, &mut f64), c: &[f64]| {
-        let s: f64 = y[f * q..(f + 1) * q]
-            .iter()
-            .zip(c)
-            .map(|(a, b)| (a - b) * (a - b))
-            .sum();
-        *dv = dv.min(s);
-    };
-    // On one thread, frames side by side over the transposed coordinates: each frame's sum
-    // still adds its coordinates in order (the same value as `nearer`), several frames per
-    // instruction.
-    let mut sums = vec![0.0; if matches!(par, Par::Seq) { n } else { 0 }];
-    let mut update = |dist: &mut [f64], c: &[f64]| match par {
-        Par::Seq => {
-            sums.fill(0.0);
-            for (row, &cc) in yt.chunks_exact(n).zip(c) {
-                for (s, &a) in sums.iter_mut().zip(row) {
-                    *s += (a - cc) * (a - cc);
-                }
-            }
-            for (dv, &s) in dist.iter_mut().zip(&sums) {
-                *dv = dv.min(s);
-            }
-        }
-        _ => dist.par_iter_mut().enumerate().for_each(|e| nearer(e, c)),
-    };
-    for k in 0..nf {
-        update(&mut dist, &p.fixed_coords()[k * q..(k + 1) * q]);
-    }
-    for _ in nf..d {
-        let total: f64 = dist.iter().filter(|v| v.is_finite()).sum();
-        let pick = if lib.is_empty() || total.is_nan() || total <= 0.0 || total.is_infinite() {
-            rng.below(n)
-        } else {
-            let mut t = rng.next_f64() * total;
-            let mut pick = n - 1;
-            for (f, &dv) in dist.iter().enumerate() {
-                if t < dv {
-                    pick = f;
-                    break;
-                }
-                t -= dv;
-            }
-            pick
-        };
-        let c = y[pick * q..(pick + 1) * q].to_vec();
-        update(&mut dist, &c);
-        lib.extend_from_slice(&c);
-    }
-    lib
-}
-
 /// Gives every unused free piece the worst-fitting frame (largest unary cost) among frames
 /// whose piece is fixed or used more than once, so that `A` stays positive definite.
 pub(crate) fn repair_empty(labels: &mut [u32], cost: &[f64], fixed: usize, d: usize) {
@@ -241,20 +175,22 @@ fn label(
         par,
     );
     buf.cost.resize(n, 0.0);
+    let terms = ChainTerms {
+        g: &buf.g,
+        xx: &prob.xx,
+        dxx: &prob.dxx,
+        chains: &prob.chains,
+        lambda,
+        d,
+    };
     if let Step::Candidates { keep } = step {
         let inp = CandidateInputs {
             y: prob.frame_coords(),
             r: lib,
             q,
-            g: &buf.g,
-            xx: &prob.xx,
-            dxx: &prob.dxx,
-            chains: &prob.chains,
-            lambda,
-            d,
+            terms,
         };
-        let e = candidate_label_step(&inp, labels, keep, &mut buf.cost, &mut buf.candidates);
-        return e;
+        return candidate_label_step(&inp, labels, keep, &mut buf.cost, &mut buf.candidates);
     }
     buf.p.resize(n * d, 0.0);
     // One GEMM per iteration: X Rᵀ gives both ‖x − r‖² and Δx·r.
@@ -266,15 +202,7 @@ fn label(
         1.0,
         par,
     );
-    let inp = LabelInputs {
-        p: &buf.p,
-        g: &buf.g,
-        xx: &prob.xx,
-        dxx: &prob.dxx,
-        chains: &prob.chains,
-        lambda,
-        d,
-    };
+    let inp = LabelInputs { p: &buf.p, terms };
     label_step(&inp, labels, &mut buf.cost, &mut buf.work)
 }
 
@@ -524,18 +452,17 @@ impl PartProblem<'_> {
             Par::Seq => self.frame_coords_transposed(),
             _ => Vec::new(),
         };
-        let runs: Vec<Result<Run>> = (0..opts.restarts)
+        // Only the best restart so far is kept (memory for two runs per thread, however
+        // many restarts): the lowest energy, the first restart among equal ones, the first
+        // restart's error in restart order.
+        let best = (0..opts.restarts)
             .into_par_iter()
             .map(|r| run(self, d, opts, r, par, &yt))
-            .collect();
-        let mut best: Option<Run> = None;
-        for r in runs {
-            let r = r?;
-            if best.as_ref().is_none_or(|b| r.energy < b.energy) {
-                best = Some(r);
-            }
-        }
-        let best = best.expect("restarts >= 1");
+            .reduce_with(|a, b| match (a, b) {
+                (Ok(a), Ok(b)) => Ok(if b.energy < a.energy { b } else { a }),
+                (Err(e), _) | (Ok(_), Err(e)) => Err(e),
+            })
+            .expect("restarts >= 1")?;
         let (pieces, labels) = finish(self, d, opts.lambda, best.labels)?;
         let energy = if evaluate_energy {
             evaluate(self, &pieces, &labels, opts.lambda).0

@@ -22,6 +22,13 @@ use std::ops::Range;
 pub(crate) struct LabelInputs<'a> {
     /// `n × d` inner products `x_f · r_k`.
     pub p: &'a [f64],
+    /// Everything else, shared with the candidate steps.
+    pub terms: ChainTerms<'a>,
+}
+
+/// What every label step takes besides the frames' inner products with the pieces.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ChainTerms<'a> {
     /// `d × d` Gram matrix `r_a · r_b`.
     pub g: &'a [f64],
     /// `‖x_f‖²` per frame.
@@ -36,36 +43,55 @@ pub(crate) struct LabelInputs<'a> {
     pub d: usize,
 }
 
+impl ChainTerms<'_> {
+    /// The diagonal `G_kk` into `gd` (contiguous, so that per-frame loops vectorize) and
+    /// `λG` symmetrized into `lg`, so that a sweep along rows and a backtrack along columns
+    /// agree exactly.
+    pub(crate) fn gram_parts(&self, gd: &mut Vec<f64>, lg: &mut Vec<f64>) {
+        let (d, g) = (self.d, self.g);
+        gd.clear();
+        gd.extend((0..d).map(|k| g[k * d + k]));
+        lg.resize(d * d, 0.0);
+        for a in 0..d {
+            for b in 0..d {
+                lg[a * d + b] = 0.5 * self.lambda * (g[a * d + b] + g[b * d + a]);
+            }
+        }
+    }
+}
+
 impl LabelInputs<'_> {
     #[inline]
     fn unary(&self, f: usize, k: usize) -> f64 {
-        self.xx[f] - 2.0 * self.p[f * self.d + k] + self.g[k * self.d + k]
+        self.terms.xx[f] - 2.0 * self.p[f * self.terms.d + k] + self.terms.g[k * self.terms.d + k]
     }
 
     #[cfg(test)]
     fn delta(&self, f: usize, k: usize) -> f64 {
-        self.p[f * self.d + k] - self.p[(f - 1) * self.d + k]
+        self.p[f * self.terms.d + k] - self.p[(f - 1) * self.terms.d + k]
     }
 
     /// Energy (StopShop Eq. 10) of a labeling, from the same Gram matrices.
     #[cfg(test)]
     pub(crate) fn energy(&self, labels: &[u32]) -> f64 {
         let mut e = 0.0;
-        for ch in self.chains {
+        for ch in self.terms.chains {
             for f in ch.clone() {
                 let b = labels[f] as usize;
                 e += self.unary(f, b);
                 if f > ch.start {
                     let a = labels[f - 1] as usize;
                     let (gaa, gbb, gab) = (
-                        self.g[a * self.d + a],
-                        self.g[b * self.d + b],
-                        self.g[a * self.d + b],
+                        self.terms.g[a * self.terms.d + a],
+                        self.terms.g[b * self.terms.d + b],
+                        self.terms.g[a * self.terms.d + b],
                     );
-                    let pair =
-                        self.dxx[f] - 2.0 * self.delta(f, b) + 2.0 * self.delta(f, a) + gaa + gbb
-                            - 2.0 * gab;
-                    e += 0.5 * self.lambda * pair;
+                    let pair = self.terms.dxx[f] - 2.0 * self.delta(f, b)
+                        + 2.0 * self.delta(f, a)
+                        + gaa
+                        + gbb
+                        - 2.0 * gab;
+                    e += 0.5 * self.terms.lambda * pair;
                 }
             }
         }
@@ -258,27 +284,22 @@ pub(crate) fn label_step(
     cost: &mut [f64],
     work: &mut ViterbiWork,
 ) -> f64 {
-    let d = inp.d;
-    let n = inp.xx.len();
-    let half = 0.5 * inp.lambda;
+    let d = inp.terms.d;
+    let n = inp.terms.xx.len();
+    let half = 0.5 * inp.terms.lambda;
     work.v.resize(n * d, 0.0);
     work.m.resize(d, 0.0);
-    work.gd.clear();
-    work.gd.extend((0..d).map(|k| inp.g[k * d + k]));
-    // λ·G, symmetrized so that forward sweep (rows) and backtrack (columns) agree exactly.
-    work.lg.resize(d * d, 0.0);
-    for a in 0..d {
-        for b in 0..d {
-            work.lg[a * d + b] = 0.5 * inp.lambda * (inp.g[a * d + b] + inp.g[b * d + a]);
-        }
-    }
+    inp.terms.gram_parts(&mut work.gd, &mut work.lg);
     let gd = &work.gd[..];
     let mut total = 0.0;
-    for ch in inp.chains {
+    for ch in inp.terms.chains {
         if ch.is_empty() {
             continue;
         }
-        let (xs, ps) = (inp.xx[ch.start], &inp.p[ch.start * d..(ch.start + 1) * d]);
+        let (xs, ps) = (
+            inp.terms.xx[ch.start],
+            &inp.p[ch.start * d..(ch.start + 1) * d],
+        );
         for ((v, &p), &g) in work.v[ch.start * d..(ch.start + 1) * d]
             .iter_mut()
             .zip(ps)
@@ -296,13 +317,13 @@ pub(crate) fn label_step(
                 *al += half * (g + 2.0 * (a1 - a0));
             }
             // m(b) = min_a (α_a − λ G_ab), swept row by row of λG (λ = 0: one minimum).
-            if inp.lambda == 0.0 {
+            if inp.terms.lambda == 0.0 {
                 let flat = alpha.iter().copied().fold(f64::INFINITY, f64::min);
                 work.m.fill(flat);
             } else {
                 min_plus(&mut work.m, alpha, &work.lg, d);
             }
-            let (xf, df) = (inp.xx[f], inp.dxx[f]);
+            let (xf, df) = (inp.terms.xx[f], inp.terms.dxx[f]);
             for ((((c, &g), &b1), &b0), &mb) in cur.iter_mut().zip(gd).zip(pf).zip(pp).zip(&work.m)
             {
                 *c = (xf - 2.0 * b1 + g) + half * (df + g - 2.0 * (b1 - b0)) + mb;
@@ -421,14 +442,14 @@ pub(crate) mod tests {
     }
 
     fn brute_force(inp: &LabelInputs<'_>, n: usize) -> f64 {
-        let total = inp.d.pow(n as u32);
+        let total = inp.terms.d.pow(n as u32);
         let mut labels = vec![0u32; n];
         let mut best = f64::INFINITY;
         for code in 0..total {
             let mut c = code;
             for l in labels.iter_mut() {
-                *l = (c % inp.d) as u32;
-                c /= inp.d;
+                *l = (c % inp.terms.d) as u32;
+                c /= inp.terms.d;
             }
             best = best.min(inp.energy(&labels));
         }
@@ -511,12 +532,14 @@ pub(crate) mod tests {
             for chains in [std::iter::once(0..n).collect::<Vec<_>>(), vec![0..2, 2..n]] {
                 let inp = LabelInputs {
                     p: &c.p,
-                    g: &c.g,
-                    xx: &c.xx,
-                    dxx: &c.dxx,
-                    chains: &chains,
-                    lambda,
-                    d,
+                    terms: ChainTerms {
+                        g: &c.g,
+                        xx: &c.xx,
+                        dxx: &c.dxx,
+                        chains: &chains,
+                        lambda,
+                        d,
+                    },
                 };
                 let mut labels = vec![0u32; n];
                 let mut cost = vec![0.0; n];
