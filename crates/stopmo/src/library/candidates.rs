@@ -25,6 +25,9 @@ pub(crate) const MIN_PIECES: usize = 64;
 /// Candidates per frame at most: the nearest ones and the labels of `f − 1`, `f`, `f + 1`.
 const STRIDE: usize = CANDIDATES + 3;
 
+/// Lanes of the dynamic programming's inner loop: [`STRIDE`] rounded up to whole registers.
+const DP_LANES: usize = STRIDE.next_multiple_of(4);
+
 /// Frames whose inner products with the pieces are computed at once (one small GEMM whose
 /// result stays in cache while the frames' candidates are picked).
 const BLOCK: usize = 64;
@@ -69,8 +72,6 @@ pub(crate) struct CandidateWork {
     rows: Vec<f64>,
     /// One frame's unary costs less `‖x_f‖²`.
     keys: Vec<f64>,
-    /// Pieces whose key is within a bound, and their keys.
-    below: Vec<(f64, u32)>,
 }
 
 /// The label step restricted to each frame's candidates.
@@ -86,6 +87,50 @@ pub(crate) struct CandidateWork {
 /// `n × pieces` matrix is never stored), `O(n · pieces)` to pick the candidates,
 /// `O(n · STRIDE²)` for the dynamic programming; no allocation once `work` is warm.
 pub(crate) fn candidate_label_step(
+    inp: &CandidateInputs<'_>,
+    labels: &mut [u32],
+    keep_current: bool,
+    cost: &mut [f64],
+    work: &mut CandidateWork,
+) -> f64 {
+    // Compiled once per instruction set (AVX2 on x86-64): the per-frame loops over keys and
+    // candidates vectorize; no sum changes order.
+    pulp::Arch::new().dispatch(Step {
+        inp,
+        labels,
+        keep_current,
+        cost,
+        work,
+    })
+}
+
+/// Arguments of [`candidate_label_step`], as a [`pulp::WithSimd`] operation.
+struct Step<'a, 'b> {
+    inp: &'a CandidateInputs<'b>,
+    labels: &'a mut [u32],
+    keep_current: bool,
+    cost: &'a mut [f64],
+    work: &'a mut CandidateWork,
+}
+
+impl pulp::WithSimd for Step<'_, '_> {
+    type Output = f64;
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> f64 {
+        let Step {
+            inp,
+            labels,
+            keep_current,
+            cost,
+            work,
+        } = self;
+        step(inp, labels, keep_current, cost, work)
+    }
+}
+
+/// The body of [`candidate_label_step`].
+#[inline(always)]
+fn step(
     inp: &CandidateInputs<'_>,
     labels: &mut [u32],
     keep_current: bool,
@@ -117,6 +162,7 @@ pub(crate) fn candidate_label_step(
 
 /// Picks every frame of chain `ch`'s candidates and the inner products the dynamic
 /// programming needs, a block of frames at a time.
+#[inline(always)]
 fn pick_candidates(
     inp: &CandidateInputs<'_>,
     ch: &Range<usize>,
@@ -151,6 +197,7 @@ fn pick_candidates(
 
 /// Frame `f`'s candidates, whose inner products are row `row` of `work.rows` (the previous
 /// frame's are the row before).
+#[inline(always)]
 fn frame_candidates(
     inp: &CandidateInputs<'_>,
     ch: &Range<usize>,
@@ -167,22 +214,15 @@ fn frame_candidates(
         *k = g - 2.0 * p;
     }
     let slots = &mut work.pieces[f * STRIDE..(f + 1) * STRIDE];
-    // The previous step's candidates bound the new nearest ones (when they were at least
-    // as many distinct pieces, their largest key is no smaller than the k-th).
+    // The previous step's candidates bound the new nearest ones: among any k distinct pieces,
+    // the k-th smallest key is no smaller than the k-th smallest of all.
     let kept = if keep_current {
         work.count[f] as usize
     } else {
         0
     };
-    let bound = (kept >= CANDIDATES.min(d))
-        .then(|| {
-            slots[..kept]
-                .iter()
-                .map(|&b| work.keys[b as usize])
-                .fold(f64::NEG_INFINITY, f64::max)
-        })
-        .filter(|t| !t.is_nan());
-    let mut c = nearest(&work.keys, bound, &mut work.below, &mut slots[..CANDIDATES]);
+    let bound = kth_smallest(&work.keys, &slots[..kept], CANDIDATES.min(d));
+    let mut c = nearest(&work.keys, bound, &mut slots[..CANDIDATES]);
     if keep_current {
         let around = f.saturating_sub(1).max(ch.start)..(f + 2).min(ch.end);
         for l in labels[around].iter().copied() {
@@ -212,6 +252,7 @@ fn frame_candidates(
 
 /// The dynamic programming over chain `ch`'s candidates; writes its labels and unary costs
 /// and returns its energy.
+#[inline(always)]
 fn chain_dp(
     inp: &CandidateInputs<'_>,
     ch: &Range<usize>,
@@ -241,21 +282,32 @@ fn chain_dp(
                 + half * (gd[a] + 2.0 * (work.after[at + i] - work.here[prev + i]));
         }
         let df = inp.terms.dxx[f];
-        for j in 0..cf {
-            let b = work.pieces[at + j] as usize;
-            // λG is symmetrized: row b holds column b.
-            let lg = &work.lg[b * d..(b + 1) * d];
-            let (mut best, mut arg) = (f64::INFINITY, 0);
-            for i in 0..cp {
-                let v = work.alpha[i] - lg[work.pieces[prev + i] as usize];
-                if v < best {
-                    (best, arg) = (v, i);
-                }
+        // Every candidate `b` of frame f runs its own chain `if v < best` over the previous
+        // frame's candidates in order (the first minimum, as the exact step takes it); the
+        // chains go side by side, one lane per `b`. λG is symmetrized: row `a` holds column `a`.
+        // Lanes past the frame's candidates read piece 0 and are never used.
+        let mut idx = [0usize; DP_LANES];
+        for (o, &b) in idx.iter_mut().zip(&work.pieces[at..at + cf]) {
+            *o = b as usize;
+        }
+        let (mut best, mut arg) = ([f64::INFINITY; DP_LANES], [0u64; DP_LANES]);
+        for i in 0..cp {
+            let a = work.pieces[prev + i] as usize;
+            let (al, lg) = (work.alpha[i], &work.lg[a * d..(a + 1) * d]);
+            let v: [f64; DP_LANES] = std::array::from_fn(|j| al - lg[idx[j]]);
+            for j in 0..DP_LANES {
+                let lower = v[j] < best[j];
+                best[j] = if lower { v[j] } else { best[j] };
+                arg[j] = if lower { i as u64 } else { arg[j] };
             }
+        }
+        for j in 0..cf {
+            let b = idx[j];
             let (gb, pb) = (gd[b], work.here[at + j]);
-            work.v[at + j] =
-                (xf - 2.0 * pb + gb) + half * (df + gb - 2.0 * (pb - work.before[at + j])) + best;
-            work.back[at + j] = arg as u8;
+            work.v[at + j] = (xf - 2.0 * pb + gb)
+                + half * (df + gb - 2.0 * (pb - work.before[at + j]))
+                + best[j];
+            work.back[at + j] = arg[j] as u8;
         }
     }
     let last = ch.end - 1;
@@ -279,40 +331,65 @@ fn chain_dp(
 /// Writes the pieces of the `out.len()` smallest `keys` into `out`, smallest first (ties to
 /// the lower piece), and returns how many there are (`min(out.len(), pieces)`, fewer when
 /// keys are NaN, at least 1). With a `bound` no smaller than the `out.len()`-th smallest key,
-/// only the keys up to it are sorted; the result is the same.
-fn nearest(
-    keys: &[f64],
-    bound: Option<f64>,
-    below: &mut Vec<(f64, u32)>,
-    out: &mut [u32],
-) -> usize {
-    let k = out.len();
+/// only the keys up to it are looked at; the result is the same.
+#[inline(always)]
+fn nearest(keys: &[f64], bound: Option<f64>, out: &mut [u32]) -> usize {
     if let Some(t) = bound {
-        below.clear();
-        below.extend(
-            keys.iter()
-                .enumerate()
-                .filter(|&(_, &key)| key <= t)
-                .map(|(b, &key)| (key, b as u32)),
-        );
-        if below.len() >= k {
-            // Stable, and ±0 equal as `<` has them: equal keys keep the lower piece first.
-            below.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap_or(std::cmp::Ordering::Equal));
-            for (o, &(_, b)) in out.iter_mut().zip(below.iter()) {
-                *o = b;
-            }
-            return k;
+        let c = smallest(keys, t, out);
+        if c == out.len() {
+            return c;
         }
     }
+    let c = smallest(keys, f64::INFINITY, out);
+    if c == 0 {
+        out[0] = 0;
+        return 1;
+    }
+    c
+}
+
+/// The `k`-th smallest of the keys of `pieces` (distinct; the first [`STRIDE`] of them), NaN
+/// keys left out; `None` when fewer than `k` are left.
+#[inline(always)]
+fn kth_smallest(keys: &[f64], pieces: &[u32], k: usize) -> Option<f64> {
+    let mut known = [0.0f64; STRIDE];
+    let mut c = 0;
+    for &b in pieces.iter().take(STRIDE) {
+        let key = keys[b as usize];
+        if !key.is_nan() {
+            known[c] = key;
+            c += 1;
+        }
+    }
+    if k == 0 || c < k {
+        return None;
+    }
+    let known = &mut known[..c];
+    known.sort_unstable_by(f64::total_cmp);
+    Some(known[k - 1])
+}
+
+/// Keys compared at once before looking at any one of them.
+const KEY_CHUNK: usize = 8;
+
+/// The pieces of the `out.len()` smallest keys up to `limit` (NaN never), smallest first, ties
+/// to the lower piece; returns how many there are. Each new key is inserted after the equal
+/// ones already kept, which is a stable sort's order. Only the keys of a chunk that are at
+/// most the current limit (the k-th key kept so far, once there are k) are looked at.
+#[inline(always)]
+fn smallest(keys: &[f64], limit: f64, out: &mut [u32]) -> usize {
+    let k = out.len();
     let mut best = [f64::INFINITY; CANDIDATES];
     let best = &mut best[..k];
     let mut c = 0;
-    for (b, &key) in keys.iter().enumerate() {
+    let mut lim = limit;
+    let mut consider = |b: usize, key: f64, c: &mut usize, lim: &mut f64| {
         // NaN keys are never candidates (nor are keys no better than the k-th).
-        if key.is_nan() || (c == k && key >= best[k - 1]) {
-            continue;
+        let within = key <= limit;
+        if !within || (*c == k && key >= best[k - 1]) {
+            return;
         }
-        let mut i = c.min(k - 1);
+        let mut i = (*c).min(k - 1);
         while i > 0 && key < best[i - 1] {
             best[i] = best[i - 1];
             out[i] = out[i - 1];
@@ -320,11 +397,28 @@ fn nearest(
         }
         best[i] = key;
         out[i] = b as u32;
-        c = (c + 1).min(k);
+        *c = (*c + 1).min(k);
+        if *c == k {
+            *lim = lim.min(best[k - 1]);
+        }
+    };
+    let chunks = keys.chunks_exact(KEY_CHUNK);
+    let tail = chunks.remainder();
+    for (ci, chunk) in chunks.enumerate() {
+        let mut mask = 0u32;
+        for (l, &key) in chunk.iter().enumerate() {
+            mask |= u32::from(key <= lim) << l;
+        }
+        while mask != 0 {
+            let l = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let b = ci * KEY_CHUNK + l;
+            consider(b, keys[b], &mut c, &mut lim);
+        }
     }
-    if c == 0 {
-        out[0] = 0;
-        c = 1;
+    let base = keys.len() - tail.len();
+    for (l, &key) in tail.iter().enumerate() {
+        consider(base + l, key, &mut c, &mut lim);
     }
     c
 }
@@ -425,5 +519,59 @@ mod tests {
         let e = candidate_label_step(&inp, &mut kept, true, &mut vec![0.0; n], &mut work);
         assert!((e - optimum).abs() <= 1e-9 * optimum.abs());
         assert_eq!(kept, exact);
+    }
+
+    /// The nearest pieces of [`nearest`] are those of a stable sort of the keys whatever the
+    /// bound (a valid one, a larger one, one too small, none), with ties, signed zeros and NaN
+    /// keys; [`kth_smallest`] gives a valid bound from any distinct pieces.
+    #[test]
+    fn nearest_pieces_are_those_of_a_stable_sort() {
+        let mut rng = anim::SplitMix64::new(11, 4);
+        for trial in 0..300 {
+            let d = 1 + rng.below(70);
+            let keys: Vec<f64> = (0..d)
+                .map(|_| match rng.below(12) {
+                    0 => f64::NAN,
+                    1 => -0.0,
+                    2 => 0.0,
+                    _ => (rng.below(9) as f64 - 4.0) * 0.5,
+                })
+                .collect();
+            let mut sorted: Vec<(f64, u32)> = keys
+                .iter()
+                .enumerate()
+                .filter(|(_, k)| !k.is_nan())
+                .map(|(b, &k)| (k, b as u32))
+                .collect();
+            sorted.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap());
+            let mut want: Vec<u32> = sorted.iter().take(CANDIDATES).map(|p| p.1).collect();
+            if want.is_empty() {
+                want.push(0);
+            }
+            let pieces: Vec<u32> = (0..d as u32).filter(|b| b % 3 != trial % 3).collect();
+            let bounds = [
+                None,
+                sorted.get(CANDIDATES - 1).map(|p| p.0),
+                sorted.last().map(|p| p.0 + 1.0),
+                sorted.first().map(|p| p.0 - 1.0),
+                kth_smallest(&keys, &pieces, CANDIDATES.min(d)),
+            ];
+            for bound in bounds {
+                let mut out = [u32::MAX; CANDIDATES];
+                let c = nearest(&keys, bound, &mut out);
+                assert_eq!(
+                    &out[..c],
+                    &want[..],
+                    "trial {trial}, bound {bound:?}: {keys:?}"
+                );
+            }
+            if let Some(t) = kth_smallest(&keys, &pieces, CANDIDATES.min(d)) {
+                let kth = sorted[CANDIDATES.min(d) - 1].0;
+                assert!(
+                    t >= kth,
+                    "trial {trial}: bound {t} below the k-th key {kth}"
+                );
+            }
+        }
     }
 }

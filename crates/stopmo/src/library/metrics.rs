@@ -158,11 +158,54 @@ fn frame_terms(
     w: Option<&[f64]>,
     want_bounds: bool,
 ) -> (FrameTerms, Aabb) {
+    pulp::Arch::new().dispatch(FrameTermsOp {
+        x,
+        r,
+        previous,
+        w,
+        want_bounds,
+    })
+}
+
+struct FrameTermsOp<'a> {
+    x: &'a [Vec3],
+    r: &'a [Vec3],
+    previous: Option<(&'a [Vec3], &'a [Vec3])>,
+    w: Option<&'a [f64]>,
+    want_bounds: bool,
+}
+
+impl pulp::WithSimd for FrameTermsOp<'_> {
+    type Output = (FrameTerms, Aabb);
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> Self::Output {
+        let FrameTermsOp {
+            x,
+            r,
+            previous,
+            w,
+            want_bounds,
+        } = self;
+        frame_terms_body(x, r, previous, w, want_bounds)
+    }
+}
+
+#[inline(always)]
+fn frame_terms_body(
+    x: &[Vec3],
+    r: &[Vec3],
+    previous: Option<(&[Vec3], &[Vec3])>,
+    w: Option<&[f64]>,
+    want_bounds: bool,
+) -> (FrameTerms, Aabb) {
     const CHUNK: usize = 16;
-    let (mut eu, mut pm, mut px) = (0.0, 0.0, 0.0f64);
-    let (mut ev, mut vm, mut vx) = (0.0, 0.0, 0.0f64);
-    // In the distance loop, the box costs no extra pass over the frame.
-    let mut bb = Aabb::EMPTY;
+    let (mut eu, mut pm, mut ev, mut vm) = (0.0, 0.0, 0.0, 0.0f64);
+    // Maxima per lane (a distance is +0 or more, or NaN, which `>` passes over as
+    // `f64::max` does): the same largest value in any order.
+    let (mut px, mut vx) = ([0.0f64; CHUNK], [0.0f64; CHUNK]);
+    // The box per lane and coordinate, in the distance loop (no extra pass over the frame).
+    let mut lo = [[f32::INFINITY; CHUNK]; 3];
+    let mut hi = [[f32::NEG_INFINITY; CHUNK]; 3];
     let (mut sq, mut dist) = ([0.0f64; CHUNK], [0.0f64; CHUNK]);
     let (mut vsq, mut vdist) = ([0.0f64; CHUNK], [0.0f64; CHUNK]);
     let n = x.len().min(r.len());
@@ -174,9 +217,10 @@ fn frame_terms(
             let s = length_squared((xc[l] - rc[l]).as_dvec3());
             sq[l] = s;
             dist[l] = s.sqrt();
+            px[l] = if dist[l] > px[l] { dist[l] } else { px[l] };
         }
         if want_bounds {
-            xc.iter().for_each(|&a| bb.grow(a));
+            grow_lanes(&mut lo, &mut hi, xc);
         }
         let wc = w.map(|w| &w[i0..i0 + len]);
         if let Some((xp, rp)) = previous {
@@ -186,27 +230,53 @@ fn frame_terms(
                 let s = length_squared(dv);
                 vsq[l] = s;
                 vdist[l] = s.sqrt();
+                vx[l] = if vdist[l] > vx[l] { vdist[l] } else { vx[l] };
             }
             for l in 0..len {
                 let wl = wc.map_or(1.0, |w| w[l]);
                 eu += wl * sq[l];
                 pm += dist[l];
-                px = px.max(dist[l]);
                 ev += wl * vsq[l];
                 vm += vdist[l];
-                vx = vx.max(vdist[l]);
             }
         } else {
             for l in 0..len {
                 eu += wc.map_or(1.0, |w| w[l]) * sq[l];
                 pm += dist[l];
-                px = px.max(dist[l]);
             }
         }
         i0 += len;
     }
+    let largest = |v: [f64; CHUNK]| v.into_iter().fold(0.0, |a, b| if b > a { b } else { a });
+    let bb = if want_bounds {
+        let lane = |c: usize| {
+            let min = lo[c].into_iter().fold(f32::INFINITY, f32::min);
+            let max = hi[c].into_iter().fold(f32::NEG_INFINITY, f32::max);
+            (min, max)
+        };
+        let ((x0, x1), (y0, y1), (z0, z1)) = (lane(0), lane(1), lane(2));
+        Aabb {
+            min: Vec3::new(x0, y0, z0),
+            max: Vec3::new(x1, y1, z1),
+        }
+    } else {
+        Aabb::EMPTY
+    };
     let m = x.len().max(1) as f64;
-    ((eu, pm / m, px, ev, vm / m, vx), bb)
+    ((eu, pm / m, largest(px), ev, vm / m, largest(vx)), bb)
+}
+
+/// Grows the per-lane box of [`frame_terms`] by the points of one chunk, leaving out points
+/// that are not finite (as [`Aabb::grow`] does).
+#[inline(always)]
+fn grow_lanes<const L: usize>(lo: &mut [[f32; L]; 3], hi: &mut [[f32; L]; 3], points: &[Vec3]) {
+    for (l, p) in points.iter().enumerate().take(L) {
+        let finite = p.x.is_finite() & p.y.is_finite() & p.z.is_finite();
+        for (c, v) in [p.x, p.y, p.z].into_iter().enumerate() {
+            lo[c][l] = if finite && v < lo[c][l] { v } else { lo[c][l] };
+            hi[c][l] = if finite && v > hi[c][l] { v } else { hi[c][l] };
+        }
+    }
 }
 
 /// `‖v‖²` summed as glam's `DVec3::length_squared` sums it (x, then y, then z).
@@ -230,5 +300,96 @@ impl PartProblem<'_> {
             && labels.iter().all(|&l| (l as usize) < pieces.len())
             && pieces.iter().all(|p| p.len() == self.vertices());
         ok.then(|| evaluate(self, pieces, labels, lambda))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use anim::SplitMix64;
+
+    /// [`frame_terms`] as a loop over single vertices: every sum in vertex order,
+    /// `f64::max` for the maxima, [`Aabb::grow`] for the box.
+    fn per_vertex(
+        x: &[Vec3],
+        r: &[Vec3],
+        previous: Option<(&[Vec3], &[Vec3])>,
+        w: Option<&[f64]>,
+    ) -> (FrameTerms, Aabb) {
+        let (mut eu, mut pm, mut px, mut ev, mut vm, mut vx) = (0.0, 0.0, 0.0f64, 0.0, 0.0, 0.0f64);
+        let mut bb = Aabb::EMPTY;
+        for i in 0..x.len() {
+            let wl = w.map_or(1.0, |w| w[i]);
+            let s = length_squared((x[i] - r[i]).as_dvec3());
+            eu += wl * s;
+            pm += s.sqrt();
+            px = px.max(s.sqrt());
+            bb.grow(x[i]);
+            if let Some((xp, rp)) = previous {
+                let s = length_squared((x[i] - xp[i]).as_dvec3() - (r[i] - rp[i]).as_dvec3());
+                ev += wl * s;
+                vm += s.sqrt();
+                vx = vx.max(s.sqrt());
+            }
+        }
+        let m = x.len().max(1) as f64;
+        ((eu, pm / m, px, ev, vm / m, vx), bb)
+    }
+
+    fn same(a: f64, b: f64) -> bool {
+        a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
+    }
+
+    /// Chunks of 16 vertices, maxima and the box per lane: the same bits as one vertex at a
+    /// time, on frames whose lengths are not whole chunks, with points that are not finite.
+    #[test]
+    fn chunked_frame_terms_are_the_per_vertex_sums() {
+        let mut rng = SplitMix64::new(5, 2);
+        let mut point = |odd: bool| {
+            let mut p = Vec3::new(
+                rng.normal() as f32,
+                rng.normal() as f32,
+                rng.normal() as f32,
+            );
+            if odd {
+                match rng.below(3) {
+                    0 => p.x = f32::NAN,
+                    1 => p.y = f32::INFINITY,
+                    _ => p.z = -0.0,
+                }
+            }
+            p
+        };
+        for (len, odd) in [
+            (0, false),
+            (1, false),
+            (15, true),
+            (16, false),
+            (17, true),
+            (203, true),
+        ] {
+            let mut frame = |k: usize| -> Vec<Vec3> {
+                (0..len)
+                    .map(|i| point(odd && (i * 7 + k) % 11 == 3))
+                    .collect()
+            };
+            let (x, r, xp, rp) = (frame(0), frame(1), frame(2), frame(3));
+            let w: Vec<f64> = (0..len).map(|i| 0.5 + (i % 5) as f64 * 0.25).collect();
+            for weights in [None, Some(&w[..])] {
+                for previous in [None, Some((&xp[..], &rp[..]))] {
+                    let (got, bb) = frame_terms(&x, &r, previous, weights, true);
+                    let (want, want_bb) = per_vertex(&x, &r, previous, weights);
+                    let g = [got.0, got.1, got.2, got.3, got.4, got.5];
+                    let e = [want.0, want.1, want.2, want.3, want.4, want.5];
+                    for (a, b) in g.iter().zip(&e) {
+                        assert!(same(*a, *b), "{len} vertices: {g:?} vs {e:?}");
+                    }
+                    assert!(
+                        bb.min == want_bb.min && bb.max == want_bb.max,
+                        "{bb:?} vs {want_bb:?}"
+                    );
+                }
+            }
+        }
     }
 }

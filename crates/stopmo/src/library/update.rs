@@ -22,7 +22,7 @@
 use std::ops::Range;
 
 use faer::linalg::solvers::Solve;
-use faer::{Mat, Side};
+use faer::{Mat, MatMut, Side};
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -165,8 +165,8 @@ pub(crate) fn right_hand_side<R: FrameRows>(
 /// * `fixed_rows` — row-major `fixed × cols` values of the fixed pieces (indices `0..fixed`).
 ///
 /// # Returns
-/// All `d` pieces, row-major `d × cols` (fixed ones copied), written over `b`: the step
-/// holds the right-hand side and the solver's copy of it, never a third `d × cols` buffer.
+/// All `d` pieces, row-major `d × cols` (fixed ones copied), solved in place over `b`: the
+/// step holds one `d × cols` buffer.
 pub(crate) fn solve_pieces(
     a: &[f64],
     mut b: Vec<f64>,
@@ -184,7 +184,10 @@ pub(crate) fn solve_pieces(
     let llt = aff
         .llt(Side::Lower)
         .map_err(|e| LibraryError::Numerical(format!("library normal equations: {e:?}")))?;
-    let mut rhs = Mat::<f64>::from_fn(nf, cols, |i, c| b[(i + fixed) * cols + c]);
+    // Solved where it stands, row-major (faer takes either layout): no column-major copy of
+    // the `pieces × cols` right-hand side in and out (docs/stopmo-scale.md, "Memory").
+    b[..fixed * cols].copy_from_slice(&fixed_rows[..fixed * cols]);
+    let mut rhs = MatMut::from_row_major_slice_mut(&mut b[fixed * cols..], nf, cols);
     if fixed > 0 {
         for i in 0..nf {
             for j in 0..fixed {
@@ -198,14 +201,6 @@ pub(crate) fn solve_pieces(
         }
     }
     llt.solve_in_place(rhs.as_mut());
-    let out = &mut b;
-    out[..fixed * cols].copy_from_slice(&fixed_rows[..fixed * cols]);
-    for i in 0..nf {
-        let row = &mut out[(i + fixed) * cols..(i + fixed + 1) * cols];
-        for (c, o) in row.iter_mut().enumerate() {
-            *o = rhs[(i, c)];
-        }
-    }
     Ok(b)
 }
 
