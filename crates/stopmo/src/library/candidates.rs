@@ -369,13 +369,11 @@ fn kth_smallest(keys: &[f64], pieces: &[u32], k: usize) -> Option<f64> {
     Some(known[k - 1])
 }
 
-/// Keys compared at once before looking at any one of them.
-const KEY_CHUNK: usize = 8;
-
 /// The pieces of the `out.len()` smallest keys up to `limit` (NaN never), smallest first, ties
 /// to the lower piece; returns how many there are. Each new key is inserted after the equal
-/// ones already kept, which is a stable sort's order. Only the keys of a chunk that are at
-/// most the current limit (the k-th key kept so far, once there are k) are looked at.
+/// ones already kept, which is a stable sort's order. One comparison per key with the current
+/// limit (the k-th key kept so far, once there are k) passes over most keys: with the
+/// previous candidates' bound, about 9 of 200 keys are looked at further on Table-1's case.
 #[inline(always)]
 fn smallest(keys: &[f64], limit: f64, out: &mut [u32]) -> usize {
     let k = out.len();
@@ -383,13 +381,14 @@ fn smallest(keys: &[f64], limit: f64, out: &mut [u32]) -> usize {
     let best = &mut best[..k];
     let mut c = 0;
     let mut lim = limit;
-    let mut consider = |b: usize, key: f64, c: &mut usize, lim: &mut f64| {
-        // NaN keys are never candidates (nor are keys no better than the k-th).
-        let within = key <= limit;
-        if !within || (*c == k && key >= best[k - 1]) {
-            return;
+    for (b, &key) in keys.iter().enumerate() {
+        // NaN keys are never candidates, nor are keys no better than the k-th (a key equal
+        // to it comes after it).
+        let within = key <= lim;
+        if !within || (c == k && key >= best[k - 1]) {
+            continue;
         }
-        let mut i = (*c).min(k - 1);
+        let mut i = c.min(k - 1);
         while i > 0 && key < best[i - 1] {
             best[i] = best[i - 1];
             out[i] = out[i - 1];
@@ -397,28 +396,10 @@ fn smallest(keys: &[f64], limit: f64, out: &mut [u32]) -> usize {
         }
         best[i] = key;
         out[i] = b as u32;
-        *c = (*c + 1).min(k);
-        if *c == k {
-            *lim = lim.min(best[k - 1]);
+        c = (c + 1).min(k);
+        if c == k {
+            lim = lim.min(best[k - 1]);
         }
-    };
-    let chunks = keys.chunks_exact(KEY_CHUNK);
-    let tail = chunks.remainder();
-    for (ci, chunk) in chunks.enumerate() {
-        let mut mask = 0u32;
-        for (l, &key) in chunk.iter().enumerate() {
-            mask |= u32::from(key <= lim) << l;
-        }
-        while mask != 0 {
-            let l = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            let b = ci * KEY_CHUNK + l;
-            consider(b, keys[b], &mut c, &mut lim);
-        }
-    }
-    let base = keys.len() - tail.len();
-    for (l, &key) in tail.iter().enumerate() {
-        consider(base + l, key, &mut c, &mut lim);
     }
     c
 }
