@@ -88,18 +88,25 @@ try {
     return Array.from(ctx.getImageData(0, 0, c.width, c.height).data);
   });
   // The server is the binary alone in an empty folder (.ci/studio.sh): three.js came from it.
-  const before = await pixels();
-  const bg = [before[0], before[1], before[2]];
-  const width = await page.evaluate(() => document.getElementById('gl').width);
-  let lit = 0, x0 = Infinity, x1 = -1, y0 = Infinity, y1 = -1;
-  for (let i = 0; i < before.length; i += 4) {
-    if (Math.abs(before[i] - bg[0]) + Math.abs(before[i + 1] - bg[1]) + Math.abs(before[i + 2] - bg[2]) <= 30) continue;
-    lit++;
-    const x = (i / 4) % width, y = Math.floor(i / 4 / width);
-    x0 = Math.min(x0, x); x1 = Math.max(x1, x); y0 = Math.min(y0, y); y1 = Math.max(y1, y);
+  // Read until the character shows (at most 10 s): the panel's text may still be laying out,
+  // and a canvas being resized is blank until it is drawn again.
+  let before, width, height, lit, x0, x1, y0, y1, centred;
+  for (const t0 = Date.now(); ;) {
+    before = await pixels();
+    const bg = [before[0], before[1], before[2]];
+    width = await page.evaluate(() => document.getElementById('gl').width);
+    lit = 0; x0 = Infinity; x1 = -1; y0 = Infinity; y1 = -1;
+    for (let i = 0; i < before.length; i += 4) {
+      if (Math.abs(before[i] - bg[0]) + Math.abs(before[i + 1] - bg[1]) + Math.abs(before[i + 2] - bg[2]) <= 30) continue;
+      lit++;
+      const x = (i / 4) % width, y = Math.floor(i / 4 / width);
+      x0 = Math.min(x0, x); x1 = Math.max(x1, x); y0 = Math.min(y0, y); y1 = Math.max(y1, y);
+    }
+    height = before.length / 4 / width;
+    centred = x0 < width / 2 && x1 > width / 2 && y0 < height / 2 && y1 > height / 2;
+    if ((lit > 2000 && centred) || Date.now() - t0 > 10000) break;
+    await page.waitForTimeout(200);
   }
-  const height = before.length / 4 / width;
-  const centred = x0 < width / 2 && x1 > width / 2 && y0 < height / 2 && y1 > height / 2;
   check('the viewport shows the character (three.js embedded in the binary)', lit > 2000 && centred, `${lit} pixels differ from the background, in x ${x0}–${x1}, y ${y0}–${y1} of ${width}×${height}`);
   // The viewport's own vertex normals (web/normals.js, per frame shown) against three.js's
   // computeVertexNormals on the same geometry: the same float32 values.

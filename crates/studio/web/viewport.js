@@ -48,7 +48,9 @@ export class Viewport {
     this.offsets = null;
     this.vertexColors = null;
     this.resize();
-    new ResizeObserver(() => this.resize()).observe(canvas);
+    // Resizing clears the canvas: drawn again at once, so that it never shows blank until
+    // the next animation frame.
+    new ResizeObserver(() => { this.resize(); this.render(); }).observe(canvas);
   }
 
   /** A surface material: physically based on a GPU, diffuse on a software renderer. */
