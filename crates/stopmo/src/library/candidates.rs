@@ -124,40 +124,28 @@ impl pulp::WithSimd for Step<'_, '_> {
             cost,
             work,
         } = self;
-        step(inp, labels, keep_current, cost, work)
-    }
-}
-
-/// The body of [`candidate_label_step`].
-#[inline(always)]
-fn step(
-    inp: &CandidateInputs<'_>,
-    labels: &mut [u32],
-    keep_current: bool,
-    cost: &mut [f64],
-    work: &mut CandidateWork,
-) -> f64 {
-    let (d, n) = (inp.terms.d, inp.terms.xx.len());
-    work.pieces.resize(n * STRIDE, 0);
-    work.count.resize(n, 0);
-    work.here.resize(n * STRIDE, 0.0);
-    work.before.resize(n * STRIDE, 0.0);
-    work.after.resize(n * STRIDE, 0.0);
-    work.v.resize(n * STRIDE, 0.0);
-    work.back.resize(n * STRIDE, 0);
-    work.alpha.resize(STRIDE, 0.0);
-    inp.terms.gram_parts(&mut work.gd, &mut work.lg);
-    work.keys.resize(d, 0.0);
-    work.rows.resize((BLOCK + 1) * d, 0.0);
-    let mut total = 0.0;
-    for ch in inp.terms.chains {
-        if ch.is_empty() {
-            continue;
+        let (d, n) = (inp.terms.d, inp.terms.xx.len());
+        work.pieces.resize(n * STRIDE, 0);
+        work.count.resize(n, 0);
+        work.here.resize(n * STRIDE, 0.0);
+        work.before.resize(n * STRIDE, 0.0);
+        work.after.resize(n * STRIDE, 0.0);
+        work.v.resize(n * STRIDE, 0.0);
+        work.back.resize(n * STRIDE, 0);
+        work.alpha.resize(STRIDE, 0.0);
+        inp.terms.gram_parts(&mut work.gd, &mut work.lg);
+        work.keys.resize(d, 0.0);
+        work.rows.resize((BLOCK + 1) * d, 0.0);
+        let mut total = 0.0;
+        for ch in inp.terms.chains {
+            if ch.is_empty() {
+                continue;
+            }
+            pick_candidates(inp, ch, labels, keep_current, work);
+            total += chain_dp(inp, ch, labels, cost, work);
         }
-        pick_candidates(inp, ch, labels, keep_current, work);
-        total += chain_dp(inp, ch, labels, cost, work);
+        total
     }
-    total
 }
 
 /// Picks every frame of chain `ch`'s candidates and the inner products the dynamic

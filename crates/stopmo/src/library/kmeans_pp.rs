@@ -63,9 +63,9 @@ pub(super) fn kmeans_pp(
             }
             pick
         };
-        let c = y[pick * q..(pick + 1) * q].to_vec();
-        update(&mut dist, &c);
-        lib.extend_from_slice(&c);
+        let c = &y[pick * q..(pick + 1) * q];
+        update(&mut dist, c);
+        lib.extend_from_slice(c);
     }
     lib
 }

@@ -149,8 +149,6 @@ pub(crate) fn evaluate(
 /// (their sums are independent chains of additions): every sum is the same sequence of f64
 /// additions as a loop over single vertices, so the energy and errors do not depend on the
 /// chunk size.
-// Not inlined: its own symbol in profiles (docs/stopmo-scale.md measures it).
-#[inline(never)]
 fn frame_terms(
     x: &[Vec3],
     r: &[Vec3],
@@ -167,6 +165,8 @@ fn frame_terms(
     })
 }
 
+/// Arguments of [`frame_terms`], as a [`pulp::WithSimd`] operation: compiled once per
+/// instruction set (AVX2 on x86-64), the same sums in the same order.
 struct FrameTermsOp<'a> {
     x: &'a [Vec3],
     r: &'a [Vec3],
@@ -186,84 +186,73 @@ impl pulp::WithSimd for FrameTermsOp<'_> {
             w,
             want_bounds,
         } = self;
-        frame_terms_body(x, r, previous, w, want_bounds)
-    }
-}
-
-#[inline(always)]
-fn frame_terms_body(
-    x: &[Vec3],
-    r: &[Vec3],
-    previous: Option<(&[Vec3], &[Vec3])>,
-    w: Option<&[f64]>,
-    want_bounds: bool,
-) -> (FrameTerms, Aabb) {
-    const CHUNK: usize = 16;
-    let (mut eu, mut pm, mut ev, mut vm) = (0.0, 0.0, 0.0, 0.0f64);
-    // Maxima per lane (a distance is +0 or more, or NaN, which `>` passes over as
-    // `f64::max` does): the same largest value in any order.
-    let (mut px, mut vx) = ([0.0f64; CHUNK], [0.0f64; CHUNK]);
-    // The box per lane and coordinate, in the distance loop (no extra pass over the frame).
-    let mut lo = [[f32::INFINITY; CHUNK]; 3];
-    let mut hi = [[f32::NEG_INFINITY; CHUNK]; 3];
-    let (mut sq, mut dist) = ([0.0f64; CHUNK], [0.0f64; CHUNK]);
-    let (mut vsq, mut vdist) = ([0.0f64; CHUNK], [0.0f64; CHUNK]);
-    let n = x.len().min(r.len());
-    let mut i0 = 0;
-    while i0 < n {
-        let len = CHUNK.min(n - i0);
-        let (xc, rc) = (&x[i0..i0 + len], &r[i0..i0 + len]);
-        for l in 0..len {
-            let s = length_squared((xc[l] - rc[l]).as_dvec3());
-            sq[l] = s;
-            dist[l] = s.sqrt();
-            px[l] = if dist[l] > px[l] { dist[l] } else { px[l] };
-        }
-        if want_bounds {
-            grow_lanes(&mut lo, &mut hi, xc);
-        }
-        let wc = w.map(|w| &w[i0..i0 + len]);
-        if let Some((xp, rp)) = previous {
-            let (xpc, rpc) = (&xp[i0..i0 + len], &rp[i0..i0 + len]);
+        const CHUNK: usize = 16;
+        let (mut eu, mut pm, mut ev, mut vm) = (0.0, 0.0, 0.0, 0.0f64);
+        // Maxima per lane (a distance is +0 or more, or NaN, which `>` passes over as
+        // `f64::max` does): the same largest value in any order.
+        let (mut px, mut vx) = ([0.0f64; CHUNK], [0.0f64; CHUNK]);
+        // The box per lane and coordinate, in the distance loop (no extra pass over the frame).
+        let mut lo = [[f32::INFINITY; CHUNK]; 3];
+        let mut hi = [[f32::NEG_INFINITY; CHUNK]; 3];
+        let (mut sq, mut dist) = ([0.0f64; CHUNK], [0.0f64; CHUNK]);
+        let (mut vsq, mut vdist) = ([0.0f64; CHUNK], [0.0f64; CHUNK]);
+        let n = x.len().min(r.len());
+        let mut i0 = 0;
+        while i0 < n {
+            let len = CHUNK.min(n - i0);
+            let (xc, rc) = (&x[i0..i0 + len], &r[i0..i0 + len]);
             for l in 0..len {
-                let dv = (xc[l] - xpc[l]).as_dvec3() - (rc[l] - rpc[l]).as_dvec3();
-                let s = length_squared(dv);
-                vsq[l] = s;
-                vdist[l] = s.sqrt();
-                vx[l] = if vdist[l] > vx[l] { vdist[l] } else { vx[l] };
+                let s = length_squared((xc[l] - rc[l]).as_dvec3());
+                sq[l] = s;
+                dist[l] = s.sqrt();
+                px[l] = if dist[l] > px[l] { dist[l] } else { px[l] };
             }
-            for l in 0..len {
-                let wl = wc.map_or(1.0, |w| w[l]);
-                eu += wl * sq[l];
-                pm += dist[l];
-                ev += wl * vsq[l];
-                vm += vdist[l];
+            if want_bounds {
+                grow_lanes(&mut lo, &mut hi, xc);
+            }
+            let wc = w.map(|w| &w[i0..i0 + len]);
+            if let Some((xp, rp)) = previous {
+                let (xpc, rpc) = (&xp[i0..i0 + len], &rp[i0..i0 + len]);
+                for l in 0..len {
+                    let dv = (xc[l] - xpc[l]).as_dvec3() - (rc[l] - rpc[l]).as_dvec3();
+                    let s = length_squared(dv);
+                    vsq[l] = s;
+                    vdist[l] = s.sqrt();
+                    vx[l] = if vdist[l] > vx[l] { vdist[l] } else { vx[l] };
+                }
+                for l in 0..len {
+                    let wl = wc.map_or(1.0, |w| w[l]);
+                    eu += wl * sq[l];
+                    pm += dist[l];
+                    ev += wl * vsq[l];
+                    vm += vdist[l];
+                }
+            } else {
+                for l in 0..len {
+                    eu += wc.map_or(1.0, |w| w[l]) * sq[l];
+                    pm += dist[l];
+                }
+            }
+            i0 += len;
+        }
+        let largest = |v: [f64; CHUNK]| v.into_iter().fold(0.0, |a, b| if b > a { b } else { a });
+        let bb = if want_bounds {
+            let lane = |c: usize| {
+                let min = lo[c].into_iter().fold(f32::INFINITY, f32::min);
+                let max = hi[c].into_iter().fold(f32::NEG_INFINITY, f32::max);
+                (min, max)
+            };
+            let ((x0, x1), (y0, y1), (z0, z1)) = (lane(0), lane(1), lane(2));
+            Aabb {
+                min: Vec3::new(x0, y0, z0),
+                max: Vec3::new(x1, y1, z1),
             }
         } else {
-            for l in 0..len {
-                eu += wc.map_or(1.0, |w| w[l]) * sq[l];
-                pm += dist[l];
-            }
-        }
-        i0 += len;
-    }
-    let largest = |v: [f64; CHUNK]| v.into_iter().fold(0.0, |a, b| if b > a { b } else { a });
-    let bb = if want_bounds {
-        let lane = |c: usize| {
-            let min = lo[c].into_iter().fold(f32::INFINITY, f32::min);
-            let max = hi[c].into_iter().fold(f32::NEG_INFINITY, f32::max);
-            (min, max)
+            Aabb::EMPTY
         };
-        let ((x0, x1), (y0, y1), (z0, z1)) = (lane(0), lane(1), lane(2));
-        Aabb {
-            min: Vec3::new(x0, y0, z0),
-            max: Vec3::new(x1, y1, z1),
-        }
-    } else {
-        Aabb::EMPTY
-    };
-    let m = x.len().max(1) as f64;
-    ((eu, pm / m, largest(px), ev, vm / m, largest(vx)), bb)
+        let m = x.len().max(1) as f64;
+        ((eu, pm / m, largest(px), ev, vm / m, largest(vx)), bb)
+    }
 }
 
 /// Grows the per-lane box of [`frame_terms`] by the points of one chunk, leaving out points

@@ -176,8 +176,8 @@ pub(crate) fn solve_pieces(
     fixed_rows: &[f64],
 ) -> Result<Vec<f64>> {
     let nf = d - fixed;
+    b[..fixed * cols].copy_from_slice(&fixed_rows[..fixed * cols]);
     if nf == 0 {
-        b[..fixed * cols].copy_from_slice(&fixed_rows[..fixed * cols]);
         return Ok(b);
     }
     let aff = Mat::<f64>::from_fn(nf, nf, |i, j| a[(i + fixed) * d + j + fixed]);
@@ -185,8 +185,8 @@ pub(crate) fn solve_pieces(
         .llt(Side::Lower)
         .map_err(|e| LibraryError::Numerical(format!("library normal equations: {e:?}")))?;
     // Solved where it stands, row-major (faer takes either layout): no column-major copy of
-    // the `pieces × cols` right-hand side in and out (docs/stopmo-scale.md, "Memory").
-    b[..fixed * cols].copy_from_slice(&fixed_rows[..fixed * cols]);
+    // the `pieces × cols` right-hand side in and out (docs/stopmo-scale.md, "Per instruction
+    // set, with the same sums").
     let mut rhs = MatMut::from_row_major_slice_mut(&mut b[fixed * cols..], nf, cols);
     if fixed > 0 {
         for i in 0..nf {
