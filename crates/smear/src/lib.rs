@@ -136,9 +136,9 @@ pub use effects::{
     overlap_spacing, sample_surface, squash_frames, subdivide_frame, subdivide_moving_frame,
     surface_point_weights, trajectory_velocities, AroundFrame, ContactStyle, EffectInputs,
     ElongateOptions, LineFrame, LineOptions, LineStyle, MultipleCopy, MultiplesOptions, Spacing,
-    Squash, StyleInput, Stylize, SubdivisionStats, Trajectories, BEND, DEFAULT_FRAME_STEP,
-    DEFAULT_LINE_SAMPLES, DEFAULT_LINE_SIDES, DEFAULT_SEED, DEFAULT_SPACING, DEFAULT_SQUASH_FRAMES,
-    DEVIATION_SHARE, MAX_SQUASH, MAX_SUBDIVISION_LEVELS,
+    Squash, StyleBlock, StyleInput, Stylize, SubdivisionStats, Trajectories, BEND,
+    DEFAULT_FRAME_STEP, DEFAULT_LINE_SAMPLES, DEFAULT_LINE_SIDES, DEFAULT_SEED, DEFAULT_SPACING,
+    DEFAULT_SQUASH_FRAMES, DEVIATION_SHARE, MAX_SQUASH, MAX_SUBDIVISION_LEVELS, STYLE_BLOCK,
 };
 pub use error::{Result, SmearError};
 pub use job::{
@@ -160,13 +160,13 @@ pub use smooth::{
 pub use solver::{mesh_offsets, offset_solves, scene_offsets, OffsetMode, OffsetSolver};
 pub use stream::{Stream, StreamOptions, DEFAULT_STREAM_HISTORY};
 pub use stylize::{
-    apply_stages, hise_curve, parameter, voronoi_f1, warp_offset, CompiledEffects, CompiledLines,
-    ElongatePreset, ElongateStyle, Expression, FunctionSpec, LinesStyle, MultiplesStyle,
-    ObjectEffects, ObjectStyle, Param, Parameter, SizeReference, SpeedUnits, Stage, Style,
-    StyleError, StyleFunction, StyleOps, StyleUnits, WeightAttribute, WeightGroup, WeightSource,
-    DEFAULT_BETA_MAX, DEFAULT_COPIES, DEFAULT_KAPPA, DEFAULT_LINE_COUNT, DEFAULT_LINE_LENGTH,
-    DEFAULT_LINE_THICKNESS, DEFAULT_MULTIPLE_COLOR, EXPRESSION_INPUTS, MAX_EXPRESSION_VARIABLES,
-    PARAMETERS,
+    apply_stages, apply_stages_block, hise_curve, parameter, voronoi_f1, warp_offset,
+    CompiledEffects, CompiledLines, ElongatePreset, ElongateStyle, Expression, FunctionSpec,
+    LinesStyle, MultiplesStyle, ObjectEffects, ObjectStyle, Param, Parameter, SizeReference,
+    SpeedUnits, Stage, Style, StyleError, StyleFunction, StyleOps, StyleUnits, WeightAttribute,
+    WeightGroup, WeightSource, DEFAULT_BETA_MAX, DEFAULT_COPIES, DEFAULT_KAPPA, DEFAULT_LINE_COUNT,
+    DEFAULT_LINE_LENGTH, DEFAULT_LINE_THICKNESS, DEFAULT_MULTIPLE_COLOR, EXPRESSION_INPUTS,
+    MAX_EXPRESSION_VARIABLES, PARAMETERS,
 };
 pub use surface::SurfacePoint;
 pub use velocity::{camera_vertex_velocities, causal_vertex_velocities, speeds, vertex_velocities};

@@ -186,26 +186,41 @@ fn differences(
         return out;
     }
     out.par_chunks_mut(n).enumerate().for_each(|(f, dst)| {
-        let (a, b, s) = difference_frames(f, frames, causal);
-        let (pa, pb) = (
-            &positions[a * n..(a + 1) * n],
-            &positions[b * n..(b + 1) * n],
-        );
-        match space {
-            None => {
-                for ((d, p), q) in dst.iter_mut().zip(pa).zip(pb) {
-                    *d = (*q - *p) * s;
-                }
-            }
-            Some(c) => {
-                let (va, vb) = (c.view[a], c.view[b]);
-                for ((d, p), q) in dst.iter_mut().zip(pa).zip(pb) {
-                    *d = (vb.transform_point3(*q) - va.transform_point3(*p)) * s;
-                }
-            }
-        }
+        let frames = difference_frames(f, frames, causal);
+        run_differences(positions, n, frames, (0, dst.len()), space, |k, v| {
+            dst[k] = v
+        });
     });
     out
+}
+
+/// Calls `emit(k, v)` with the velocity `v` of point `start + k` for `k < len`, from the
+/// difference `frames` of [`difference_frames`] in a frame-major buffer of `n` points per
+/// frame: one loop per space, the camera's transforms looked up once.
+#[inline(always)]
+fn run_differences(
+    positions: &[Vec3],
+    n: usize,
+    (a, b, s): (usize, usize, f32),
+    (start, len): (usize, usize),
+    space: Option<&CameraSpace>,
+    mut emit: impl FnMut(usize, Vec3),
+) {
+    let pa = &positions[a * n + start..a * n + start + len];
+    let pb = &positions[b * n + start..b * n + start + len];
+    match space {
+        None => {
+            for (k, (p, q)) in pa.iter().zip(pb).enumerate() {
+                emit(k, (*q - *p) * s);
+            }
+        }
+        Some(c) => {
+            let (va, vb) = (c.view[a], c.view[b]);
+            for (k, (p, q)) in pa.iter().zip(pb).enumerate() {
+                emit(k, (vb.transform_point3(*q) - va.transform_point3(*p)) * s);
+            }
+        }
+    }
 }
 
 /// The velocity at frame `f` of point `i` of a frame-major `frames × n` buffer, as
@@ -228,6 +243,24 @@ pub(crate) fn point_velocity(
     }
 }
 
+/// The speeds `|v|` at frame `f` of points `start..start + out.len()` of a frame-major
+/// `frames × n` buffer: those of [`point_velocity`] (the same operations, so the same values
+/// bit for bit) with the frames and the camera's transforms looked up once for the run.
+pub(crate) fn run_speeds(
+    positions: &[Vec3],
+    (frames, n): (usize, usize),
+    (f, start): (usize, usize),
+    space: Option<&CameraSpace>,
+    causal: bool,
+    out: &mut [f32],
+) {
+    let frames = difference_frames(f, frames, causal);
+    let len = out.len();
+    run_differences(positions, n, frames, (start, len), space, |k, v| {
+        out[k] = v.length();
+    });
+}
+
 /// Speeds |v| of a velocity buffer (units per frame), as stylization uses them.
 pub fn speeds(velocities: &[Vec3]) -> Vec<f32> {
     velocities.par_iter().map(|v| v.length()).collect()
@@ -236,7 +269,8 @@ pub fn speeds(velocities: &[Vec3]) -> Vec<f32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use anim::{Mesh, Projection};
+    use crate::effects::test_util::camera;
+    use anim::Mesh;
 
     fn moving_point(xs: &[f32]) -> MeshAnimation {
         let m = Mesh::new("p", vec![Vec3::ZERO], vec![]);
@@ -259,18 +293,11 @@ mod tests {
     #[test]
     fn camera_following_the_point_sees_it_still() {
         let anim = moving_point(&[0.0, 1.0, 2.0]);
-        let cam = Camera {
-            name: "c".into(),
-            projection: Projection::Orthographic {
-                xmag: 1.0,
-                ymag: 1.0,
-                znear: 0.1,
-                zfar: 10.0,
-            },
-            world: (0..3)
+        let cam = camera(
+            (0..3)
                 .map(|f| Mat4::from_translation(Vec3::new(f as f32, 0.0, 5.0)))
                 .collect(),
-        };
+        );
         for v in camera_vertex_velocities(&anim, &cam) {
             assert!(v.length() < 1e-6);
         }

@@ -6,7 +6,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::inputs::{check_frame, check_step, held_frame};
-use super::{EffectInputs, Stylize, DEFAULT_FRAME_STEP};
+use super::{EffectInputs, Stylize, DEFAULT_FRAME_STEP, STYLE_BLOCK};
 use crate::{Result, SmearError};
 
 /// Vertices per parallel task when elongating one frame.
@@ -27,7 +27,8 @@ impl Default for ElongateOptions {
     }
 }
 
-/// Fills `out` with points `start..start + out.len()` of the drawing at frame `h`.
+/// Fills `out` with points `start..start + out.len()` of the drawing at frame `h`: S_E over
+/// runs of [`STYLE_BLOCK`] points ([`Stylize::eval_block`]), then each point displaced.
 #[inline]
 fn fill(
     inputs: &EffectInputs<'_>,
@@ -38,10 +39,15 @@ fn fill(
     out: &mut [Vec3],
 ) {
     let tr = inputs.trajectories();
-    for (k, o) in out.iter_mut().enumerate() {
-        let i = start + k;
-        let beta = scale * style.eval(&inputs.style_input(h, i));
-        *o = tr.displaced(h, i, beta);
+    let mut beta = [0.0f32; STYLE_BLOCK];
+    let mut first = start;
+    for run in out.chunks_mut(STYLE_BLOCK) {
+        let beta = &mut beta[..run.len()];
+        style.eval_block(&inputs.style_block(h, first, run.len()), beta);
+        for (k, (o, b)) in run.iter_mut().zip(beta.iter()).enumerate() {
+            *o = tr.displaced(h, first + k, scale * b);
+        }
+        first += run.len();
     }
 }
 

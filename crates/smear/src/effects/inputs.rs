@@ -9,9 +9,11 @@ use anim::MeshAnimation;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::{StyleInput, Trajectories};
+use super::{StyleBlock, StyleInput, Trajectories};
 use crate::revolve::Arcs;
-use crate::velocity::{buffer_velocities, camera_buffer_velocities, point_velocity, CameraSpace};
+use crate::velocity::{
+    buffer_velocities, camera_buffer_velocities, point_velocity, run_speeds, CameraSpace,
+};
 use crate::Collider;
 use crate::{MotionOffsets, Result, SmearError, SurfacePoint};
 
@@ -319,6 +321,11 @@ impl<'a> EffectInputs<'a> {
         &self.positions
     }
 
+    /// The painted weights ω, one per point, `None` when every weight is 1.
+    pub fn weights(&self) -> Option<&[f32]> {
+        self.weights.as_deref()
+    }
+
     /// The motion offsets.
     pub fn offsets(&self) -> &MotionOffsets {
         &self.offsets
@@ -343,6 +350,34 @@ impl<'a> EffectInputs<'a> {
             .expect("length checked on construction")
             .shaped(self.causal, self.ground, self.arcs.as_deref())
             .with_colliders(self.colliders)
+    }
+
+    /// The stylization inputs of points `start..start + len` of frame `f` as one run
+    /// ([`Stylize::eval_block`](super::Stylize::eval_block)), `m` and `t` 0. Panics when the
+    /// run is out of range.
+    pub fn style_block(&self, f: usize, start: usize, len: usize) -> StyleBlock<'_> {
+        StyleBlock::new(self, f, start, len)
+    }
+
+    /// The speeds of points `start..start + out.len()` at frame `f`: those of
+    /// [`EffectInputs::style_input`], bit for bit.
+    pub(crate) fn run_speeds(&self, f: usize, start: usize, out: &mut [f32]) {
+        match &self.velocities {
+            Velocities::Buffer(v) => {
+                let (k, len) = (f * self.points + start, out.len());
+                for (o, v) in out.iter_mut().zip(&v[k..k + len]) {
+                    *o = v.length();
+                }
+            }
+            Velocities::Differences { space, causal, .. } => run_speeds(
+                &self.positions,
+                (self.frames, self.points),
+                (f, start),
+                *space,
+                *causal,
+                out,
+            ),
+        }
     }
 
     /// The stylization inputs of point `i` at frame `f` (`m` and `t` left 0). `f` and `i`

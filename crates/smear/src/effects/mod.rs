@@ -7,10 +7,11 @@ mod inputs;
 mod lines;
 mod multiples;
 mod seeds;
+mod style_block;
 mod stylization;
 mod subdivide;
 #[cfg(test)]
-mod test_util;
+pub(crate) mod test_util;
 mod trajectory;
 mod tube;
 mod weights;
@@ -27,6 +28,7 @@ pub use multiples::{
     MultiplesOptions, Spacing, DEFAULT_SPACING,
 };
 pub use seeds::{sample_surface, DEFAULT_SEED};
+pub use style_block::{StyleBlock, STYLE_BLOCK};
 pub use stylization::{StyleInput, Stylize};
 pub use subdivide::{
     subdivide_frame, subdivide_moving_frame, trajectory_velocities, AroundFrame, SubdivisionStats,

@@ -6,7 +6,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::inputs::{check_frame, check_step, held_frame};
-use super::{EffectInputs, StyleInput, Stylize, DEFAULT_FRAME_STEP};
+use super::{EffectInputs, StyleInput, Stylize, DEFAULT_FRAME_STEP, STYLE_BLOCK};
 use crate::{smoothstep, Param, Result, SmearError};
 
 /// Default temporal spacing Δf between copies (Section 4.2's example: half a frame).
@@ -224,16 +224,25 @@ fn fill(
     } else {
         m as usize <= future
     };
-    for (i, (p, a)) in pos.iter_mut().zip(alpha.iter_mut()).enumerate() {
-        if !shown {
-            *a = 0.0;
-            *p = inputs.positions()[h * inputs.point_count() + i];
-            continue;
+    if !shown {
+        let n = inputs.point_count();
+        alpha.fill(0.0);
+        pos.copy_from_slice(&inputs.positions()[h * n..(h + 1) * n]);
+        return;
+    }
+    // S_M over runs of points (`Stylize::eval_block`), then each point's opacity and place.
+    let mut first = 0;
+    for (pos, alpha) in pos
+        .chunks_mut(STYLE_BLOCK)
+        .zip(alpha.chunks_mut(STYLE_BLOCK))
+    {
+        let block = inputs.style_block(h, first, pos.len()).with_m(m as f32);
+        style.eval_block(&block, alpha);
+        for (k, (p, a)) in pos.iter_mut().zip(alpha.iter_mut()).enumerate() {
+            *a = clamp_alpha(*a);
+            *p = tr.displaced(h, first + k, beta);
         }
-        let mut x = inputs.style_input(h, i);
-        x.m = m as f32;
-        *a = clamp_alpha(style.eval(&x));
-        *p = tr.displaced(h, i, beta);
+        first += pos.len();
     }
 }
 

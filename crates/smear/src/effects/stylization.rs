@@ -1,6 +1,8 @@
 //! The contract between the effects (Section 4) and the stylization functions (paper G3,
 //! S_E / S_M / S_L): the inputs a function may read and the trait it implements.
 
+use super::StyleBlock;
+
 /// Everything a stylization function (paper G3, S_E / S_M / S_L) may read at one vertex or
 /// motion-line sample. Unused inputs are 0.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -31,6 +33,16 @@ pub struct StyleInput {
 pub trait Stylize: Send + Sync {
     /// Evaluates the function at one vertex / sample.
     fn eval(&self, x: &StyleInput) -> f32;
+
+    /// Evaluates the function at every point of a run, `out[k]` for [`StyleBlock::input`]`(k)`
+    /// (`out.len()` = the run's length). Must give the values of [`Stylize::eval`] bit for
+    /// bit; the default calls it point by point, a function that can work over the run's
+    /// slices at once (the preset chains) overrides it.
+    fn eval_block(&self, block: &StyleBlock<'_>, out: &mut [f32]) {
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = self.eval(&block.input(k));
+        }
+    }
 }
 
 impl<F: Fn(&StyleInput) -> f32 + Send + Sync> Stylize for F {

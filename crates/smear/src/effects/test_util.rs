@@ -1,7 +1,7 @@
-//! Test fixtures: a UV sphere and a translating ball.
+//! Test fixtures: a UV sphere, a translating ball and a camera.
 
-use anim::{Mesh, MeshAnimation};
-use glam::Vec3;
+use anim::{Camera, Mesh, MeshAnimation, Projection};
+use glam::{Mat4, Vec3};
 
 /// A UV sphere of radius `r`.
 pub(crate) fn ball(r: f32, rings: usize, segments: usize) -> Mesh {
@@ -36,4 +36,18 @@ pub(crate) fn translating_ball(frames: usize, speed: f32) -> MeshAnimation {
         })
         .collect();
     MeshAnimation::new(mesh, 24.0, pos).unwrap()
+}
+
+/// An orthographic camera placed by `world` (one matrix per frame).
+pub(crate) fn camera(world: Vec<Mat4>) -> Camera {
+    Camera {
+        name: "c".into(),
+        projection: Projection::Orthographic {
+            xmag: 1.0,
+            ymag: 1.0,
+            znear: 0.1,
+            zfar: 10.0,
+        },
+        world,
+    }
 }

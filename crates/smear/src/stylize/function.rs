@@ -7,9 +7,9 @@ use serde::{Deserialize, Serialize};
 use super::error::StyleError;
 use super::expr::Expression;
 use super::param::Param;
-use super::stage::{apply_stages, Stage};
+use super::stage::{apply_stages, apply_stages_block, Stage};
 use super::units::StyleUnits;
-use crate::effects::{StyleInput, Stylize};
+use crate::effects::{StyleBlock, StyleInput, Stylize};
 
 /// A stylization function as written in a style file: either `stages` (a preset chain, see
 /// [`Stage`]) or `expr` (a user expression over the inputs of
@@ -170,6 +170,17 @@ impl Stylize for StyleFunction {
         match self {
             StyleFunction::Stages(s) => apply_stages(s, x),
             StyleFunction::Expr(e) => e.evaluate(x),
+        }
+    }
+
+    fn eval_block(&self, block: &StyleBlock<'_>, out: &mut [f32]) {
+        match self {
+            StyleFunction::Stages(s) => apply_stages_block(s, block, out),
+            StyleFunction::Expr(e) => {
+                for (k, o) in out.iter_mut().enumerate() {
+                    *o = e.evaluate(&block.input(k));
+                }
+            }
         }
     }
 }

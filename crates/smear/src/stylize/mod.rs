@@ -35,7 +35,7 @@ pub use preset::{
     parameter, ElongatePreset, Parameter, DEFAULT_BETA_MAX, DEFAULT_COPIES, DEFAULT_KAPPA,
     DEFAULT_LINE_LENGTH, PARAMETERS,
 };
-pub use stage::{apply_stages, Stage};
+pub use stage::{apply_stages, apply_stages_block, Stage};
 pub use style::{
     ElongateStyle, LinesStyle, MultiplesStyle, ObjectEffects, ObjectStyle, Style,
     DEFAULT_LINE_COUNT, DEFAULT_LINE_THICKNESS, DEFAULT_MULTIPLE_COLOR,

@@ -7,7 +7,7 @@ use super::error::StyleError;
 use super::param::Param;
 use super::voronoi::voronoi_f1;
 use super::warp::warp_offset;
-use crate::effects::{multiple_opacity, StyleInput};
+use crate::effects::{multiple_opacity, StyleBlock, StyleInput, STYLE_BLOCK};
 
 /// One operation of a preset chain. The chain starts from x = δ and applies its stages in
 /// order; e.g. `[past, speed, noise(κ = 18), scale(10)]` is Fig. 11d's
@@ -125,6 +125,107 @@ pub fn apply_stages(stages: &[Stage], i: &StyleInput) -> f32 {
         x
     } else {
         0.0
+    }
+}
+
+/// [`apply_stages`] at every point of a run (`out.len()` = `block.len()`), stage by stage over
+/// the run: each stage's parameters are read once, the speeds computed only when a stage reads
+/// them. Every point goes through the same operations in the same order as [`apply_stages`],
+/// so the values are the same bit for bit.
+pub fn apply_stages_block(stages: &[Stage], block: &StyleBlock<'_>, out: &mut [f32]) {
+    assert_eq!(out.len(), block.len(), "one value per point of the run");
+    let mut start = 0;
+    for chunk in out.chunks_mut(STYLE_BLOCK) {
+        let run = block.part(start, chunk.len());
+        apply_run(stages, &run, chunk);
+        start += chunk.len();
+    }
+}
+
+/// [`apply_stages_block`] on a run of at most [`STYLE_BLOCK`] points.
+fn apply_run(stages: &[Stage], run: &StyleBlock<'_>, x: &mut [f32]) {
+    let frame = run.frame();
+    x.copy_from_slice(run.deltas());
+    let mut speeds = Speeds::new(x.len());
+    for stage in stages {
+        match stage {
+            Stage::Warp { s, p } => {
+                let (s, p) = (s.at(frame), p.at(frame));
+                x.iter_mut().for_each(|x| *x = warp_offset(*x, s, p));
+            }
+            Stage::Past => x.iter_mut().for_each(|x| *x = x.min(0.0)),
+            Stage::Future => x.iter_mut().for_each(|x| *x = x.max(0.0)),
+            Stage::Scale { by } => {
+                let by = by.at(frame);
+                x.iter_mut().for_each(|x| *x *= by);
+            }
+            Stage::Speed => {
+                for (x, v) in x.iter_mut().zip(speeds.of(run)) {
+                    *x *= v;
+                }
+            }
+            Stage::Weight => match run.weights() {
+                Some(w) => x.iter_mut().zip(w).for_each(|(x, w)| *x *= w),
+                None => x.iter_mut().for_each(|x| *x *= 1.0),
+            },
+            Stage::Noise { kappa, seed } => {
+                let kappa = kappa.at(frame);
+                for (x, rest) in x.iter_mut().zip(run.rest()) {
+                    // As in `Stage::apply`: a zero stays the same zero.
+                    if *x != 0.0 {
+                        *x *= voronoi_f1(*rest, kappa, *seed);
+                    }
+                }
+            }
+            Stage::Threshold { min_speed } => {
+                let min = min_speed.at(frame);
+                for (x, v) in x.iter_mut().zip(speeds.of(run)) {
+                    // As in `Stage::apply`: a NaN speed is below every threshold.
+                    *x = if *v >= min { *x } else { 0.0 };
+                }
+            }
+            Stage::Multiples { m_max } => {
+                let (m, m_max) = (run.m(), m_max.at(frame));
+                x.iter_mut()
+                    .for_each(|x| *x = multiple_opacity(*x, m, m_max));
+            }
+            Stage::Fade => {
+                let keep = 1.0 - run.t().clamp(0.0, 1.0);
+                x.iter_mut().for_each(|x| *x *= keep);
+            }
+            Stage::Set { value } => x.fill(value.at(frame)),
+        }
+    }
+    for x in x.iter_mut() {
+        if !x.is_finite() {
+            *x = 0.0;
+        }
+    }
+}
+
+/// The speeds of a run, computed the first time a stage reads them.
+struct Speeds {
+    values: [f32; STYLE_BLOCK],
+    len: usize,
+    ready: bool,
+}
+
+impl Speeds {
+    fn new(len: usize) -> Self {
+        Speeds {
+            values: [0.0; STYLE_BLOCK],
+            len,
+            ready: false,
+        }
+    }
+
+    fn of(&mut self, run: &StyleBlock<'_>) -> &[f32] {
+        let values = &mut self.values[..self.len];
+        if !self.ready {
+            run.speeds(values);
+            self.ready = true;
+        }
+        values
     }
 }
 
