@@ -3,7 +3,7 @@
 //!
 //! Layout: `u32` header length `H`, `H` bytes of JSON (space-padded to a multiple of 4),
 //! then the buffers back to back. The header is the caller's JSON object plus
-//! `"buffers": [{"name", "type": "f32"|"u32"|"i16", "offset", "count"}]` (offset in bytes from the
+//! `"buffers": [{"name", "type": "f32"|"u32"|"i16"|"u8", "offset", "count"}]` (offset in bytes from the
 //! start of the data, count in elements), so the page can view each one as a typed array
 //! without copying.
 //!
@@ -163,25 +163,19 @@ impl Pack {
         self.entry(name, "u32", offset, count)
     }
 
-    /// Adds an int16 buffer made of `parts` one after the other (a frame each), copied as
-    /// bytes into one chunk (a chunk per frame made the answer slower to send and to read)
-    /// and zero-padded as [`Pack::i16`].
-    pub fn i16_parts(&mut self, name: &str, parts: Vec<Vec<i16>>) -> &mut Pack {
+    /// Adds a uint8 buffer made of `parts` one after the other (a frame each), copied into one
+    /// chunk and zero-padded to a multiple of 4 bytes (the buffers after it stay aligned for
+    /// the page's typed arrays).
+    pub fn u8_parts(&mut self, name: &str, parts: Vec<Vec<u8>>) -> &mut Pack {
         let offset = self.offset();
         let count: usize = parts.iter().map(Vec::len).sum();
         self.end_large_chunk();
-        self.data.reserve_exact(2 * count + 2);
+        self.data.reserve_exact(count + 3);
         for part in parts {
-            if cfg!(target_endian = "little") {
-                self.data.extend_from_slice(bytemuck::cast_slice(&part));
-            } else {
-                self.data.extend(part.iter().flat_map(|v| v.to_le_bytes()));
-            }
+            self.data.extend_from_slice(&part);
         }
-        if count % 2 == 1 {
-            self.data.extend_from_slice(&[0, 0]);
-        }
-        self.entry(name, "i16", offset, count)
+        self.data.resize(self.data.len() + (4 - count % 4) % 4, 0);
+        self.entry(name, "u8", offset, count)
     }
 
     /// Adds a uint32 buffer handed over without copying (copied as [`Pack::u32`] on a
@@ -333,6 +327,27 @@ pub fn read_u32(bytes: &[u8], name: &str) -> Option<Vec<u32>> {
     )
 }
 
+/// Reads a pack back: the named uint8 buffer (for tests and tools).
+pub fn read_u8(bytes: &[u8], name: &str) -> Option<Vec<u8>> {
+    read_raw(bytes, name, "u8", 1).map(|(_, raw)| raw.to_vec())
+}
+
+/// The zigzag LEB128 integers of a `u8` buffer such as `body.varints` (7 bits a byte from
+/// the lowest, the high bit set on every byte but an integer's last; the low bit of the
+/// result the sign), for tests and tools. A last integer cut short reads as what it holds.
+pub fn zigzag_varints(bytes: &[u8]) -> Vec<i32> {
+    let (mut out, mut z, mut shift) = (Vec::new(), 0u32, 0);
+    for &b in bytes {
+        z |= u32::from(b & 0x7f).checked_shl(shift).unwrap_or(0);
+        shift += 7;
+        if b & 0x80 == 0 {
+            out.push((z >> 1) as i32 ^ -((z & 1) as i32));
+            (z, shift) = (0, 0);
+        }
+    }
+    out
+}
+
 /// Reads a pack back: the named int16 buffer (for tests and tools).
 pub fn read_i16(bytes: &[u8], name: &str) -> Option<Vec<i16>> {
     let (_, raw) = read_raw(bytes, name, "i16", 2)?;
@@ -363,7 +378,7 @@ mod tests {
         p.shared("held", held.clone(), |v| &v[..]);
         p.u32("after", [9]);
         p.i16("small", [-3, 7, 1]).u32("aligned", [5]);
-        p.i16_parts("parts", vec![vec![1, -2], vec![], vec![3]])
+        p.u8_parts("parts", vec![vec![1, 254], vec![], vec![3]])
             .u32_vec("words", vec![6, 7]);
         let bytes = p.finish(json!({"frames": 3}));
         let (header, pos) = read_f32(&bytes, "pos").unwrap();
@@ -377,8 +392,9 @@ mod tests {
         assert_eq!(header["buffers"][6]["offset"], 56);
         assert_eq!(read_u32(&bytes, "aligned").unwrap(), vec![5]);
         assert_eq!(read_i16(&bytes, "small").unwrap(), vec![-3, 7, 1]);
-        assert_eq!(read_i16(&bytes, "parts").unwrap(), vec![1, -2, 3]);
-        assert_eq!(header["buffers"][8]["offset"], 68);
+        assert_eq!(read_u8(&bytes, "parts").unwrap(), vec![1, 254, 3]);
+        // Three bytes and one of padding: the next buffer is aligned.
+        assert_eq!(header["buffers"][8]["offset"], 64);
         assert_eq!(read_u32(&bytes, "words").unwrap(), vec![6, 7]);
         assert_eq!(header["buffers"][1]["offset"], 12);
         let len = u32::from_le_bytes(bytes[..4].try_into().unwrap()) as usize;

@@ -157,7 +157,7 @@ async fn the_whole_clip_sent_as_changes_rebuilds_the_cores_body_within_its_bound
     let dir = tempfile::tempdir().unwrap();
     let app = app(dir.path());
     let input = dance_input(&app).await;
-    // The bound of the 16-bit displacements: 1e-5 of the clip's bounding-box diagonal.
+    // The bound of the quantized displacements: 1e-5 of the clip's bounding-box diagonal.
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     for (i, &x) in input.iter().enumerate() {
         lo[i % 3] = lo[i % 3].min(x);
@@ -180,20 +180,25 @@ async fn the_whole_clip_sent_as_changes_rebuilds_the_cores_body_within_its_bound
         assert!(pack::read_f32(&sent, "body.positions").is_none());
         let mask = read_u32(&sent, "body.changed");
         let (_, steps) = pack::read_f32(&sent, "body.step").unwrap();
-        let delta = pack::read_i16(&sent, "body.delta").unwrap();
+        let offsets = read_u32(&sent, "body.offsets");
+        let varints = pack::read_u8(&sent, "body.varints").unwrap();
         let frames = header["frames"].as_u64().unwrap() as usize;
         let first = header["first_frame"].as_u64().unwrap() as usize;
         let n = body.len() / frames / 3;
         let words = n.div_ceil(32);
         // The page's rebuild: the input clip, moved vertices displaced in vertex order.
         let mut rebuilt = input[first * n * 3..(first + frames) * n * 3].to_vec();
-        let mut k = 0;
+        let mut moved = 0;
         for f in 0..frames {
+            // Each frame's values from its own offsets, as the page reads a frame it draws.
+            let values =
+                pack::zigzag_varints(&varints[offsets[f] as usize..offsets[f + 1] as usize]);
+            let mut k = 0;
             for v in 0..n {
                 if mask[f * words + v / 32] >> (v % 32) & 1 == 1 {
                     let o = (f * n + v) * 3;
                     for c in 0..3 {
-                        rebuilt[o + c] += f32::from(delta[k + c]) * steps[f];
+                        rebuilt[o + c] += values[k + c] as f32 * steps[f];
                     }
                     k += 3;
                 } else {
@@ -205,8 +210,14 @@ async fn the_whole_clip_sent_as_changes_rebuilds_the_cores_body_within_its_bound
                     );
                 }
             }
+            assert_eq!(
+                k,
+                values.len(),
+                "{range:?}: every moved vertex of frame {f} is placed"
+            );
+            moved += k;
         }
-        assert_eq!(k, delta.len(), "{range:?}: every moved vertex is placed");
+        assert_eq!(offsets[frames] as usize, varints.len());
         let worst = rebuilt
             .iter()
             .zip(&body)
@@ -217,10 +228,15 @@ async fn the_whole_clip_sent_as_changes_rebuilds_the_cores_body_within_its_bound
             "{range:?}: the rebuilt body is {worst} off (diagonal {diagonal})"
         );
         assert!(
-            delta.len() * 2 < body.len(),
-            "{range:?}: the speed style moves {} of {} coordinates",
-            delta.len(),
+            moved * 2 < body.len(),
+            "{range:?}: the speed style moves {moved} of {} coordinates",
             body.len()
+        );
+        // Most displacements are a few hundred steps: under two bytes a coordinate.
+        assert!(
+            varints.len() < 2 * moved,
+            "{range:?}: {} bytes for {moved} coordinates",
+            varints.len()
         );
         assert!(
             sent.len() * 4 < dense.len(),
@@ -317,13 +333,14 @@ fn buffers_after_a_megabyte_chunk_read_back_at_their_offsets() {
         .u32("words", words.iter().copied())
         .i16("small", [-3, 7, 1])
         .f32_slices("slices", [&big[..10], &big[10..20]])
-        .i16_parts("parts", vec![vec![1, -2], vec![3]])
+        .u8_parts("parts", vec![vec![1, 254], vec![3]])
         .f32("alpha", big.iter().copied().filter(|v| *v > 1.0));
     let bytes = p.finish(json!({}));
     assert_eq!(f32s(&bytes, "big"), big);
     assert_eq!(read_u32(&bytes, "words"), words);
     assert_eq!(pack::read_i16(&bytes, "small").unwrap(), vec![-3, 7, 1]);
     assert_eq!(f32s(&bytes, "slices"), big[..20].to_vec());
-    assert_eq!(pack::read_i16(&bytes, "parts").unwrap(), vec![1, -2, 3]);
+    // Three bytes, padded: the float32 buffer after them stays aligned.
+    assert_eq!(pack::read_u8(&bytes, "parts").unwrap(), vec![1, 254, 3]);
     assert_eq!(f32s(&bytes, "alpha"), big[3..].to_vec());
 }

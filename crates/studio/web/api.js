@@ -24,7 +24,7 @@ export function parsePack(buffer) {
   const base = 4 + length;
   const buffers = {};
   for (const b of header.buffers) {
-    const Kind = b.type === 'u32' ? Uint32Array : b.type === 'i16' ? Int16Array : Float32Array;
+    const Kind = { u32: Uint32Array, i16: Int16Array, u8: Uint8Array }[b.type] || Float32Array;
     buffers[b.name] = new Kind(buffer, base + b.offset, b.count);
   }
   return { header, buffers, bytes: buffer.byteLength };

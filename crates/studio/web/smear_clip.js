@@ -63,13 +63,15 @@ export class ClipBody {
   }
 
   /**
-   * A whole-clip answer of changes: `body.changed` bits, `body.step` + `body.delta` or
-   * `body.positions` for the moved vertices (frames in `keep` stay as they are). Only where each frame's moved vertices start is
-   * worked out now (a popcount of the bits); the frames are rebuilt when asked for.
+   * A whole-clip answer of changes: `body.changed` bits, and for the moved vertices
+   * `body.step` + `body.offsets` + `body.varints` (displacements in steps) or
+   * `body.positions` (frames in `keep` stay as they are). Nothing is decoded now: a frame's
+   * values start at its offset (or, for positions, where a popcount of the bits says), and
+   * the frames are rebuilt when asked for.
    */
   setChanges(first, count, buffers, keep = null) {
-    const bits = buffers['body.changed'];
-    this.changes = { first, count, bits, starts: starts(bits, this.words, count, 3), exact: buffers['body.positions'], delta: buffers['body.delta'], steps: buffers['body.step'] };
+    const bits = buffers['body.changed'], exact = buffers['body.positions'];
+    this.changes = { first, count, bits, starts: exact ? starts(bits, this.words, count, 3) : buffers['body.offsets'], exact, varints: buffers['body.varints'], steps: buffers['body.step'] };
     unready(this.ready, first, count, keep);
   }
 
@@ -82,12 +84,23 @@ export class ClipBody {
     if (this.ready[f]) return out;
     out.set(this.input.positions.subarray(f * n3, (f + 1) * n3));
     const c = this.changes, j = c ? f - c.first : -1;
-    if (c && j >= 0 && j < c.count) {
-      const { exact, delta } = c, step = c.steps ? c.steps[j] : 0, k0 = c.starts[j];
+    if (c && j >= 0 && j < c.count && c.exact) {
+      const exact = c.exact, k0 = c.starts[j];
       eachSet(c.bits, this.words, j, (v, i) => {
         const o = v * 3, k = k0 + i * 3;
-        if (exact) { out[o] = exact[k]; out[o + 1] = exact[k + 1]; out[o + 2] = exact[k + 2]; }
-        else { out[o] += delta[k] * step; out[o + 1] += delta[k + 1] * step; out[o + 2] += delta[k + 2] * step; }
+        out[o] = exact[k]; out[o + 1] = exact[k + 1]; out[o + 2] = exact[k + 2];
+      });
+    } else if (c && j >= 0 && j < c.count) {
+      // Zigzag LEB128 integers (crates/studio/src/api/changes.rs): 7 bits a byte from the
+      // lowest, the high bit set on every byte but the last, the low bit the sign.
+      const bytes = c.varints, step = c.steps[j];
+      let k = c.starts[j];
+      eachSet(c.bits, this.words, j, (v) => {
+        for (let o = v * 3, end = o + 3; o < end; o++) {
+          let b = bytes[k++], z = b & 127;
+          for (let shift = 7; b & 128; shift += 7) { b = bytes[k++]; z |= (b & 127) << shift; }
+          out[o] += ((z >>> 1) ^ -(z & 1)) * step;
+        }
       });
     }
     this.ready[f] = 1;

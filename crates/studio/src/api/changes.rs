@@ -1,9 +1,10 @@
 //! The whole clip's elongated body as what changed: per frame a bit per vertex (set where the
 //! style moved it off the input) and the moved vertices' displacements from the input,
-//! quantized to 16 bits with a per-frame step. The page holds the input already
-//! (`/api/scene`), so it rebuilds the core's result from few bytes — a speed style leaves the
-//! slow vertices (~60 % of the robot's Dance) where they were. The error bound is in
-//! docs/studio.md ("Whole clips").
+//! quantized on a step fixed by the error bound and sent as variable-length integers (one
+//! byte for most coordinates). The page holds the input already (`/api/scene`), so it
+//! rebuilds the core's result from few bytes — a speed style leaves the slow vertices (~60 %
+//! of the robot's Dance) where they were. The format and its error bound are in
+//! docs/studio.md ("Smear: what the style moved").
 
 use anim::glam::Vec3;
 use rayon::prelude::*;
@@ -11,20 +12,31 @@ use rayon::prelude::*;
 use crate::pack::Pack;
 
 /// Largest quantization error of a moved vertex coordinate, as a fraction of the input clip's
-/// bounding-box diagonal: a frame whose displacements would need a coarser step sends the
-/// whole answer as float32 (`body.positions`).
+/// bounding-box diagonal: a frame whose displacements would need more than
+/// [`MAX_STEPS`] steps sends the whole answer as float32 (`body.positions`).
 pub(crate) const MAX_QUANTIZATION_ERROR: f32 = 1e-5;
 
+/// The quantization step as a fraction of the diagonal: a rounding error of half a step stays
+/// a tenth below [`MAX_QUANTIZATION_ERROR`], which leaves room for float32's own rounding of
+/// the displacement and of the page's sum.
+const STEP: f32 = 2.0 * 0.9 * MAX_QUANTIZATION_ERROR;
+
+/// Largest displacement coordinate in steps: below 2²², where float32 still holds every
+/// integer and [`round_i32`] is exact (about 75 diagonals of the clip).
+const MAX_STEPS: f32 = (1 << 22) as f32;
+
 /// Adds `body.changed` (u32 words, per frame `⌈vertices / 32⌉`, bit `v % 32` of word
-/// `v / 32` set when vertex `v` moved), `body.step` (f32 per frame) and `body.delta` (i16 xyz
-/// of the moved vertices, frame-major, in vertex order: the position is the input's plus
-/// `delta × step`). When a frame's displacements are too large for 16 bits within
-/// [`MAX_QUANTIZATION_ERROR`] of `diagonal` (the input's bounding box over the frames
-/// answered, [`crate::files::Clip::diagonal`]), `body.positions` (f32 xyz of the moved
-/// vertices) replaces `body.step` and `body.delta`. `body(f)` and `input(f)` are the merged
-/// vertices of frame `f` of the answer and of the input clip. Each frame is compared and
-/// quantized by one task while its vertices are in cache, frames in parallel; the answer's
-/// buffers are handed to the pack, not copied.
+/// `v / 32` set when vertex `v` moved), `body.step` (f32 per frame: the quantization step,
+/// [`STEP`] of `diagonal`), `body.offsets` (u32 per frame and one more: where each frame's
+/// values start in `body.varints`) and `body.varints` (u8: the moved vertices' displacements
+/// in steps, x, y, z, frame-major in vertex order, each as a zigzag LEB128 integer — 7 bits a
+/// byte, the low bit the sign: the position is the input's plus `value × step`). When a
+/// frame's displacements are larger than [`MAX_STEPS`] steps, `body.positions` (f32 xyz of
+/// the moved vertices) replaces `body.step`, `body.offsets` and `body.varints`. `diagonal`
+/// is the input's bounding box over the frames answered ([`crate::files::Clip::diagonal`]);
+/// `body(f)` and `input(f)` are the merged vertices of frame `f` of the answer and of the
+/// input clip. Each frame is compared and encoded by one task while its vertices are in
+/// cache, frames in parallel; the answer's buffers are handed to the pack, not copied.
 pub(crate) fn pack_changes<'a>(
     pack: &mut Pack,
     (frames, vertices): (usize, usize),
@@ -33,47 +45,54 @@ pub(crate) fn pack_changes<'a>(
     input: impl Fn(usize) -> &'a [Vec3] + Sync,
 ) {
     let words = vertices.div_ceil(32);
-    let limit = 2.0 * f32::from(i16::MAX) * MAX_QUANTIZATION_ERROR * diagonal;
+    let step = STEP * diagonal;
+    // Steps per unit (infinite for a clip without extent: nothing then fits).
+    let per_unit = 1.0 / step;
     let mut mask = vec![0u32; frames * words];
-    // Per frame: its step (0 when it does not fit in 16 bits) and its moved vertices' deltas.
-    let quantized: Vec<(f32, Vec<i16>)> = mask
+    // Per frame, in one pass over its vertices: the bits, whether its displacements fit, and
+    // the moved vertices' values.
+    let encoded: Vec<(bool, Vec<u8>)> = mask
         .par_chunks_mut(words.max(1))
         .enumerate()
         .map(|(f, bits)| {
             let (slices, before) = (body(f), input(f));
-            let (mut count, mut largest) = (0, 0.0f32);
+            let mut values = Vec::with_capacity(3 * before.len());
+            let mut fits = true;
             each_vertex(&slices, |v, p| {
                 // Bit-exact: an unmoved vertex is drawn from the input itself.
                 match before.get(v) {
                     Some(q) if q.to_array() == p.to_array() => {}
                     q => {
                         bits[v / 32] |= 1 << (v % 32);
-                        count += 1;
-                        largest =
-                            largest.max(q.map_or(f32::INFINITY, |q| (p - *q).abs().max_element()));
+                        // Not finite, too far, or no input vertex: not sent in steps.
+                        let d = q.map_or(Vec3::NAN, |q| (p - *q) * per_unit);
+                        if d.abs().max_element() <= MAX_STEPS && !d.is_nan() {
+                            for x in d.to_array() {
+                                push_varint(&mut values, round_i32(x));
+                            }
+                        } else {
+                            fits = false;
+                        }
                     }
                 }
             });
-            if largest > limit {
-                return (0.0, Vec::new());
-            }
-            let step = if largest > 0.0 {
-                largest / f32::from(i16::MAX)
-            } else {
-                1.0
-            };
-            let mut delta = Vec::with_capacity(3 * count);
-            each_moved(&slices, before, bits, |_, p, q| {
-                delta.extend(((p - q) / step).to_array().map(round_i16));
-            });
-            (step, delta)
+            (fits, values)
         })
         .collect();
-    if quantized.iter().all(|(step, _)| *step > 0.0) {
-        let (steps, delta): (Vec<f32>, Vec<Vec<i16>>) = quantized.into_iter().unzip();
+    if encoded.iter().all(|(fits, _)| *fits) {
+        let offsets = std::iter::once(0)
+            .chain(encoded.iter().scan(0u32, |at, (_, v)| {
+                *at += v.len() as u32;
+                Some(*at)
+            }))
+            .collect::<Vec<u32>>();
         pack.u32_vec("body.changed", mask);
-        pack.f32("body.step", steps);
-        pack.i16_parts("body.delta", delta);
+        pack.f32("body.step", std::iter::repeat_n(step, frames));
+        pack.u32_vec("body.offsets", offsets);
+        pack.u8_parts(
+            "body.varints",
+            encoded.into_iter().map(|(_, v)| v).collect(),
+        );
     } else {
         let counts: Vec<usize> = mask
             .chunks(words.max(1))
@@ -94,12 +113,25 @@ pub(crate) fn pack_changes<'a>(
     }
 }
 
-/// `x` (|x| ≤ 32,767) rounded to the nearest integer, ties to even, without a call into the
-/// C library: adding and taking away 1.5 × 2²³ leaves no bit for a fraction.
+/// `x` (|x| ≤ 2²²) rounded to the nearest integer, ties to even, without a call into the C
+/// library: adding and taking away 1.5 × 2²³ leaves no bit for a fraction.
 #[inline]
-fn round_i16(x: f32) -> i16 {
+fn round_i32(x: f32) -> i32 {
     const SHIFT: f32 = 12_582_912.0;
-    ((x + SHIFT) - SHIFT) as i16
+    ((x + SHIFT) - SHIFT) as i32
+}
+
+/// Appends `value` as a zigzag LEB128 integer: `2|v|` or `2|v| − 1` for a negative `v`, 7 bits
+/// a byte from the lowest, the high bit set on every byte but the last (1 byte below 64 steps,
+/// 2 below 8,192, 3 below 2²⁰, 4 up to [`MAX_STEPS`]).
+#[inline]
+fn push_varint(out: &mut Vec<u8>, value: i32) {
+    let mut z = ((value << 1) ^ (value >> 31)) as u32;
+    while z >= 0x80 {
+        out.push((z as u8) | 0x80);
+        z >>= 7;
+    }
+    out.push(z as u8);
 }
 
 /// Calls `visit(v, p)` for every vertex of a frame given as its objects' slices.
@@ -143,4 +175,27 @@ pub(super) fn split_frames<T>(
         rest = tail;
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn varints_hold_every_step_count_in_as_few_bytes_as_its_size_needs() {
+        let values = [0, 1, -1, 63, -64, 64, -65, 8191, -8192, 8192];
+        let values = [&values[..], &[(1 << 20) - 1, -(1 << 22), 1 << 22]].concat();
+        let mut bytes = Vec::new();
+        let mut sizes = Vec::new();
+        for &v in &values {
+            let before = bytes.len();
+            push_varint(&mut bytes, v);
+            sizes.push(bytes.len() - before);
+        }
+        assert_eq!(crate::pack::zigzag_varints(&bytes), values);
+        assert_eq!(sizes, [1, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 4, 4]);
+        assert_eq!(round_i32(2.5), 2);
+        assert_eq!(round_i32(-3.5), -4);
+        assert_eq!(round_i32(MAX_STEPS), 1 << 22);
+    }
 }

@@ -197,7 +197,7 @@ fn stylized(
 /// `copyN.alpha` (frames × copy vertices), `copyN.triangles`; per line set
 /// `linesN.counts` (u32 per frame: vertices, triangles), `linesN.positions`,
 /// `linesN.triangles`, `linesN.alpha`. With `"changes": true` the body comes as
-/// `body.changed` and `body.step` + `body.delta` (or `body.positions`) instead
+/// `body.changed` and `body.step`, `body.offsets` + `body.varints` (or `body.positions`) instead
 /// ([`super::changes`]), each copy as `copyN.shown`, `copyN.shown_positions` and
 /// `copyN.shown_alpha` with its `first_vertex` in the input ([`super::shown`]), and the lines'
 /// triangles as `linesN.triangles16` (i16) when every frame's tubes have at most 32,767
