@@ -28,7 +28,8 @@ impl Default for ElongateOptions {
 }
 
 /// Fills `out` with points `start..start + out.len()` of the drawing at frame `h`: S_E over
-/// runs of [`STYLE_BLOCK`] points ([`Stylize::eval_block`]), then each point displaced.
+/// runs of [`STYLE_BLOCK`] points ([`Stylize::eval_block`]), then the run displaced
+/// ([`Trajectories::displaced_run`](super::Trajectories::displaced_run)).
 #[inline]
 fn fill(
     inputs: &EffectInputs<'_>,
@@ -44,9 +45,7 @@ fn fill(
     for run in out.chunks_mut(STYLE_BLOCK) {
         let beta = &mut beta[..run.len()];
         style.eval_block(&inputs.style_block(h, first, run.len()), beta);
-        for (k, (o, b)) in run.iter_mut().zip(beta.iter()).enumerate() {
-            *o = tr.displaced(h, first + k, scale * b);
-        }
+        tr.displaced_run(h, first, scale, beta, run);
         first += run.len();
     }
 }

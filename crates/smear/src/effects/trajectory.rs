@@ -282,6 +282,38 @@ impl<'a> Trajectories<'a> {
         self.displaced_shaped(f, i, beta)
     }
 
+    /// Points `start..start + out.len()` of frame `f`, point `start + k` displaced by
+    /// `scale · betas[k]` frames: [`Trajectories::displaced`] of each, the same bits. On plain
+    /// trajectories a point that does not move (β = 0, what a past-only or thresholded style
+    /// gives most points) is its sampled position, without the cubic: `Q_{i,f}(0)` is that
+    /// position but for the sign of a zero coordinate, so a −0 coordinate takes the cubic.
+    pub fn displaced_run(
+        &self,
+        f: usize,
+        start: usize,
+        scale: f32,
+        betas: &[f32],
+        out: &mut [Vec3],
+    ) {
+        let n = self.points;
+        // Frames past 2²⁴ are not exact as f32 times: the general path.
+        if !self.is_plain() || f >= self.frames || f > 1 << 24 {
+            for (k, (o, b)) in out.iter_mut().zip(betas).enumerate() {
+                *o = self.displaced(f, start + k, scale * b);
+            }
+            return;
+        }
+        let here = &self.positions[f * n + start..f * n + start + out.len()];
+        for (k, ((o, b), p)) in out.iter_mut().zip(betas).zip(here).enumerate() {
+            let beta = scale * b;
+            *o = if beta == 0.0 && !has_negative_zero(*p) {
+                *p
+            } else {
+                self.displaced(f, start + k, beta)
+            };
+        }
+    }
+
     /// [`Self::displaced`] of shaped trajectories (past-only, arcs, ground, colliders): kept
     /// out of line so that the plain path inlines into the per-vertex loops.
     #[inline(never)]
@@ -315,6 +347,14 @@ impl<'a> Trajectories<'a> {
         }
         self.lifted(f, q)
     }
+}
+
+/// Whether a coordinate of `p` is −0 (which [`hermite`] at `t = 0` may turn into +0).
+#[inline]
+fn has_negative_zero(p: Vec3) -> bool {
+    p.to_array()
+        .iter()
+        .any(|c| c.to_bits() == (-0.0f32).to_bits())
 }
 
 /// Cubic Hermite segment from `a` (tangent `ma`) to `b` (tangent `mb`) at `t ∈ [0, 1]`.
@@ -396,6 +436,45 @@ mod tests {
         }
         let shaped = tr.shaped(true, None, None);
         assert!(!shaped.is_plain() && !tr.shaped(false, Some(0.0), None).is_plain());
+    }
+
+    #[test]
+    fn a_run_is_each_point_displaced_bit_for_bit() {
+        // Points still at zero (both signs, with tangents of both signs, where the cubic at
+        // t = 0 turns −0 into +0), still and moving, displaced by zero, −0, non-finite, small
+        // and large β: the run's values are `displaced`'s, on plain and on shaped trajectories.
+        let (frames, points) = (6, 8);
+        let p: Vec<Vec3> = (0..frames * points)
+            .map(|k| {
+                let (f, i) = ((k / points) as f32, k % points);
+                match i {
+                    0 => Vec3::new(-0.0, 0.0, -0.0),
+                    1 => Vec3::new(-0.0, f - 2.0, 0.0),
+                    2 => Vec3::new(0.3 * f, -0.0, 2.0 - f),
+                    _ => Vec3::new((0.9 * f + i as f32).sin(), f * f * 0.1, -0.5 * f),
+                }
+            })
+            .collect();
+        let betas = [0.0, -0.0, f32::NAN, 0.4, -1.7, f32::INFINITY, 9.0, 0.0];
+        let plain = Trajectories::new(&p, frames, points).unwrap();
+        for tr in [plain, plain.shaped(false, Some(0.1), None)] {
+            for f in 0..frames {
+                for (start, scale) in [(0, 1.0), (3, 2.0)] {
+                    let len = points - start;
+                    let mut run = vec![Vec3::NAN; len];
+                    tr.displaced_run(f, start, scale, &betas[..len], &mut run);
+                    for (k, q) in run.iter().enumerate() {
+                        let one = tr.displaced(f, start + k, scale * betas[k]);
+                        assert_eq!(
+                            q.to_array().map(f32::to_bits),
+                            one.to_array().map(f32::to_bits),
+                            "frame {f}, point {}",
+                            start + k
+                        );
+                    }
+                }
+            }
+        }
     }
 
     #[test]
