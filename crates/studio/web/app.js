@@ -93,10 +93,17 @@ async function main() {
   clipSel.addEventListener('change', async () => { studio.clip = clipSel.value; await studio.panels[studio.tab].reload(); });
 
   let last = performance.now(), acc = 0, fpsFrames = 0, fpsTime = 0;
+  const fpsLabel = $('fps-label');
   const loop = (now) => {
     const dt = (now - last) / 1000; last = now;
     fpsFrames++; fpsTime += dt;
-    if (fpsTime > 0.5) { $('fps-label').textContent = `${Math.round(fpsFrames / fpsTime)} fps draw${view.software ? ' (software GL: plain shading)' : ''} · ${studio.timeline.fps} fps clip`; fpsFrames = 0; fpsTime = 0; }
+    if (fpsTime > 0.5) {
+      // Written only when it reads differently: a new text is laid out, painted and
+      // composited again (on the CPU with software GL), twice a second on an idle page.
+      const text = `${Math.round(fpsFrames / fpsTime)} fps draw${view.software ? ' (software GL: plain shading)' : ''} · ${studio.timeline.fps} fps clip`;
+      if (fpsLabel.textContent !== text) fpsLabel.textContent = text;
+      fpsFrames = 0; fpsTime = 0;
+    }
     if (studio.playing) {
       acc += dt * studio.timeline.fps;
       if (acc >= 1) { const step = Math.floor(acc); acc -= step; setFrame((studio.frame + step) % studio.timeline.frames); }
