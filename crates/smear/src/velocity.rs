@@ -187,37 +187,37 @@ fn differences(
     }
     out.par_chunks_mut(n).enumerate().for_each(|(f, dst)| {
         let frames = difference_frames(f, frames, causal);
-        run_differences(positions, n, frames, (0, dst.len()), space, |k, v| {
-            dst[k] = v
-        });
+        run_differences(positions, n, frames, 0, space, dst, |v| v);
     });
     out
 }
 
-/// Calls `emit(k, v)` with the velocity `v` of point `start + k` for `k < len`, from the
-/// difference `frames` of [`difference_frames`] in a frame-major buffer of `n` points per
-/// frame: one loop per space, the camera's transforms looked up once.
+/// Writes `each(v)` of the velocity `v` of points `start..start + out.len()` into `out`, from
+/// the difference `frames` of [`difference_frames`] in a frame-major buffer of `n` points
+/// per frame: one loop per space, the camera's transforms looked up once.
 #[inline(always)]
-fn run_differences(
+fn run_differences<T>(
     positions: &[Vec3],
     n: usize,
     (a, b, s): (usize, usize, f32),
-    (start, len): (usize, usize),
+    start: usize,
     space: Option<&CameraSpace>,
-    mut emit: impl FnMut(usize, Vec3),
+    out: &mut [T],
+    each: impl Fn(Vec3) -> T,
 ) {
+    let len = out.len();
     let pa = &positions[a * n + start..a * n + start + len];
     let pb = &positions[b * n + start..b * n + start + len];
     match space {
         None => {
-            for (k, (p, q)) in pa.iter().zip(pb).enumerate() {
-                emit(k, (*q - *p) * s);
+            for ((o, p), q) in out.iter_mut().zip(pa).zip(pb) {
+                *o = each((*q - *p) * s);
             }
         }
         Some(c) => {
             let (va, vb) = (c.view[a], c.view[b]);
-            for (k, (p, q)) in pa.iter().zip(pb).enumerate() {
-                emit(k, (vb.transform_point3(*q) - va.transform_point3(*p)) * s);
+            for ((o, p), q) in out.iter_mut().zip(pa).zip(pb) {
+                *o = each((vb.transform_point3(*q) - va.transform_point3(*p)) * s);
             }
         }
     }
@@ -255,10 +255,7 @@ pub(crate) fn run_speeds(
     out: &mut [f32],
 ) {
     let frames = difference_frames(f, frames, causal);
-    let len = out.len();
-    run_differences(positions, n, frames, (start, len), space, |k, v| {
-        out[k] = v.length();
-    });
+    run_differences(positions, n, frames, start, space, out, |v| v.length());
 }
 
 /// Speeds |v| of a velocity buffer (units per frame), as stylization uses them.

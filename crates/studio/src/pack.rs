@@ -332,9 +332,23 @@ pub fn read_u8(bytes: &[u8], name: &str) -> Option<Vec<u8>> {
     read_raw(bytes, name, "u8", 1).map(|(_, raw)| raw.to_vec())
 }
 
-/// The zigzag LEB128 integers of a `u8` buffer such as `body.varints` (7 bits a byte from
-/// the lowest, the high bit set on every byte but an integer's last; the low bit of the
-/// result the sign), for tests and tools. A last integer cut short reads as what it holds.
+/// Appends `value` as a zigzag LEB128 integer (a `u8` buffer's values such as
+/// `body.varints`): `2|v|` or `2|v| − 1` for a negative `v`, 7 bits a byte from the lowest,
+/// the high bit set on every byte but the last — 1 byte below 64 in size, 2 below 8,192, 3
+/// below 2²⁰.
+#[inline]
+pub(crate) fn push_zigzag_varint(out: &mut Vec<u8>, value: i32) {
+    let mut z = ((value << 1) ^ (value >> 31)) as u32;
+    while z >= 0x80 {
+        out.push((z as u8) | 0x80);
+        z >>= 7;
+    }
+    out.push(z as u8);
+}
+
+/// The zigzag LEB128 integers of a `u8` buffer such as `body.varints`
+/// ([`push_zigzag_varint`]), for tests and tools. A last integer cut short reads as what it
+/// holds.
 pub fn zigzag_varints(bytes: &[u8]) -> Vec<i32> {
     let (mut out, mut z, mut shift) = (Vec::new(), 0u32, 0);
     for &b in bytes {
@@ -368,6 +382,21 @@ pub fn split(bytes: &[u8]) -> Option<(Value, &[u8])> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn varints_hold_every_step_count_in_as_few_bytes_as_its_size_needs() {
+        let values = [0, 1, -1, 63, -64, 64, -65, 8191, -8192, 8192];
+        let values = [&values[..], &[(1 << 20) - 1, -(1 << 22), 1 << 22]].concat();
+        let mut bytes = Vec::new();
+        let mut sizes = Vec::new();
+        for &v in &values {
+            let before = bytes.len();
+            push_zigzag_varint(&mut bytes, v);
+            sizes.push(bytes.len() - before);
+        }
+        assert_eq!(zigzag_varints(&bytes), values);
+        assert_eq!(sizes, [1, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 4, 4]);
+    }
 
     #[test]
     fn a_pack_reads_back() {

@@ -353,8 +353,8 @@ impl<'a> EffectInputs<'a> {
     }
 
     /// The stylization inputs of points `start..start + len` of frame `f` as one run
-    /// ([`Stylize::eval_block`](super::Stylize::eval_block)), `m` and `t` 0. Panics when the
-    /// run is out of range.
+    /// ([`Stylize::eval_block`](super::Stylize::eval_block)), `m` 0. Panics when the run is
+    /// out of range.
     pub fn style_block(&self, f: usize, start: usize, len: usize) -> StyleBlock<'_> {
         StyleBlock::new(self, f, start, len)
     }

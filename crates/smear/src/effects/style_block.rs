@@ -16,7 +16,8 @@ use super::{EffectInputs, StyleInput};
 pub const STYLE_BLOCK: usize = 256;
 
 /// Points `start..start + len` of frame `frame` of an [`EffectInputs`], with the multiple index
-/// `m` and line position `t` every point of the run shares. [`StyleBlock::input`] is the
+/// `m` every point of the run shares (the points are vertices: line position `t` 0).
+/// [`StyleBlock::input`] is the
 /// [`StyleInput`] of one point, exactly as [`EffectInputs::style_input`] builds it.
 #[derive(Debug, Clone, Copy)]
 pub struct StyleBlock<'a> {
@@ -25,11 +26,10 @@ pub struct StyleBlock<'a> {
     start: usize,
     len: usize,
     m: f32,
-    t: f32,
 }
 
 impl<'a> StyleBlock<'a> {
-    /// The run `start..start + len` of frame `frame` (`m` and `t` 0). Panics when the run is
+    /// The run `start..start + len` of frame `frame` (`m` 0). Panics when the run is
     /// outside the inputs' points or `frame` outside their frames.
     pub(crate) fn new(
         inputs: &'a EffectInputs<'a>,
@@ -50,11 +50,10 @@ impl<'a> StyleBlock<'a> {
             start,
             len,
             m: 0.0,
-            t: 0.0,
         }
     }
 
-    /// Points `from..from + len` of this run as a run of their own (the same `m` and `t`).
+    /// Points `from..from + len` of this run as a run of their own (the same `m`).
     /// Panics when they are not inside this run.
     pub fn part(&self, from: usize, len: usize) -> Self {
         assert!(
@@ -95,11 +94,6 @@ impl<'a> StyleBlock<'a> {
         self.m
     }
 
-    /// The line position every point of the run shares.
-    pub fn t(&self) -> f32 {
-        self.t
-    }
-
     /// The motion offsets δ of the run.
     pub fn deltas(&self) -> &'a [f32] {
         let k = self.frame * self.inputs.point_count() + self.start;
@@ -130,7 +124,6 @@ impl<'a> StyleBlock<'a> {
         debug_assert!(k < self.len);
         StyleInput {
             m: self.m,
-            t: self.t,
             ..self.inputs.style_input(self.frame, self.start + k)
         }
     }

@@ -9,7 +9,7 @@
 use anim::glam::Vec3;
 use rayon::prelude::*;
 
-use crate::pack::Pack;
+use crate::pack::{push_zigzag_varint, Pack};
 
 /// Largest quantization error of a moved vertex coordinate, as a fraction of the input clip's
 /// bounding-box diagonal: a frame whose displacements would need more than
@@ -68,7 +68,7 @@ pub(crate) fn pack_changes<'a>(
                         let d = q.map_or(Vec3::NAN, |q| (p - *q) * per_unit);
                         if d.abs().max_element() <= MAX_STEPS && !d.is_nan() {
                             for x in d.to_array() {
-                                push_varint(&mut values, round_i32(x));
+                                push_zigzag_varint(&mut values, round_i32(x));
                             }
                         } else {
                             fits = false;
@@ -121,19 +121,6 @@ fn round_i32(x: f32) -> i32 {
     ((x + SHIFT) - SHIFT) as i32
 }
 
-/// Appends `value` as a zigzag LEB128 integer: `2|v|` or `2|v| − 1` for a negative `v`, 7 bits
-/// a byte from the lowest, the high bit set on every byte but the last (1 byte below 64 steps,
-/// 2 below 8,192, 3 below 2²⁰, 4 up to [`MAX_STEPS`]).
-#[inline]
-fn push_varint(out: &mut Vec<u8>, value: i32) {
-    let mut z = ((value << 1) ^ (value >> 31)) as u32;
-    while z >= 0x80 {
-        out.push((z as u8) | 0x80);
-        z >>= 7;
-    }
-    out.push(z as u8);
-}
-
 /// Calls `visit(v, p)` for every vertex of a frame given as its objects' slices.
 fn each_vertex(slices: &[&[Vec3]], mut visit: impl FnMut(usize, Vec3)) {
     let mut v = 0;
@@ -182,18 +169,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn varints_hold_every_step_count_in_as_few_bytes_as_its_size_needs() {
-        let values = [0, 1, -1, 63, -64, 64, -65, 8191, -8192, 8192];
-        let values = [&values[..], &[(1 << 20) - 1, -(1 << 22), 1 << 22]].concat();
-        let mut bytes = Vec::new();
-        let mut sizes = Vec::new();
-        for &v in &values {
-            let before = bytes.len();
-            push_varint(&mut bytes, v);
-            sizes.push(bytes.len() - before);
-        }
-        assert_eq!(crate::pack::zigzag_varints(&bytes), values);
-        assert_eq!(sizes, [1, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 4, 4]);
+    fn step_counts_round_to_nearest_even_up_to_the_largest() {
         assert_eq!(round_i32(2.5), 2);
         assert_eq!(round_i32(-3.5), -4);
         assert_eq!(round_i32(MAX_STEPS), 1 << 22);
