@@ -215,6 +215,7 @@ async fn segment_curve_build_reconstruct_and_export_the_library_folder() {
     for f in [
         "assembly.csv",
         "report.json",
+        "reconstruction.pc2",
         "pieces/part1_00.stl",
         "pieces/part2_01.stl",
     ] {

@@ -175,6 +175,8 @@ pub fn save_with(path: &Path, output: &Output<'_>, options: SaveOptions) -> Resu
         files.push((p.to_path_buf(), bytes));
         Ok(())
     };
+    // Files streamed to disk during the match (listed first among the files written).
+    let mut streamed: Vec<PathBuf> = Vec::new();
     match *output {
         Output::Text(text) => put(path, text.as_bytes().to_vec())?,
         Output::Bytes(bytes) => put(path, bytes.to_vec())?,
@@ -301,6 +303,7 @@ pub fn save_with(path: &Path, output: &Output<'_>, options: SaveOptions) -> Resu
                     // The cache streams to disk first; the rest mesh follows, all or nothing
                     // for it.
                     crate::shapes::write_pc2(path, parts)?;
+                    streamed.push(path.to_path_buf());
                 }
                 Format::Glb => put(
                     path,
@@ -328,7 +331,8 @@ pub fn save_with(path: &Path, output: &Output<'_>, options: SaveOptions) -> Resu
         }
     }
     write_atomic_all(&files)?;
-    Ok(files.into_iter().map(|(p, _)| p).collect())
+    streamed.extend(files.into_iter().map(|(p, _)| p));
+    Ok(streamed)
 }
 
 /// The format of an output path, or an error naming the extensions toonkit writes.
