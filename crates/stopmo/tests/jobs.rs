@@ -468,3 +468,65 @@ fn a_pieces_folder_gives_each_part_its_pieces_and_back_by_name() {
     assert_eq!(backs["upper"], vec![Vec3::splat(3.0)]);
     assert!(!backs.contains_key("upper_lip"));
 }
+
+/// A clip cut into shots (StopShop Sec. 6: a sheet per shot for the animator on set): one
+/// assembly sheet per shot, numbered in shot order, each showing only its own shot's faces
+/// (the shots are made in parallel and listed in order).
+#[test]
+fn each_shot_has_its_assembly_sheet_in_order() {
+    let anim = talking_tube(24, 30, 36);
+    let parts: Vec<MeshAnimation> = stopmo::segment(
+        &anim,
+        &SegmentJobOptions {
+            parts: tube_parts(),
+            ..Default::default()
+        },
+    )
+    .unwrap()
+    .parts
+    .iter()
+    .map(|p| p.animation.clone())
+    .collect();
+    let opts = LibraryJobOptions {
+        pieces: PieceCount::Each(4),
+        cuts: vec![2, 30],
+        print: false,
+        ..Default::default()
+    };
+    let lib = stopmo::library(&parts, &opts).unwrap();
+    let names: Vec<&str> = lib.sheets.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "assembly_shot01.png",
+            "assembly_shot02.png",
+            "assembly_shot03.png"
+        ]
+    );
+    // Each sheet has a cell per run of equal assemblies in its shot, 12 to a row: a sheet is
+    // as tall as its own shot's rows say.
+    let labels = lib.labels();
+    let rows = |shot: std::ops::Range<usize>| {
+        shot.clone()
+            .filter(|&f| f == shot.start || labels.iter().any(|l| l[f] != l[f - 1]))
+            .count()
+            .div_ceil(12)
+    };
+    let rows = [rows(0..2), rows(2..30), rows(30..36)];
+    // The long middle shot needs more rows: a sheet given to the wrong shot shows here.
+    assert!(rows[1] > rows[0] && rows[1] > rows[2], "{rows:?}");
+    let heights: Vec<u32> = lib
+        .sheets
+        .iter()
+        .map(|(_, png)| render::decode_png(png).unwrap().height())
+        .collect();
+    for i in 0..3 {
+        for j in 0..3 {
+            assert_eq!(
+                rows[i].cmp(&rows[j]),
+                heights[i].cmp(&heights[j]),
+                "rows {rows:?}, heights {heights:?}"
+            );
+        }
+    }
+}

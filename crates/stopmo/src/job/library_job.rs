@@ -387,9 +387,14 @@ pub(super) fn finish(
     let mut printed = printed;
     let library_3mf = lay_out_plates(&mut printed, names, opts)?;
     let thumbnails = piece_thumbnails(&lib, anims)?;
-    let catalogue = catalogue_png(&lib, &thumbnails)?;
     let assembly = lib.assembly();
-    let sheets = assembly_sheets(&lib, anims, &assembly, &opts.cuts, &thumbnails)?;
+    // Each sheet's PNG is compressed on one thread: the catalogue and the shots' sheets
+    // side by side.
+    let (catalogue, sheets) = rayon::join(
+        || catalogue_png(&lib, &thumbnails),
+        || assembly_sheets(&lib, anims, &assembly, &opts.cuts, &thumbnails),
+    );
+    let (catalogue, sheets) = (catalogue?, sheets?);
     drop(thumbnails);
     let order = shooting_order(&assembly);
     let reconstruction = anims

@@ -109,45 +109,57 @@ pub(crate) fn assembly_sheets(
         .collect();
     starts.sort_unstable();
     starts.dedup();
-    let mut sheets = Vec::new();
-    for (s, &start) in starts.iter().enumerate() {
-        let end = starts.get(s + 1).copied().unwrap_or(frames);
-        let mut runs: Vec<usize> = (start..end)
-            .filter(|&f| f == start || assembly.frames[f] != assembly.frames[f - 1])
-            .collect();
-        runs.truncate(MAX_SHEET_CELLS);
-        let images: Vec<render::Image> = runs
-            .par_iter()
-            .map(|&f| -> Result<render::Image> {
-                if let ([sol], [pieces]) = (&lib.parts[..], thumbnails) {
-                    return Ok(pieces[sol.solution.labels[f] as usize].clone());
-                }
-                let mut positions = Vec::new();
-                let mut triangles = Vec::new();
-                for (p, a) in anims.iter().enumerate() {
-                    let sol = &lib.parts[p].solution;
-                    let base = positions.len() as u32;
-                    positions.extend_from_slice(&sol.pieces[sol.labels[f] as usize]);
-                    triangles.extend(a.mesh.triangles.iter().map(|t| t.map(|i| i + base)));
-                }
-                thumbnail(&positions, &triangles, render::categorical(0))
-            })
-            .collect::<Result<_>>()?;
-        if images.is_empty() {
-            continue;
-        }
-        let sheet = render::contact_sheet(
-            &images,
-            Some(&runs),
-            &render::SheetOptions {
-                columns: 12,
-                ..Default::default()
-            },
-        )?;
-        sheets.push((
-            format!("assembly_shot{:02}.png", s + 1),
-            render::encode_png(&sheet)?,
-        ));
+    // Shots side by side (each sheet's PNG is compressed on one thread), listed in order.
+    let sheets = starts
+        .par_iter()
+        .enumerate()
+        .map(|(s, &start)| -> Result<Option<(String, Vec<u8>)>> {
+            let end = starts.get(s + 1).copied().unwrap_or(frames);
+            let mut runs: Vec<usize> = (start..end)
+                .filter(|&f| f == start || assembly.frames[f] != assembly.frames[f - 1])
+                .collect();
+            runs.truncate(MAX_SHEET_CELLS);
+            let images: Vec<render::Image> = runs
+                .par_iter()
+                .map(|&f| shot_thumbnail(lib, anims, thumbnails, f))
+                .collect::<Result<_>>()?;
+            if images.is_empty() {
+                return Ok(None);
+            }
+            let sheet = render::contact_sheet(
+                &images,
+                Some(&runs),
+                &render::SheetOptions {
+                    columns: 12,
+                    ..Default::default()
+                },
+            )?;
+            Ok(Some((
+                format!("assembly_shot{:02}.png", s + 1),
+                render::encode_png(&sheet)?,
+            )))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(sheets.into_iter().flatten().collect())
+}
+
+/// The assembled face of frame `f` (every part's piece on that frame).
+fn shot_thumbnail(
+    lib: &Library,
+    anims: &[&MeshAnimation],
+    thumbnails: &[Vec<render::Image>],
+    f: usize,
+) -> Result<render::Image> {
+    if let ([sol], [pieces]) = (&lib.parts[..], thumbnails) {
+        return Ok(pieces[sol.solution.labels[f] as usize].clone());
     }
-    Ok(sheets)
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for (p, a) in anims.iter().enumerate() {
+        let sol = &lib.parts[p].solution;
+        let base = positions.len() as u32;
+        positions.extend_from_slice(&sol.pieces[sol.labels[f] as usize]);
+        triangles.extend(a.mesh.triangles.iter().map(|t| t.map(|i| i + base)));
+    }
+    thumbnail(&positions, &triangles, render::categorical(0))
 }
