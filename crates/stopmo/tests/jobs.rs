@@ -469,9 +469,9 @@ fn a_pieces_folder_gives_each_part_its_pieces_and_back_by_name() {
     assert!(!backs.contains_key("upper_lip"));
 }
 
-/// A clip cut into shots (each frame's piece IDs, StopShop Sec. 4, read on
-/// set shot by shot): one assembly sheet per shot, numbered in shot order, each showing only its own shot's faces
-/// (the shots are made in parallel and listed in order).
+/// A clip cut into shots (each frame's piece IDs, StopShop Sec. 4, read on set shot by
+/// shot): one assembly sheet per shot, numbered in shot order, each showing only its own
+/// shot's faces (the shots are made in parallel and listed in order).
 #[test]
 fn each_shot_has_its_assembly_sheet_in_order() {
     let anim = talking_tube(24, 30, 36);
