@@ -107,7 +107,7 @@ fn largest_first(files: &[OutputFile<'_>]) -> Vec<usize> {
 impl FileData<'_> {
     /// About how many bytes the file at `path` will hold (its extension says the format):
     /// only the order in which [`save_files`] starts the files depends on it.
-    pub fn size_hint(&self, path: &str) -> u64 {
+    fn size_hint(&self, path: &str) -> u64 {
         let ext = path.rsplit('.').next().unwrap_or("").to_ascii_lowercase();
         // Text formats: about 36 bytes per vertex and 24 per triangle (OBJ); binary STL: 50
         // per triangle; float32 positions elsewhere.

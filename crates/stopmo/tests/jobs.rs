@@ -506,13 +506,13 @@ fn each_shot_has_its_assembly_sheet_in_order() {
     // Each sheet has a cell per run of equal assemblies in its shot, 12 to a row: a sheet is
     // as tall as its own shot's rows say.
     let labels = lib.labels();
-    let rows = |shot: std::ops::Range<usize>| {
+    let rows_of = |shot: std::ops::Range<usize>| {
         shot.clone()
             .filter(|&f| f == shot.start || labels.iter().any(|l| l[f] != l[f - 1]))
             .count()
             .div_ceil(12)
     };
-    let rows = [rows(0..2), rows(2..30), rows(30..36)];
+    let rows = [rows_of(0..2), rows_of(2..30), rows_of(30..36)];
     // The long middle shot needs more rows: a sheet given to the wrong shot shows here.
     assert!(rows[1] > rows[0] && rows[1] > rows[2], "{rows:?}");
     let heights: Vec<u32> = lib

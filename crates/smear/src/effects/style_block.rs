@@ -17,8 +17,8 @@ pub const STYLE_BLOCK: usize = 256;
 
 /// Points `start..start + len` of frame `frame` of an [`EffectInputs`], with the multiple index
 /// `m` every point of the run shares (the points are vertices: line position `t` 0).
-/// [`StyleBlock::input`] is the
-/// [`StyleInput`] of one point, exactly as [`EffectInputs::style_input`] builds it.
+/// [`StyleBlock::input`] is the [`StyleInput`] of one point, exactly as
+/// [`EffectInputs::style_input`] builds it.
 #[derive(Debug, Clone, Copy)]
 pub struct StyleBlock<'a> {
     inputs: &'a EffectInputs<'a>,

@@ -189,8 +189,8 @@ fn apply_run(stages: &[Stage], run: &StyleBlock<'_>, x: &mut [f32]) {
                 x.iter_mut()
                     .for_each(|x| *x = multiple_opacity(*x, m, m_max));
             }
-            // A run's points are vertices, at t = 0 of no motion line: x·(1 − 0).
-            Stage::Fade => x.iter_mut().for_each(|x| *x *= 1.0),
+            // A run's points are vertices, at t = 0 of no motion line: x·(1 − 0) is x.
+            Stage::Fade => {}
             Stage::Set { value } => x.fill(value.at(frame)),
         }
     }
