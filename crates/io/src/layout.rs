@@ -80,9 +80,16 @@ impl FileData<'_> {
 /// threads wait.
 ///
 /// # Errors
-/// The first [`IoError`](crate::IoError), naming its file.
+/// [`IoError::WouldOverwriteInput`](crate::IoError::WouldOverwriteInput) before anything
+/// is written when a target is a file the job read; else the first
+/// [`IoError`](crate::IoError), naming its file.
 pub fn save_files(dir: &Path, files: &[OutputFile<'_>]) -> crate::Result<Vec<PathBuf>> {
     use rayon::prelude::*;
+    // Every target is checked before any is written: a layout that would write over an
+    // input of the job writes nothing.
+    for f in files {
+        crate::inputs::check_not_input(&dir.join(&f.path))?;
+    }
     let mut written: Vec<(usize, Vec<PathBuf>)> = largest_first(files)
         .into_par_iter()
         .map(|i| {
@@ -218,5 +225,32 @@ mod tests {
         );
         let pc2 = std::fs::metadata(dir.path().join("reconstruction.pc2")).unwrap();
         assert_eq!(pc2.len(), 32 + 12 * 5_000 * 100);
+    }
+
+    /// A library written into its input's folder, where one of its files has the input's
+    /// name: refused before any file of the layout is written (no half-written folder).
+    #[test]
+    fn a_layout_over_its_input_writes_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let input = dir.path().join("reconstruction.glb");
+        std::fs::write(&input, b"glTF").unwrap();
+        let scope = crate::inputs::ReadScope::open();
+        crate::inputs::note_read(&input);
+        let piece = mesh(10);
+        let files = vec![
+            OutputFile {
+                path: "pieces/a.obj".into(),
+                data: FileData::Mesh(&piece),
+            },
+            OutputFile {
+                path: "reconstruction.glb".into(),
+                data: FileData::Text("x".into()),
+            },
+        ];
+        let e = save_files(dir.path(), &files).unwrap_err().to_string();
+        assert!(e.contains("reconstruction.glb"), "{e}");
+        assert_eq!(std::fs::read(&input).unwrap(), b"glTF");
+        assert!(!dir.path().join("pieces").exists(), "nothing written");
+        drop(scope);
     }
 }
