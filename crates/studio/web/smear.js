@@ -274,7 +274,7 @@ export class SmearPanel {
         const applied = performance.now();
         await s.view.rendered();
         const ms = performance.now() - t0;
-        s.stats.smear.push({ ms, server_ms: r.header.seconds * 1000, bytes: r.bytes, fetch_ms: fetched - t0, apply_ms: applied - fetched, draw_ms: performance.now() - applied, render_ms: s.view.renderMs });
+        s.stats.smear.push({ ms, server_ms: r.header.seconds * 1000, bytes: r.bytes, fetch_ms: fetched - t0, apply_ms: applied - fetched, draw_ms: performance.now() - applied, render_ms: s.view.renderMs, scale: s.view.scale });
         $('smear-report').textContent = `frame ${f} restyled in ${ms.toFixed(0)} ms (server ${(r.header.seconds * 1000).toFixed(0)} ms, ${(r.bytes / 1024).toFixed(0)} KiB)`;
         this.loadRest(gen, t0, rest, ctl);
       }

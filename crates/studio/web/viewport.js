@@ -8,6 +8,20 @@ import { computeVertexNormals } from './normals.js';
 const BASE = new THREE.Color(0.78, 0.78, 0.8);
 
 /**
+ * On a software renderer, the share of the canvas's width and height drawn while something
+ * changes (a slider, a stroke, playback, the orbit camera): a quarter of the pixels, about
+ * half of the CPU a frame costs there, the CPU the server answers on.
+ */
+export const INTERACTIVE_SCALE = 0.5;
+
+/**
+ * Milliseconds without a new frame after which a software renderer draws the frame shown
+ * again at full resolution (a change's answers arrive within this time; a still view is
+ * always sharp).
+ */
+export const SETTLE_MS = 300;
+
+/**
  * Whether WebGL draws on the CPU (SwiftShader, llvmpipe: a machine or VM without a GPU).
  * There a frame with 4× multisampling and physically based shading costs tens of
  * milliseconds of both cores, the cores the server restyles on, so the viewport draws
@@ -29,6 +43,10 @@ export class Viewport {
     this.software = softwareRenderer();
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: !this.software, preserveDrawingBuffer: true });
     this.renderer.setPixelRatio(1);
+    // Drawn at INTERACTIVE_SCALE while things change on a software renderer (`render`),
+    // at full resolution once they settle.
+    this.scale = 1;
+    this.settleTimer = 0;
     this.scene = new THREE.Scene();
     this.scene.background = new THREE.Color(0x33363b);
     this.scene.add(new THREE.HemisphereLight(0xffffff, 0x444455, 2.2));
@@ -285,9 +303,32 @@ export class Viewport {
 
   render() {
     const t = performance.now();
+    if (this.software) {
+      // A change: drawn at the interactive scale, and sharp again once nothing changes.
+      this.setScale(INTERACTIVE_SCALE);
+      clearTimeout(this.settleTimer);
+      this.settleTimer = setTimeout(() => this.settle(), SETTLE_MS);
+    }
     this.renderer.render(this.scene, this.camera);
     this.renderMs = performance.now() - t;
     this.dirty = false;
+  }
+
+  /** The frame shown, drawn again at full resolution (software renderer, nothing changing). */
+  settle() {
+    this.settleTimer = 0;
+    this.setScale(1);
+    this.renderer.render(this.scene, this.camera);
+  }
+
+  /** Whether the canvas holds the frame shown at full resolution. */
+  get settled() { return this.scale === 1 && !this.dirty; }
+
+  /** Canvas pixels per CSS pixel (a new drawing buffer when it changes). */
+  setScale(scale) {
+    if (this.scale === scale) return;
+    this.scale = scale;
+    this.renderer.setPixelRatio(scale);
   }
 
   /**
