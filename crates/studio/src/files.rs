@@ -127,6 +127,8 @@ pub struct Clip {
     /// Per frame the merged vertices' bounding box, worked out on first use (the bound of a
     /// whole-clip answer of changes, docs/studio.md): not again for every restyle.
     bounds: OnceLock<Vec<Aabb>>,
+    /// Per merged vertex its twin ([`Clip::twins`]), worked out on first use.
+    twins: OnceLock<Vec<u32>>,
 }
 
 impl Clip {
@@ -141,6 +143,7 @@ impl Clip {
             sampled,
             several,
             bounds: OnceLock::new(),
+            twins: OnceLock::new(),
         })
     }
 
@@ -180,10 +183,61 @@ impl Clip {
             .map_or(0.0, |b| b.diagonal())
     }
 
+    /// Per merged vertex its twin: the first vertex whose positions are the same bits in every
+    /// frame of the clip (itself when none is). A mesh split at its seams and hard edges holds
+    /// each corner several times (the robot's 7,214 vertices are 1,820 points): a whole-clip
+    /// answer of changes sends a vertex the style moved as its twin did only once
+    /// (docs/studio.md, "Smear: what the style moved"). Found once per clip.
+    pub fn twins(&self) -> &[u32] {
+        self.twins.get_or_init(|| twins_of(self.merged()))
+    }
+
     /// The merged positions as float32 coordinates (for [`crate::pack::Pack::shared`]).
     pub fn coordinates(&self) -> &[f32] {
         crate::pack::coordinates(self.merged().positions())
     }
+}
+
+/// [`Clip::twins`] of `m`: each vertex's positions over the frames hashed (frame by frame, in
+/// memory order), then a vertex whose hash an earlier one has is compared with it in full.
+fn twins_of(m: &MeshAnimation) -> Vec<u32> {
+    let n = m.vertex_count();
+    let mut hashes = vec![0u64; n];
+    for f in 0..m.frame_count() {
+        for (h, p) in hashes.iter_mut().zip(m.frame(f)) {
+            for x in p.to_array() {
+                *h = mix(*h ^ u64::from(x.to_bits()));
+            }
+        }
+    }
+    let same = |u: usize, v: usize| {
+        (0..m.frame_count()).all(|f| {
+            let p = m.frame(f);
+            p[u].to_array().map(f32::to_bits) == p[v].to_array().map(f32::to_bits)
+        })
+    };
+    // The first vertices of each hash, in vertex order (collisions keep several).
+    let mut firsts: std::collections::HashMap<u64, Vec<u32>> = Default::default();
+    (0..n)
+        .map(|v| {
+            let group = firsts.entry(hashes[v]).or_default();
+            match group.iter().find(|&&u| same(u as usize, v)) {
+                Some(&u) => u,
+                None => {
+                    group.push(v as u32);
+                    v as u32
+                }
+            }
+        })
+        .collect()
+}
+
+/// One round of splitmix64's finalizer: every input bit moves about half the output's.
+fn mix(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
 }
 
 /// Makes (if needed) and canonicalizes the output folder.
@@ -244,6 +298,20 @@ pub fn output_path(folder: &Path, name: &str) -> ApiResult<PathBuf> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use anim::glam::Vec3;
+    use anim::Mesh;
+
+    #[test]
+    fn twins_are_the_same_point_in_every_frame() {
+        // Vertices 0, 2 and 4 are one point throughout; 1 and 3 part in the second frame;
+        // 5 is -0.0 where 0 is 0.0 (other bits: not a twin).
+        let (a, b) = (Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.0, 0.0, 0.0));
+        let first = vec![a, b, a, b, a, Vec3::new(-0.0, 0.0, 0.0)];
+        let second = vec![a, b, a, Vec3::X, a, Vec3::new(-0.0, 0.0, 0.0)];
+        let mesh = Mesh::new("m", first.clone(), vec![[0, 1, 2]]);
+        let m = MeshAnimation::new(mesh, 24.0, [first, second].concat()).unwrap();
+        assert_eq!(twins_of(&m), vec![0, 1, 0, 3, 0, 5]);
+    }
 
     #[test]
     fn export_names_stay_inside_the_folder() {

@@ -63,21 +63,28 @@ export class ClipBody {
   }
 
   /**
-   * A whole-clip answer of changes: `body.changed` bits, and for the moved vertices
-   * `body.step` + `body.offsets` + `body.varints` (displacements in steps) or
+   * A whole-clip answer of changes: `body.twins`, `body.changed` bits, and for the vertices
+   * sent `body.step` + `body.offsets` + `body.varints` (displacements in steps) or
    * `body.positions` (frames in `keep` stay as they are). Nothing is decoded now: a frame's
    * values start at its offset (or, for positions, where a popcount of the bits says), and
-   * the frames are rebuilt when asked for.
+   * the frames are rebuilt when asked for. A vertex not sent is where its twin is drawn
+   * (itself: the input's position).
    */
   setChanges(first, count, buffers, keep = null) {
-    const bits = buffers['body.changed'], exact = buffers['body.positions'];
-    this.changes = { first, count, bits, starts: exact ? starts(bits, this.words, count, 3) : buffers['body.offsets'], exact, varints: buffers['body.varints'], steps: buffers['body.step'] };
+    const bits = buffers['body.changed'], exact = buffers['body.positions'], twins = buffers['body.twins'];
+    // The vertices with a twin other than themselves, and their twins.
+    let n = 0;
+    for (let v = 0; v < twins.length; v++) if (twins[v] !== v) n++;
+    const copies = new Uint32Array(2 * n);
+    for (let v = 0, k = 0; v < twins.length; v++) if (twins[v] !== v) { copies[k++] = v; copies[k++] = twins[v]; }
+    this.changes = { first, count, bits, copies, starts: exact ? starts(bits, this.words, count, 3) : buffers['body.offsets'], exact, varints: buffers['body.varints'], steps: buffers['body.step'] };
     unready(this.ready, first, count, keep);
   }
 
   /**
-   * Clip frame `f`'s positions: the input's with the moved vertices set (the core's numbers
-   * within 1e-5 of the clip's diagonal, docs/studio.md; unmoved vertices exact).
+   * Clip frame `f`'s positions: the input's with the sent vertices set and the others where
+   * their twins are (the core's numbers within 1e-5 of the clip's diagonal, docs/studio.md;
+   * unmoved vertices exact).
    */
   frame(f) {
     const n3 = this.n3, out = this.positions.subarray(f * n3, (f + 1) * n3);
@@ -102,6 +109,17 @@ export class ClipBody {
           out[o] += ((z >>> 1) ^ -(z & 1)) * step;
         }
       });
+    }
+    if (c && j >= 0 && j < c.count) {
+      // A vertex not sent is where its twin is: the twin (the first vertex of its point,
+      // never itself a copy) is final after the values above.
+      const copies = c.copies, bits = c.bits, base = j * this.words;
+      for (let i = 0; i < copies.length; i += 2) {
+        const v = copies[i];
+        if (bits[base + (v >>> 5)] & (1 << (v & 31))) continue;
+        const o = v * 3, t = copies[i + 1] * 3;
+        out[o] = out[t]; out[o + 1] = out[t + 1]; out[o + 2] = out[t + 2];
+      }
     }
     this.ready[f] = 1;
     return out;

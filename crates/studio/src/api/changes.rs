@@ -1,10 +1,12 @@
-//! The whole clip's elongated body as what changed: per frame a bit per vertex (set where the
-//! style moved it off the input) and the moved vertices' displacements from the input,
-//! quantized on a step fixed by the error bound and sent as variable-length integers (one
-//! byte for most coordinates). The page holds the input already (`/api/scene`), so it
-//! rebuilds the core's result from few bytes — a speed style leaves the slow vertices (~60 %
-//! of the robot's Dance) where they were. The format and its error bound are in
-//! docs/studio.md ("Smear: what the style moved").
+//! The whole clip's elongated body as what changed: per frame a bit per vertex (set where its
+//! values are sent) and those vertices' displacements from the input, quantized on a step
+//! fixed by the error bound and sent as variable-length integers (one byte for most
+//! coordinates). The page holds the input already (`/api/scene`), so it rebuilds the core's
+//! result from few bytes: a vertex the style left where it was is the input's (a speed style
+//! leaves ~60 % of the robot's Dance), and a vertex the style moved as its twin — the same
+//! corner of a mesh split at its seams — is drawn where the twin is (three in four of the
+//! Dance's moved vertices). The format and its error bound are in docs/studio.md ("Smear:
+//! what the style moved").
 
 use anim::glam::Vec3;
 use rayon::prelude::*;
@@ -25,22 +27,25 @@ const STEP: f32 = 2.0 * 0.9 * MAX_QUANTIZATION_ERROR;
 /// integer and [`round_i32`] is exact (about 75 diagonals of the clip).
 const MAX_STEPS: f32 = (1 << 22) as f32;
 
-/// Adds `body.changed` (u32 words, per frame `⌈vertices / 32⌉`, bit `v % 32` of word
-/// `v / 32` set when vertex `v` moved), `body.step` (f32 per frame: the quantization step,
-/// [`STEP`] of `diagonal`), `body.offsets` (u32 per frame and one more: where each frame's
-/// values start in `body.varints`) and `body.varints` (u8: the moved vertices' displacements
-/// in steps, x, y, z, frame-major in vertex order, each as a zigzag LEB128 integer — 7 bits a
-/// byte, the low bit the sign: the position is the input's plus `value × step`). When a
+/// Adds `body.twins` (u32 per vertex: [`crate::files::Clip::twins`]), `body.changed` (u32
+/// words, per frame `⌈vertices / 32⌉`, bit `v % 32` of word `v / 32` set when vertex `v`'s
+/// values are sent), `body.step` (f32 per frame: the quantization step, [`STEP`] of
+/// `diagonal`), `body.offsets` (u32 per frame and one more: where each frame's values start in
+/// `body.varints`) and `body.varints` (u8: the sent vertices' displacements from the input in
+/// steps, x, y, z, frame-major in vertex order, each as a zigzag LEB128 integer — 7 bits a
+/// byte, the low bit the sign: the position is the input's plus `value × step`). A vertex
+/// whose bit is clear is where its twin is drawn (its twin itself: the input's position): the
+/// server clears it only when the core's position is the same bits as the twin's. When a
 /// frame's displacements are larger than [`MAX_STEPS`] steps, `body.positions` (f32 xyz of
-/// the moved vertices) replaces `body.step`, `body.offsets` and `body.varints`. `diagonal`
-/// is the input's bounding box over the frames answered ([`crate::files::Clip::diagonal`]);
+/// the sent vertices) replaces `body.step`, `body.offsets` and `body.varints`. `diagonal` is
+/// the input's bounding box over the frames answered ([`crate::files::Clip::diagonal`]);
 /// `body(f)` and `input(f)` are the merged vertices of frame `f` of the answer and of the
 /// input clip. Each frame is compared and encoded by one task while its vertices are in
 /// cache, frames in parallel; the answer's buffers are handed to the pack, not copied.
 pub(crate) fn pack_changes<'a>(
     pack: &mut Pack,
     (frames, vertices): (usize, usize),
-    diagonal: f32,
+    (diagonal, twins): (f32, &[u32]),
     body: impl Fn(usize) -> Vec<&'a [Vec3]> + Sync,
     input: impl Fn(usize) -> &'a [Vec3] + Sync,
 ) {
@@ -50,35 +55,45 @@ pub(crate) fn pack_changes<'a>(
     let per_unit = 1.0 / step;
     let mut mask = vec![0u32; frames * words];
     // Per frame, in one pass over its vertices: the bits, whether its displacements fit, and
-    // the moved vertices' values.
+    // the sent vertices' values.
     let encoded: Vec<(bool, Vec<u8>)> = mask
         .par_chunks_mut(words.max(1))
         .enumerate()
-        .map(|(f, bits)| {
-            let (slices, before) = (body(f), input(f));
+        .map_init(Vec::new, |merged, (f, bits)| {
+            let before = input(f);
+            merged.clear();
+            merged.extend(body(f).into_iter().flatten().copied());
             let mut values = Vec::with_capacity(3 * before.len());
             let mut fits = true;
-            each_vertex(&slices, |v, p| {
-                // Bit-exact: an unmoved vertex is drawn from the input itself.
-                match before.get(v) {
-                    Some(q) if q.to_array() == p.to_array() => {}
-                    q => {
-                        bits[v / 32] |= 1 << (v % 32);
-                        // Not finite, too far, or no input vertex: not sent in steps.
-                        let d = q.map_or(Vec3::NAN, |q| (p - *q) * per_unit);
-                        if d.abs().max_element() <= MAX_STEPS && !d.is_nan() {
-                            for x in d.to_array() {
-                                push_zigzag_varint(&mut values, round_i32(x));
-                            }
-                        } else {
-                            fits = false;
-                        }
-                    }
+            for (v, &p) in merged.iter().enumerate() {
+                // Bit-exact: a vertex not sent is drawn from its twin or the input itself.
+                let twin = twins.get(v).map_or(v, |&t| t as usize);
+                let drawn = if twin == v {
+                    before.get(v)
+                } else {
+                    merged.get(twin)
+                };
+                if drawn.is_some_and(|&q| same_bits(p, q)) {
+                    continue;
                 }
-            });
+                bits[v / 32] |= 1 << (v % 32);
+                // Not finite, too far, or no input vertex: not sent in steps.
+                let d = before.get(v).map_or(Vec3::NAN, |&q| (p - q) * per_unit);
+                if d.abs().max_element() <= MAX_STEPS && !d.is_nan() {
+                    for x in d.to_array() {
+                        push_zigzag_varint(&mut values, round_i32(x));
+                    }
+                } else {
+                    fits = false;
+                }
+            }
             (fits, values)
         })
         .collect();
+    pack.u32(
+        "body.twins",
+        (0..vertices).map(|v| twins.get(v).map_or(v as u32, |&t| t)),
+    );
     if encoded.iter().all(|(fits, _)| *fits) {
         let offsets = std::iter::once(0)
             .chain(encoded.iter().scan(0u32, |at, (_, v)| {
@@ -121,6 +136,12 @@ fn round_i32(x: f32) -> i32 {
     ((x + SHIFT) - SHIFT) as i32
 }
 
+/// Whether `p` and `q` are the same bits (an unmoved vertex is drawn exactly).
+#[inline]
+fn same_bits(p: Vec3, q: Vec3) -> bool {
+    p.to_array().map(f32::to_bits) == q.to_array().map(f32::to_bits)
+}
+
 /// Calls `visit(v, p)` for every vertex of a frame given as its objects' slices.
 fn each_vertex(slices: &[&[Vec3]], mut visit: impl FnMut(usize, Vec3)) {
     let mut v = 0;
@@ -132,7 +153,7 @@ fn each_vertex(slices: &[&[Vec3]], mut visit: impl FnMut(usize, Vec3)) {
     }
 }
 
-/// Calls `emit(k, p, q)` for every moved vertex (its bit set) of a frame: `k` its first value
+/// Calls `emit(k, p, q)` for every sent vertex (its bit set) of a frame: `k` its first value
 /// in the frame's slice, `p` its position, `q` the input's.
 fn each_moved(
     slices: &[&[Vec3]],

@@ -230,11 +230,12 @@ pub(crate) async fn stylize(
                 // Found once per clip (it may wait for another request finding it): before
                 // the pool's task, which must not wait.
                 let diagonal = input.diagonal(s.first_frame..s.first_frame + frames);
+                let twins = input.twins();
                 on_core_pool(|| {
                     pack_changes(
                         &mut pack,
                         (frames, vertices),
-                        diagonal,
+                        (diagonal, twins),
                         |f| bodies.iter().map(|a| a.frame(f)).collect(),
                         |f| m.frame(s.first_frame + f),
                     )
