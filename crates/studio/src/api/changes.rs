@@ -62,23 +62,31 @@ pub(crate) fn pack_changes<'a>(
         .map_init(Vec::new, |merged, (f, bits)| {
             let before = input(f);
             merged.clear();
-            merged.extend(body(f).into_iter().flatten().copied());
+            for object in body(f) {
+                merged.extend_from_slice(object);
+            }
             let mut values = Vec::with_capacity(3 * before.len());
             let mut fits = true;
-            for (v, &p) in merged.iter().enumerate() {
-                // Bit-exact: a vertex not sent is drawn from its twin or the input itself.
-                let twin = twins.get(v).map_or(v, |&t| t as usize);
-                let drawn = if twin == v {
-                    before.get(v)
-                } else {
-                    merged.get(twin)
-                };
-                if drawn.is_some_and(|&q| same_bits(p, q)) {
-                    continue;
+            // Compared as bits: a vertex not sent is drawn from its twin or the input itself,
+            // exactly.
+            let now: &[[u32; 3]] = bytemuck::cast_slice(&merged[..]);
+            let was: &[[u32; 3]] = bytemuck::cast_slice(before);
+            // A vertex with no input vertex or no twin (a body larger than the input) is sent.
+            let known = now.len().min(was.len()).min(twins.len());
+            for (v, &p) in now.iter().enumerate() {
+                if v < known {
+                    let t = twins[v] as usize;
+                    // Both compared, one taken: no branch on the mesh's irregular twins.
+                    let (as_input, as_twin) = (p == was[v], now.get(t) == Some(&p));
+                    if if t == v { as_input } else { as_twin } {
+                        continue;
+                    }
                 }
                 bits[v / 32] |= 1 << (v % 32);
                 // Not finite, too far, or no input vertex: not sent in steps.
-                let d = before.get(v).map_or(Vec3::NAN, |&q| (p - q) * per_unit);
+                let d = before
+                    .get(v)
+                    .map_or(Vec3::NAN, |&q| (merged[v] - q) * per_unit);
                 if d.abs().max_element() <= MAX_STEPS && !d.is_nan() {
                     for x in d.to_array() {
                         push_zigzag_varint(&mut values, round_i32(x));
@@ -134,12 +142,6 @@ pub(crate) fn pack_changes<'a>(
 fn round_i32(x: f32) -> i32 {
     const SHIFT: f32 = 12_582_912.0;
     ((x + SHIFT) - SHIFT) as i32
-}
-
-/// Whether `p` and `q` are the same bits (an unmoved vertex is drawn exactly).
-#[inline]
-fn same_bits(p: Vec3, q: Vec3) -> bool {
-    p.to_array().map(f32::to_bits) == q.to_array().map(f32::to_bits)
 }
 
 /// Calls `visit(v, p)` for every vertex of a frame given as its objects' slices.
