@@ -201,12 +201,13 @@ impl Clip {
 /// [`Clip::twins`] of `m`: each vertex's positions over the frames hashed (frame by frame, in
 /// memory order), then a vertex whose hash an earlier one has is compared with it in full.
 fn twins_of(m: &MeshAnimation) -> Vec<u32> {
+    use std::hash::Hasher;
     let n = m.vertex_count();
-    let mut hashes = vec![0u64; n];
+    let mut hashers = vec![rustc_hash::FxHasher::default(); n];
     for f in 0..m.frame_count() {
-        for (h, p) in hashes.iter_mut().zip(m.frame(f)) {
+        for (h, p) in hashers.iter_mut().zip(m.frame(f)) {
             for x in p.to_array() {
-                *h = mix(*h ^ u64::from(x.to_bits()));
+                h.write_u32(x.to_bits());
             }
         }
     }
@@ -217,10 +218,10 @@ fn twins_of(m: &MeshAnimation) -> Vec<u32> {
         })
     };
     // The first vertices of each hash, in vertex order (collisions keep several).
-    let mut firsts: std::collections::HashMap<u64, Vec<u32>> = Default::default();
+    let mut firsts: rustc_hash::FxHashMap<u64, Vec<u32>> = Default::default();
     (0..n)
         .map(|v| {
-            let group = firsts.entry(hashes[v]).or_default();
+            let group = firsts.entry(hashers[v].finish()).or_default();
             match group.iter().find(|&&u| same(u as usize, v)) {
                 Some(&u) => u,
                 None => {
@@ -230,14 +231,6 @@ fn twins_of(m: &MeshAnimation) -> Vec<u32> {
             }
         })
         .collect()
-}
-
-/// One round of splitmix64's finalizer: every input bit moves about half the output's.
-fn mix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
 }
 
 /// Makes (if needed) and canonicalizes the output folder.
