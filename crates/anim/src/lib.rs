@@ -37,6 +37,7 @@ mod scene;
 mod skeleton;
 mod skin;
 mod transform;
+mod twins;
 
 pub use budget::{check_budget, OverBudget};
 pub use camera::{Camera, Projection};

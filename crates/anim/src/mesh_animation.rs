@@ -39,7 +39,7 @@ impl MeshAnimation {
                 found: positions.len(),
             });
         }
-        if !positions.iter().all(|p| p.is_finite()) {
+        if !all_finite(&positions) {
             return Err(AnimError::NonFinite {
                 what: format!("point cache of '{}'", mesh.name),
             });
@@ -221,6 +221,14 @@ impl MeshAnimation {
     }
 }
 
+/// Whether every coordinate of `positions` is finite: runs of coordinates tested without
+/// stopping early (so the test vectorizes), the runs stopping at the first that is not.
+fn all_finite(positions: &[Vec3]) -> bool {
+    let x: &[f32] = bytemuck::cast_slice(positions);
+    x.chunks(1024)
+        .all(|run| run.iter().fold(true, |ok, c| ok & c.is_finite()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -242,6 +250,17 @@ mod tests {
     fn wrong_length_and_nan_are_errors() {
         assert!(MeshAnimation::new(tri(), 24.0, vec![Vec3::ZERO; 4]).is_err());
         assert!(MeshAnimation::new(tri(), 24.0, vec![Vec3::NAN; 3]).is_err());
+        // One coordinate anywhere in a long cache (past the first run tested at once).
+        for (k, bad) in [
+            (0, f32::INFINITY),
+            (1000, f32::NAN),
+            (3 * 999 + 2, f32::NEG_INFINITY),
+        ] {
+            let mut p = vec![Vec3::ONE; 3 * 1000];
+            p[k / 3][k % 3] = bad;
+            assert!(MeshAnimation::new(tri(), 24.0, p).is_err(), "{k}");
+        }
+        assert!(MeshAnimation::new(tri(), 24.0, vec![Vec3::ONE; 3 * 1000]).is_ok());
     }
 
     #[test]

@@ -189,48 +189,13 @@ impl Clip {
     /// answer of changes sends a vertex the style moved as its twin did only once
     /// (docs/studio.md, "Smear: what the style moved"). Found once per clip.
     pub fn twins(&self) -> &[u32] {
-        self.twins.get_or_init(|| twins_of(self.merged()))
+        self.twins.get_or_init(|| self.merged().twins())
     }
 
     /// The merged positions as float32 coordinates (for [`crate::pack::Pack::shared`]).
     pub fn coordinates(&self) -> &[f32] {
         crate::pack::coordinates(self.merged().positions())
     }
-}
-
-/// [`Clip::twins`] of `m`: each vertex's positions over the frames hashed (frame by frame, in
-/// memory order), then a vertex whose hash an earlier one has is compared with it in full.
-fn twins_of(m: &MeshAnimation) -> Vec<u32> {
-    use std::hash::Hasher;
-    let n = m.vertex_count();
-    let mut hashers = vec![rustc_hash::FxHasher::default(); n];
-    for f in 0..m.frame_count() {
-        for (h, p) in hashers.iter_mut().zip(m.frame(f)) {
-            for x in p.to_array() {
-                h.write_u32(x.to_bits());
-            }
-        }
-    }
-    let same = |u: usize, v: usize| {
-        (0..m.frame_count()).all(|f| {
-            let p = m.frame(f);
-            p[u].to_array().map(f32::to_bits) == p[v].to_array().map(f32::to_bits)
-        })
-    };
-    // The first vertices of each hash, in vertex order (collisions keep several).
-    let mut firsts: rustc_hash::FxHashMap<u64, Vec<u32>> = Default::default();
-    (0..n)
-        .map(|v| {
-            let group = firsts.entry(hashers[v].finish()).or_default();
-            match group.iter().find(|&&u| same(u as usize, v)) {
-                Some(&u) => u,
-                None => {
-                    group.push(v as u32);
-                    v as u32
-                }
-            }
-        })
-        .collect()
 }
 
 /// Makes (if needed) and canonicalizes the output folder.
@@ -291,20 +256,6 @@ pub fn output_path(folder: &Path, name: &str) -> ApiResult<PathBuf> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use anim::glam::Vec3;
-    use anim::Mesh;
-
-    #[test]
-    fn twins_are_the_same_point_in_every_frame() {
-        // Vertices 0, 2 and 4 are one point throughout; 1 and 3 part in the second frame;
-        // 5 is -0.0 where 0 is 0.0 (other bits: not a twin).
-        let (a, b) = (Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.0, 0.0, 0.0));
-        let first = vec![a, b, a, b, a, Vec3::new(-0.0, 0.0, 0.0)];
-        let second = vec![a, b, a, Vec3::X, a, Vec3::new(-0.0, 0.0, 0.0)];
-        let mesh = Mesh::new("m", first.clone(), vec![[0, 1, 2]]);
-        let m = MeshAnimation::new(mesh, 24.0, [first, second].concat()).unwrap();
-        assert_eq!(twins_of(&m), vec![0, 1, 0, 3, 0, 5]);
-    }
 
     #[test]
     fn export_names_stay_inside_the_folder() {

@@ -28,26 +28,27 @@ impl Default for ElongateOptions {
 }
 
 /// Fills `out` with points `start..start + out.len()` of the drawing at frame `h`: S_E over
-/// runs of [`STYLE_BLOCK`] points ([`Stylize::eval_block`]), then the run displaced
-/// ([`Trajectories::displaced_run`](super::Trajectories::displaced_run)).
+/// runs of [`STYLE_BLOCK`] points ([`Stylize::eval_block`]) into `beta` (one per point of
+/// `out`), then the points displaced
+/// ([`Trajectories::displaced_twins`](super::Trajectories::displaced_twins): a point whose
+/// twin is in `out` with the same β is a copy of it).
 #[inline]
 fn fill(
     inputs: &EffectInputs<'_>,
     style: &dyn Stylize,
-    h: usize,
-    scale: f32,
+    (h, scale): (usize, f32),
     start: usize,
     out: &mut [Vec3],
+    beta: &mut [f32],
 ) {
-    let tr = inputs.trajectories();
-    let mut beta = [0.0f32; STYLE_BLOCK];
-    let mut first = start;
-    for run in out.chunks_mut(STYLE_BLOCK) {
-        let beta = &mut beta[..run.len()];
-        style.eval_block(&inputs.style_block(h, first, run.len()), beta);
-        tr.displaced_run(h, first, scale, beta, run);
-        first += run.len();
+    let beta = &mut beta[..out.len()];
+    for (k, run) in beta.chunks_mut(STYLE_BLOCK).enumerate() {
+        let first = start + k * STYLE_BLOCK;
+        style.eval_block(&inputs.style_block(h, first, run.len()), run);
     }
+    inputs
+        .trajectories()
+        .displaced_twins(h, start, scale, beta, inputs.twins(), out);
 }
 
 /// The elongated in-between of one frame, written into a caller buffer (for interactive
@@ -106,9 +107,10 @@ pub fn elongate_frame(
         });
     }
     let h = held_frame(frame, step);
-    out.par_chunks_mut(CHUNK)
-        .enumerate()
-        .for_each(|(c, dst)| fill(inputs, style, h, step as f32, c * CHUNK, dst));
+    out.par_chunks_mut(CHUNK).enumerate().for_each(|(c, dst)| {
+        let mut beta = [0.0f32; CHUNK];
+        fill(inputs, style, (h, step as f32), c * CHUNK, dst, &mut beta);
+    });
     Ok(())
 }
 
@@ -134,10 +136,20 @@ pub fn elongate(
     let (frames, n) = (inputs.frame_count(), inputs.point_count());
     let mut positions = vec![Vec3::ZERO; frames * n];
     if n > 0 {
-        positions
-            .par_chunks_mut(n)
-            .enumerate()
-            .for_each(|(f, dst)| fill(inputs, style, held_frame(f, step), step as f32, 0, dst));
+        // Whole frames per task: every twin of a point is in the same task.
+        positions.par_chunks_mut(n).enumerate().for_each_init(
+            || vec![0.0f32; n],
+            |beta, (f, dst)| {
+                fill(
+                    inputs,
+                    style,
+                    (held_frame(f, step), step as f32),
+                    0,
+                    dst,
+                    beta,
+                )
+            },
+        );
     }
     let mut out = MeshAnimation::new(anim.mesh.clone(), anim.fps, positions)
         .map_err(|e| SmearError::InvalidScene(e.to_string()))?;
@@ -199,6 +211,68 @@ mod tests {
         // Held frame 2 displaced by ±2 frames: covers frames 0..4 → 2 + 4 × 0.5.
         assert!((bb.max.x - bb.min.x - 4.0).abs() < 1e-3, "{bb:?}");
         assert!(elongate(&inputs, &linear, &ElongateOptions { step: 0 }).is_err());
+    }
+
+    #[test]
+    fn twins_of_a_split_mesh_give_the_same_drawing() {
+        // Every triangle of the ball with its own three corners (flat shading splits a mesh
+        // so): the elongated in-betweens with the twins are those without, bit for bit, for a
+        // β every twin shares and for one that reads the offsets (which a split vertex may
+        // not share with its twins).
+        let ball = translating_ball(7, 0.6);
+        let (n, frames) = (ball.vertex_count(), ball.frame_count());
+        let corners: Vec<usize> = ball
+            .mesh
+            .triangles
+            .iter()
+            .flatten()
+            .map(|&v| v as usize)
+            .collect();
+        let positions = (0..frames)
+            .flat_map(|f| corners.iter().map(move |&v| (f, v)))
+            .map(|(f, v)| {
+                ball.positions()[f * n + v]
+                    + Vec3::Y * (0.1 * f as f32 * ball.positions()[v].x).sin()
+            })
+            .collect();
+        let triangles =
+            (0..ball.mesh.triangles.len() as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]);
+        let mesh = anim::Mesh::new(
+            "split",
+            corners.iter().map(|&v| ball.mesh.positions[v]).collect(),
+            triangles.collect(),
+        );
+        let split = MeshAnimation::new(mesh, 24.0, positions).unwrap();
+        let twins = split.twins();
+        assert!(
+            twins
+                .iter()
+                .enumerate()
+                .filter(|&(v, &t)| t as usize != v)
+                .count()
+                > corners.len() / 2
+        );
+        let delta = mesh_offsets(&split, &OffsetOptions::default()).unwrap();
+        let inputs = EffectInputs::new(&split, &delta).unwrap();
+        let with = inputs.clone().with_twins(&twins).unwrap();
+        let bits = |a: &MeshAnimation| {
+            a.positions()
+                .iter()
+                .map(|p| p.to_array().map(f32::to_bits))
+                .collect::<Vec<_>>()
+        };
+        let fixed = |_: &StyleInput| 1.3f32;
+        let offsets = |x: &StyleInput| 2.0 * x.delta;
+        for style in [&fixed as &dyn Stylize, &offsets] {
+            let options = ElongateOptions::default();
+            let a = elongate(&inputs, style, &options).unwrap();
+            let b = elongate(&with, style, &options).unwrap();
+            assert_eq!(bits(&a), bits(&b));
+            let mut one = vec![Vec3::ZERO; split.vertex_count()];
+            elongate_frame(&with, style, 3, &options, &mut one).unwrap();
+            assert_eq!(one.as_slice(), a.frame(3));
+        }
+        assert!(inputs.with_twins(&[1; 3]).is_err());
     }
 
     #[test]

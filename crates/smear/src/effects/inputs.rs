@@ -43,6 +43,9 @@ pub struct EffectInputs<'a> {
     arcs: Option<Cow<'a, Arcs>>,
     /// Collider meshes the displaced points never enter.
     colliders: &'a [Collider],
+    /// Per point its twin ([`MeshAnimation::twins`]): displaced by the same β, a point is its
+    /// twin's result (docs/smear-speed.md, "Twins").
+    twins: Option<&'a [u32]>,
 }
 
 /// Where the velocities of [`EffectInputs`] come from.
@@ -105,6 +108,7 @@ impl<'a> EffectInputs<'a> {
             ground: None,
             arcs: None,
             colliders: &[],
+            twins: None,
         }
     }
 
@@ -188,6 +192,7 @@ impl<'a> EffectInputs<'a> {
             ground: None,
             arcs: None,
             colliders: &[],
+            twins: None,
         })
     }
 
@@ -218,6 +223,31 @@ impl<'a> EffectInputs<'a> {
     pub fn with_colliders(mut self, colliders: &'a [Collider]) -> Self {
         self.colliders = colliders;
         self
+    }
+
+    /// The points' twins ([`MeshAnimation::twins`] of the positions these inputs hold): an
+    /// effect displaces a point whose twin has the same β once.
+    ///
+    /// # Errors
+    /// [`SmearError::InvalidParameter`] when there is not one twin per point or a twin comes
+    /// after its point.
+    pub(crate) fn with_twins(mut self, twins: &'a [u32]) -> Result<Self> {
+        if twins.len() != self.points {
+            return Err(mismatch("twins", self.points, twins.len()));
+        }
+        if twins.iter().enumerate().any(|(v, &t)| t as usize > v) {
+            return Err(SmearError::InvalidParameter {
+                name: "twins",
+                reason: "a twin comes after its point".into(),
+            });
+        }
+        self.twins = Some(twins);
+        Ok(self)
+    }
+
+    /// The points' twins, if known ([`EffectInputs::with_twins`]).
+    pub(crate) fn twins(&self) -> Option<&'a [u32]> {
+        self.twins
     }
 
     /// The collider meshes.

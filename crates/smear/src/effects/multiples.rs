@@ -230,19 +230,23 @@ fn fill(
         pos.copy_from_slice(&inputs.positions()[h * n..(h + 1) * n]);
         return;
     }
-    // S_M over runs of points (`Stylize::eval_block`), then each point's opacity and place.
-    let mut first = 0;
-    for (pos, alpha) in pos
-        .chunks_mut(STYLE_BLOCK)
-        .zip(alpha.chunks_mut(STYLE_BLOCK))
-    {
-        let block = inputs.style_block(h, first, pos.len()).with_m(m as f32);
+    // S_M over runs of points (`Stylize::eval_block`), then each point's opacity.
+    for (k, alpha) in alpha.chunks_mut(STYLE_BLOCK).enumerate() {
+        let block = inputs
+            .style_block(h, k * STYLE_BLOCK, alpha.len())
+            .with_m(m as f32);
         style.eval_block(&block, alpha);
-        for (k, (p, a)) in pos.iter_mut().zip(alpha.iter_mut()).enumerate() {
-            *a = clamp_alpha(*a);
-            *p = tr.displaced(h, first + k, beta);
-        }
-        first += pos.len();
+        alpha.iter_mut().for_each(|a| *a = clamp_alpha(*a));
+    }
+    // Every point moves by the same β: a point with a twin on the same arcs is its copy.
+    let twins = inputs.twins();
+    for i in 0..pos.len() {
+        let t = twins.map_or(i, |t| t[i] as usize);
+        pos[i] = if t < i && tr.same_arcs(i, t) {
+            pos[t]
+        } else {
+            tr.displaced(h, i, beta)
+        };
     }
 }
 

@@ -295,23 +295,52 @@ impl<'a> Trajectories<'a> {
         betas: &[f32],
         out: &mut [Vec3],
     ) {
+        self.displaced_twins(f, start, scale, betas, None, out);
+    }
+
+    /// [`Self::displaced_run`], where a point whose twin (`twins[i] < i`, a point with the
+    /// same positions in every frame: [`anim::MeshAnimation::twins`]) is in the run, has the
+    /// same β and moves along the same arcs, is a copy of the twin's result: the same bits,
+    /// one cubic per point of the surface instead of one per vertex of a split mesh.
+    pub fn displaced_twins(
+        &self,
+        f: usize,
+        start: usize,
+        scale: f32,
+        betas: &[f32],
+        twins: Option<&[u32]>,
+        out: &mut [Vec3],
+    ) {
         let n = self.points;
         // Frames past 2²⁴ are not exact as f32 times: the general path.
-        if !self.is_plain() || f >= self.frames || f > 1 << 24 {
-            for (k, (o, b)) in out.iter_mut().zip(betas).enumerate() {
-                *o = self.displaced(f, start + k, scale * b);
+        let plain = self.is_plain() && f < self.frames && f <= 1 << 24;
+        let here = if plain {
+            &self.positions[f * n + start..f * n + start + out.len()]
+        } else {
+            &[]
+        };
+        for k in 0..out.len().min(betas.len()) {
+            let i = start + k;
+            if let Some(t) = twins.map(|t| t[i] as usize) {
+                let same = t < i && t >= start && betas[t - start].to_bits() == betas[k].to_bits();
+                if same && self.same_arcs(i, t) {
+                    out[k] = out[t - start];
+                    continue;
+                }
             }
-            return;
-        }
-        let here = &self.positions[f * n + start..f * n + start + out.len()];
-        for (k, ((o, b), p)) in out.iter_mut().zip(betas).zip(here).enumerate() {
-            let beta = scale * b;
-            *o = if beta == 0.0 && !has_negative_zero(*p) {
-                *p
-            } else {
-                self.displaced(f, start + k, beta)
+            let beta = scale * betas[k];
+            out[k] = match here.get(k) {
+                Some(&p) if beta == 0.0 && !has_negative_zero(p) => p,
+                _ => self.displaced(f, i, beta),
             };
         }
+    }
+
+    /// Whether points `i` and `j` move along the same arcs (or neither revolves): with the
+    /// same positions in every frame, they have the same trajectory.
+    #[inline]
+    pub(crate) fn same_arcs(&self, i: usize, j: usize) -> bool {
+        self.arcs.is_none_or(|a| a.same_part(i, j))
     }
 
     /// [`Self::displaced`] of shaped trajectories (past-only, arcs, ground, colliders): kept
@@ -475,6 +504,47 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_twin_with_the_same_beta_is_a_copy_of_its_twin() {
+        // Points 3 and 4 are points 1 and 2 again (a split mesh's seam); 5 is 0 again but
+        // displaced by another β. With the twins the run is the run without them, bit for bit;
+        // a twin outside the run is not read.
+        let (frames, points) = (6, 6);
+        let base = |i: usize, f: f32| match i {
+            0 | 5 => Vec3::new(0.3 * f, -0.0, 2.0 - f),
+            1 | 3 => Vec3::new((0.9 * f).sin(), f * f * 0.1, -0.5 * f),
+            _ => Vec3::new(1.0, (0.4 * f).cos(), 0.2 * f),
+        };
+        let p: Vec<Vec3> = (0..frames * points)
+            .map(|k| base(k % points, (k / points) as f32))
+            .collect();
+        let twins = [0, 1, 2, 1, 2, 0];
+        let betas = [0.4, -1.7, 0.0, -1.7, 0.0, 1.1];
+        let plain = Trajectories::new(&p, frames, points).unwrap();
+        for tr in [plain, plain.shaped(true, Some(0.1), None)] {
+            for f in 0..frames {
+                for start in [0, 2] {
+                    let len = points - start;
+                    let mut run = vec![Vec3::NAN; len];
+                    let mut copied = vec![Vec3::NAN; len];
+                    tr.displaced_run(f, start, 2.0, &betas[start..], &mut run);
+                    tr.displaced_twins(f, start, 2.0, &betas[start..], Some(&twins), &mut copied);
+                    let bits = |v: &[Vec3]| {
+                        v.iter()
+                            .map(|q| q.to_array().map(f32::to_bits))
+                            .collect::<Vec<_>>()
+                    };
+                    assert_eq!(bits(&run), bits(&copied), "frame {f}, start {start}");
+                }
+            }
+        }
+        // The copy is taken (not recomputed): a point declared a twin gets the twin's result.
+        let mut out = [Vec3::NAN; 2];
+        plain.displaced_twins(3, 0, 1.0, &[0.5, 0.5], Some(&[0, 0]), &mut out);
+        assert_eq!(out[1], out[0]);
+        assert_ne!(out[0], plain.displaced(3, 1, 0.5));
     }
 
     #[test]

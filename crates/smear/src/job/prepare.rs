@@ -2,7 +2,7 @@
 //! (SMEAR Eqs. 1–9) per object group, merged inside the crate, the camera, painted weights and
 //! the velocities the stylization functions read.
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 use anim::{Camera, MeshAnimation, SampledScene};
@@ -86,6 +86,8 @@ struct Target {
     weights: Option<Vec<f32>>,
     /// Revolving parts (issue #22).
     arcs: Option<Arcs>,
+    /// Per vertex its twin ([`MeshAnimation::twins`]), found on the first stylization.
+    twins: OnceLock<Vec<u32>>,
 }
 
 /// A scene with its motion offsets solved, ready to be stylized any number of times
@@ -301,6 +303,7 @@ pub fn prepare(scene: impl Into<Arc<SampledScene>>, options: &PrepareOptions) ->
                 offsets,
                 weights,
                 arcs: target_arcs(&scene, &revolving, None),
+                twins: OnceLock::new(),
             };
             (Some(anim), vec![target])
         }
@@ -315,6 +318,7 @@ pub fn prepare(scene: impl Into<Arc<SampledScene>>, options: &PrepareOptions) ->
                         None => None,
                     },
                     arcs: target_arcs(&scene, &revolving, Some(i)),
+                    twins: OnceLock::new(),
                 });
             }
             (None, targets)
@@ -518,10 +522,13 @@ impl Prepared {
         })?;
         let causal = self.options.offsets.causal;
         let velocities = (self.space.as_ref(), causal);
-        let inputs = EffectInputs::from_prepared(self.animation(i), &t.offsets, velocities, None)
+        let anim = self.animation(i);
+        let twins = t.twins.get_or_init(|| anim.twins());
+        let inputs = EffectInputs::from_prepared(anim, &t.offsets, velocities, None)
             .with_causal(causal)
             .with_arcs(t.arcs.as_ref().map(std::borrow::Cow::Borrowed))?
-            .with_colliders(&self.colliders);
+            .with_colliders(&self.colliders)
+            .with_twins(twins)?;
         match weights {
             Some(w) => inputs.with_weights(w),
             None => Ok(inputs),

@@ -89,6 +89,12 @@ impl Arcs {
         }
     }
 
+    /// Whether points `i` and `j` move along the same arcs (or neither revolves).
+    #[inline]
+    pub(crate) fn same_part(&self, i: usize, j: usize) -> bool {
+        self.part.get(i) == self.part.get(j)
+    }
+
     /// The arcs of other points, each taking the part of point `source(k)` (e.g. a surface
     /// point takes its triangle's first corner's).
     pub fn remap(&self, count: usize, source: impl Fn(usize) -> usize) -> Arcs {
