@@ -60,21 +60,31 @@ impl MeshAnimation {
                 p[u].to_array().map(f32::to_bits) == p[v].to_array().map(f32::to_bits)
             })
         };
-        // The first vertex of each point, by hash (a collision keeps several).
-        let mut firsts: FxHashMap<u64, Vec<u32>> = FxHashMap::default();
-        (0..n)
-            .map(|v| {
-                let group = firsts.entry(hashes[v]).or_default();
-                match group.iter().find(|&&u| same(u as usize, v)) {
-                    Some(&u) => u,
-                    None => {
-                        group.push(v as u32);
-                        v as u32
-                    }
-                }
-            })
-            .collect()
+        first_of_each(&hashes, same)
     }
+}
+
+/// Per item the first item it is the `same` as, comparing only items of equal hashes: the
+/// first item of each hash in a map, the first items of other groups with that hash (a
+/// collision) chained behind it, newest first.
+fn first_of_each(hashes: &[u64], same: impl Fn(usize, usize) -> bool) -> Vec<u32> {
+    let mut head: FxHashMap<u64, u32> = FxHashMap::default();
+    let mut chain = vec![u32::MAX; hashes.len()];
+    (0..hashes.len())
+        .map(|v| {
+            let mut u = head.get(&hashes[v]).copied().unwrap_or(u32::MAX);
+            while u != u32::MAX && !same(u as usize, v) {
+                u = chain[u as usize];
+            }
+            if u == u32::MAX {
+                if let Some(h) = head.insert(hashes[v], v as u32) {
+                    chain[v] = h;
+                }
+                u = v as u32;
+            }
+            u
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -91,6 +101,14 @@ mod tests {
         let mesh = Mesh::new("m", f0.to_vec(), vec![[0, 1, 2], [3, 4, 5]]);
         let m = MeshAnimation::new(mesh, 24.0, [f0, f1].concat()).unwrap();
         assert_eq!(m.twins(), vec![0, 1, 0, 3, 0, 5]);
+    }
+
+    #[test]
+    fn colliding_hashes_still_compare_in_full() {
+        // Every item hashed alike: three groups (by value) found through the chain.
+        let values = [5, 7, 5, 9, 7, 9, 5];
+        let firsts = super::first_of_each(&[0; 7], |u, v| values[u] == values[v]);
+        assert_eq!(firsts, vec![0, 1, 0, 3, 1, 3, 0]);
     }
 
     #[test]
