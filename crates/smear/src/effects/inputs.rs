@@ -228,18 +228,14 @@ impl<'a> EffectInputs<'a> {
     /// The points' twins ([`MeshAnimation::twins`] of the positions these inputs hold): an
     /// effect displaces a point whose twin has the same β once.
     ///
+    /// The effects copy only from an earlier point (`twins[i] < i`), so any other entry
+    /// means "no twin".
+    ///
     /// # Errors
-    /// [`SmearError::InvalidParameter`] when there is not one twin per point or a twin comes
-    /// after its point.
+    /// [`SmearError::InvalidParameter`] when there is not one twin per point.
     pub(crate) fn with_twins(mut self, twins: &'a [u32]) -> Result<Self> {
         if twins.len() != self.points {
             return Err(mismatch("twins", self.points, twins.len()));
-        }
-        if twins.iter().enumerate().any(|(v, &t)| t as usize > v) {
-            return Err(SmearError::InvalidParameter {
-                name: "twins",
-                reason: "a twin comes after its point".into(),
-            });
         }
         self.twins = Some(twins);
         Ok(self)
