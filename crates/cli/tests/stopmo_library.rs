@@ -293,6 +293,9 @@ fn bad_library_inputs_exit_2_with_one_line() {
     run(with(&["--max-error=-1"]), "--max-error");
     run(with(&["--pieces", "nose=3"]), "nose");
     run(with(&["--thickness", "0"]), "--thickness");
+    // Ten million restarts would run for weeks: refused before any work, with the range.
+    run(with(&["--restarts", "10000000"]), "between 1 and 1024");
+    run(with(&["--restarts", "0"]), "restarts");
     let npy = dir.path().join("short.npy");
     std::fs::write(&npy, tkio::npy::write_f32(&[3], &[1.0, 1.0, 1.0]).unwrap()).unwrap();
     let mut a = with(&["--saliency"]);

@@ -86,6 +86,10 @@ def test_bad_parts_raise(face):
         toonkit.stopmo.segment(face, parts={"a": [(0, 0)]})
     with pytest.raises(ValueError, match="options"):
         toonkit.stopmo.library(toonkit.stopmo.segment(face, parts=PARTS), pieces=-1)
+    # Ten million restarts: refused by the core's range, as the CLI refuses them.
+    with pytest.raises(ValueError, match="between 1 and 1024"):
+        toonkit.stopmo.library(toonkit.stopmo.segment(face, parts=PARTS), pieces=2,
+                               restarts=10**7, print=False)
 
 
 def test_budget_replaces_the_piece_count(face):

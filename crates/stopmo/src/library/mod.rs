@@ -111,7 +111,7 @@ pub use regularize::{regularize, Regularized};
 pub use size::{allocate_budget, CurvePoint};
 pub use solver::{
     PartSolution, SolveOptions, DEFAULT_LAMBDA, DEFAULT_MAX_ITERATIONS, DEFAULT_RESTARTS,
-    DEFAULT_SEED, DEFAULT_TOLERANCE,
+    DEFAULT_SEED, DEFAULT_TOLERANCE, MAX_RESTARTS,
 };
 pub(crate) use source::Source;
 pub use subspace::{

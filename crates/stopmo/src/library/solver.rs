@@ -19,6 +19,10 @@ use anim::{MorphAnimation, SplitMix64};
 pub const DEFAULT_LAMBDA: f64 = 2.0;
 /// Random restarts; the best energy is kept.
 pub const DEFAULT_RESTARTS: usize = 8;
+/// Most random restarts one optimization takes. Each restart is a whole block coordinate
+/// descent (about a quarter of a CPU second at StopShop Table-1 scale), so this bounds a
+/// solve's work, not its memory (only the best restart so far is kept).
+pub const MAX_RESTARTS: usize = 1024;
 /// Cap on block coordinate descent iterations (the paper reports 5–10).
 pub const DEFAULT_MAX_ITERATIONS: usize = 50;
 /// Stop when one iteration lowers the energy by less than this fraction.
@@ -62,10 +66,11 @@ impl SolveOptions {
                 self.lambda
             )));
         }
-        if self.restarts == 0 {
-            return Err(LibraryError::InvalidParameter(
-                "restarts must be >= 1".into(),
-            ));
+        if !(1..=MAX_RESTARTS).contains(&self.restarts) {
+            return Err(LibraryError::InvalidParameter(format!(
+                "restarts must be between 1 and {MAX_RESTARTS}, got {}",
+                self.restarts
+            )));
         }
         if !(self.tolerance.is_finite() && self.tolerance >= 0.0) {
             return Err(LibraryError::InvalidParameter(
