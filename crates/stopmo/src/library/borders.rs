@@ -11,6 +11,7 @@
 //! StopShop Eq. 10 solution over [`BORDER_RINGS`] rings of vertices, so no step appears.
 
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 
 use super::problem::PartProblem;
 use super::solver::PartSolution;
@@ -81,17 +82,22 @@ impl PartProblem<'_> {
                     }
                 }
                 let (base, targets) = (anim.base(), anim.targets());
-                for k in 0..pieces {
-                    for (s, &(v, _)) in sums[k * near.len()..(k + 1) * near.len()]
-                        .iter_mut()
-                        .zip(near)
-                    {
-                        *s = base[v].as_dvec3() * counts[k] as f64;
-                        for (j, &w) in wsum[k * nt..(k + 1) * nt].iter().enumerate() {
-                            *s += targets[j * m + v].as_dvec3() * w;
+                // Pieces on their own tasks; per piece, target by target over the border's
+                // vertices (each sum still adds the targets in order, so the same values).
+                sums.par_chunks_mut(near.len())
+                    .zip(counts.par_iter())
+                    .enumerate()
+                    .for_each(|(k, (sums, &count))| {
+                        for (s, &(v, _)) in sums.iter_mut().zip(near) {
+                            *s = base[v].as_dvec3() * count as f64;
                         }
-                    }
-                }
+                        for (j, &w) in wsum[k * nt..(k + 1) * nt].iter().enumerate() {
+                            let target = &targets[j * m..(j + 1) * m];
+                            for (s, &(v, _)) in sums.iter_mut().zip(near) {
+                                *s += target[v].as_dvec3() * w;
+                            }
+                        }
+                    });
             }
         }
         let m = self.src.vertex_count();
