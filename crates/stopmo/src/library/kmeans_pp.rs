@@ -23,19 +23,13 @@ pub(super) fn kmeans_pp(
     lib.extend_from_slice(p.fixed_coords());
     let mut dist = vec![f64::INFINITY; n];
     let nearer = |(f, dv): (usize, &mut f64), c: &[f64]| {
-        let s: f64 = y[f * q..(f + 1) * q]
-            .iter()
-            .zip(c)
-            .map(|(a, b)| (a - b) * (a - b))
-            .sum();
-        *dv = dv.min(s);
+        *dv = dv.min(squared_distance(&y[f * q..(f + 1) * q], c));
     };
     // On one thread, frames side by side over the transposed coordinates: each frame's sum
     // still adds its coordinates in order (the same value as `nearer`), several frames per
     // instruction; a block of frames that the new centre cannot come nearer to is skipped
     // (see `FAR_MARGIN`).
     let seq = matches!(par, Par::Seq);
-    let mut sums = vec![0.0; if seq { n } else { 0 }];
     let mut owner = vec![NO_CENTRE; if seq { n } else { 0 }];
     let mut reach = Vec::with_capacity(if seq { d } else { 0 });
     let mut update = |dist: &mut [f64], lib: &[f64], c: &[f64]| {
@@ -45,14 +39,10 @@ pub(super) fn kmeans_pp(
         }
         // Squared distances from the new centre to the centres before it.
         reach.clear();
-        reach.extend(
-            lib.chunks_exact(q.max(1))
-                .map(|r| r.iter().zip(c).map(|(a, b)| (a - b) * (a - b)).sum::<f64>()),
-        );
+        reach.extend(lib.chunks_exact(q.max(1)).map(|r| squared_distance(r, c)));
         pulp::Arch::new().dispatch(Nearer {
             dist,
             owner: &mut owner,
-            sums: &mut sums,
             yt,
             c,
             reach: &reach,
@@ -86,6 +76,11 @@ pub(super) fn kmeans_pp(
     lib
 }
 
+/// `‖a − b‖²`, the coordinates added in order.
+fn squared_distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(a, b)| (a - b) * (a - b)).sum()
+}
+
 /// `owner` of a frame no centre has come nearest to yet.
 const NO_CENTRE: u32 = u32::MAX;
 
@@ -109,7 +104,6 @@ struct Nearer<'a> {
     dist: &'a mut [f64],
     /// Index of each frame's nearest centre so far ([`NO_CENTRE`] before the first).
     owner: &'a mut [u32],
-    sums: &'a mut [f64],
     yt: &'a [f64],
     c: &'a [f64],
     /// Squared distance from `c` to every centre before it; `c` is centre `reach.len()`.
@@ -124,7 +118,6 @@ impl pulp::WithSimd for Nearer<'_> {
         let Nearer {
             dist,
             owner,
-            sums,
             yt,
             c,
             reach,
@@ -144,8 +137,8 @@ impl pulp::WithSimd for Nearer<'_> {
                 b0 = b1;
                 continue;
             }
-            let sums = &mut sums[b0..b1];
-            sums.fill(0.0);
+            let mut sums = [0.0f64; FAR_BLOCK];
+            let sums = &mut sums[..b1 - b0];
             for (row, &cc) in yt.chunks_exact(n).zip(c) {
                 for (s, &a) in sums.iter_mut().zip(&row[b0..b1]) {
                     *s += (a - cc) * (a - cc);

@@ -21,8 +21,10 @@
 
 use std::ops::Range;
 
+use anim::MorphAnimation;
+use faer::linalg::matmul::matmul;
 use faer::linalg::solvers::Solve;
-use faer::{Mat, MatMut, Side};
+use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -156,6 +158,58 @@ pub(crate) fn right_hand_side<R: FrameRows>(
         }
     }
     b
+}
+
+/// The right-hand side `S L X` of the full-space library step for a morph clip
+/// `x_f = b + T w_f`: `(S L W) T + (S L 1) bᵀ`, so only the pieces are expanded, never the
+/// frames (`d × K` and `d × 1` right-hand sides, then one `d × K × 3m` GEMM).
+pub(crate) fn morph_right_hand_side(
+    anim: &MorphAnimation,
+    labels: &[u32],
+    chains: &[std::ops::Range<usize>],
+    lambda: f64,
+    d: usize,
+) -> Vec<f64> {
+    let (n, m, k) = (anim.frame_count(), anim.vertex_count(), anim.target_count());
+    let w: Vec<f64> = (0..n)
+        .flat_map(|f| anim.frame_weights(f).iter().map(|&v| f64::from(v)))
+        .collect();
+    let bw = right_hand_side(&Dense { data: &w, cols: k }, labels, chains, lambda, d);
+    let ones = vec![1.0; n];
+    let b1 = right_hand_side(
+        &Dense {
+            data: &ones,
+            cols: 1,
+        },
+        labels,
+        chains,
+        lambda,
+        d,
+    );
+    let base: &[f32] = bytemuck::cast_slice(anim.base());
+    // Each piece's row of the base term on its own task (d × 3m values: 56 MB at StopShop
+    // Table-1 scale, which one thread wrote for 0.05 s).
+    let mut out = vec![0.0f64; d * base.len()];
+    out.par_chunks_mut(base.len().max(1))
+        .zip(b1.par_iter())
+        .for_each(|(row, &s)| {
+            for (o, &v) in row.iter_mut().zip(base) {
+                *o = s * f64::from(v);
+            }
+        });
+    if k > 0 {
+        let t: &[f32] = bytemuck::cast_slice(anim.targets());
+        let t64 = faer::Mat::<f64>::from_fn(k, 3 * m, |j, c| f64::from(t[j * 3 * m + c]));
+        matmul(
+            MatMut::from_row_major_slice_mut(&mut out, d, 3 * m),
+            Accum::Add,
+            MatRef::from_row_major_slice(&bw, d, k),
+            t64.as_ref(),
+            1.0,
+            Par::rayon(rayon::current_num_threads().max(1)),
+        );
+    }
+    out
 }
 
 /// Solves `A_FF R_F = B_F − A_FX R_X` for the free pieces (indices `fixed..d`).
